@@ -1,0 +1,80 @@
+//! The orbit camera: left drag rotates, middle drag pans, right drag or the wheel zooms.
+
+use bevy::input::mouse::{AccumulatedMouseMotion, AccumulatedMouseScroll, MouseScrollUnit};
+use bevy::prelude::*;
+
+/// An orbit around `focus` (world space), at `distance`, with `yaw`/`pitch` in radians.
+#[derive(Component, Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct OrbitCamera {
+    pub focus: Vec3,
+    pub yaw: f32,
+    pub pitch: f32,
+    pub distance: f32,
+}
+
+impl Default for OrbitCamera {
+    fn default() -> Self {
+        Self { focus: Vec3::new(0.0, 0.5, 0.0), yaw: 0.0, pitch: -0.25, distance: 3.0 }
+    }
+}
+
+impl OrbitCamera {
+    /// A camera looking at a box so that it fills most of the view.
+    pub fn framing(lo: Vec3, hi: Vec3) -> Self {
+        let center = (lo + hi) / 2.0;
+        let radius = ((hi - lo).length() / 2.0).max(0.05);
+        Self { focus: center, yaw: 0.35, pitch: -0.25, distance: radius * 2.6 }
+    }
+
+    pub fn transform(&self) -> Transform {
+        let rotation = Quat::from_euler(EulerRot::YXZ, self.yaw, self.pitch, 0.0);
+        let eye = self.focus + rotation * Vec3::new(0.0, 0.0, self.distance);
+        Transform::from_translation(eye).looking_at(self.focus, Vec3::Y)
+    }
+}
+
+/// Whether the pointer belongs to the viewport this frame (false while egui uses it).
+#[derive(Resource, Default)]
+pub struct ViewportHasPointer(pub bool);
+
+/// Reads mouse drags and the wheel into the orbit (reads input; writes `OrbitCamera`).
+pub fn orbit_camera_input(
+    buttons: Res<ButtonInput<MouseButton>>,
+    motion: Res<AccumulatedMouseMotion>,
+    scroll: Res<AccumulatedMouseScroll>,
+    pointer: Option<Res<ViewportHasPointer>>,
+    mut cameras: Query<&mut OrbitCamera>,
+) {
+    if pointer.is_some_and(|p| !p.0) {
+        return;
+    }
+    let delta = motion.delta;
+    let wheel = match scroll.unit {
+        MouseScrollUnit::Line => scroll.delta.y,
+        MouseScrollUnit::Pixel => scroll.delta.y / 40.0,
+    };
+    for mut orbit in &mut cameras {
+        if buttons.pressed(MouseButton::Left) && delta != Vec2::ZERO {
+            orbit.yaw -= delta.x * 0.008;
+            orbit.pitch = (orbit.pitch - delta.y * 0.008).clamp(-1.55, 1.55);
+        }
+        if buttons.pressed(MouseButton::Middle) && delta != Vec2::ZERO {
+            let rotation = Quat::from_euler(EulerRot::YXZ, orbit.yaw, orbit.pitch, 0.0);
+            let scale = orbit.distance * 0.0015;
+            orbit.focus += rotation * Vec3::new(-delta.x * scale, delta.y * scale, 0.0);
+        }
+        if buttons.pressed(MouseButton::Right) && delta.y != 0.0 {
+            orbit.distance = (orbit.distance * (1.0 + delta.y * 0.005)).clamp(0.05, 500.0);
+        }
+        if wheel != 0.0 {
+            orbit.distance = (orbit.distance * 0.9f32.powf(wheel)).clamp(0.05, 500.0);
+        }
+    }
+}
+
+/// Places cameras from their orbit (reads `OrbitCamera`; writes `Transform`).
+pub fn apply_orbit_camera(mut cameras: Query<(&OrbitCamera, &mut Transform), Changed<OrbitCamera>>) {
+    for (orbit, mut transform) in &mut cameras {
+        *transform = orbit.transform();
+    }
+}

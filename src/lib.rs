@@ -1,0 +1,13 @@
+//! Marionette: scenes of skinned characters.
+//!
+//! - [`rig`]: skeletons, matrix stack, poses, skinning kernels (no Bevy).
+//! - [`formats`]: readers and writers of the course formats (no Bevy).
+//! - [`scene`]: the ECS (joints as entities, matrix-stack and skinning systems).
+//! - [`editor`]: the windowed app.
+
+pub mod editor;
+pub mod formats;
+pub mod posing;
+pub mod puppet;
+pub mod rig;
+pub mod scene;

@@ -1,0 +1,80 @@
+//! Skin binding from geometry: weights from each vertex's distance to the bones.
+
+use glam::Vec3;
+
+use super::skeleton::Skeleton;
+use super::skinning::SkinWeights;
+
+/// A bone: the segment from a joint to one of its children, moved by that joint.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Bone {
+    /// The joint whose frame carries the bone (the segment's start).
+    pub joint: usize,
+    pub start: Vec3,
+    pub end: Vec3,
+}
+
+/// Every bone of a skeleton given world (or model) joint positions; zero-length bones
+/// are skipped. A leaf adds nothing (it has no child to reach).
+pub fn bones(skeleton: &Skeleton, joint_positions: &[Vec3]) -> Vec<Bone> {
+    (1..skeleton.len())
+        .filter_map(|c| {
+            let p = skeleton.parent(c)?;
+            let (start, end) = (joint_positions[p], joint_positions[c]);
+            (start.distance_squared(end) > 1e-12).then_some(Bone { joint: p, start, end })
+        })
+        .collect()
+}
+
+/// Distance from `p` to the segment `a`–`b` (clamped at its ends).
+pub fn segment_distance(p: Vec3, a: Vec3, b: Vec3) -> f32 {
+    let ab = b - a;
+    let t = ((p - a).dot(ab) / ab.length_squared().max(1e-20)).clamp(0.0, 1.0);
+    p.distance(a + t * ab)
+}
+
+/// Rigid binding: each vertex to the joint of the nearest bone.
+pub fn nearest_bone_weights(positions: &[Vec3], bones: &[Bone]) -> SkinWeights {
+    let joints: Vec<u16> = positions
+        .iter()
+        .map(|&p| {
+            bones
+                .iter()
+                .min_by(|x, y| segment_distance(p, x.start, x.end).total_cmp(&segment_distance(p, y.start, y.end)))
+                .map_or(0, |b| b.joint as u16)
+        })
+        .collect();
+    SkinWeights::rigid(&joints)
+}
+
+/// Smooth binding: the nearest `max_bones` bones weigh `1 / (d² + ε)²`, bones more than
+/// `falloff` times farther than the nearest are dropped, weights are summed per joint and
+/// normalised. `ε` is a small fraction of the skeleton's size so a vertex on a bone does
+/// not blow up.
+pub fn smooth_bone_weights(positions: &[Vec3], bones: &[Bone], joint_count: usize, max_bones: usize, falloff: f32) -> SkinWeights {
+    let size = bones.iter().map(|b| b.start.distance(b.end)).fold(0.0f32, f32::max).max(1e-6);
+    let eps = (0.02 * size).powi(2);
+    let mut distances: Vec<(f32, usize)> = Vec::with_capacity(bones.len());
+    let rows: Vec<Vec<(usize, f32)>> = positions
+        .iter()
+        .map(|&p| {
+            distances.clear();
+            distances.extend(bones.iter().enumerate().map(|(i, b)| (segment_distance(p, b.start, b.end), i)));
+            distances.sort_by(|a, b| a.0.total_cmp(&b.0));
+            let nearest = distances.first().map_or(0.0, |d| d.0);
+            let mut row: Vec<(usize, f32)> = Vec::new();
+            for &(d, i) in distances.iter().take(max_bones.max(1)) {
+                if d > falloff * nearest + 1e-6 && !row.is_empty() {
+                    break;
+                }
+                let w = 1.0 / (d * d + eps).powi(2);
+                match row.iter_mut().find(|(j, _)| *j == bones[i].joint) {
+                    Some((_, acc)) => *acc += w,
+                    None => row.push((bones[i].joint, w)),
+                }
+            }
+            row
+        })
+        .collect();
+    SkinWeights::from_rows(rows, joint_count).expect("distance weights are positive and in range").0
+}

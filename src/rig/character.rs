@@ -1,0 +1,134 @@
+//! A loaded character: a skeleton, its skin and its bind matrices. Shared (in an `Arc`)
+//! by every scene character made from the same files.
+
+use glam::{Mat4, Vec3};
+
+use super::RigError;
+use super::fk::{bind_world_to_joint, forward_kinematics};
+use super::skeleton::{BoneBox, Skeleton};
+use super::skinning::SkinWeights;
+
+/// A triangle mesh in the bind (model) space and its weights.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct Skin {
+    /// Bind-pose vertex positions, model space.
+    pub bind_positions: Vec<Vec3>,
+    /// Triangles as indices into `bind_positions`, counter-clockwise front faces.
+    pub triangles: Vec<[u32; 3]>,
+    /// One row of influences per vertex.
+    pub weights: SkinWeights,
+}
+
+impl Skin {
+    /// Checks that weights and triangles fit the vertices.
+    pub fn validate(&self) -> Result<(), RigError> {
+        let count = self.bind_positions.len();
+        if self.weights.vertex_count() != count {
+            return Err(RigError::WeightCountMismatch { mesh: count, weights: self.weights.vertex_count() });
+        }
+        for (t, tri) in self.triangles.iter().enumerate() {
+            if let Some(&index) = tri.iter().find(|&&i| i as usize >= count) {
+                return Err(RigError::TriangleIndexOutOfRange { triangle: t, index, count });
+            }
+        }
+        Ok(())
+    }
+}
+
+/// How a character's skin was made.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum SkinKind {
+    /// A mesh with weights from the source files.
+    Mesh,
+    /// No mesh in the source: one box per joint, rigidly attached.
+    BoneBoxes,
+}
+
+/// Everything loaded for one character.
+#[derive(Debug, Clone, PartialEq)]
+pub struct CharacterAsset {
+    pub name: String,
+    pub skeleton: Skeleton,
+    pub skin: Skin,
+    pub skin_kind: SkinKind,
+    /// Inverse of each joint's model-space transform at the bind pose.
+    pub bind_world_to_joint: Vec<Mat4>,
+    /// Things the loader fixed and the user should know (normalised weight rows, ...).
+    pub warnings: Vec<String>,
+}
+
+impl CharacterAsset {
+    /// A skinned character whose bind pose is the skeleton's rest pose.
+    pub fn new(name: impl Into<String>, skeleton: Skeleton, skin: Skin, warnings: Vec<String>) -> Result<Self, RigError> {
+        skin.validate()?;
+        let bind_world_to_joint = bind_world_to_joint(&skeleton, None);
+        Ok(Self { name: name.into(), skeleton, skin, skin_kind: SkinKind::Mesh, bind_world_to_joint, warnings })
+    }
+
+    /// A character without a mesh: each joint's bone box (its own, or ±0.1) rigidly
+    /// bound to that joint.
+    pub fn with_bone_boxes(name: impl Into<String>, skeleton: Skeleton, warnings: Vec<String>) -> Self {
+        let skin = bone_box_skin(&skeleton);
+        let bind_world_to_joint = bind_world_to_joint(&skeleton, None);
+        Self { name: name.into(), skeleton, skin, skin_kind: SkinKind::BoneBoxes, bind_world_to_joint, warnings }
+    }
+
+    pub fn vertex_count(&self) -> usize {
+        self.skin.bind_positions.len()
+    }
+
+    pub fn triangle_count(&self) -> usize {
+        self.skin.triangles.len()
+    }
+
+    /// Axis-aligned bounds of the bind-pose mesh (model space).
+    pub fn bounds(&self) -> (Vec3, Vec3) {
+        let mut lo = Vec3::splat(f32::INFINITY);
+        let mut hi = Vec3::splat(f32::NEG_INFINITY);
+        for p in &self.skin.bind_positions {
+            lo = lo.min(*p);
+            hi = hi.max(*p);
+        }
+        if lo.x > hi.x { (Vec3::ZERO, Vec3::ZERO) } else { (lo, hi) }
+    }
+}
+
+/// The 12 triangles of a box, counter-clockwise seen from outside; corner `i` has
+/// x from bit 0, y from bit 1, z from bit 2 (0 = min, 1 = max).
+pub const BOX_TRIANGLES: [[u32; 3]; 12] = [
+    [0, 2, 1], [1, 2, 3], // -z
+    [4, 5, 6], [5, 7, 6], // +z
+    [0, 1, 4], [1, 5, 4], // -y
+    [2, 6, 3], [3, 6, 7], // +y
+    [0, 4, 2], [2, 4, 6], // -x
+    [1, 3, 5], [3, 7, 5], // +x
+];
+
+/// Corners of a box in the order [`BOX_TRIANGLES`] expects.
+pub fn box_corners(b: &BoneBox) -> [Vec3; 8] {
+    std::array::from_fn(|i| {
+        Vec3::new(
+            if i & 1 == 0 { b.min.x } else { b.max.x },
+            if i & 2 == 0 { b.min.y } else { b.max.y },
+            if i & 4 == 0 { b.min.z } else { b.max.z },
+        )
+    })
+}
+
+/// One box per joint, placed at the joint's rest (file pose) frame, weighted 1 to it.
+fn bone_box_skin(skeleton: &Skeleton) -> Skin {
+    let mut rest = vec![Mat4::IDENTITY; skeleton.len()];
+    forward_kinematics(skeleton, &skeleton.rest_pose(), Mat4::IDENTITY, &mut rest);
+    let mut skin = Skin::default();
+    let mut joint_of_vertex = Vec::new();
+    let default_box = BoneBox { min: Vec3::splat(-0.1), max: Vec3::splat(0.1) };
+    for (j, joint) in skeleton.joints().iter().enumerate() {
+        let first = skin.bind_positions.len() as u32;
+        let b = joint.bone_box.unwrap_or(default_box);
+        skin.bind_positions.extend(box_corners(&b).iter().map(|c| rest[j].transform_point3(*c)));
+        skin.triangles.extend(BOX_TRIANGLES.iter().map(|t| t.map(|i| first + i)));
+        joint_of_vertex.extend(std::iter::repeat_n(j as u16, 8));
+    }
+    skin.weights = SkinWeights::rigid(&joint_of_vertex);
+    skin
+}

@@ -1,0 +1,44 @@
+//! The rig core: skeletons, the matrix stack, poses, forward kinematics and skinning.
+//! Pure data and math; no Bevy.
+
+pub mod bind;
+pub mod character;
+pub mod fk;
+pub mod ik;
+pub mod matrix_stack;
+pub mod pose;
+pub mod skeleton;
+pub mod skinning;
+pub mod smpl;
+
+pub use character::{CharacterAsset, Skin};
+pub use fk::{bind_world_to_joint, forward_kinematics, skinning_palette};
+pub use matrix_stack::MatrixStack;
+pub use pose::{DofLimits, EulerOrder, JointRotation};
+pub use skeleton::{BoneBox, JointDef, RawJoint, Skeleton};
+pub use skinning::{Influence, SkinWeights};
+
+/// What can be wrong with a rig, independent of the file it came from.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum RigError {
+    #[error("the skeleton has no joints")]
+    EmptySkeleton,
+    #[error("joint {joint}: parent index {parent} is out of range (the skeleton has {count} joints)")]
+    ParentOutOfRange { joint: usize, parent: usize, count: usize },
+    #[error("the skeleton has several roots: {}", roots.join(", "))]
+    SeveralRoots { roots: Vec<String> },
+    #[error("joint `{joint}` is on a cycle of parents")]
+    Cycle { joint: String },
+    #[error("joint `{joint}` (index {index}) comes before its parent {parent}")]
+    NotParentFirst { joint: String, index: usize, parent: usize },
+    #[error("vertex {vertex}: joint {joint} is out of range (the skeleton has {count} joints)")]
+    InfluenceJointOutOfRange { vertex: usize, joint: usize, count: usize },
+    #[error("vertex {vertex}: weight {weight} for joint {joint} is negative or not a number")]
+    BadWeight { vertex: usize, joint: usize, weight: f32 },
+    #[error("vertex {vertex} has no positive weight")]
+    NoInfluence { vertex: usize },
+    #[error("the mesh has {mesh} vertices but the weights cover {weights}")]
+    WeightCountMismatch { mesh: usize, weights: usize },
+    #[error("triangle {triangle} uses vertex {index}, but the mesh has {count}")]
+    TriangleIndexOutOfRange { triangle: usize, index: u32, count: usize },
+}

@@ -1,0 +1,216 @@
+//! The runtime skeleton: a validated tree of named joints stored flat, parents before
+//! children (the ozz-animation layout). Built once from a [`RawSkeleton`].
+
+use glam::Vec3;
+
+use super::RigError;
+use super::pose::{DofLimits, JointRotation};
+
+/// An axis-aligned box in a joint's local space (CSE169 `boxmin`/`boxmax`).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct BoneBox {
+    pub min: Vec3,
+    pub max: Vec3,
+}
+
+/// One joint as a file describes it, before validation.
+#[derive(Debug, Clone, PartialEq)]
+pub struct RawJoint {
+    pub name: String,
+    /// Index of the parent in the raw list; `None` for a root.
+    pub parent: Option<usize>,
+    /// Translation from the parent's frame to this joint's frame, in the parent's local
+    /// space (model units). For the root: its place in the character's model space.
+    pub rest_offset: Vec3,
+    /// Per-axis rotation limits in radians (unlimited by default).
+    pub limits: DofLimits,
+    /// Optional box drawn for a skeleton without skin.
+    pub bone_box: Option<BoneBox>,
+    /// The pose the file gives (already clamped to `limits` by [`Skeleton::build`]).
+    pub initial_rotation: JointRotation,
+}
+
+impl RawJoint {
+    /// A joint with only a name, a parent and an offset; everything else default.
+    pub fn new(name: impl Into<String>, parent: Option<usize>, rest_offset: Vec3) -> Self {
+        Self {
+            name: name.into(),
+            parent,
+            rest_offset,
+            limits: DofLimits::UNLIMITED,
+            bone_box: None,
+            initial_rotation: JointRotation::IDENTITY,
+        }
+    }
+}
+
+/// A joint of a validated skeleton.
+#[derive(Debug, Clone, PartialEq)]
+pub struct JointDef {
+    pub name: String,
+    /// Parent index, always smaller than this joint's index; `None` for the root.
+    pub parent: Option<usize>,
+    /// Translation relative to the parent, in the parent's local space.
+    pub rest_offset: Vec3,
+    pub limits: DofLimits,
+    pub bone_box: Option<BoneBox>,
+    /// The file's pose, clamped to `limits`.
+    pub initial_rotation: JointRotation,
+}
+
+/// A validated joint tree: exactly one root (index 0), parents before children.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Skeleton {
+    joints: Vec<JointDef>,
+    /// `children[j]`: indices of j's children, in index order.
+    children: Vec<Vec<usize>>,
+}
+
+impl Skeleton {
+    /// Validates a raw joint list and reorders it so that parents come before children
+    /// (depth-first, children in file order). Returns the skeleton and, for each raw index,
+    /// its new index.
+    pub fn build_reordered(raw: Vec<RawJoint>) -> Result<(Self, Vec<usize>), RigError> {
+        let n = raw.len();
+        if n == 0 {
+            return Err(RigError::EmptySkeleton);
+        }
+        for (i, j) in raw.iter().enumerate() {
+            if let Some(p) = j.parent {
+                if p >= n {
+                    return Err(RigError::ParentOutOfRange { joint: i, parent: p, count: n });
+                }
+                if p == i {
+                    return Err(RigError::Cycle { joint: j.name.clone() });
+                }
+            }
+        }
+        let roots: Vec<usize> = (0..n).filter(|&i| raw[i].parent.is_none()).collect();
+        match roots.len() {
+            0 => return Err(RigError::Cycle { joint: raw[0].name.clone() }),
+            1 => {}
+            _ => return Err(RigError::SeveralRoots { roots: roots.iter().map(|&r| raw[r].name.clone()).collect() }),
+        }
+        let mut raw_children = vec![Vec::new(); n];
+        for (i, j) in raw.iter().enumerate() {
+            if let Some(p) = j.parent {
+                raw_children[p].push(i);
+            }
+        }
+        // Depth-first order from the root; joints never reached sit on a cycle.
+        let mut order = Vec::with_capacity(n);
+        let mut todo = vec![roots[0]];
+        while let Some(j) = todo.pop() {
+            order.push(j);
+            todo.extend(raw_children[j].iter().rev());
+        }
+        if order.len() != n {
+            let mut reached = vec![false; n];
+            order.iter().for_each(|&j| reached[j] = true);
+            let lost = (0..n).find(|&j| !reached[j]).unwrap_or(0);
+            return Err(RigError::Cycle { joint: raw[lost].name.clone() });
+        }
+        let mut new_index = vec![0; n];
+        for (new, &old) in order.iter().enumerate() {
+            new_index[old] = new;
+        }
+        let mut raw: Vec<Option<RawJoint>> = raw.into_iter().map(Some).collect();
+        let joints = order
+            .iter()
+            .map(|&old| {
+                let j = raw[old].take().expect("each joint is visited once");
+                JointDef {
+                    initial_rotation: j.initial_rotation.clamped(&j.limits),
+                    name: j.name,
+                    parent: j.parent.map(|p| new_index[p]),
+                    rest_offset: j.rest_offset,
+                    limits: j.limits,
+                    bone_box: j.bone_box,
+                }
+            })
+            .collect();
+        Ok((Self::from_ordered(joints), new_index))
+    }
+
+    /// Validates a raw joint list whose parents already precede their children and keeps
+    /// its order (file indices stay joint indices, as weight files expect).
+    pub fn build(raw: Vec<RawJoint>) -> Result<Self, RigError> {
+        for (i, j) in raw.iter().enumerate() {
+            if let Some(p) = j.parent
+                && p >= i
+                && p < raw.len()
+            {
+                // A forward reference: either a cycle or an order the caller must fix.
+                let (skeleton, new_index) = Self::build_reordered(raw)?;
+                return Err(RigError::NotParentFirst {
+                    joint: skeleton.joints[new_index[i]].name.clone(),
+                    index: i,
+                    parent: p,
+                });
+            }
+        }
+        let (skeleton, _) = Self::build_reordered(raw)?;
+        Ok(skeleton)
+    }
+
+    fn from_ordered(joints: Vec<JointDef>) -> Self {
+        let mut children = vec![Vec::new(); joints.len()];
+        for (i, j) in joints.iter().enumerate() {
+            if let Some(p) = j.parent {
+                children[p].push(i);
+            }
+        }
+        Self { joints, children }
+    }
+
+    pub fn len(&self) -> usize {
+        self.joints.len()
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.joints.is_empty()
+    }
+
+    pub fn joints(&self) -> &[JointDef] {
+        &self.joints
+    }
+
+    pub fn joint(&self, index: usize) -> &JointDef {
+        &self.joints[index]
+    }
+
+    pub fn children(&self, index: usize) -> &[usize] {
+        &self.children[index]
+    }
+
+    pub fn parent(&self, index: usize) -> Option<usize> {
+        self.joints[index].parent
+    }
+
+    /// First joint with this name (names are not unique in every file).
+    pub fn find(&self, name: &str) -> Option<usize> {
+        self.joints.iter().position(|j| j.name == name)
+    }
+
+    /// A joint by name, or by index written as a number.
+    pub fn resolve(&self, name_or_index: &str) -> Option<usize> {
+        self.find(name_or_index).or_else(|| name_or_index.parse::<usize>().ok().filter(|&i| i < self.len()))
+    }
+
+    /// The initial pose the file gave (clamped).
+    pub fn initial_pose(&self) -> Vec<JointRotation> {
+        self.joints.iter().map(|j| j.initial_rotation).collect()
+    }
+
+    /// The rest pose: every joint at identity rotation.
+    pub fn rest_pose(&self) -> Vec<JointRotation> {
+        vec![JointRotation::IDENTITY; self.len()]
+    }
+
+    /// Replaces rest offsets (a reshaped skeleton keeps its topology).
+    pub fn set_rest_offsets(&mut self, offsets: &[Vec3]) {
+        for (j, &o) in self.joints.iter_mut().zip(offsets) {
+            j.rest_offset = o;
+        }
+    }
+}

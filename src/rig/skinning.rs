@@ -1,0 +1,185 @@
+//! Linear blend skinning (skeletal subspace deformation) over plain slices, flat normals
+//! and weight colours. No allocation per call: callers own every buffer.
+
+use glam::{Mat4, Vec3};
+
+use super::RigError;
+
+/// One joint's influence on a vertex.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Influence {
+    pub joint: u16,
+    pub weight: f32,
+}
+
+/// Sparse per-vertex influences, stored compressed: the influences of vertex `v` are
+/// `influences[offsets[v]..offsets[v + 1]]`. Any number per vertex.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct SkinWeights {
+    offsets: Vec<u32>,
+    influences: Vec<Influence>,
+}
+
+/// A vertex whose weights did not sum to 1 and were normalised.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct NormalisedRow {
+    pub vertex: usize,
+    pub sum: f32,
+}
+
+/// Rows whose sum differs from 1 by more than this are reported when normalised.
+pub const WEIGHT_SUM_TOLERANCE: f32 = 1e-3;
+
+impl SkinWeights {
+    /// Builds from one list of (joint, weight) per vertex. Zero weights are dropped; rows
+    /// are normalised to sum to 1 and those off by more than [`WEIGHT_SUM_TOLERANCE`]
+    /// are returned. A row with no positive weight, a negative weight or a joint out of
+    /// range is an error.
+    pub fn from_rows<I, R>(rows: I, joint_count: usize) -> Result<(Self, Vec<NormalisedRow>), RigError>
+    where
+        I: IntoIterator<Item = R>,
+        R: IntoIterator<Item = (usize, f32)>,
+    {
+        let mut weights = SkinWeights { offsets: vec![0], influences: Vec::new() };
+        let mut normalised = Vec::new();
+        for (vertex, row) in rows.into_iter().enumerate() {
+            let start = weights.influences.len();
+            for (joint, weight) in row {
+                if joint >= joint_count {
+                    return Err(RigError::InfluenceJointOutOfRange { vertex, joint, count: joint_count });
+                }
+                if !(weight >= 0.0) || !weight.is_finite() {
+                    return Err(RigError::BadWeight { vertex, joint, weight });
+                }
+                if weight > 0.0 {
+                    weights.influences.push(Influence { joint: joint as u16, weight });
+                }
+            }
+            let row = &mut weights.influences[start..];
+            let sum: f32 = row.iter().map(|i| i.weight).sum();
+            if sum <= 0.0 {
+                return Err(RigError::NoInfluence { vertex });
+            }
+            if (sum - 1.0).abs() > WEIGHT_SUM_TOLERANCE {
+                normalised.push(NormalisedRow { vertex, sum });
+            }
+            row.iter_mut().for_each(|i| i.weight /= sum);
+            weights.offsets.push(weights.influences.len() as u32);
+        }
+        Ok((weights, normalised))
+    }
+
+    /// Every vertex bound rigidly to one joint.
+    pub fn rigid(joint_of_vertex: &[u16]) -> Self {
+        Self {
+            offsets: (0..=joint_of_vertex.len() as u32).collect(),
+            influences: joint_of_vertex.iter().map(|&joint| Influence { joint, weight: 1.0 }).collect(),
+        }
+    }
+
+    pub fn vertex_count(&self) -> usize {
+        self.offsets.len() - 1
+    }
+
+    pub fn of_vertex(&self, v: usize) -> &[Influence] {
+        &self.influences[self.offsets[v] as usize..self.offsets[v + 1] as usize]
+    }
+
+    /// Largest number of influences on one vertex.
+    pub fn max_influences(&self) -> usize {
+        self.offsets.windows(2).map(|w| (w[1] - w[0]) as usize).max().unwrap_or(0)
+    }
+
+    pub fn total_influences(&self) -> usize {
+        self.influences.len()
+    }
+
+    /// The weight of `joint` on vertex `v` (0 when it has none).
+    pub fn weight(&self, v: usize, joint: usize) -> f32 {
+        self.of_vertex(v).iter().filter(|i| i.joint as usize == joint).map(|i| i.weight).sum()
+    }
+}
+
+/// Skins bind-pose vertices: `out[v] = Σ w · palette[j] · bind[v]` over v's influences.
+///
+/// `bind_positions` are in the bind (model) space, `palette[j]` is
+/// `current_joint_to_world · bind_world_to_joint`, `out` is in world space.
+///
+/// # Panics
+/// When the lengths of `bind_positions`, `weights` and `out` differ, or an influence names
+/// a joint beyond the palette.
+pub fn skin_positions(bind_positions: &[Vec3], weights: &SkinWeights, palette: &[Mat4], out: &mut [Vec3]) {
+    assert_eq!(bind_positions.len(), weights.vertex_count(), "one weight row per vertex");
+    assert_eq!(out.len(), bind_positions.len(), "one output per vertex");
+    let offsets = &weights.offsets;
+    for (v, (p, o)) in bind_positions.iter().zip(out.iter_mut()).enumerate() {
+        let row = &weights.influences[offsets[v] as usize..offsets[v + 1] as usize];
+        let mut acc = Vec3::ZERO;
+        for inf in row {
+            acc += inf.weight * palette[inf.joint as usize].transform_point3(*p);
+        }
+        *o = acc;
+    }
+}
+
+/// Unshares the vertices of every triangle and gives each the triangle's unit normal:
+/// `out_positions[3t + k] = positions[triangles[t][k]]`, `out_normals[3t + k]` = the
+/// normal of t (counter-clockwise front; zero for a degenerate triangle).
+///
+/// # Panics
+/// When the outputs are not 3 entries per triangle or an index is out of range.
+pub fn flat_shade(positions: &[Vec3], triangles: &[[u32; 3]], out_positions: &mut [[f32; 3]], out_normals: &mut [[f32; 3]]) {
+    assert_eq!(out_positions.len(), triangles.len() * 3);
+    assert_eq!(out_normals.len(), triangles.len() * 3);
+    for (t, tri) in triangles.iter().enumerate() {
+        let [a, b, c] = tri.map(|i| positions[i as usize]);
+        let n = (b - a).cross(c - a).normalize_or_zero().to_array();
+        out_positions[3 * t] = a.to_array();
+        out_positions[3 * t + 1] = b.to_array();
+        out_positions[3 * t + 2] = c.to_array();
+        out_normals[3 * t..3 * t + 3].fill(n);
+    }
+}
+
+/// A distinct colour per joint: hues spaced by the golden angle, saturated, bright.
+pub fn joint_colors(joint_count: usize) -> Vec<[f32; 3]> {
+    (0..joint_count).map(|j| hsv_to_rgb((j as f32 * 0.618_034).fract(), 0.75, 0.95)).collect()
+}
+
+/// Each vertex's colour is the weight-blended colour of its joints.
+pub fn weight_colors(weights: &SkinWeights, colors: &[[f32; 3]], out: &mut [[f32; 3]]) {
+    assert_eq!(out.len(), weights.vertex_count());
+    for (v, o) in out.iter_mut().enumerate() {
+        let mut c = Vec3::ZERO;
+        for inf in weights.of_vertex(v) {
+            c += inf.weight * Vec3::from(colors[inf.joint as usize]);
+        }
+        *o = c.to_array();
+    }
+}
+
+/// A heat map of one joint's weights: blue (0) through green to red (1).
+pub fn heat_colors(weights: &SkinWeights, joint: usize, out: &mut [[f32; 3]]) {
+    assert_eq!(out.len(), weights.vertex_count());
+    for (v, o) in out.iter_mut().enumerate() {
+        let w = weights.weight(v, joint).clamp(0.0, 1.0);
+        *o = hsv_to_rgb((1.0 - w) * 0.66, 0.85, 0.95);
+    }
+}
+
+/// HSV (all in [0, 1]) to linear-ish RGB.
+pub fn hsv_to_rgb(h: f32, s: f32, v: f32) -> [f32; 3] {
+    let h6 = (h.rem_euclid(1.0)) * 6.0;
+    let c = v * s;
+    let x = c * (1.0 - ((h6 % 2.0) - 1.0).abs());
+    let (r, g, b) = match h6 as u32 {
+        0 => (c, x, 0.0),
+        1 => (x, c, 0.0),
+        2 => (0.0, c, x),
+        3 => (0.0, x, c),
+        4 => (x, 0.0, c),
+        _ => (c, 0.0, x),
+    };
+    let m = v - c;
+    [r + m, g + m, b + m]
+}

@@ -1,0 +1,162 @@
+//! Components of characters and joints.
+
+use std::sync::Arc;
+
+use bevy::prelude::*;
+
+use crate::rig::{CharacterAsset, DofLimits, JointRotation};
+
+/// A character: the loaded asset it was made from (shared by every character made from
+/// the same files), its joint entities by joint index and the entity that draws its skin.
+#[derive(Component, Clone)]
+#[require(Placement, SkinView, DisplayMode, PoseDirty, Transform, Visibility)]
+pub struct Character {
+    pub asset: Arc<CharacterAsset>,
+    /// `joints[i]` is the entity of joint `i` of `asset.skeleton`.
+    pub joints: Vec<Entity>,
+    /// The child entity with the skinned render mesh.
+    pub skin_entity: Entity,
+    pub mesh: Handle<Mesh>,
+}
+
+/// Where a character stands in the world: model space → world is
+/// `T(translation) · Ry(yaw) · S(scale)`.
+#[derive(Component, Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct Placement {
+    pub translation: Vec3,
+    /// Rotation about the vertical (y) axis, radians.
+    pub yaw: f32,
+    /// Uniform scale.
+    pub scale: f32,
+}
+
+impl Default for Placement {
+    fn default() -> Self {
+        Self { translation: Vec3::ZERO, yaw: 0.0, scale: 1.0 }
+    }
+}
+
+impl Placement {
+    pub fn at(translation: Vec3) -> Self {
+        Self { translation, ..default() }
+    }
+
+    /// The model-to-world matrix.
+    pub fn to_mat4(&self) -> Mat4 {
+        Mat4::from_scale_rotation_translation(Vec3::splat(self.scale), Quat::from_rotation_y(self.yaw), self.translation)
+    }
+}
+
+/// How a character's skin is coloured.
+#[derive(Component, Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct SkinView {
+    /// Base colour when weight colours are off (linear RGB).
+    pub tint: [f32; 3],
+    /// A distinct hue per joint, blended by the weights.
+    pub weight_colors: bool,
+    /// A heat map of this joint's weights (overrides `weight_colors`).
+    pub heat_joint: Option<usize>,
+}
+
+impl Default for SkinView {
+    fn default() -> Self {
+        Self { tint: [0.8, 0.62, 0.45], weight_colors: false, heat_joint: None }
+    }
+}
+
+/// Whether a character shows its skin, its skeleton, or both.
+#[derive(Component, Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+pub enum DisplayMode {
+    #[default]
+    Mesh,
+    Skeleton,
+    Both,
+}
+
+impl DisplayMode {
+    /// The next mode in the cycle mesh → skeleton → both.
+    pub fn next(self) -> Self {
+        match self {
+            DisplayMode::Mesh => DisplayMode::Skeleton,
+            DisplayMode::Skeleton => DisplayMode::Both,
+            DisplayMode::Both => DisplayMode::Mesh,
+        }
+    }
+}
+
+/// Set when a character's pose, placement or view changed and its skin must be redone.
+#[derive(Component, Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct PoseDirty {
+    /// Joint matrices must be recomputed (pose or placement changed).
+    pub matrices: bool,
+    /// Bind matrices must be recomputed (rest offsets changed, or just spawned).
+    pub bind: bool,
+    /// Vertex colours must be rewritten.
+    pub colors: bool,
+}
+
+impl PoseDirty {
+    pub const ALL: Self = Self { matrices: true, bind: true, colors: true };
+}
+
+/// A joint of a character.
+#[derive(Component, Clone, Debug)]
+#[require(RestOffset, JointPose, JointLimits, BindWorldToJoint, CurrentJointToWorld)]
+pub struct Joint {
+    /// Index in the character's skeleton (and in its weights).
+    pub index: usize,
+    pub name: String,
+    /// The character entity this joint belongs to.
+    pub character: Entity,
+}
+
+/// Translation from the parent joint's frame, in the parent's local space (model units).
+#[derive(Component, Clone, Copy, Debug, Default, PartialEq)]
+pub struct RestOffset(pub Vec3);
+
+/// The joint's rotation relative to its parent, kept within its limits.
+#[derive(Component, Clone, Copy, Debug, Default, PartialEq)]
+pub struct JointPose(pub JointRotation);
+
+/// The joint's rotation limits (radians).
+#[derive(Component, Clone, Copy, Debug, Default, PartialEq)]
+pub struct JointLimits(pub DofLimits);
+
+/// Inverse of the joint's model-space transform at the bind (rest) pose.
+#[derive(Component, Clone, Copy, Debug, PartialEq)]
+pub struct BindWorldToJoint(pub Mat4);
+
+impl Default for BindWorldToJoint {
+    fn default() -> Self {
+        Self(Mat4::IDENTITY)
+    }
+}
+
+/// The joint's current transform to world space (placement included).
+#[derive(Component, Clone, Copy, Debug, PartialEq)]
+pub struct CurrentJointToWorld(pub Mat4);
+
+impl Default for CurrentJointToWorld {
+    fn default() -> Self {
+        Self(Mat4::IDENTITY)
+    }
+}
+
+impl CurrentJointToWorld {
+    pub fn position(&self) -> Vec3 {
+        self.0.w_axis.truncate()
+    }
+}
+
+/// Marks the entity that draws a character's skin.
+#[derive(Component, Clone, Copy, Debug)]
+pub struct SkinMesh {
+    pub character: Entity,
+}
+
+/// Scratch buffers reused by the skinning system (no allocation per frame).
+#[derive(Component, Default)]
+pub struct SkinScratch {
+    pub palette: Vec<Mat4>,
+    pub positions: Vec<Vec3>,
+}

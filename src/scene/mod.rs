@@ -1,0 +1,67 @@
+//! The ECS: characters and joints as entities, our matrix-stack system and CPU skinning.
+//!
+//! System order, configured once in [`RigCorePlugin`] (all in `PostUpdate`, before Bevy's
+//! transform propagation, which plays no part in joint matrices):
+//!
+//! `Animate` (clips, sliders) → `Solve` (IK, limits) → `MatrixStack` (mark, bind, FK)
+//! → `Skin` (LBS, normals, colours) → `Draw` (skeleton gizmos, overlays).
+
+pub mod components;
+pub mod spawn;
+pub mod systems;
+
+use bevy::prelude::*;
+
+pub use components::*;
+pub use spawn::{spawn_character, spawn_character_posed};
+
+/// The ordered steps of a frame.
+#[derive(SystemSet, Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum MarionetteSystems {
+    /// Motion playback and user edits write `JointPose`.
+    Animate,
+    /// Inverse kinematics and limit clamping adjust `JointPose`.
+    Solve,
+    /// Bind pass and matrix stack write `BindWorldToJoint` and `CurrentJointToWorld`.
+    MatrixStack,
+    /// Skinning rewrites render meshes.
+    Skin,
+    /// Drawing of skeletons and overlays.
+    Draw,
+}
+
+/// Configures the set chain (once) and runs the matrix stack.
+pub struct RigCorePlugin;
+
+impl Plugin for RigCorePlugin {
+    fn build(&self, app: &mut App) {
+        app.configure_sets(
+            PostUpdate,
+            (
+                MarionetteSystems::Animate,
+                MarionetteSystems::Solve,
+                MarionetteSystems::MatrixStack,
+                MarionetteSystems::Skin,
+                MarionetteSystems::Draw,
+            )
+                .chain()
+                .before(bevy::transform::TransformSystems::Propagate),
+        )
+        .add_systems(PostUpdate, systems::clamp_poses_to_limits.in_set(MarionetteSystems::Solve))
+        .add_systems(
+            PostUpdate,
+            (systems::mark_changed_characters, systems::bind_rest_pose, systems::compute_joint_to_world)
+                .chain()
+                .in_set(MarionetteSystems::MatrixStack),
+        );
+    }
+}
+
+/// CPU skinning of changed characters into their render meshes.
+pub struct SkinningPlugin;
+
+impl Plugin for SkinningPlugin {
+    fn build(&self, app: &mut App) {
+        app.add_systems(PostUpdate, systems::skin_changed_characters.in_set(MarionetteSystems::Skin));
+    }
+}

@@ -1,0 +1,159 @@
+//! The systems of the rig chain: mark what changed, bind, run the matrix stack, skin.
+
+use bevy::mesh::VertexAttributeValues;
+use bevy::prelude::*;
+
+use super::components::*;
+use crate::rig::MatrixStack;
+use crate::rig::skinning::{flat_shade, heat_colors, joint_colors, skin_positions, weight_colors};
+
+/// Clamps changed joint poses to their limits (reads `JointLimits`, writes `JointPose`).
+pub fn clamp_poses_to_limits(mut joints: Query<(&mut JointPose, &JointLimits), Changed<JointPose>>) {
+    for (mut pose, limits) in &mut joints {
+        let clamped = pose.0.clamped(&limits.0);
+        pose.set_if_neq(JointPose(clamped));
+    }
+}
+
+/// Marks characters whose joints' poses or offsets, placement or view changed
+/// (reads change ticks, writes `PoseDirty`).
+pub fn mark_changed_characters(
+    posed: Query<&Joint, Or<(Changed<JointPose>, Changed<RestOffset>)>>,
+    reshaped: Query<&Joint, Changed<RestOffset>>,
+    mut characters: Query<(Ref<Placement>, Ref<SkinView>, &mut PoseDirty)>,
+) {
+    for joint in &posed {
+        if let Ok((_, _, mut dirty)) = characters.get_mut(joint.character) {
+            dirty.matrices = true;
+        }
+    }
+    for joint in &reshaped {
+        if let Ok((_, _, mut dirty)) = characters.get_mut(joint.character) {
+            dirty.bind = true;
+        }
+    }
+    for (placement, view, mut dirty) in &mut characters {
+        if placement.is_changed() {
+            dirty.matrices = true;
+        }
+        if view.is_changed() {
+            dirty.colors = true;
+        }
+    }
+}
+
+/// The bind pass: for characters whose rest offsets changed, walks the joint tree at the
+/// rest pose with the matrix stack (model space) and stores each inverse in
+/// `BindWorldToJoint` (reads `RestOffset`, `Children`; writes `BindWorldToJoint`).
+pub fn bind_rest_pose(
+    characters: Query<(&Character, &PoseDirty)>,
+    offsets: Query<(&RestOffset, Option<&Children>), With<Joint>>,
+    mut binds: Query<&mut BindWorldToJoint>,
+) {
+    for (character, dirty) in &characters {
+        if !dirty.bind {
+            continue;
+        }
+        walk_joint_tree(character.joints[0], &mut MatrixStack::new(), &offsets, &mut |entity, top| {
+            if let Ok(mut bind) = binds.get_mut(entity) {
+                bind.0 = top.inverse();
+            }
+        }, &|_| Mat4::IDENTITY);
+    }
+}
+
+/// The matrix-stack pass: for characters marked dirty, pushes the placement, then walks
+/// the joint tree depth-first (push `T(offset) · R(pose)`, write the top, recurse, pop)
+/// (reads `Placement`, `RestOffset`, `JointPose`, `Children`; writes `CurrentJointToWorld`).
+pub fn compute_joint_to_world(
+    characters: Query<(&Character, &Placement, &PoseDirty)>,
+    offsets: Query<(&RestOffset, Option<&Children>), With<Joint>>,
+    poses: Query<&JointPose>,
+    mut currents: Query<&mut CurrentJointToWorld>,
+) {
+    for (character, placement, dirty) in &characters {
+        if !dirty.matrices && !dirty.bind {
+            continue;
+        }
+        let mut stack = MatrixStack::with_capacity(character.joints.len() + 1);
+        stack.push(placement.to_mat4());
+        walk_joint_tree(character.joints[0], &mut stack, &offsets, &mut |entity, top| {
+            if let Ok(mut current) = currents.get_mut(entity) {
+                current.0 = top;
+            }
+        }, &|entity| poses.get(entity).map_or(Mat4::IDENTITY, |p| Mat4::from_mat3(p.0.to_mat3())));
+    }
+}
+
+/// Depth-first walk: push `T(offset) · rotation(entity)`, call `visit` with the top,
+/// recurse into joint children, pop.
+fn walk_joint_tree(
+    entity: Entity,
+    stack: &mut MatrixStack,
+    offsets: &Query<(&RestOffset, Option<&Children>), With<Joint>>,
+    visit: &mut impl FnMut(Entity, Mat4),
+    rotation: &impl Fn(Entity) -> Mat4,
+) {
+    let Ok((offset, children)) = offsets.get(entity) else { return };
+    let top = stack.push(Mat4::from_translation(offset.0) * rotation(entity));
+    visit(entity, top);
+    for &child in children.into_iter().flatten() {
+        walk_joint_tree(child, stack, offsets, visit, rotation);
+    }
+    stack.pop();
+}
+
+/// Skins characters marked dirty: palette `CurrentJointToWorld · BindWorldToJoint`, LBS of
+/// the bind vertices, then rewrites the render mesh's positions and flat normals, and its
+/// colours when the view changed (reads joint matrices; writes `Mesh` assets, clears
+/// `PoseDirty`).
+pub fn skin_changed_characters(
+    mut characters: Query<(&Character, &SkinView, &mut PoseDirty, &mut SkinScratch)>,
+    joints: Query<(&CurrentJointToWorld, &BindWorldToJoint)>,
+    mut meshes: ResMut<Assets<Mesh>>,
+) {
+    for (character, view, mut dirty, mut scratch) in &mut characters {
+        if *dirty == PoseDirty::default() {
+            continue;
+        }
+        let skin = &character.asset.skin;
+        let Some(mut mesh) = meshes.get_mut(&character.mesh) else { continue };
+        let SkinScratch { palette, positions } = &mut *scratch;
+        if dirty.matrices || dirty.bind {
+            palette.clear();
+            palette.extend(character.joints.iter().map(|&e| joints.get(e).map_or(Mat4::IDENTITY, |(c, b)| c.0 * b.0)));
+            positions.resize(skin.bind_positions.len(), Vec3::ZERO);
+            skin_positions(&skin.bind_positions, &skin.weights, palette, positions);
+            let mut normals = match mesh.remove_attribute(Mesh::ATTRIBUTE_NORMAL) {
+                Some(VertexAttributeValues::Float32x3(n)) => n,
+                _ => vec![[0.0; 3]; skin.triangles.len() * 3],
+            };
+            if let Some(VertexAttributeValues::Float32x3(out)) = mesh.attribute_mut(Mesh::ATTRIBUTE_POSITION) {
+                flat_shade(positions, &skin.triangles, out, &mut normals);
+            }
+            mesh.insert_attribute(Mesh::ATTRIBUTE_NORMAL, normals);
+        }
+        if dirty.colors {
+            write_colors(&mut mesh, character, view);
+        }
+        *dirty = PoseDirty::default();
+    }
+}
+
+/// Rewrites the per-corner colours: the tint, the weight colours or a joint's heat map.
+fn write_colors(mesh: &mut Mesh, character: &Character, view: &SkinView) {
+    let skin = &character.asset.skin;
+    let n = skin.bind_positions.len();
+    let mut per_vertex = vec![view.tint; n];
+    if let Some(j) = view.heat_joint.filter(|&j| j < character.joints.len()) {
+        heat_colors(&skin.weights, j, &mut per_vertex);
+    } else if view.weight_colors {
+        weight_colors(&skin.weights, &joint_colors(character.joints.len()), &mut per_vertex);
+    }
+    if let Some(VertexAttributeValues::Float32x4(out)) = mesh.attribute_mut(Mesh::ATTRIBUTE_COLOR) {
+        for (corner, &v) in out.iter_mut().zip(skin.triangles.iter().flatten()) {
+            let [r, g, b] = per_vertex[v as usize];
+            *corner = [r, g, b, 1.0];
+        }
+    }
+}

@@ -1,0 +1,44 @@
+//! Helpers shared by the tests.
+
+use std::path::{Path, PathBuf};
+
+use glam::{Mat4, Vec3};
+
+/// The real data folder from `MARIONETTE_DATA`, or `None` (and a note that the test was
+/// skipped) when it is unset.
+pub fn data_dir(test: &str) -> Option<PathBuf> {
+    match std::env::var_os("MARIONETTE_DATA") {
+        Some(dir) => {
+            let dir = PathBuf::from(dir);
+            assert!(dir.is_dir(), "MARIONETTE_DATA={} is not a folder", dir.display());
+            Some(dir)
+        }
+        None => {
+            eprintln!("skipped {test}: MARIONETTE_DATA is not set");
+            None
+        }
+    }
+}
+
+pub fn path(s: &str) -> &Path {
+    Path::new(s)
+}
+
+pub fn assert_mat_close(a: Mat4, b: Mat4, tol: f32) {
+    let (a, b) = (a.to_cols_array(), b.to_cols_array());
+    for k in 0..16 {
+        assert!((a[k] - b[k]).abs() <= tol, "matrices differ at {k}: {a:?} vs {b:?}");
+    }
+}
+
+pub fn assert_vec_close(a: Vec3, b: Vec3, tol: f32) {
+    assert!(a.distance(b) <= tol, "{a} vs {b} (distance {})", a.distance(b));
+}
+
+/// A unique scratch folder for one test.
+pub fn scratch(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("marionette-test-{}-{name}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}

@@ -1,0 +1,7 @@
+//! The one integration-test binary (each test binary links bevy, so there is only one).
+
+mod common;
+mod data;
+mod ecs;
+mod formats;
+mod rig;
