@@ -91,7 +91,7 @@ fn generate(design: &Design) -> Generated {
         add_capsule(&mut positions, &mut triangles, start, Vec3::from(end), radius);
     }
     // A pelvis block across the hips.
-    add_capsule(&mut positions, &mut triangles, Vec3::new(-0.07, 0.49, 0.0), Vec3::new(0.07, 0.49, 0.0), 0.08);
+    add_capsule(&mut positions, &mut triangles, Vec3::new(-0.045, 0.53, 0.0), Vec3::new(0.045, 0.53, 0.0), 0.075);
 
     let all_bones = bones(&skeleton, &joint_positions);
     let weights = smooth_bone_weights(&positions, &all_bones, skeleton.len(), 3, 1.6);
