@@ -37,6 +37,17 @@ enum Command {
         #[arg(long = "pose", value_name = "JOINT=rx,ry,rz")]
         poses: Vec<PoseSpec>,
     },
+    /// Render a scene (.ron) or characters offscreen to a PNG, without a window.
+    Render {
+        /// A scene file or character files; none renders the default scene.
+        paths: Vec<PathBuf>,
+        #[arg(long)]
+        out: PathBuf,
+        #[arg(long, default_value_t = 1280)]
+        width: u32,
+        #[arg(long, default_value_t = 720)]
+        height: u32,
+    },
     /// Rebuild the project's own characters into a folder (normally `assets`).
     GenAssets {
         #[arg(default_value = "assets")]
@@ -70,9 +81,19 @@ fn run(cli: Cli) -> Result<()> {
             write_file(&out, |w| obj::write_obj(w, &positions, &asset.skin.triangles))?;
             println!("wrote {} ({} vertices, {} triangles)", out.display(), positions.len(), asset.triangle_count());
         }
+        Some(Command::Render { paths, out, width, height }) => {
+            let started = std::time::Instant::now();
+            let notes = marionette::editor::render::render(paths, out.clone(), width, height).map_err(anyhow::Error::msg)?;
+            for n in notes {
+                eprintln!("note: {n}");
+            }
+            println!("wrote {} ({width}x{height}) in {:.2} s", out.display(), started.elapsed().as_secs_f64());
+        }
         Some(Command::GenAssets { dir }) => {
             marionette::puppet::write_6837(&marionette::puppet::puppet(), &dir, "puppet").with_context(|| format!("writing {}", dir.display()))?;
-            println!("wrote {}/puppet.{{skel,obj,attach}}", dir.display());
+            let scene = dir.join("default_scene.ron");
+            marionette::formats::scene::save_scene(&scene, &marionette::editor::default_scene::generate())?;
+            println!("wrote {}/puppet.{{skel,obj,attach}} and {}", dir.display(), scene.display());
         }
     }
     Ok(())

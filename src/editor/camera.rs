@@ -34,8 +34,14 @@ impl OrbitCamera {
 }
 
 /// Whether the pointer belongs to the viewport this frame (false while egui uses it).
-#[derive(Resource, Default)]
+#[derive(Resource)]
 pub struct ViewportHasPointer(pub bool);
+
+impl Default for ViewportHasPointer {
+    fn default() -> Self {
+        Self(true)
+    }
+}
 
 /// Reads mouse drags and the wheel into the orbit (reads input; writes `OrbitCamera`).
 pub fn orbit_camera_input(
@@ -76,5 +82,15 @@ pub fn orbit_camera_input(
 pub fn apply_orbit_camera(mut cameras: Query<(&OrbitCamera, &mut Transform), Changed<OrbitCamera>>) {
     for (orbit, mut transform) in &mut cameras {
         *transform = orbit.transform();
+    }
+}
+
+/// Notes whether egui uses the pointer, so drags over panels do not orbit (reads
+/// `EguiWantsInput`; writes `ViewportHasPointer`).
+pub fn track_egui_pointer(wants: Option<Res<bevy_egui::input::EguiWantsInput>>, buttons: Res<ButtonInput<MouseButton>>, mut pointer: ResMut<ViewportHasPointer>) {
+    let egui_wants = wants.is_some_and(|w| w.wants_any_pointer_input());
+    // Decide when a drag starts and keep it for the whole drag.
+    if buttons.get_just_pressed().next().is_some() || !buttons.get_pressed().any(|_| true) {
+        pointer.0 = !egui_wants;
     }
 }

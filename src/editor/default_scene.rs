@@ -1,23 +1,22 @@
-//! The embedded default scene: two of the project's puppets greeting each other.
+//! The default scene, as generated into `assets/default_scene.ron` by
+//! `marionette gen-assets`: two of the project's puppets greeting each other, and a third
+//! shown as a skeleton with weight colours.
 
-use std::sync::Arc;
+use std::collections::BTreeMap;
 
-use glam::Vec3;
+use crate::formats::scene::{CameraDoc, CharacterDoc, DisplayDoc, PlacementDoc, SceneDoc, SourceDoc, StageDoc, ViewDoc};
+use crate::rig::JointRotation;
 
-use super::Placed;
-use crate::posing::{PoseSpec, apply_pose_specs};
-use crate::puppet::embedded_puppet;
-use crate::scene::Placement;
+fn pose(specs: &[(&str, [f32; 3])]) -> BTreeMap<String, JointRotation> {
+    specs.iter().map(|(j, [x, y, z])| (j.to_string(), JointRotation::euler_xyz(*x, *y, *z))).collect()
+}
 
-/// The characters of the default scene, posed.
-pub fn characters() -> Vec<Placed> {
-    let puppet = Arc::new(embedded_puppet());
-    let pose = |specs: &[(&str, [f32; 3])]| {
-        let mut pose = puppet.skeleton.initial_pose();
-        let specs: Vec<PoseSpec> = specs.iter().map(|(j, a)| PoseSpec { joint: j.to_string(), angles: Vec3::from(*a) }).collect();
-        apply_pose_specs(&puppet.skeleton, &mut pose, &specs).expect("the default poses name puppet joints");
-        pose
-    };
+fn puppet(name: &str, translation: [f32; 3], yaw: f32, pose: BTreeMap<String, JointRotation>, view: ViewDoc) -> CharacterDoc {
+    CharacterDoc { source: SourceDoc::Embedded("puppet".into()), name: name.into(), placement: PlacementDoc { translation, yaw, scale: 1.0 }, pose, view, smpl: None }
+}
+
+/// The default scene document.
+pub fn generate() -> SceneDoc {
     // Left: waves with the right hand, weight on one leg.
     let waving = pose(&[
         ("l_shoulder", [0.0, 0.0, -1.25]),
@@ -41,8 +40,28 @@ pub fn characters() -> Vec<Placed> {
         ("l_hip", [0.25, 0.0, 0.0]),
         ("head", [-0.1, -0.2, 0.0]),
     ]);
-    vec![
-        (puppet.clone(), Placement { translation: Vec3::new(-0.4, 0.0, 0.0), yaw: 0.9, scale: 1.0 }, waving),
-        (puppet, Placement { translation: Vec3::new(0.4, 0.0, 0.05), yaw: -0.9, scale: 1.0 }, reaching),
-    ]
+    // Behind: sits on the floor, hands on knees, in weight colours.
+    let sitting = pose(&[
+        ("pelvis", [0.0, 0.0, 0.0]),
+        ("l_hip", [-1.45, 0.0, -0.15]),
+        ("r_hip", [-1.45, 0.0, 0.15]),
+        ("l_knee", [1.5, 0.0, 0.0]),
+        ("r_knee", [1.5, 0.0, 0.0]),
+        ("l_shoulder", [-0.6, 0.0, -1.1]),
+        ("r_shoulder", [-0.6, 0.0, 1.1]),
+        ("l_elbow", [0.0, -0.8, 0.0]),
+        ("r_elbow", [0.0, 0.8, 0.0]),
+        ("spine", [-0.15, 0.0, 0.0]),
+    ]);
+    let weights = ViewDoc { weight_colors: true, display: DisplayDoc::Both, ..ViewDoc::default() };
+    let blue = ViewDoc { tint: [0.45, 0.6, 0.8], ..ViewDoc::default() };
+    SceneDoc {
+        characters: vec![
+            puppet("Ada", [-0.4, 0.0, 0.0], 0.9, waving, ViewDoc::default()),
+            puppet("Bo", [0.4, 0.0, 0.05], -0.9, reaching, blue),
+            puppet("Cy", [0.0, -0.29, -0.95], 0.0, sitting, weights),
+        ],
+        camera: Some(CameraDoc { focus: [0.0, 0.42, -0.3], yaw: 0.0, pitch: -0.32, distance: 2.9 }),
+        stage: StageDoc::default(),
+    }
 }

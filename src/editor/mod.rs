@@ -1,48 +1,90 @@
-//! The windowed app: stage, orbit camera, characters, skeleton overlay.
+//! The app around the ECS core: the stage, the scene document (load, save, undo), the
+//! orbit camera, skeleton drawing, picking, the egui inspector, screenshots, and the
+//! headless renderer.
+//!
+//! Plugins (one per capability): [`ViewPlugin`] (stage, document, drawing; also used
+//! headless), [`InteractionPlugin`] (camera input, picking, shortcuts),
+//! [`inspector::InspectorPlugin`], [`screenshot::ScreenshotPlugin`].
 
 pub mod camera;
 pub mod default_scene;
+pub mod document;
+pub mod draw;
+pub mod history;
+pub mod inspector;
+pub mod picking;
+pub mod render;
+pub mod screenshot;
 pub mod stage;
 
 use std::path::PathBuf;
-use std::sync::Arc;
 
 use bevy::prelude::*;
 use bevy::window::WindowResolution;
 
-use crate::formats::load_character;
-use crate::rig::CharacterAsset;
-use crate::rig::JointRotation;
-use crate::scene::{Character, CurrentJointToWorld, DisplayMode, Joint, MarionetteSystems, Placement, RigCorePlugin, SkinMesh, SkinningPlugin, spawn_character_posed};
+use crate::scene::{Character, DisplayMode, MarionetteSystems, RigCorePlugin, SkinMesh, SkinView, SkinningPlugin};
 use camera::{OrbitCamera, apply_orbit_camera, orbit_camera_input};
+use document::{AssetLibrary, NextCharacterId, PendingScene, SceneCharacter, spawn_from_doc, startup_doc};
 use stage::{StageSettings, apply_stage_settings, draw_grid_and_axes, spawn_stage};
 
-/// What the editor opens with: character files, or the default scene when empty.
+/// What the app opens with: a scene file, character files, or (empty) the default scene.
 #[derive(Resource, Clone, Debug, Default)]
 pub struct StartupPaths(pub Vec<PathBuf>);
 
-/// Messages for the user (load errors and warnings), newest last.
+/// Messages for the user (load errors, warnings, where files went), newest last.
 #[derive(Resource, Clone, Debug, Default)]
 pub struct Messages(pub Vec<String>);
+
+impl Messages {
+    pub fn push(&mut self, m: impl Into<String>) {
+        let m = m.into();
+        info!("{m}");
+        self.0.push(m);
+    }
+}
+
+/// The selected character (by scene id) and joints.
+#[derive(Resource, Clone, Debug, Default, PartialEq)]
+pub struct Selection {
+    pub character: Option<u64>,
+    pub joints: Vec<usize>,
+}
 
 /// One material for every skin: white, so vertex colours (tint or weights) show as they are.
 #[derive(Resource)]
 pub struct SkinMaterial(pub Handle<StandardMaterial>);
 
-/// Everything the windowed editor adds to the core plugins.
-pub struct EditorPlugin;
+/// Stage, scene document and drawing: everything both the window and the headless
+/// renderer need besides the core.
+pub struct ViewPlugin;
 
-impl Plugin for EditorPlugin {
+impl Plugin for ViewPlugin {
     fn build(&self, app: &mut App) {
         app.init_resource::<StageSettings>()
             .init_resource::<Messages>()
             .init_resource::<StartupPaths>()
-            .add_systems(Startup, (setup_skin_material, spawn_stage, spawn_camera, open_startup_paths).chain())
-            .add_systems(Update, (orbit_camera_input, apply_orbit_camera).chain())
+            .init_resource::<Selection>()
+            .init_resource::<AssetLibrary>()
+            .init_resource::<PendingScene>()
+            .init_resource::<NextCharacterId>()
+            .add_systems(Startup, (setup_skin_material, spawn_stage, queue_startup_scene).chain())
+            .add_systems(PostUpdate, (apply_pending_scene, sync_character_views).chain().in_set(MarionetteSystems::Animate))
             .add_systems(
                 PostUpdate,
-                (attach_skin_material, apply_display_mode, apply_stage_settings, draw_skeletons, draw_grid_and_axes).in_set(MarionetteSystems::Draw),
+                (attach_skin_material, apply_display_mode, apply_stage_settings, apply_orbit_camera, draw::draw_skeletons, draw_grid_and_axes)
+                    .in_set(MarionetteSystems::Draw),
             );
+    }
+}
+
+/// Mouse and keyboard in the viewport: orbit camera, picking, shortcuts.
+pub struct InteractionPlugin;
+
+impl Plugin for InteractionPlugin {
+    fn build(&self, app: &mut App) {
+        app.init_resource::<camera::ViewportHasPointer>()
+            .init_resource::<picking::PointerPress>()
+            .add_systems(Update, (camera::track_egui_pointer, orbit_camera_input, picking::pick_joint_on_click, inspector::shortcuts).chain());
     }
 }
 
@@ -53,10 +95,17 @@ pub fn run(paths: Vec<PathBuf>) {
             primary_window: Some(Window { title: "Marionette".into(), resolution: WindowResolution::new(1280, 800), ..default() }),
             ..default()
         }))
-        .insert_resource(ClearColor(Color::srgb(0.62, 0.7, 0.78)))
+        .add_plugins(bevy_egui::EguiPlugin::default())
+        .insert_resource(ClearColor(stage::SKY))
         .insert_resource(StartupPaths(paths))
-        .add_plugins((RigCorePlugin, SkinningPlugin, EditorPlugin))
+        .add_plugins((RigCorePlugin, SkinningPlugin, ViewPlugin, InteractionPlugin, inspector::InspectorPlugin, screenshot::ScreenshotPlugin, history::HistoryPlugin))
+        .add_systems(Startup, spawn_window_camera)
         .run();
+}
+
+fn spawn_window_camera(mut commands: Commands) {
+    let orbit = OrbitCamera::default();
+    commands.spawn((Camera3d::default(), orbit, orbit.transform()));
 }
 
 fn setup_skin_material(mut commands: Commands, mut materials: ResMut<Assets<StandardMaterial>>) {
@@ -64,74 +113,81 @@ fn setup_skin_material(mut commands: Commands, mut materials: ResMut<Assets<Stan
     commands.insert_resource(SkinMaterial(material));
 }
 
-fn spawn_camera(mut commands: Commands) {
-    let orbit = OrbitCamera::default();
-    commands.spawn((Camera3d::default(), orbit, orbit.transform()));
+/// Turns the startup paths into the first scene (writes `PendingScene`, `Messages`).
+fn queue_startup_scene(paths: Res<StartupPaths>, mut library: ResMut<AssetLibrary>, mut messages: ResMut<Messages>, mut pending: ResMut<PendingScene>) {
+    let mut notes = Vec::new();
+    let doc = startup_doc(&paths.0, &mut library, &mut notes);
+    notes.into_iter().for_each(|m| messages.push(m));
+    if let Some(doc) = doc {
+        pending.frame = doc.camera.is_none();
+        pending.with_camera = true;
+        pending.doc = Some(doc);
+    }
 }
 
-/// Loads the startup paths (or the default scene), spawns the characters side by side
-/// and frames them (writes entities, `Messages`, `OrbitCamera`).
-fn open_startup_paths(
+/// Replaces every character with those of the pending document; sets camera and stage
+/// when asked; frames the characters when the document has no camera (reads
+/// `PendingScene`; writes entities, `OrbitCamera`, `StageSettings`, `Messages`).
+#[allow(clippy::too_many_arguments)]
+pub fn apply_pending_scene(
     mut commands: Commands,
+    mut pending: ResMut<PendingScene>,
     mut meshes: ResMut<Assets<Mesh>>,
-    paths: Res<StartupPaths>,
+    mut library: ResMut<AssetLibrary>,
+    mut ids: ResMut<NextCharacterId>,
     mut messages: ResMut<Messages>,
+    mut stage: ResMut<StageSettings>,
+    existing: Query<Entity, With<SceneCharacter>>,
     mut cameras: Query<&mut OrbitCamera>,
 ) {
-    let placed: Vec<Placed> = if paths.0.is_empty() {
-        default_scene::characters()
-    } else {
-        let mut loaded = Vec::new();
-        for path in &paths.0 {
-            match load_character(path) {
-                Ok(asset) => {
-                    messages.0.extend(asset.warnings.iter().cloned());
-                    loaded.push(Arc::new(asset));
-                }
-                Err(e) => {
-                    error!("{e}");
-                    messages.0.push(e.to_string());
+    let Some(doc) = pending.doc.take() else { return };
+    for e in &existing {
+        commands.entity(e).despawn();
+    }
+    let (mut lo, mut hi) = (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY));
+    for (k, c) in doc.characters.iter().enumerate() {
+        // Ids follow document order so undo keeps selections.
+        let id = k as u64 + 1;
+        match spawn_from_doc(&mut commands, &mut meshes, &mut library, c, id) {
+            Ok((_, notes)) => {
+                notes.into_iter().for_each(|m| messages.push(m));
+                if let Ok(asset) = library.load(&c.source) {
+                    let (a, b) = asset.bounds();
+                    let m = Mat4::from_scale_rotation_translation(Vec3::splat(c.placement.scale), Quat::from_rotation_y(c.placement.yaw), Vec3::from(c.placement.translation));
+                    for corner in [a, b, Vec3::new(a.x, b.y, a.z), Vec3::new(b.x, a.y, b.z)] {
+                        lo = lo.min(m.transform_point3(corner));
+                        hi = hi.max(m.transform_point3(corner));
+                    }
                 }
             }
+            Err(e) => messages.push(e.to_string()),
         }
-        side_by_side(loaded)
-    };
-    let (mut lo, mut hi) = (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY));
-    for (asset, placement, pose) in placed {
-        let (a, b) = asset.bounds();
-        let m = placement.to_mat4();
-        lo = lo.min(m.transform_point3(a)).min(m.transform_point3(b));
-        hi = hi.max(m.transform_point3(a)).max(m.transform_point3(b));
-        spawn_character_posed(&mut commands, &mut meshes, asset, placement, &pose);
     }
-    if lo.x <= hi.x {
+    ids.0 = ids.0.max(doc.characters.len() as u64);
+    if pending.with_camera {
+        let s = doc.stage;
+        *stage = StageSettings { floor: s.floor, shadows: s.shadows, axes: s.axes, floor_height: s.floor_height };
         for mut orbit in &mut cameras {
-            *orbit = OrbitCamera::framing(lo, hi);
+            if let Some(c) = doc.camera {
+                *orbit = OrbitCamera { focus: Vec3::from(c.focus), yaw: c.yaw, pitch: c.pitch, distance: c.distance };
+            } else if pending.frame && lo.x <= hi.x {
+                *orbit = OrbitCamera::framing(lo, hi);
+            }
         }
     }
 }
 
-/// A character to spawn: its asset, where it stands, its pose.
-pub type Placed = (Arc<CharacterAsset>, Placement, Vec<JointRotation>);
-
-/// Places characters in a row along x, each standing on the floor (y = 0).
-pub fn side_by_side(assets: Vec<Arc<CharacterAsset>>) -> Vec<Placed> {
-    let gap = 0.15;
-    let widths: Vec<f32> = assets.iter().map(|a| { let (lo, hi) = a.bounds(); (hi.x - lo.x).max(0.1) }).collect();
-    let total: f32 = widths.iter().sum::<f32>() + gap * (assets.len().saturating_sub(1)) as f32;
-    let mut x = -total / 2.0;
-    assets
-        .into_iter()
-        .zip(widths)
-        .map(|(asset, w)| {
-            let (lo, hi) = asset.bounds();
-            let center = (lo + hi) / 2.0;
-            let placement = Placement::at(Vec3::new(x + w / 2.0 - center.x, -lo.y, -center.z));
-            x += w + gap;
-            let pose = asset.skeleton.initial_pose();
-            (asset, placement, pose)
-        })
-        .collect()
+/// Keeps each character's colouring in step with its options and the selection (reads
+/// `SceneCharacter`, `Selection`; writes `SkinView`, `Visibility`).
+fn sync_character_views(selection: Res<Selection>, mut characters: Query<(&SceneCharacter, &mut SkinView, &mut Visibility)>) {
+    for (sc, mut view, mut visibility) in &mut characters {
+        let heat = (sc.heat_of_selected && selection.character == Some(sc.id)).then(|| selection.joints.first().copied()).flatten();
+        if view.heat_joint != heat {
+            view.heat_joint = heat;
+        }
+        let wanted = if sc.visible { Visibility::Inherited } else { Visibility::Hidden };
+        visibility.set_if_neq(wanted);
+    }
 }
 
 /// Gives new skin meshes the shared material (writes `MeshMaterial3d`).
@@ -141,32 +197,11 @@ fn attach_skin_material(mut commands: Commands, material: Res<SkinMaterial>, new
     }
 }
 
-/// Shows or hides skins by display mode (reads `DisplayMode`; writes `Visibility`).
-fn apply_display_mode(characters: Query<(&Character, Option<&DisplayMode>), Changed<DisplayMode>>, mut visibility: Query<&mut Visibility, With<SkinMesh>>) {
+/// Shows or hides skins by display mode (reads `DisplayMode`; writes skin `Visibility`).
+fn apply_display_mode(characters: Query<(&Character, &DisplayMode), Changed<DisplayMode>>, mut visibility: Query<&mut Visibility, With<SkinMesh>>) {
     for (character, mode) in &characters {
         if let Ok(mut v) = visibility.get_mut(character.skin_entity) {
-            *v = if mode == Some(&DisplayMode::Skeleton) { Visibility::Hidden } else { Visibility::Inherited };
-        }
-    }
-}
-
-/// Draws joints and bones of characters in skeleton view (reads joint matrices; gizmos).
-fn draw_skeletons(characters: Query<(&Character, &DisplayMode)>, joints: Query<(&Joint, &CurrentJointToWorld)>, mut gizmos: Gizmos) {
-    for (character, mode) in &characters {
-        if *mode == DisplayMode::Mesh {
-            continue;
-        }
-        let (lo, hi) = character.asset.bounds();
-        let radius = ((hi - lo).length() * 0.008).max(0.004);
-        for (j, &entity) in character.joints.iter().enumerate() {
-            let Ok((_, current)) = joints.get(entity) else { continue };
-            let p = current.position();
-            gizmos.sphere(Isometry3d::from_translation(p), radius, Color::srgb(1.0, 0.85, 0.2));
-            if let Some(parent) = character.asset.skeleton.parent(j)
-                && let Ok((_, pc)) = joints.get(character.joints[parent])
-            {
-                gizmos.line(pc.position(), p, Color::srgb(0.95, 0.95, 1.0));
-            }
+            *v = if *mode == DisplayMode::Skeleton { Visibility::Hidden } else { Visibility::Inherited };
         }
     }
 }

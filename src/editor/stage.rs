@@ -19,6 +19,9 @@ impl Default for StageSettings {
     }
 }
 
+/// The sky (clear) colour.
+pub const SKY: Color = Color::srgb(0.62, 0.7, 0.78);
+
 #[derive(Component)]
 pub struct Floor;
 

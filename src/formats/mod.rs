@@ -8,6 +8,7 @@ pub mod error;
 pub mod mit6837;
 pub mod obj;
 pub mod off;
+pub mod scene;
 pub mod smpl;
 
 pub use character::{load_character, CharacterSource};

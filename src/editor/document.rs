@@ -1,0 +1,252 @@
+//! The scene as a document: capture the ECS state into a `SceneDoc`, and rebuild the ECS
+//! from one (used by scene files, undo/redo and the startup scene).
+
+use std::collections::HashMap;
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+
+use bevy::ecs::system::SystemParam;
+use bevy::prelude::*;
+
+use super::camera::OrbitCamera;
+use super::stage::StageSettings;
+use crate::formats::scene::{CameraDoc, CharacterDoc, DisplayDoc, PlacementDoc, SceneDoc, SourceDoc, ViewDoc, joint_of_pose_key, pose_key};
+use crate::formats::{FormatError, load_character};
+use crate::rig::{CharacterAsset, JointRotation};
+use crate::scene::{Character, DisplayMode, JointPose, Placement, SkinView, spawn_character_posed};
+
+/// A character as the editor knows it: a stable id (kept across undo), its source, name,
+/// visibility and whether the selected joint's weights are shown.
+#[derive(Component, Clone, Debug)]
+pub struct SceneCharacter {
+    pub id: u64,
+    pub source: SourceDoc,
+    pub name: String,
+    pub visible: bool,
+    pub heat_of_selected: bool,
+}
+
+/// Loaded characters by source, shared by every scene character made from them.
+#[derive(Resource, Default)]
+pub struct AssetLibrary {
+    cache: HashMap<SourceDoc, Arc<CharacterAsset>>,
+}
+
+impl AssetLibrary {
+    /// The character of `source`, loaded once.
+    pub fn load(&mut self, source: &SourceDoc) -> Result<Arc<CharacterAsset>, FormatError> {
+        if let Some(asset) = self.cache.get(source) {
+            return Ok(asset.clone());
+        }
+        let asset = Arc::new(match source {
+            SourceDoc::Embedded(name) if name == "puppet" => crate::puppet::embedded_puppet(),
+            SourceDoc::Embedded(name) => return Err(FormatError::other(Path::new(name), "expected a built-in character (`puppet`), found an unknown name")),
+            SourceDoc::File(path) => load_character(path)?,
+        });
+        self.cache.insert(source.clone(), asset.clone());
+        Ok(asset)
+    }
+}
+
+/// A scene to build in place of the current one (all characters are replaced).
+#[derive(Resource, Default)]
+pub struct PendingScene {
+    pub doc: Option<SceneDoc>,
+    /// Also set camera and stage from the document (not for undo).
+    pub with_camera: bool,
+    /// Frame all characters afterwards (when the document has no camera).
+    pub frame: bool,
+}
+
+/// Ids for new characters.
+#[derive(Resource, Default)]
+pub struct NextCharacterId(pub u64);
+
+impl NextCharacterId {
+    pub fn take(&mut self) -> u64 {
+        self.0 += 1;
+        self.0
+    }
+}
+
+/// Everything needed to capture the scene as a document.
+#[derive(SystemParam)]
+pub struct SceneReader<'w, 's> {
+    pub characters: Query<'w, 's, (Entity, &'static SceneCharacter, &'static Character, &'static Placement, &'static SkinView, &'static DisplayMode)>,
+    pub poses: Query<'w, 's, &'static JointPose>,
+    pub cameras: Query<'w, 's, &'static OrbitCamera>,
+    pub stage: Res<'w, StageSettings>,
+}
+
+impl SceneReader<'_, '_> {
+    /// The current scene, characters in id order.
+    pub fn capture(&self) -> SceneDoc {
+        let mut characters: Vec<(u64, CharacterDoc)> = self
+            .characters
+            .iter()
+            .map(|(_, sc, character, placement, view, display)| (sc.id, self.character_doc(sc, character, placement, view, display)))
+            .collect();
+        characters.sort_by_key(|(id, _)| *id);
+        SceneDoc {
+            characters: characters.into_iter().map(|(_, d)| d).collect(),
+            camera: self.cameras.iter().next().map(|o| CameraDoc { focus: o.focus.to_array(), yaw: o.yaw, pitch: o.pitch, distance: o.distance }),
+            stage: crate::formats::scene::StageDoc { floor: self.stage.floor, shadows: self.stage.shadows, axes: self.stage.axes, floor_height: self.stage.floor_height },
+        }
+    }
+
+    fn character_doc(&self, sc: &SceneCharacter, character: &Character, placement: &Placement, view: &SkinView, display: &DisplayMode) -> CharacterDoc {
+        let skeleton = &character.asset.skeleton;
+        let initial = skeleton.initial_pose();
+        let pose = character
+            .joints
+            .iter()
+            .enumerate()
+            .filter_map(|(j, &e)| {
+                let p = self.poses.get(e).ok()?.0;
+                (p != initial[j]).then(|| (pose_key(skeleton, j), p))
+            })
+            .collect();
+        CharacterDoc {
+            source: sc.source.clone(),
+            name: sc.name.clone(),
+            placement: PlacementDoc { translation: placement.translation.to_array(), yaw: placement.yaw, scale: placement.scale },
+            pose,
+            view: ViewDoc {
+                display: match display {
+                    DisplayMode::Mesh => DisplayDoc::Mesh,
+                    DisplayMode::Skeleton => DisplayDoc::Skeleton,
+                    DisplayMode::Both => DisplayDoc::Both,
+                },
+                visible: sc.visible,
+                weight_colors: view.weight_colors,
+                heat_of_selected: sc.heat_of_selected,
+                tint: view.tint,
+            },
+            smpl: None,
+        }
+    }
+
+    /// The entity of a character id.
+    pub fn entity_of(&self, id: u64) -> Option<Entity> {
+        self.characters.iter().find(|c| c.1.id == id).map(|c| c.0)
+    }
+}
+
+/// The pose a document gives a character: the source's pose with the listed joints
+/// replaced. Keys that name no joint are returned as messages.
+pub fn pose_from_doc(asset: &CharacterAsset, doc: &CharacterDoc) -> (Vec<JointRotation>, Vec<String>) {
+    let mut pose = asset.skeleton.initial_pose();
+    let mut unknown = Vec::new();
+    for (key, rotation) in &doc.pose {
+        match joint_of_pose_key(&asset.skeleton, key) {
+            Some(j) => pose[j] = rotation.clamped(&asset.skeleton.joint(j).limits),
+            None => unknown.push(format!("{}: no joint `{key}` in {}; its pose was skipped", doc.name, doc.source.label())),
+        }
+    }
+    (pose, unknown)
+}
+
+/// Spawns one character of a document with the given id.
+pub fn spawn_from_doc(commands: &mut Commands, meshes: &mut Assets<Mesh>, library: &mut AssetLibrary, doc: &CharacterDoc, id: u64) -> Result<(Entity, Vec<String>), FormatError> {
+    let asset = library.load(&doc.source)?;
+    let (pose, messages) = pose_from_doc(&asset, doc);
+    let p = doc.placement;
+    let placement = Placement { translation: Vec3::from(p.translation), yaw: p.yaw, scale: p.scale };
+    let entity = spawn_character_posed(commands, meshes, asset, placement, &pose);
+    let display = match doc.view.display {
+        DisplayDoc::Mesh => DisplayMode::Mesh,
+        DisplayDoc::Skeleton => DisplayMode::Skeleton,
+        DisplayDoc::Both => DisplayMode::Both,
+    };
+    commands.entity(entity).insert((
+        SceneCharacter { id, source: doc.source.clone(), name: doc.name.clone(), visible: doc.view.visible, heat_of_selected: doc.view.heat_of_selected },
+        SkinView { tint: doc.view.tint, weight_colors: doc.view.weight_colors, heat_joint: None },
+        display,
+        if doc.view.visible { Visibility::Inherited } else { Visibility::Hidden },
+    ));
+    Ok((entity, messages))
+}
+
+/// A document of characters placed side by side along x, each standing on y = 0.
+pub fn doc_side_by_side(library: &mut AssetLibrary, sources: Vec<SourceDoc>, messages: &mut Vec<String>) -> SceneDoc {
+    let gap = 0.15;
+    let loaded: Vec<(SourceDoc, Arc<CharacterAsset>)> = sources
+        .into_iter()
+        .filter_map(|s| match library.load(&s) {
+            Ok(a) => {
+                messages.extend(a.warnings.iter().cloned());
+                Some((s, a))
+            }
+            Err(e) => {
+                messages.push(e.to_string());
+                None
+            }
+        })
+        .collect();
+    let widths: Vec<f32> = loaded.iter().map(|(_, a)| { let (lo, hi) = a.bounds(); (hi.x - lo.x).max(0.1) }).collect();
+    let total: f32 = widths.iter().sum::<f32>() + gap * loaded.len().saturating_sub(1) as f32;
+    let mut x = -total / 2.0;
+    let characters = loaded
+        .into_iter()
+        .zip(widths)
+        .map(|((source, asset), w)| {
+            let (lo, hi) = asset.bounds();
+            let center = (lo + hi) / 2.0;
+            let doc = CharacterDoc {
+                name: asset.name.clone(),
+                source,
+                placement: PlacementDoc { translation: [x + w / 2.0 - center.x, -lo.y, -center.z], yaw: 0.0, scale: 1.0 },
+                pose: Default::default(),
+                view: ViewDoc::default(),
+                smpl: None,
+            };
+            x += w + gap;
+            doc
+        })
+        .collect();
+    SceneDoc { characters, camera: None, stage: Default::default() }
+}
+
+/// The embedded default scene (`assets/default_scene.ron`).
+pub fn default_scene_doc() -> SceneDoc {
+    crate::formats::scene::parse_scene(std::io::Cursor::new(include_str!("../../assets/default_scene.ron")), Path::new("assets/default_scene.ron"))
+        .expect("the embedded default scene parses (rebuild it with `marionette gen-assets assets`)")
+}
+
+/// What the command line asked to open, as a document: a `.ron` scene (sources relative
+/// to it), character paths side by side, or the default scene.
+pub fn startup_doc(paths: &[PathBuf], library: &mut AssetLibrary, messages: &mut Vec<String>) -> Option<SceneDoc> {
+    if paths.is_empty() {
+        return Some(default_scene_doc());
+    }
+    if paths.len() == 1 && paths[0].extension().is_some_and(|e| e == "ron") {
+        return match read_scene(&paths[0]) {
+            Ok(doc) => Some(doc),
+            Err(e) => {
+                messages.push(e.to_string());
+                None
+            }
+        };
+    }
+    Some(doc_side_by_side(library, paths.iter().map(|p| SourceDoc::File(p.clone())).collect(), messages))
+}
+
+/// Reads a scene file and resolves its sources against its folder.
+pub fn read_scene(path: &Path) -> Result<SceneDoc, FormatError> {
+    let mut doc = crate::formats::scene::parse_scene(crate::formats::error::open(path)?, path)?;
+    let dir = path.parent().unwrap_or(Path::new("."));
+    for c in &mut doc.characters {
+        c.source = c.source.resolved(dir);
+    }
+    Ok(doc)
+}
+
+/// Writes a scene file with sources relative to its folder.
+pub fn write_scene(path: &Path, doc: &SceneDoc) -> Result<(), FormatError> {
+    let mut doc = doc.clone();
+    let dir = path.parent().filter(|d| !d.as_os_str().is_empty()).unwrap_or(Path::new("."));
+    for c in &mut doc.characters {
+        c.source = c.source.relative_to(dir);
+    }
+    crate::formats::scene::save_scene(path, &doc)
+}

@@ -1,0 +1,78 @@
+//! Clicking a joint (or the mesh near it) in the viewport selects that joint.
+
+use bevy::prelude::*;
+use bevy::window::PrimaryWindow;
+
+use super::Selection;
+use super::camera::ViewportHasPointer;
+use super::document::SceneCharacter;
+use crate::scene::{Character, CurrentJointToWorld};
+
+/// Where the left button went down, to tell a click from a drag.
+#[derive(Resource, Default)]
+pub struct PointerPress(pub Option<Vec2>);
+
+/// Screen distance (pixels) within which a click picks a joint.
+pub const PICK_RADIUS_PX: f32 = 40.0;
+
+/// On a left click (press and release within a few pixels) in the viewport, selects the
+/// visible joint nearest to the cursor on screen; Shift or Ctrl adds to the selection
+/// (reads input, joint matrices; writes `Selection`).
+pub fn pick_joint_on_click(
+    buttons: Res<ButtonInput<MouseButton>>,
+    keys: Res<ButtonInput<KeyCode>>,
+    windows: Query<&Window, With<PrimaryWindow>>,
+    cameras: Query<(&Camera, &GlobalTransform)>,
+    characters: Query<(&SceneCharacter, &Character, &InheritedVisibility)>,
+    joints: Query<&CurrentJointToWorld>,
+    pointer: Res<ViewportHasPointer>,
+    mut press: ResMut<PointerPress>,
+    mut selection: ResMut<Selection>,
+) {
+    let Ok(window) = windows.single() else { return };
+    let cursor = window.cursor_position();
+    if buttons.just_pressed(MouseButton::Left) {
+        press.0 = cursor.filter(|_| pointer.0);
+    }
+    if !buttons.just_released(MouseButton::Left) {
+        return;
+    }
+    let (Some(start), Some(cursor)) = (press.0.take(), cursor) else { return };
+    if start.distance(cursor) > 4.0 {
+        return;
+    }
+    let Ok((camera, camera_transform)) = cameras.single() else { return };
+    let mut best: Option<(f32, u64, usize)> = None;
+    for (sc, character, visible) in &characters {
+        if !visible.get() {
+            continue;
+        }
+        for (j, &e) in character.joints.iter().enumerate() {
+            let Ok(m) = joints.get(e) else { continue };
+            let Ok(screen) = camera.world_to_viewport(camera_transform, m.position()) else { continue };
+            let d = screen.distance(cursor);
+            // Deeper joints win ties (zero-length bones stack joints on one point).
+            if d < PICK_RADIUS_PX && best.is_none_or(|b| d < b.0 - 0.5) {
+                best = Some((d, sc.id, j));
+            }
+        }
+    }
+    let additive = keys.any_pressed([KeyCode::ShiftLeft, KeyCode::ShiftRight, KeyCode::ControlLeft, KeyCode::ControlRight]);
+    match best {
+        Some((_, id, j)) => select_joint(&mut selection, id, j, additive),
+        None if !additive => selection.joints.clear(),
+        None => {}
+    }
+}
+
+/// Selects joint `j` of character `id`; `additive` toggles it within the selection.
+pub fn select_joint(selection: &mut Selection, id: u64, j: usize, additive: bool) {
+    if selection.character != Some(id) || !additive {
+        selection.character = Some(id);
+        selection.joints = vec![j];
+    } else if let Some(k) = selection.joints.iter().position(|&x| x == j) {
+        selection.joints.remove(k);
+    } else {
+        selection.joints.push(j);
+    }
+}

@@ -1,0 +1,94 @@
+//! Screenshots of the window (F12 or the panel's button): a PNG named by date and time in
+//! a chosen folder, without the panels unless asked; the messages say where it went.
+
+use std::path::{Path, PathBuf};
+
+use bevy::prelude::*;
+use bevy::render::view::screenshot::{Screenshot, ScreenshotCaptured};
+
+use super::Messages;
+
+/// A pending screenshot and the options of the next one.
+#[derive(Resource)]
+pub struct ScreenshotRequest {
+    /// The folder field of the panel.
+    pub dir_text: String,
+    pub with_panels: bool,
+    /// Frames left before the capture (the panels are hidden meanwhile).
+    countdown: Option<u8>,
+}
+
+impl Default for ScreenshotRequest {
+    fn default() -> Self {
+        let dir = std::env::current_dir().map(|d| d.join("screenshots")).unwrap_or_else(|_| PathBuf::from("screenshots"));
+        Self { dir_text: dir.display().to_string(), with_panels: false, countdown: None }
+    }
+}
+
+impl ScreenshotRequest {
+    pub fn request(&mut self) {
+        // Two frames without panels, so the captured frame has none.
+        self.countdown = Some(if self.with_panels { 0 } else { 2 });
+    }
+
+    /// Whether the panels are hidden this frame (for a screenshot without them).
+    pub fn hide_ui(&self) -> bool {
+        self.countdown.is_some() && !self.with_panels
+    }
+}
+
+pub struct ScreenshotPlugin;
+
+impl Plugin for ScreenshotPlugin {
+    fn build(&self, app: &mut App) {
+        app.init_resource::<ScreenshotRequest>().add_systems(Last, take_requested_screenshot);
+    }
+}
+
+/// `YYYY-MM-DD_HH-MM-SS` (UTC) of a Unix time.
+pub fn timestamp(unix_seconds: u64) -> String {
+    let days = (unix_seconds / 86_400) as i64;
+    let secs = unix_seconds % 86_400;
+    // Civil date from days since 1970-01-01 (Howard Hinnant's algorithm).
+    let z = days + 719_468;
+    let era = z.div_euclid(146_097);
+    let doe = z.rem_euclid(146_097);
+    let yoe = (doe - doe / 1460 + doe / 36_524 - doe / 146_096) / 365;
+    let doy = doe - (365 * yoe + yoe / 4 - yoe / 100);
+    let mp = (5 * doy + 2) / 153;
+    let day = doy - (153 * mp + 2) / 5 + 1;
+    let month = if mp < 10 { mp + 3 } else { mp - 9 };
+    let year = yoe + era * 400 + i64::from(month <= 2);
+    format!("{year:04}-{month:02}-{day:02}_{:02}-{:02}-{:02}", secs / 3600, secs / 60 % 60, secs % 60)
+}
+
+/// Counts down a request and captures the window (writes a `Screenshot` entity).
+fn take_requested_screenshot(mut commands: Commands, mut request: ResMut<ScreenshotRequest>, mut messages: ResMut<Messages>) {
+    let Some(n) = request.countdown else { return };
+    if n > 0 {
+        request.countdown = Some(n - 1);
+        return;
+    }
+    request.countdown = None;
+    let dir = PathBuf::from(request.dir_text.trim());
+    if let Err(e) = std::fs::create_dir_all(&dir) {
+        messages.push(format!("no screenshot: cannot create {}: {e}", dir.display()));
+        return;
+    }
+    let now = std::time::SystemTime::now().duration_since(std::time::UNIX_EPOCH).map_or(0, |d| d.as_secs());
+    let path = dir.join(format!("marionette_{}.png", timestamp(now)));
+    commands.spawn(Screenshot::primary_window()).observe(move |captured: On<ScreenshotCaptured>, mut messages: ResMut<Messages>| {
+        match save_png(&captured.image, &path) {
+            Ok(()) => messages.push(format!("saved screenshot {}", path.display())),
+            Err(e) => messages.push(format!("no screenshot: {e}")),
+        }
+    });
+}
+
+/// Writes a captured image as PNG (RGB), whole or not at all.
+pub fn save_png(image: &Image, path: &Path) -> Result<(), String> {
+    let rgb = image.clone().try_into_dynamic().map_err(|e| format!("unreadable capture: {e}"))?.to_rgb8();
+    let mut bytes = Vec::new();
+    rgb.write_to(&mut std::io::Cursor::new(&mut bytes), image::ImageFormat::Png).map_err(|e| e.to_string())?;
+    crate::formats::write_atomically(path, |w| std::io::Write::write_all(w, &bytes)).map_err(|e| format!("{}: {e}", path.display()))
+}

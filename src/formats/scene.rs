@@ -1,0 +1,220 @@
+//! Scene files (RON): every character's source, name, placement, pose by joint name and
+//! view options; the camera; the floor. Plain serde documents, no Bevy.
+
+use std::collections::BTreeMap;
+use std::io::BufRead;
+use std::path::{Path, PathBuf};
+
+use serde::{Deserialize, Serialize};
+
+use super::error::FormatError;
+use crate::rig::{JointRotation, Skeleton};
+
+/// Where a character comes from.
+#[derive(Debug, Clone, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize)]
+pub enum SourceDoc {
+    /// One of the project's own characters built into the binary (`"puppet"`).
+    Embedded(String),
+    /// A file or folder; relative to the scene file's folder when written in a scene.
+    File(PathBuf),
+}
+
+impl SourceDoc {
+    /// This source with a relative path resolved against `dir`.
+    pub fn resolved(&self, dir: &Path) -> Self {
+        match self {
+            SourceDoc::File(p) if p.is_relative() => SourceDoc::File(dir.join(p)),
+            other => other.clone(),
+        }
+    }
+
+    /// This source with its path made relative to `dir` where it lies below it, or
+    /// expressed with `..` steps when both are absolute.
+    pub fn relative_to(&self, dir: &Path) -> Self {
+        match self {
+            SourceDoc::File(p) => SourceDoc::File(relative_path(p, dir)),
+            other => other.clone(),
+        }
+    }
+
+    pub fn label(&self) -> String {
+        match self {
+            SourceDoc::Embedded(name) => format!("{name} (built in)"),
+            SourceDoc::File(p) => p.display().to_string(),
+        }
+    }
+}
+
+/// `path` relative to `dir` (both made absolute first); `path` itself when that fails.
+pub fn relative_path(path: &Path, dir: &Path) -> PathBuf {
+    let abs = |p: &Path| if p.is_absolute() { Some(p.to_path_buf()) } else { std::env::current_dir().ok().map(|c| c.join(p)) };
+    let (Some(path_abs), Some(dir_abs)) = (abs(path), abs(dir)) else { return path.to_path_buf() };
+    let clean = |p: PathBuf| -> Vec<std::ffi::OsString> {
+        let mut out: Vec<std::ffi::OsString> = Vec::new();
+        for c in p.components() {
+            match c {
+                std::path::Component::ParentDir => {
+                    out.pop();
+                }
+                std::path::Component::CurDir => {}
+                other => out.push(other.as_os_str().to_owned()),
+            }
+        }
+        out
+    };
+    let (p, d) = (clean(path_abs), clean(dir_abs));
+    let common = p.iter().zip(&d).take_while(|(a, b)| a == b).count();
+    if common == 0 {
+        return path.to_path_buf();
+    }
+    let mut out = PathBuf::new();
+    for _ in common..d.len() {
+        out.push("..");
+    }
+    for c in &p[common..] {
+        out.push(c);
+    }
+    out
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct PlacementDoc {
+    pub translation: [f32; 3],
+    /// Radians about the vertical axis.
+    pub yaw: f32,
+    pub scale: f32,
+}
+
+impl Default for PlacementDoc {
+    fn default() -> Self {
+        Self { translation: [0.0; 3], yaw: 0.0, scale: 1.0 }
+    }
+}
+
+/// Display of one character.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+pub enum DisplayDoc {
+    #[default]
+    Mesh,
+    Skeleton,
+    Both,
+}
+
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default)]
+pub struct ViewDoc {
+    pub display: DisplayDoc,
+    pub visible: bool,
+    pub weight_colors: bool,
+    /// Show the selected joint's weights as a heat map.
+    pub heat_of_selected: bool,
+    pub tint: [f32; 3],
+}
+
+impl Default for ViewDoc {
+    fn default() -> Self {
+        Self { display: DisplayDoc::Mesh, visible: true, weight_colors: false, heat_of_selected: false, tint: [0.8, 0.62, 0.45] }
+    }
+}
+
+/// SMPL state of a character made from the SMPL folder.
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+#[serde(default)]
+pub struct SmplDoc {
+    pub betas: Vec<f32>,
+    /// Clip file name in the SMPL folder, if one plays.
+    pub clip: Option<String>,
+    /// Playback time in frames.
+    pub time: f32,
+    pub playing: bool,
+    pub speed: f32,
+    pub looping: bool,
+    /// A second clip blended in with `blend` (0 = first clip only).
+    pub blend_clip: Option<String>,
+    pub blend: f32,
+}
+
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct CharacterDoc {
+    pub source: SourceDoc,
+    pub name: String,
+    #[serde(default)]
+    pub placement: PlacementDoc,
+    /// Rotations by joint name (`name#index` where a name is not unique); joints not
+    /// listed keep the source's pose.
+    #[serde(default)]
+    pub pose: BTreeMap<String, JointRotation>,
+    #[serde(default)]
+    pub view: ViewDoc,
+    #[serde(default)]
+    pub smpl: Option<SmplDoc>,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct CameraDoc {
+    pub focus: [f32; 3],
+    pub yaw: f32,
+    pub pitch: f32,
+    pub distance: f32,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(default)]
+pub struct StageDoc {
+    pub floor: bool,
+    pub shadows: bool,
+    pub axes: bool,
+    pub floor_height: f32,
+}
+
+impl Default for StageDoc {
+    fn default() -> Self {
+        Self { floor: true, shadows: true, axes: false, floor_height: 0.0 }
+    }
+}
+
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+pub struct SceneDoc {
+    pub characters: Vec<CharacterDoc>,
+    #[serde(default)]
+    pub camera: Option<CameraDoc>,
+    #[serde(default)]
+    pub stage: StageDoc,
+}
+
+/// The key a joint's pose is stored under: its name, or `name#index` when another joint
+/// has the same name (CSE169's dragon repeats names).
+pub fn pose_key(skeleton: &Skeleton, joint: usize) -> String {
+    let name = &skeleton.joint(joint).name;
+    if skeleton.joints().iter().filter(|j| &j.name == name).count() > 1 { format!("{name}#{joint}") } else { name.clone() }
+}
+
+/// Resolves a pose key back to a joint.
+pub fn joint_of_pose_key(skeleton: &Skeleton, key: &str) -> Option<usize> {
+    if let Some((name, index)) = key.rsplit_once('#')
+        && let Ok(i) = index.parse::<usize>()
+        && i < skeleton.len()
+        && skeleton.joint(i).name == name
+    {
+        return Some(i);
+    }
+    skeleton.find(key)
+}
+
+/// Reads a scene; errors carry the line.
+pub fn parse_scene(mut reader: impl BufRead, path: &Path) -> Result<SceneDoc, FormatError> {
+    let mut text = String::new();
+    reader.read_to_string(&mut text).map_err(|e| FormatError::io(path, e))?;
+    ron::from_str(&text).map_err(|e| FormatError::syntax(path, e.span.start.line, e.code.to_string()))
+}
+
+/// The scene as pretty RON text.
+pub fn scene_to_string(doc: &SceneDoc) -> String {
+    ron::ser::to_string_pretty(doc, ron::ser::PrettyConfig::default()).expect("scene documents serialise")
+}
+
+/// Writes a scene whole or not at all (temporary file, then rename).
+pub fn save_scene(path: &Path, doc: &SceneDoc) -> Result<(), FormatError> {
+    let text = scene_to_string(doc);
+    super::write_atomically(path, |w| std::io::Write::write_all(w, text.as_bytes())).map_err(|e| FormatError::io(path, e))
+}
