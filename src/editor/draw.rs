@@ -9,6 +9,19 @@ use super::document::SceneCharacter;
 use crate::rig::character::SkinKind;
 use crate::scene::{Character, CurrentJointToWorld, DisplayMode, Placement};
 
+/// Skeleton gizmos draw over the meshes (they would be hidden inside them).
+#[derive(Default, Reflect, GizmoConfigGroup)]
+pub struct SkeletonGizmos;
+
+/// Registers the skeleton gizmo group, drawn on top.
+pub fn setup_skeleton_gizmos(app: &mut App) {
+    app.init_gizmo_group::<SkeletonGizmos>();
+    let mut store = app.world_mut().resource_mut::<GizmoConfigStore>();
+    let (config, _) = store.config_mut::<SkeletonGizmos>();
+    config.depth_bias = -1.0;
+    config.line.width = 2.5;
+}
+
 const JOINT_COLOR: Color = Color::srgb(1.0, 0.85, 0.2);
 const BONE_COLOR: Color = Color::srgb(0.92, 0.94, 1.0);
 const SELECTED_COLOR: Color = Color::srgb(1.0, 0.15, 0.3);
@@ -19,7 +32,7 @@ pub fn draw_skeletons(
     characters: Query<(&Character, &DisplayMode, &Placement, Option<&SceneCharacter>, &InheritedVisibility)>,
     joints: Query<&CurrentJointToWorld>,
     selection: Res<Selection>,
-    mut gizmos: Gizmos,
+    mut gizmos: Gizmos<SkeletonGizmos>,
 ) {
     for (character, mode, placement, sc, visible) in &characters {
         if !visible.get() {

@@ -60,6 +60,7 @@ pub struct ViewPlugin;
 
 impl Plugin for ViewPlugin {
     fn build(&self, app: &mut App) {
+        draw::setup_skeleton_gizmos(app);
         app.init_resource::<StageSettings>()
             .init_resource::<Messages>()
             .init_resource::<StartupPaths>()
