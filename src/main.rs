@@ -11,7 +11,11 @@ use marionette::formats::{load_character, obj};
 use marionette::posing::{PoseSpec, apply_pose_specs, describe, posed_positions};
 
 #[derive(Parser)]
-#[command(name = "marionette", version, about = "Build scenes of skinned characters: load, pose, see and export them.")]
+#[command(
+    name = "marionette",
+    version,
+    about = "Build scenes of skinned characters: load, pose, see and export them."
+)]
 struct Cli {
     #[command(subcommand)]
     command: Option<Command>,
@@ -78,28 +82,57 @@ fn run(cli: Cli) -> Result<()> {
             let mut pose = asset.skeleton.initial_pose();
             apply_pose_specs(&asset.skeleton, &mut pose, &poses)?;
             let positions = posed_positions(&asset, &pose, Mat4::IDENTITY);
-            write_file(&out, |w| obj::write_obj(w, &positions, &asset.skin.triangles))?;
-            println!("wrote {} ({} vertices, {} triangles)", out.display(), positions.len(), asset.triangle_count());
+            write_file(&out, |w| {
+                obj::write_obj(w, &positions, &asset.skin.triangles)
+            })?;
+            println!(
+                "wrote {} ({} vertices, {} triangles)",
+                out.display(),
+                positions.len(),
+                asset.triangle_count()
+            );
         }
-        Some(Command::Render { paths, out, width, height }) => {
+        Some(Command::Render {
+            paths,
+            out,
+            width,
+            height,
+        }) => {
             let started = std::time::Instant::now();
-            let notes = marionette::editor::render::render(paths, out.clone(), width, height).map_err(anyhow::Error::msg)?;
+            let notes = marionette::editor::render::render(paths, out.clone(), width, height)
+                .map_err(anyhow::Error::msg)?;
             for n in notes {
                 eprintln!("note: {n}");
             }
-            println!("wrote {} ({width}x{height}) in {:.2} s", out.display(), started.elapsed().as_secs_f64());
+            println!(
+                "wrote {} ({width}x{height}) in {:.2} s",
+                out.display(),
+                started.elapsed().as_secs_f64()
+            );
         }
         Some(Command::GenAssets { dir }) => {
-            marionette::puppet::write_6837(&marionette::puppet::puppet(), &dir, "puppet").with_context(|| format!("writing {}", dir.display()))?;
+            marionette::puppet::write_6837(&marionette::puppet::puppet(), &dir, "puppet")
+                .with_context(|| format!("writing {}", dir.display()))?;
             let scene = dir.join("default_scene.ron");
-            marionette::formats::scene::save_scene(&scene, &marionette::editor::default_scene::generate())?;
-            println!("wrote {}/puppet.{{skel,obj,attach}} and {}", dir.display(), scene.display());
+            marionette::formats::scene::save_scene(
+                &scene,
+                &marionette::editor::default_scene::generate(),
+            )?;
+            println!(
+                "wrote {}/puppet.{{skel,obj,attach}} and {}",
+                dir.display(),
+                scene.display()
+            );
         }
     }
     Ok(())
 }
 
 /// Writes a whole file or nothing: into a temporary sibling, then renamed over `path`.
-fn write_file(path: &std::path::Path, write: impl FnOnce(&mut std::io::BufWriter<std::fs::File>) -> std::io::Result<()>) -> Result<()> {
-    marionette::formats::write_atomically(path, write).with_context(|| format!("writing {}", path.display()))
+fn write_file(
+    path: &std::path::Path,
+    write: impl FnOnce(&mut std::io::BufWriter<std::fs::File>) -> std::io::Result<()>,
+) -> Result<()> {
+    marionette::formats::write_atomically(path, write)
+        .with_context(|| format!("writing {}", path.display()))
 }

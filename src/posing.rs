@@ -13,7 +13,11 @@ pub enum PoseSpecError {
     #[error("`{spec}`: expected JOINT=rx,ry,rz (radians)")]
     Syntax { spec: String },
     #[error("`{spec}`: no joint named or numbered `{joint}` (joints: {known})")]
-    UnknownJoint { spec: String, joint: String, known: String },
+    UnknownJoint {
+        spec: String,
+        joint: String,
+        known: String,
+    },
 }
 
 /// A parsed `JOINT=rx,ry,rz` (angles in radians, x applied first).
@@ -27,24 +31,42 @@ impl std::str::FromStr for PoseSpec {
     type Err = PoseSpecError;
 
     fn from_str(spec: &str) -> Result<Self, Self::Err> {
-        let err = || PoseSpecError::Syntax { spec: spec.to_string() };
+        let err = || PoseSpecError::Syntax {
+            spec: spec.to_string(),
+        };
         let (joint, angles) = spec.split_once('=').ok_or_else(err)?;
-        let a: Vec<f32> = angles.split(',').map(|t| t.trim().parse::<f32>()).collect::<Result<_, _>>().map_err(|_| err())?;
+        let a: Vec<f32> = angles
+            .split(',')
+            .map(|t| t.trim().parse::<f32>())
+            .collect::<Result<_, _>>()
+            .map_err(|_| err())?;
         if joint.is_empty() || a.len() != 3 || a.iter().any(|v| !v.is_finite()) {
             return Err(err());
         }
-        Ok(Self { joint: joint.to_string(), angles: Vec3::new(a[0], a[1], a[2]) })
+        Ok(Self {
+            joint: joint.to_string(),
+            angles: Vec3::new(a[0], a[1], a[2]),
+        })
     }
 }
 
 /// Applies specs on top of `pose`, each clamped to its joint's limits.
-pub fn apply_pose_specs(skeleton: &Skeleton, pose: &mut [JointRotation], specs: &[PoseSpec]) -> Result<(), PoseSpecError> {
+pub fn apply_pose_specs(
+    skeleton: &Skeleton,
+    pose: &mut [JointRotation],
+    specs: &[PoseSpec],
+) -> Result<(), PoseSpecError> {
     for spec in specs {
-        let j = skeleton.resolve(&spec.joint).ok_or_else(|| PoseSpecError::UnknownJoint {
-            spec: format!("{}={},{},{}", spec.joint, spec.angles.x, spec.angles.y, spec.angles.z),
-            joint: spec.joint.clone(),
-            known: joint_list(skeleton),
-        })?;
+        let j = skeleton
+            .resolve(&spec.joint)
+            .ok_or_else(|| PoseSpecError::UnknownJoint {
+                spec: format!(
+                    "{}={},{},{}",
+                    spec.joint, spec.angles.x, spec.angles.y, spec.angles.z
+                ),
+                joint: spec.joint.clone(),
+                known: joint_list(skeleton),
+            })?;
         let order = match pose[j] {
             JointRotation::Euler(_, order) => order,
             JointRotation::Quat(_) => Default::default(),
@@ -56,18 +78,31 @@ pub fn apply_pose_specs(skeleton: &Skeleton, pose: &mut [JointRotation], specs: 
 
 fn joint_list(skeleton: &Skeleton) -> String {
     let names: Vec<&str> = skeleton.joints().iter().map(|j| j.name.as_str()).collect();
-    if names.len() > 12 { format!("{}, ... ({} in all)", names[..12].join(", "), names.len()) } else { names.join(", ") }
+    if names.len() > 12 {
+        format!("{}, ... ({} in all)", names[..12].join(", "), names.len())
+    } else {
+        names.join(", ")
+    }
 }
 
 /// The skin's vertices at `pose`, in source order, with the character placed by `placement`.
-pub fn posed_positions(asset: &CharacterAsset, pose: &[JointRotation], placement: Mat4) -> Vec<Vec3> {
+pub fn posed_positions(
+    asset: &CharacterAsset,
+    pose: &[JointRotation],
+    placement: Mat4,
+) -> Vec<Vec3> {
     let n = asset.skeleton.len();
     let mut current = vec![Mat4::IDENTITY; n];
     forward_kinematics(&asset.skeleton, pose, placement, &mut current);
     let mut palette = vec![Mat4::IDENTITY; n];
     skinning_palette(&current, &asset.bind_world_to_joint, &mut palette);
     let mut out = vec![Vec3::ZERO; asset.vertex_count()];
-    skin_positions(&asset.skin.bind_positions, &asset.skin.weights, &palette, &mut out);
+    skin_positions(
+        &asset.skin.bind_positions,
+        &asset.skin.weights,
+        &palette,
+        &mut out,
+    );
     out
 }
 
@@ -84,9 +119,20 @@ pub fn describe(asset: &CharacterAsset) -> String {
         let limits = if j.limits.is_unlimited() {
             String::new()
         } else {
-            format!("  limits x[{:.3},{:.3}] y[{:.3},{:.3}] z[{:.3},{:.3}]", j.limits.min.x, j.limits.max.x, j.limits.min.y, j.limits.max.y, j.limits.min.z, j.limits.max.z)
+            format!(
+                "  limits x[{:.3},{:.3}] y[{:.3},{:.3}] z[{:.3},{:.3}]",
+                j.limits.min.x,
+                j.limits.max.x,
+                j.limits.min.y,
+                j.limits.max.y,
+                j.limits.min.z,
+                j.limits.max.z
+            )
         };
-        out += &format!("  {i:3} {:<24} parent {parent:>3}  offset ({:.4}, {:.4}, {:.4}){limits}\n", j.name, j.rest_offset.x, j.rest_offset.y, j.rest_offset.z);
+        out += &format!(
+            "  {i:3} {:<24} parent {parent:>3}  offset ({:.4}, {:.4}, {:.4}){limits}\n",
+            j.name, j.rest_offset.x, j.rest_offset.y, j.rest_offset.z
+        );
     }
     let kind = match asset.skin_kind {
         crate::rig::character::SkinKind::Mesh => "mesh",
@@ -95,9 +141,19 @@ pub fn describe(asset: &CharacterAsset) -> String {
     out += &format!("skin: {kind}\n");
     out += &format!("vertices: {}\n", asset.vertex_count());
     out += &format!("triangles: {}\n", asset.triangle_count());
-    let avg = if w.vertex_count() > 0 { w.total_influences() as f32 / w.vertex_count() as f32 } else { 0.0 };
-    out += &format!("influences per vertex: max {}, mean {avg:.2}\n", w.max_influences());
-    out += &format!("bounds: ({:.3}, {:.3}, {:.3}) .. ({:.3}, {:.3}, {:.3})\n", lo.x, lo.y, lo.z, hi.x, hi.y, hi.z);
+    let avg = if w.vertex_count() > 0 {
+        w.total_influences() as f32 / w.vertex_count() as f32
+    } else {
+        0.0
+    };
+    out += &format!(
+        "influences per vertex: max {}, mean {avg:.2}\n",
+        w.max_influences()
+    );
+    out += &format!(
+        "bounds: ({:.3}, {:.3}, {:.3}) .. ({:.3}, {:.3}, {:.3})\n",
+        lo.x, lo.y, lo.z, hi.x, hi.y, hi.z
+    );
     if asset.warnings.is_empty() {
         out += "weight warnings: none\n";
     } else {

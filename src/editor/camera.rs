@@ -14,7 +14,12 @@ pub struct OrbitCamera {
 
 impl Default for OrbitCamera {
     fn default() -> Self {
-        Self { focus: Vec3::new(0.0, 0.5, 0.0), yaw: 0.0, pitch: -0.25, distance: 3.0 }
+        Self {
+            focus: Vec3::new(0.0, 0.5, 0.0),
+            yaw: 0.0,
+            pitch: -0.25,
+            distance: 3.0,
+        }
     }
 }
 
@@ -23,7 +28,12 @@ impl OrbitCamera {
     pub fn framing(lo: Vec3, hi: Vec3) -> Self {
         let center = (lo + hi) / 2.0;
         let radius = ((hi - lo).length() / 2.0).max(0.05);
-        Self { focus: center, yaw: 0.35, pitch: -0.25, distance: radius * 2.6 }
+        Self {
+            focus: center,
+            yaw: 0.35,
+            pitch: -0.25,
+            distance: radius * 2.6,
+        }
     }
 
     pub fn transform(&self) -> Transform {
@@ -79,7 +89,9 @@ pub fn orbit_camera_input(
 }
 
 /// Places cameras from their orbit (reads `OrbitCamera`; writes `Transform`).
-pub fn apply_orbit_camera(mut cameras: Query<(&OrbitCamera, &mut Transform), Changed<OrbitCamera>>) {
+pub fn apply_orbit_camera(
+    mut cameras: Query<(&OrbitCamera, &mut Transform), Changed<OrbitCamera>>,
+) {
     for (orbit, mut transform) in &mut cameras {
         *transform = orbit.transform();
     }
@@ -87,7 +99,11 @@ pub fn apply_orbit_camera(mut cameras: Query<(&OrbitCamera, &mut Transform), Cha
 
 /// Notes whether egui uses the pointer, so drags over panels do not orbit (reads
 /// `EguiWantsInput`; writes `ViewportHasPointer`).
-pub fn track_egui_pointer(wants: Option<Res<bevy_egui::input::EguiWantsInput>>, buttons: Res<ButtonInput<MouseButton>>, mut pointer: ResMut<ViewportHasPointer>) {
+pub fn track_egui_pointer(
+    wants: Option<Res<bevy_egui::input::EguiWantsInput>>,
+    buttons: Res<ButtonInput<MouseButton>>,
+    mut pointer: ResMut<ViewportHasPointer>,
+) {
     let egui_wants = wants.is_some_and(|w| w.wants_any_pointer_input());
     // Decide when a drag starts and keep it for the whole drag.
     if buttons.get_just_pressed().next().is_some() || !buttons.get_pressed().any(|_| true) {

@@ -10,7 +10,10 @@ use bevy::prelude::*;
 
 use super::camera::OrbitCamera;
 use super::stage::StageSettings;
-use crate::formats::scene::{CameraDoc, CharacterDoc, DisplayDoc, PlacementDoc, SceneDoc, SourceDoc, ViewDoc, joint_of_pose_key, pose_key};
+use crate::formats::scene::{
+    CameraDoc, CharacterDoc, DisplayDoc, PlacementDoc, SceneDoc, SourceDoc, ViewDoc,
+    joint_of_pose_key, pose_key,
+};
 use crate::formats::{FormatError, load_character};
 use crate::rig::{CharacterAsset, JointRotation};
 use crate::scene::{Character, DisplayMode, JointPose, Placement, SkinView, spawn_character_posed};
@@ -40,7 +43,12 @@ impl AssetLibrary {
         }
         let asset = Arc::new(match source {
             SourceDoc::Embedded(name) if name == "puppet" => crate::puppet::embedded_puppet(),
-            SourceDoc::Embedded(name) => return Err(FormatError::other(Path::new(name), "expected a built-in character (`puppet`), found an unknown name")),
+            SourceDoc::Embedded(name) => {
+                return Err(FormatError::other(
+                    Path::new(name),
+                    "expected a built-in character (`puppet`), found an unknown name",
+                ));
+            }
             SourceDoc::File(path) => load_character(path)?,
         });
         self.cache.insert(source.clone(), asset.clone());
@@ -72,7 +80,18 @@ impl NextCharacterId {
 /// Everything needed to capture the scene as a document.
 #[derive(SystemParam)]
 pub struct SceneReader<'w, 's> {
-    pub characters: Query<'w, 's, (Entity, &'static SceneCharacter, &'static Character, &'static Placement, &'static SkinView, &'static DisplayMode)>,
+    pub characters: Query<
+        'w,
+        's,
+        (
+            Entity,
+            &'static SceneCharacter,
+            &'static Character,
+            &'static Placement,
+            &'static SkinView,
+            &'static DisplayMode,
+        ),
+    >,
     pub poses: Query<'w, 's, &'static JointPose>,
     pub cameras: Query<'w, 's, &'static OrbitCamera>,
     pub stage: Res<'w, StageSettings>,
@@ -84,17 +103,39 @@ impl SceneReader<'_, '_> {
         let mut characters: Vec<(u64, CharacterDoc)> = self
             .characters
             .iter()
-            .map(|(_, sc, character, placement, view, display)| (sc.id, self.character_doc(sc, character, placement, view, display)))
+            .map(|(_, sc, character, placement, view, display)| {
+                (
+                    sc.id,
+                    self.character_doc(sc, character, placement, view, display),
+                )
+            })
             .collect();
         characters.sort_by_key(|(id, _)| *id);
         SceneDoc {
             characters: characters.into_iter().map(|(_, d)| d).collect(),
-            camera: self.cameras.iter().next().map(|o| CameraDoc { focus: o.focus.to_array(), yaw: o.yaw, pitch: o.pitch, distance: o.distance }),
-            stage: crate::formats::scene::StageDoc { floor: self.stage.floor, shadows: self.stage.shadows, axes: self.stage.axes, floor_height: self.stage.floor_height },
+            camera: self.cameras.iter().next().map(|o| CameraDoc {
+                focus: o.focus.to_array(),
+                yaw: o.yaw,
+                pitch: o.pitch,
+                distance: o.distance,
+            }),
+            stage: crate::formats::scene::StageDoc {
+                floor: self.stage.floor,
+                shadows: self.stage.shadows,
+                axes: self.stage.axes,
+                floor_height: self.stage.floor_height,
+            },
         }
     }
 
-    fn character_doc(&self, sc: &SceneCharacter, character: &Character, placement: &Placement, view: &SkinView, display: &DisplayMode) -> CharacterDoc {
+    fn character_doc(
+        &self,
+        sc: &SceneCharacter,
+        character: &Character,
+        placement: &Placement,
+        view: &SkinView,
+        display: &DisplayMode,
+    ) -> CharacterDoc {
         let skeleton = &character.asset.skeleton;
         let initial = skeleton.initial_pose();
         let pose = character
@@ -109,7 +150,11 @@ impl SceneReader<'_, '_> {
         CharacterDoc {
             source: sc.source.clone(),
             name: sc.name.clone(),
-            placement: PlacementDoc { translation: placement.translation.to_array(), yaw: placement.yaw, scale: placement.scale },
+            placement: PlacementDoc {
+                translation: placement.translation.to_array(),
+                yaw: placement.yaw,
+                scale: placement.scale,
+            },
             pose,
             view: ViewDoc {
                 display: match display {
@@ -134,24 +179,41 @@ impl SceneReader<'_, '_> {
 
 /// The pose a document gives a character: the source's pose with the listed joints
 /// replaced. Keys that name no joint are returned as messages.
-pub fn pose_from_doc(asset: &CharacterAsset, doc: &CharacterDoc) -> (Vec<JointRotation>, Vec<String>) {
+pub fn pose_from_doc(
+    asset: &CharacterAsset,
+    doc: &CharacterDoc,
+) -> (Vec<JointRotation>, Vec<String>) {
     let mut pose = asset.skeleton.initial_pose();
     let mut unknown = Vec::new();
     for (key, rotation) in &doc.pose {
         match joint_of_pose_key(&asset.skeleton, key) {
             Some(j) => pose[j] = rotation.clamped(&asset.skeleton.joint(j).limits),
-            None => unknown.push(format!("{}: no joint `{key}` in {}; its pose was skipped", doc.name, doc.source.label())),
+            None => unknown.push(format!(
+                "{}: no joint `{key}` in {}; its pose was skipped",
+                doc.name,
+                doc.source.label()
+            )),
         }
     }
     (pose, unknown)
 }
 
 /// Spawns one character of a document with the given id.
-pub fn spawn_from_doc(commands: &mut Commands, meshes: &mut Assets<Mesh>, library: &mut AssetLibrary, doc: &CharacterDoc, id: u64) -> Result<(Entity, Vec<String>), FormatError> {
+pub fn spawn_from_doc(
+    commands: &mut Commands,
+    meshes: &mut Assets<Mesh>,
+    library: &mut AssetLibrary,
+    doc: &CharacterDoc,
+    id: u64,
+) -> Result<(Entity, Vec<String>), FormatError> {
     let asset = library.load(&doc.source)?;
     let (pose, messages) = pose_from_doc(&asset, doc);
     let p = doc.placement;
-    let placement = Placement { translation: Vec3::from(p.translation), yaw: p.yaw, scale: p.scale };
+    let placement = Placement {
+        translation: Vec3::from(p.translation),
+        yaw: p.yaw,
+        scale: p.scale,
+    };
     let entity = spawn_character_posed(commands, meshes, asset, placement, &pose);
     let display = match doc.view.display {
         DisplayDoc::Mesh => DisplayMode::Mesh,
@@ -159,16 +221,34 @@ pub fn spawn_from_doc(commands: &mut Commands, meshes: &mut Assets<Mesh>, librar
         DisplayDoc::Both => DisplayMode::Both,
     };
     commands.entity(entity).insert((
-        SceneCharacter { id, source: doc.source.clone(), name: doc.name.clone(), visible: doc.view.visible, heat_of_selected: doc.view.heat_of_selected },
-        SkinView { tint: doc.view.tint, weight_colors: doc.view.weight_colors, heat_joint: None },
+        SceneCharacter {
+            id,
+            source: doc.source.clone(),
+            name: doc.name.clone(),
+            visible: doc.view.visible,
+            heat_of_selected: doc.view.heat_of_selected,
+        },
+        SkinView {
+            tint: doc.view.tint,
+            weight_colors: doc.view.weight_colors,
+            heat_joint: None,
+        },
         display,
-        if doc.view.visible { Visibility::Inherited } else { Visibility::Hidden },
+        if doc.view.visible {
+            Visibility::Inherited
+        } else {
+            Visibility::Hidden
+        },
     ));
     Ok((entity, messages))
 }
 
 /// A document of characters placed side by side along x, each standing on y = 0.
-pub fn doc_side_by_side(library: &mut AssetLibrary, sources: Vec<SourceDoc>, messages: &mut Vec<String>) -> SceneDoc {
+pub fn doc_side_by_side(
+    library: &mut AssetLibrary,
+    sources: Vec<SourceDoc>,
+    messages: &mut Vec<String>,
+) -> SceneDoc {
     let gap = 0.15;
     let loaded: Vec<(SourceDoc, Arc<CharacterAsset>)> = sources
         .into_iter()
@@ -183,7 +263,13 @@ pub fn doc_side_by_side(library: &mut AssetLibrary, sources: Vec<SourceDoc>, mes
             }
         })
         .collect();
-    let widths: Vec<f32> = loaded.iter().map(|(_, a)| { let (lo, hi) = a.bounds(); (hi.x - lo.x).max(0.1) }).collect();
+    let widths: Vec<f32> = loaded
+        .iter()
+        .map(|(_, a)| {
+            let (lo, hi) = a.bounds();
+            (hi.x - lo.x).max(0.1)
+        })
+        .collect();
     let total: f32 = widths.iter().sum::<f32>() + gap * loaded.len().saturating_sub(1) as f32;
     let mut x = -total / 2.0;
     let characters = loaded
@@ -195,7 +281,11 @@ pub fn doc_side_by_side(library: &mut AssetLibrary, sources: Vec<SourceDoc>, mes
             let doc = CharacterDoc {
                 name: asset.name.clone(),
                 source,
-                placement: PlacementDoc { translation: [x + w / 2.0 - center.x, -lo.y, -center.z], yaw: 0.0, scale: 1.0 },
+                placement: PlacementDoc {
+                    translation: [x + w / 2.0 - center.x, -lo.y, -center.z],
+                    yaw: 0.0,
+                    scale: 1.0,
+                },
                 pose: Default::default(),
                 view: ViewDoc::default(),
                 smpl: None,
@@ -204,18 +294,29 @@ pub fn doc_side_by_side(library: &mut AssetLibrary, sources: Vec<SourceDoc>, mes
             doc
         })
         .collect();
-    SceneDoc { characters, camera: None, stage: Default::default() }
+    SceneDoc {
+        characters,
+        camera: None,
+        stage: Default::default(),
+    }
 }
 
 /// The embedded default scene (`assets/default_scene.ron`).
 pub fn default_scene_doc() -> SceneDoc {
-    crate::formats::scene::parse_scene(std::io::Cursor::new(include_str!("../../assets/default_scene.ron")), Path::new("assets/default_scene.ron"))
-        .expect("the embedded default scene parses (rebuild it with `marionette gen-assets assets`)")
+    crate::formats::scene::parse_scene(
+        std::io::Cursor::new(include_str!("../../assets/default_scene.ron")),
+        Path::new("assets/default_scene.ron"),
+    )
+    .expect("the embedded default scene parses (rebuild it with `marionette gen-assets assets`)")
 }
 
 /// What the command line asked to open, as a document: a `.ron` scene (sources relative
 /// to it), character paths side by side, or the default scene.
-pub fn startup_doc(paths: &[PathBuf], library: &mut AssetLibrary, messages: &mut Vec<String>) -> Option<SceneDoc> {
+pub fn startup_doc(
+    paths: &[PathBuf],
+    library: &mut AssetLibrary,
+    messages: &mut Vec<String>,
+) -> Option<SceneDoc> {
     if paths.is_empty() {
         return Some(default_scene_doc());
     }
@@ -228,7 +329,11 @@ pub fn startup_doc(paths: &[PathBuf], library: &mut AssetLibrary, messages: &mut
             }
         };
     }
-    Some(doc_side_by_side(library, paths.iter().map(|p| SourceDoc::File(p.clone())).collect(), messages))
+    Some(doc_side_by_side(
+        library,
+        paths.iter().map(|p| SourceDoc::File(p.clone())).collect(),
+        messages,
+    ))
 }
 
 /// Reads a scene file and resolves its sources against its folder.
@@ -244,7 +349,10 @@ pub fn read_scene(path: &Path) -> Result<SceneDoc, FormatError> {
 /// Writes a scene file with sources relative to its folder.
 pub fn write_scene(path: &Path, doc: &SceneDoc) -> Result<(), FormatError> {
     let mut doc = doc.clone();
-    let dir = path.parent().filter(|d| !d.as_os_str().is_empty()).unwrap_or(Path::new("."));
+    let dir = path
+        .parent()
+        .filter(|d| !d.as_os_str().is_empty())
+        .unwrap_or(Path::new("."));
     for c in &mut doc.characters {
         c.source = c.source.relative_to(dir);
     }

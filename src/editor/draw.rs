@@ -29,7 +29,13 @@ const SELECTED_COLOR: Color = Color::srgb(1.0, 0.15, 0.3);
 /// Draws skeletons of characters in skeleton or both view, and the selected joints of
 /// any character (reads joint matrices, `Selection`; draws gizmos).
 pub fn draw_skeletons(
-    characters: Query<(&Character, &DisplayMode, &Placement, Option<&SceneCharacter>, &InheritedVisibility)>,
+    characters: Query<(
+        &Character,
+        &DisplayMode,
+        &Placement,
+        Option<&SceneCharacter>,
+        &InheritedVisibility,
+    )>,
     joints: Query<&CurrentJointToWorld>,
     selection: Res<Selection>,
     mut gizmos: Gizmos<SkeletonGizmos>,
@@ -38,12 +44,25 @@ pub fn draw_skeletons(
         if !visible.get() {
             continue;
         }
-        let selected: &[usize] = if sc.is_some_and(|s| Some(s.id) == selection.character) { &selection.joints } else { &[] };
+        let selected: &[usize] = if sc.is_some_and(|s| Some(s.id) == selection.character) {
+            &selection.joints
+        } else {
+            &[]
+        };
         let size = character_size(character) * placement.scale;
         let radius = (size * 0.012).max(0.003);
-        let world = |j: usize| joints.get(character.joints[j]).map(|c| c.0).unwrap_or(Mat4::IDENTITY);
+        let world = |j: usize| {
+            joints
+                .get(character.joints[j])
+                .map(|c| c.0)
+                .unwrap_or(Mat4::IDENTITY)
+        };
         for &j in selected {
-            gizmos.sphere(Isometry3d::from_translation(world(j).w_axis.truncate()), radius * 2.2, SELECTED_COLOR);
+            gizmos.sphere(
+                Isometry3d::from_translation(world(j).w_axis.truncate()),
+                radius * 2.2,
+                SELECTED_COLOR,
+            );
         }
         if *mode == DisplayMode::Mesh {
             continue;
@@ -56,7 +75,11 @@ pub fn draw_skeletons(
             if character.asset.skin_kind == SkinKind::BoneBoxes
                 && let Some(b) = skeleton.joint(j).bone_box
             {
-                let local = Mat4::from_scale_rotation_translation((b.max - b.min).max(Vec3::splat(1e-4)), Quat::IDENTITY, (b.min + b.max) / 2.0);
+                let local = Mat4::from_scale_rotation_translation(
+                    (b.max - b.min).max(Vec3::splat(1e-4)),
+                    Quat::IDENTITY,
+                    (b.min + b.max) / 2.0,
+                );
                 gizmos.cube(Transform::from_matrix(m * local), BONE_COLOR);
             } else if let Some(parent) = skeleton.parent(j) {
                 let from = world(parent).w_axis.truncate();
@@ -64,7 +87,14 @@ pub fn draw_skeletons(
                 if length > 1e-6 {
                     let thickness = (length * 0.12).min(radius * 1.5);
                     let rotation = Quat::from_rotation_arc(Vec3::Z, (p - from) / length);
-                    gizmos.cube(Transform { translation: (from + p) / 2.0, rotation, scale: Vec3::new(thickness, thickness, length) }, BONE_COLOR);
+                    gizmos.cube(
+                        Transform {
+                            translation: (from + p) / 2.0,
+                            rotation,
+                            scale: Vec3::new(thickness, thickness, length),
+                        },
+                        BONE_COLOR,
+                    );
                 }
             }
         }

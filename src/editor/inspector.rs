@@ -9,14 +9,19 @@ use bevy::prelude::*;
 use bevy_egui::{EguiContexts, EguiPrimaryContextPass, egui};
 
 use super::camera::OrbitCamera;
-use super::document::{AssetLibrary, NextCharacterId, PendingScene, SceneCharacter, SceneReader, read_scene, spawn_from_doc, write_scene};
+use super::document::{
+    AssetLibrary, NextCharacterId, PendingScene, SceneCharacter, SceneReader, read_scene,
+    spawn_from_doc, write_scene,
+};
 use super::history::{History, HistoryRequest};
 use super::screenshot::ScreenshotRequest;
 use super::stage::StageSettings;
 use super::{Messages, Selection};
 use crate::formats::scene::{CharacterDoc, PlacementDoc, SceneDoc, SourceDoc, ViewDoc};
 use crate::rig::{EulerOrder, JointRotation, Skeleton};
-use crate::scene::{Character, CurrentJointToWorld, DisplayMode, JointLimits, JointPose, Placement, SkinView};
+use crate::scene::{
+    Character, CurrentJointToWorld, DisplayMode, JointLimits, JointPose, Placement, SkinView,
+};
 
 /// Text fields and transient state of the inspector.
 #[derive(Resource)]
@@ -30,8 +35,15 @@ pub struct InspectorState {
 
 impl Default for InspectorState {
     fn default() -> Self {
-        let cwd = std::env::current_dir().map(|d| d.display().to_string()).unwrap_or_default();
-        Self { add_path: format!("{cwd}/"), recent: Vec::new(), scene_path: format!("{cwd}/scene.ron"), active_dof: None }
+        let cwd = std::env::current_dir()
+            .map(|d| d.display().to_string())
+            .unwrap_or_default();
+        Self {
+            add_path: format!("{cwd}/"),
+            recent: Vec::new(),
+            scene_path: format!("{cwd}/scene.ron"),
+            active_dof: None,
+        }
     }
 }
 
@@ -59,7 +71,18 @@ fn capture_snapshot(reader: SceneReader, mut snapshot: ResMut<SceneSnapshot>) {
 /// What the inspector edits.
 #[derive(SystemParam)]
 pub struct Editable<'w, 's> {
-    pub characters: Query<'w, 's, (Entity, &'static mut SceneCharacter, &'static Character, &'static mut Placement, &'static mut SkinView, &'static mut DisplayMode)>,
+    pub characters: Query<
+        'w,
+        's,
+        (
+            Entity,
+            &'static mut SceneCharacter,
+            &'static Character,
+            &'static mut Placement,
+            &'static mut SkinView,
+            &'static mut DisplayMode,
+        ),
+    >,
     pub poses: Query<'w, 's, (&'static mut JointPose, &'static JointLimits)>,
     pub stage: ResMut<'w, StageSettings>,
     pub selection: ResMut<'w, Selection>,
@@ -79,28 +102,50 @@ pub struct SceneOps<'w, 's> {
 }
 
 /// Draws the panels and applies their edits; one undo step per gesture.
-fn inspector_ui(mut contexts: EguiContexts, mut state: ResMut<InspectorState>, mut edit: Editable, mut ops: SceneOps, mut shot: ResMut<ScreenshotRequest>) -> Result {
+fn inspector_ui(
+    mut contexts: EguiContexts,
+    mut state: ResMut<InspectorState>,
+    mut edit: Editable,
+    mut ops: SceneOps,
+    mut shot: ResMut<ScreenshotRequest>,
+) -> Result {
     if shot.hide_ui() {
         return Ok(());
     }
     let ctx = contexts.ctx_mut()?.clone();
-    let mut ui = egui::Ui::new(ctx.clone(), "viewport".into(), egui::UiBuilder::new().layer_id(egui::LayerId::background()).max_rect(ctx.viewport_rect()));
+    let mut ui = egui::Ui::new(
+        ctx.clone(),
+        "viewport".into(),
+        egui::UiBuilder::new()
+            .layer_id(egui::LayerId::background())
+            .max_rect(ctx.viewport_rect()),
+    );
     let mut edited = false;
     state.active_dof = None;
-    egui::Panel::left("scene_panel").resizable(true).default_size(250.0).show(&mut ui, |ui| {
-        egui::ScrollArea::vertical().show(ui, |ui| {
-            edited |= scene_panel(ui, &mut state, &mut edit, &mut ops, &mut shot);
+    egui::Panel::left("scene_panel")
+        .resizable(true)
+        .default_size(250.0)
+        .show(&mut ui, |ui| {
+            egui::ScrollArea::vertical().show(ui, |ui| {
+                edited |= scene_panel(ui, &mut state, &mut edit, &mut ops, &mut shot);
+            });
         });
-    });
-    egui::Panel::right("joint_panel").resizable(true).default_size(250.0).show(&mut ui, |ui| {
-        egui::ScrollArea::vertical().show(ui, |ui| {
-            edited |= joint_panel(ui, &mut state, &mut edit);
+    egui::Panel::right("joint_panel")
+        .resizable(true)
+        .default_size(250.0)
+        .show(&mut ui, |ui| {
+            egui::ScrollArea::vertical().show(ui, |ui| {
+                edited |= joint_panel(ui, &mut state, &mut edit);
+            });
         });
-    });
     if let Some(text) = &state.active_dof {
-        egui::Area::new("active_dof".into()).anchor(egui::Align2::CENTER_TOP, [0.0, 12.0]).show(&ctx, |ui| {
-            egui::Frame::popup(ui.style()).show(ui, |ui| ui.label(egui::RichText::new(text).size(20.0).strong()));
-        });
+        egui::Area::new("active_dof".into())
+            .anchor(egui::Align2::CENTER_TOP, [0.0, 12.0])
+            .show(&ctx, |ui| {
+                egui::Frame::popup(ui.style()).show(ui, |ui| {
+                    ui.label(egui::RichText::new(text).size(20.0).strong())
+                });
+            });
     }
     if edited {
         let before = ops.snapshot.0.clone();
@@ -109,7 +154,13 @@ fn inspector_ui(mut contexts: EguiContexts, mut state: ResMut<InspectorState>, m
     Ok(())
 }
 
-fn scene_panel(ui: &mut egui::Ui, state: &mut InspectorState, edit: &mut Editable, ops: &mut SceneOps, shot: &mut ScreenshotRequest) -> bool {
+fn scene_panel(
+    ui: &mut egui::Ui,
+    state: &mut InspectorState,
+    edit: &mut Editable,
+    ops: &mut SceneOps,
+    shot: &mut ScreenshotRequest,
+) -> bool {
     let mut edited = false;
     ui.heading("Scene");
     ui.horizontal(|ui| {
@@ -122,10 +173,18 @@ fn scene_panel(ui: &mut egui::Ui, state: &mut InspectorState, edit: &mut Editabl
         }
     });
     ui.horizontal(|ui| {
-        if ui.add_enabled(!edit.history.undo.is_empty(), egui::Button::new("Undo")).on_hover_text("Ctrl+Z").clicked() {
+        if ui
+            .add_enabled(!edit.history.undo.is_empty(), egui::Button::new("Undo"))
+            .on_hover_text("Ctrl+Z")
+            .clicked()
+        {
             edit.history.request = Some(HistoryRequest::Undo);
         }
-        if ui.add_enabled(!edit.history.redo.is_empty(), egui::Button::new("Redo")).on_hover_text("Ctrl+Shift+Z").clicked() {
+        if ui
+            .add_enabled(!edit.history.redo.is_empty(), egui::Button::new("Redo"))
+            .on_hover_text("Ctrl+Shift+Z")
+            .clicked()
+        {
             edit.history.request = Some(HistoryRequest::Redo);
         }
     });
@@ -142,7 +201,9 @@ fn scene_panel(ui: &mut egui::Ui, state: &mut InspectorState, edit: &mut Editabl
         ui.horizontal_wrapped(|ui| {
             ui.label("Recent:");
             for r in state.recent.clone() {
-                let label = Path::new(&r).file_name().map_or(r.clone(), |n| n.to_string_lossy().into_owned());
+                let label = Path::new(&r)
+                    .file_name()
+                    .map_or(r.clone(), |n| n.to_string_lossy().into_owned());
                 if ui.small_button(label).on_hover_text(&r).clicked() {
                     edited |= add_character(&r, state, edit, ops);
                 }
@@ -152,17 +213,28 @@ fn scene_panel(ui: &mut egui::Ui, state: &mut InspectorState, edit: &mut Editabl
     ui.separator();
     let mut remove = None;
     let mut duplicate = None;
-    let mut list: Vec<(Entity, u64, String)> = edit.characters.iter().map(|c| (c.0, c.1.id, c.1.name.clone())).collect();
+    let mut list: Vec<(Entity, u64, String)> = edit
+        .characters
+        .iter()
+        .map(|c| (c.0, c.1.id, c.1.name.clone()))
+        .collect();
     list.sort_by_key(|c| c.1);
     for (entity, id, name) in list {
         let selected = edit.selection.character == Some(id);
         ui.horizontal(|ui| {
             if ui.selectable_label(selected, &name).clicked() && !selected {
-                *edit.selection = Selection { character: Some(id), joints: Vec::new() };
+                *edit.selection = Selection {
+                    character: Some(id),
+                    joints: Vec::new(),
+                };
             }
             if let Ok(mut c) = edit.characters.get_mut(entity) {
                 let mut visible = c.1.visible;
-                if ui.checkbox(&mut visible, "").on_hover_text("show").changed() {
+                if ui
+                    .checkbox(&mut visible, "")
+                    .on_hover_text("show")
+                    .changed()
+                {
                     c.1.visible = visible;
                     edited = true;
                 }
@@ -171,14 +243,22 @@ fn scene_panel(ui: &mut egui::Ui, state: &mut InspectorState, edit: &mut Editabl
         if !selected {
             continue;
         }
-        let Ok((_, mut sc, character, mut placement, mut view, mut display)) = edit.characters.get_mut(entity) else { continue };
+        let Ok((_, mut sc, character, mut placement, mut view, mut display)) =
+            edit.characters.get_mut(entity)
+        else {
+            continue;
+        };
         egui::Frame::group(ui.style()).show(ui, |ui| {
             ui.horizontal(|ui| {
                 ui.label("Name");
                 edited |= ui.text_edit_singleline(&mut sc.name).changed();
             });
             ui.label(egui::RichText::new(sc.source.label()).small());
-            ui.label(format!("{} joints, {} vertices", character.asset.skeleton.len(), character.asset.vertex_count()));
+            ui.label(format!(
+                "{} joints, {} vertices",
+                character.asset.skeleton.len(),
+                character.asset.vertex_count()
+            ));
             ui.horizontal(|ui| {
                 if ui.button("Duplicate").clicked() {
                     duplicate = Some(id);
@@ -191,7 +271,11 @@ fn scene_panel(ui: &mut egui::Ui, state: &mut InspectorState, edit: &mut Editabl
             ui.horizontal(|ui| {
                 ui.label("Position");
                 for k in 0..3 {
-                    ui.add(egui::DragValue::new(&mut p.translation[k]).speed(0.01).max_decimals(3));
+                    ui.add(
+                        egui::DragValue::new(&mut p.translation[k])
+                            .speed(0.01)
+                            .max_decimals(3),
+                    );
                 }
             });
             let mut yaw_deg = p.yaw.to_degrees();
@@ -199,7 +283,11 @@ fn scene_panel(ui: &mut egui::Ui, state: &mut InspectorState, edit: &mut Editabl
                 ui.label("Turn");
                 ui.add(egui::DragValue::new(&mut yaw_deg).speed(1.0).suffix("°"));
                 ui.label("Scale");
-                ui.add(egui::DragValue::new(&mut p.scale).speed(0.01).range(0.01..=100.0));
+                ui.add(
+                    egui::DragValue::new(&mut p.scale)
+                        .speed(0.01)
+                        .range(0.01..=100.0),
+                );
             });
             p.yaw = yaw_deg.to_radians();
             if p != *placement {
@@ -221,7 +309,9 @@ fn scene_panel(ui: &mut egui::Ui, state: &mut InspectorState, edit: &mut Editabl
                 view.weight_colors = colors;
                 edited = true;
             }
-            edited |= ui.checkbox(&mut sc.heat_of_selected, "weights of the selected joint").changed();
+            edited |= ui
+                .checkbox(&mut sc.heat_of_selected, "weights of the selected joint")
+                .changed();
         });
     }
     if let Some(entity) = remove {
@@ -249,7 +339,9 @@ fn scene_panel(ui: &mut egui::Ui, state: &mut InspectorState, edit: &mut Editabl
     if s != *edit.stage {
         *edit.stage = s;
     }
-    ui.label("S cycles mesh / skeleton / both; F frames the selection; click a joint to select it.");
+    ui.label(
+        "S cycles mesh / skeleton / both; F frames the selection; click a joint to select it.",
+    );
     ui.separator();
     ui.heading("Screenshot");
     ui.horizontal(|ui| {
@@ -263,7 +355,11 @@ fn scene_panel(ui: &mut egui::Ui, state: &mut InspectorState, edit: &mut Editabl
     ui.separator();
     ui.heading("Messages");
     for m in edit.messages.0.iter().rev().take(8) {
-        let color = if m.contains("saved") || m.contains("wrote") { egui::Color32::DARK_GREEN } else { egui::Color32::from_rgb(190, 40, 40) };
+        let color = if m.contains("saved") || m.contains("wrote") {
+            egui::Color32::DARK_GREEN
+        } else {
+            egui::Color32::from_rgb(190, 40, 40)
+        };
         ui.colored_label(color, m);
     }
     edited
@@ -278,7 +374,12 @@ fn character_doc(snapshot: &SceneDoc, edit: &Editable, id: u64) -> Option<Charac
 }
 
 /// Loads and adds a character beside the others; errors go to the messages.
-fn add_character(path: &str, state: &mut InspectorState, edit: &mut Editable, ops: &mut SceneOps) -> bool {
+fn add_character(
+    path: &str,
+    state: &mut InspectorState,
+    edit: &mut Editable,
+    ops: &mut SceneOps,
+) -> bool {
     if path.is_empty() {
         return false;
     }
@@ -291,14 +392,26 @@ fn add_character(path: &str, state: &mut InspectorState, edit: &mut Editable, op
         }
     };
     edit.messages.0.extend(asset.warnings.iter().cloned());
-    let right = edit.characters.iter().map(|c| c.3.translation.x).fold(f32::NEG_INFINITY, f32::max);
+    let right = edit
+        .characters
+        .iter()
+        .map(|c| c.3.translation.x)
+        .fold(f32::NEG_INFINITY, f32::max);
     let (lo, hi) = asset.bounds();
-    let x = if right.is_finite() { right + 0.3 + (hi.x - lo.x) } else { 0.0 };
+    let x = if right.is_finite() {
+        right + 0.3 + (hi.x - lo.x)
+    } else {
+        0.0
+    };
     let center = (lo + hi) / 2.0;
     let doc = CharacterDoc {
         source,
         name: asset.name.clone(),
-        placement: PlacementDoc { translation: [x - center.x, -lo.y, -center.z], yaw: 0.0, scale: 1.0 },
+        placement: PlacementDoc {
+            translation: [x - center.x, -lo.y, -center.z],
+            yaw: 0.0,
+            scale: 1.0,
+        },
         pose: Default::default(),
         view: ViewDoc::default(),
         smpl: None,
@@ -314,10 +427,19 @@ fn add_character(path: &str, state: &mut InspectorState, edit: &mut Editable, op
 
 fn spawn_doc(doc: &CharacterDoc, edit: &mut Editable, ops: &mut SceneOps) -> bool {
     let id = ops.ids.take();
-    match spawn_from_doc(&mut ops.commands, &mut ops.meshes, &mut ops.library, doc, id) {
+    match spawn_from_doc(
+        &mut ops.commands,
+        &mut ops.meshes,
+        &mut ops.library,
+        doc,
+        id,
+    ) {
         Ok((_, notes)) => {
             notes.into_iter().for_each(|m| edit.messages.push(m));
-            *edit.selection = Selection { character: Some(id), joints: Vec::new() };
+            *edit.selection = Selection {
+                character: Some(id),
+                joints: Vec::new(),
+            };
             true
         }
         Err(e) => {
@@ -336,7 +458,13 @@ fn save_scene(path: &str, doc: &SceneDoc, messages: &mut Messages) {
 
 fn open_scene(path: &str, pending: &mut PendingScene, messages: &mut Messages) {
     match read_scene(Path::new(path)) {
-        Ok(doc) => *pending = PendingScene { frame: doc.camera.is_none(), doc: Some(doc), with_camera: true },
+        Ok(doc) => {
+            *pending = PendingScene {
+                frame: doc.camera.is_none(),
+                doc: Some(doc),
+                with_camera: true,
+            }
+        }
         Err(e) => messages.push(e.to_string()),
     }
 }
@@ -350,7 +478,9 @@ fn joint_panel(ui: &mut egui::Ui, state: &mut InspectorState, edit: &mut Editabl
         ui.label("Select a character (left panel) or click a joint in the viewport.");
         return false;
     };
-    let Some((_, _, character, ..)) = edit.characters.iter().find(|c| c.1.id == id) else { return false };
+    let Some((_, _, character, ..)) = edit.characters.iter().find(|c| c.1.id == id) else {
+        return false;
+    };
     let character = character.clone();
     let skeleton = &character.asset.skeleton;
     if ui.button("Reset the whole pose").clicked() {
@@ -364,7 +494,9 @@ fn joint_panel(ui: &mut egui::Ui, state: &mut InspectorState, edit: &mut Editabl
     ui.separator();
     let selected = edit.selection.joints.clone();
     for &j in &selected {
-        let Ok((mut pose, limits)) = edit.poses.get_mut(character.joints[j]) else { continue };
+        let Ok((mut pose, limits)) = edit.poses.get_mut(character.joints[j]) else {
+            continue;
+        };
         let name = &skeleton.joint(j).name;
         ui.label(egui::RichText::new(name).strong());
         let (mut angles, order) = match pose.0 {
@@ -375,7 +507,9 @@ fn joint_panel(ui: &mut egui::Ui, state: &mut InspectorState, edit: &mut Editabl
         for axis in 0..3 {
             let (lo, hi) = limits.0.display_range(axis);
             let locked = limits.0.is_locked(axis);
-            let slider = egui::Slider::new(&mut angles[axis], lo..=hi.max(lo)).text(format!("{name} {}", AXES[axis])).max_decimals(3);
+            let slider = egui::Slider::new(&mut angles[axis], lo..=hi.max(lo))
+                .text(format!("{name} {}", AXES[axis]))
+                .max_decimals(3);
             let response = ui.add_enabled(!locked, slider);
             changed |= response.changed();
             if response.dragged() || response.has_focus() {
@@ -385,7 +519,9 @@ fn joint_panel(ui: &mut egui::Ui, state: &mut InspectorState, edit: &mut Editabl
         if changed {
             let rotation = match pose.0 {
                 JointRotation::Euler(..) => JointRotation::Euler(angles, order),
-                JointRotation::Quat(_) => JointRotation::Quat(JointRotation::Euler(angles, EulerOrder::Xyz).to_quat()),
+                JointRotation::Quat(_) => {
+                    JointRotation::Quat(JointRotation::Euler(angles, EulerOrder::Xyz).to_quat())
+                }
             };
             pose.0 = rotation.clamped(&limits.0);
             edited = true;
@@ -402,7 +538,14 @@ fn joint_panel(ui: &mut egui::Ui, state: &mut InspectorState, edit: &mut Editabl
 }
 
 /// The joint tree, collapsible by name; a click selects, Shift/Ctrl-click adds.
-fn joint_tree(ui: &mut egui::Ui, skeleton: &Skeleton, j: usize, id: u64, selection: &mut Selection, additive: bool) {
+fn joint_tree(
+    ui: &mut egui::Ui,
+    skeleton: &Skeleton,
+    j: usize,
+    id: u64,
+    selection: &mut Selection,
+    additive: bool,
+) {
     let is_selected = selection.character == Some(id) && selection.joints.contains(&j);
     let label = format!("{} ({j})", skeleton.joint(j).name);
     let children = skeleton.children(j);
@@ -412,7 +555,11 @@ fn joint_tree(ui: &mut egui::Ui, skeleton: &Skeleton, j: usize, id: u64, selecti
         }
         return;
     }
-    let state = egui::collapsing_header::CollapsingState::load_with_default_open(ui.ctx(), ui.make_persistent_id(("joint", id, j)), true);
+    let state = egui::collapsing_header::CollapsingState::load_with_default_open(
+        ui.ctx(),
+        ui.make_persistent_id(("joint", id, j)),
+        true,
+    );
     state
         .show_header(ui, |ui| {
             if ui.selectable_label(is_selected, label).clicked() {
@@ -447,14 +594,23 @@ pub fn shortcuts(
     if wants.is_some_and(|w| w.wants_any_keyboard_input()) {
         return;
     }
-    let ctrl = keys.any_pressed([KeyCode::ControlLeft, KeyCode::ControlRight, KeyCode::SuperLeft, KeyCode::SuperRight]);
+    let ctrl = keys.any_pressed([
+        KeyCode::ControlLeft,
+        KeyCode::ControlRight,
+        KeyCode::SuperLeft,
+        KeyCode::SuperRight,
+    ]);
     let shift = keys.any_pressed([KeyCode::ShiftLeft, KeyCode::ShiftRight]);
     if keys.just_pressed(KeyCode::F12) {
         shot.request();
     }
     if ctrl {
         if keys.just_pressed(KeyCode::KeyZ) {
-            history.request = Some(if shift { HistoryRequest::Redo } else { HistoryRequest::Undo });
+            history.request = Some(if shift {
+                HistoryRequest::Redo
+            } else {
+                HistoryRequest::Undo
+            });
         }
         if let (Some(state), Some(snapshot)) = (&state, &snapshot) {
             if keys.just_pressed(KeyCode::KeyS) {
@@ -469,7 +625,9 @@ pub fn shortcuts(
     if keys.just_pressed(KeyCode::KeyA) {
         stage.axes = !stage.axes;
     }
-    let selected = characters.iter_mut().find(|c| Some(c.0.id) == selection.character);
+    let selected = characters
+        .iter_mut()
+        .find(|c| Some(c.0.id) == selection.character);
     if keys.just_pressed(KeyCode::KeyS) {
         if let Some((.., mut display)) = selected {
             *display = display.next();
@@ -483,13 +641,25 @@ pub fn shortcuts(
             .iter()
             .filter(|c| selection.character.is_none() || Some(c.0.id) == selection.character)
             .flat_map(|(_, character, _)| {
-                let chosen: Vec<usize> = if selection.joints.is_empty() || selection.character.is_none() { (0..character.joints.len()).collect() } else { selection.joints.clone() };
-                chosen.into_iter().filter_map(|j| joints.get(character.joints[j]).ok().map(|m| m.position())).collect::<Vec<_>>()
+                let chosen: Vec<usize> =
+                    if selection.joints.is_empty() || selection.character.is_none() {
+                        (0..character.joints.len()).collect()
+                    } else {
+                        selection.joints.clone()
+                    };
+                chosen
+                    .into_iter()
+                    .filter_map(|j| joints.get(character.joints[j]).ok().map(|m| m.position()))
+                    .collect::<Vec<_>>()
             })
             .collect();
         if !points.is_empty() {
-            let lo = points.iter().fold(Vec3::splat(f32::INFINITY), |a, p| a.min(*p));
-            let hi = points.iter().fold(Vec3::splat(f32::NEG_INFINITY), |a, p| a.max(*p));
+            let lo = points
+                .iter()
+                .fold(Vec3::splat(f32::INFINITY), |a, p| a.min(*p));
+            let hi = points
+                .iter()
+                .fold(Vec3::splat(f32::NEG_INFINITY), |a, p| a.max(*p));
             for mut orbit in &mut cameras {
                 let framed = OrbitCamera::framing(lo, hi + Vec3::splat(0.15));
                 orbit.focus = (lo + hi) / 2.0;

@@ -22,9 +22,13 @@ use std::path::PathBuf;
 use bevy::prelude::*;
 use bevy::window::WindowResolution;
 
-use crate::scene::{Character, DisplayMode, MarionetteSystems, RigCorePlugin, SkinMesh, SkinView, SkinningPlugin};
+use crate::scene::{
+    Character, DisplayMode, MarionetteSystems, RigCorePlugin, SkinMesh, SkinView, SkinningPlugin,
+};
 use camera::{OrbitCamera, apply_orbit_camera, orbit_camera_input};
-use document::{AssetLibrary, NextCharacterId, PendingScene, SceneCharacter, spawn_from_doc, startup_doc};
+use document::{
+    AssetLibrary, NextCharacterId, PendingScene, SceneCharacter, spawn_from_doc, startup_doc,
+};
 use stage::{StageSettings, apply_stage_settings, draw_grid_and_axes, spawn_stage};
 
 /// What the app opens with: a scene file, character files, or (empty) the default scene.
@@ -68,11 +72,26 @@ impl Plugin for ViewPlugin {
             .init_resource::<AssetLibrary>()
             .init_resource::<PendingScene>()
             .init_resource::<NextCharacterId>()
-            .add_systems(Startup, (setup_skin_material, spawn_stage, queue_startup_scene).chain())
-            .add_systems(PostUpdate, (apply_pending_scene, sync_character_views).chain().in_set(MarionetteSystems::Animate))
+            .add_systems(
+                Startup,
+                (setup_skin_material, spawn_stage, queue_startup_scene).chain(),
+            )
             .add_systems(
                 PostUpdate,
-                (attach_skin_material, apply_display_mode, apply_stage_settings, apply_orbit_camera, draw::draw_skeletons, draw_grid_and_axes)
+                (apply_pending_scene, sync_character_views)
+                    .chain()
+                    .in_set(MarionetteSystems::Animate),
+            )
+            .add_systems(
+                PostUpdate,
+                (
+                    attach_skin_material,
+                    apply_display_mode,
+                    apply_stage_settings,
+                    apply_orbit_camera,
+                    draw::draw_skeletons,
+                    draw_grid_and_axes,
+                )
                     .in_set(MarionetteSystems::Draw),
             );
     }
@@ -85,7 +104,16 @@ impl Plugin for InteractionPlugin {
     fn build(&self, app: &mut App) {
         app.init_resource::<camera::ViewportHasPointer>()
             .init_resource::<picking::PointerPress>()
-            .add_systems(Update, (camera::track_egui_pointer, orbit_camera_input, picking::pick_joint_on_click, inspector::shortcuts).chain());
+            .add_systems(
+                Update,
+                (
+                    camera::track_egui_pointer,
+                    orbit_camera_input,
+                    picking::pick_joint_on_click,
+                    inspector::shortcuts,
+                )
+                    .chain(),
+            );
     }
 }
 
@@ -93,13 +121,25 @@ impl Plugin for InteractionPlugin {
 pub fn run(paths: Vec<PathBuf>) {
     App::new()
         .add_plugins(DefaultPlugins.set(WindowPlugin {
-            primary_window: Some(Window { title: "Marionette".into(), resolution: WindowResolution::new(1280, 800), ..default() }),
+            primary_window: Some(Window {
+                title: "Marionette".into(),
+                resolution: WindowResolution::new(1280, 800),
+                ..default()
+            }),
             ..default()
         }))
         .add_plugins(bevy_egui::EguiPlugin::default())
         .insert_resource(ClearColor(stage::SKY))
         .insert_resource(StartupPaths(paths))
-        .add_plugins((RigCorePlugin, SkinningPlugin, ViewPlugin, InteractionPlugin, inspector::InspectorPlugin, screenshot::ScreenshotPlugin, history::HistoryPlugin))
+        .add_plugins((
+            RigCorePlugin,
+            SkinningPlugin,
+            ViewPlugin,
+            InteractionPlugin,
+            inspector::InspectorPlugin,
+            screenshot::ScreenshotPlugin,
+            history::HistoryPlugin,
+        ))
         .add_systems(Startup, spawn_window_camera)
         .run();
 }
@@ -110,12 +150,21 @@ fn spawn_window_camera(mut commands: Commands) {
 }
 
 fn setup_skin_material(mut commands: Commands, mut materials: ResMut<Assets<StandardMaterial>>) {
-    let material = materials.add(StandardMaterial { base_color: Color::WHITE, perceptual_roughness: 0.75, ..default() });
+    let material = materials.add(StandardMaterial {
+        base_color: Color::WHITE,
+        perceptual_roughness: 0.75,
+        ..default()
+    });
     commands.insert_resource(SkinMaterial(material));
 }
 
 /// Turns the startup paths into the first scene (writes `PendingScene`, `Messages`).
-fn queue_startup_scene(paths: Res<StartupPaths>, mut library: ResMut<AssetLibrary>, mut messages: ResMut<Messages>, mut pending: ResMut<PendingScene>) {
+fn queue_startup_scene(
+    paths: Res<StartupPaths>,
+    mut library: ResMut<AssetLibrary>,
+    mut messages: ResMut<Messages>,
+    mut pending: ResMut<PendingScene>,
+) {
     let mut notes = Vec::new();
     let doc = startup_doc(&paths.0, &mut library, &mut notes);
     notes.into_iter().for_each(|m| messages.push(m));
@@ -141,7 +190,9 @@ pub fn apply_pending_scene(
     existing: Query<Entity, With<SceneCharacter>>,
     mut cameras: Query<&mut OrbitCamera>,
 ) {
-    let Some(doc) = pending.doc.take() else { return };
+    let Some(doc) = pending.doc.take() else {
+        return;
+    };
     for e in &existing {
         commands.entity(e).despawn();
     }
@@ -154,7 +205,11 @@ pub fn apply_pending_scene(
                 notes.into_iter().for_each(|m| messages.push(m));
                 if let Ok(asset) = library.load(&c.source) {
                     let (a, b) = asset.bounds();
-                    let m = Mat4::from_scale_rotation_translation(Vec3::splat(c.placement.scale), Quat::from_rotation_y(c.placement.yaw), Vec3::from(c.placement.translation));
+                    let m = Mat4::from_scale_rotation_translation(
+                        Vec3::splat(c.placement.scale),
+                        Quat::from_rotation_y(c.placement.yaw),
+                        Vec3::from(c.placement.translation),
+                    );
                     for corner in [a, b, Vec3::new(a.x, b.y, a.z), Vec3::new(b.x, a.y, b.z)] {
                         lo = lo.min(m.transform_point3(corner));
                         hi = hi.max(m.transform_point3(corner));
@@ -167,10 +222,20 @@ pub fn apply_pending_scene(
     ids.0 = ids.0.max(doc.characters.len() as u64);
     if pending.with_camera {
         let s = doc.stage;
-        *stage = StageSettings { floor: s.floor, shadows: s.shadows, axes: s.axes, floor_height: s.floor_height };
+        *stage = StageSettings {
+            floor: s.floor,
+            shadows: s.shadows,
+            axes: s.axes,
+            floor_height: s.floor_height,
+        };
         for mut orbit in &mut cameras {
             if let Some(c) = doc.camera {
-                *orbit = OrbitCamera { focus: Vec3::from(c.focus), yaw: c.yaw, pitch: c.pitch, distance: c.distance };
+                *orbit = OrbitCamera {
+                    focus: Vec3::from(c.focus),
+                    yaw: c.yaw,
+                    pitch: c.pitch,
+                    distance: c.distance,
+                };
             } else if pending.frame && lo.x <= hi.x {
                 *orbit = OrbitCamera::framing(lo, hi);
             }
@@ -180,29 +245,51 @@ pub fn apply_pending_scene(
 
 /// Keeps each character's colouring in step with its options and the selection (reads
 /// `SceneCharacter`, `Selection`; writes `SkinView`, `Visibility`).
-fn sync_character_views(selection: Res<Selection>, mut characters: Query<(&SceneCharacter, &mut SkinView, &mut Visibility)>) {
+fn sync_character_views(
+    selection: Res<Selection>,
+    mut characters: Query<(&SceneCharacter, &mut SkinView, &mut Visibility)>,
+) {
     for (sc, mut view, mut visibility) in &mut characters {
-        let heat = (sc.heat_of_selected && selection.character == Some(sc.id)).then(|| selection.joints.first().copied()).flatten();
+        let heat = (sc.heat_of_selected && selection.character == Some(sc.id))
+            .then(|| selection.joints.first().copied())
+            .flatten();
         if view.heat_joint != heat {
             view.heat_joint = heat;
         }
-        let wanted = if sc.visible { Visibility::Inherited } else { Visibility::Hidden };
+        let wanted = if sc.visible {
+            Visibility::Inherited
+        } else {
+            Visibility::Hidden
+        };
         visibility.set_if_neq(wanted);
     }
 }
 
 /// Gives new skin meshes the shared material (writes `MeshMaterial3d`).
-fn attach_skin_material(mut commands: Commands, material: Res<SkinMaterial>, new_skins: Query<Entity, Added<SkinMesh>>) {
+fn attach_skin_material(
+    mut commands: Commands,
+    material: Res<SkinMaterial>,
+    new_skins: Query<Entity, Added<SkinMesh>>,
+) {
     for entity in &new_skins {
-        commands.entity(entity).insert(MeshMaterial3d(material.0.clone()));
+        commands
+            .entity(entity)
+            .insert(MeshMaterial3d(material.0.clone()));
     }
 }
 
 /// Shows or hides skins by display mode (reads `DisplayMode`; writes skin `Visibility`).
-fn apply_display_mode(characters: Query<(&Character, &DisplayMode), Changed<DisplayMode>>, mut visibility: Query<&mut Visibility, With<SkinMesh>>) {
+fn apply_display_mode(
+    characters: Query<(&Character, &DisplayMode), Changed<DisplayMode>>,
+    mut visibility: Query<&mut Visibility, With<SkinMesh>>,
+) {
     for (character, mode) in &characters {
         if let Ok(mut v) = visibility.get_mut(character.skin_entity) {
-            *v = if *mode == DisplayMode::Skeleton { Visibility::Hidden } else { Visibility::Inherited };
+            *v = if *mode == DisplayMode::Skeleton {
+                Visibility::Hidden
+            } else {
+                Visibility::Inherited
+            };
         }
     }
 }

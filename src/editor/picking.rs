@@ -37,11 +37,15 @@ pub fn pick_joint_on_click(
     if !buttons.just_released(MouseButton::Left) {
         return;
     }
-    let (Some(start), Some(cursor)) = (press.0.take(), cursor) else { return };
+    let (Some(start), Some(cursor)) = (press.0.take(), cursor) else {
+        return;
+    };
     if start.distance(cursor) > 4.0 {
         return;
     }
-    let Ok((camera, camera_transform)) = cameras.single() else { return };
+    let Ok((camera, camera_transform)) = cameras.single() else {
+        return;
+    };
     let mut best: Option<(f32, u64, usize)> = None;
     for (sc, character, visible) in &characters {
         if !visible.get() {
@@ -49,7 +53,9 @@ pub fn pick_joint_on_click(
         }
         for (j, &e) in character.joints.iter().enumerate() {
             let Ok(m) = joints.get(e) else { continue };
-            let Ok(screen) = camera.world_to_viewport(camera_transform, m.position()) else { continue };
+            let Ok(screen) = camera.world_to_viewport(camera_transform, m.position()) else {
+                continue;
+            };
             let d = screen.distance(cursor);
             // Deeper joints win ties (zero-length bones stack joints on one point).
             if d < PICK_RADIUS_PX && best.is_none_or(|b| d < b.0 - 0.5) {
@@ -57,7 +63,12 @@ pub fn pick_joint_on_click(
             }
         }
     }
-    let additive = keys.any_pressed([KeyCode::ShiftLeft, KeyCode::ShiftRight, KeyCode::ControlLeft, KeyCode::ControlRight]);
+    let additive = keys.any_pressed([
+        KeyCode::ShiftLeft,
+        KeyCode::ShiftRight,
+        KeyCode::ControlLeft,
+        KeyCode::ControlRight,
+    ]);
     match best {
         Some((_, id, j)) => select_joint(&mut selection, id, j, additive),
         None if !additive => selection.joints.clear(),

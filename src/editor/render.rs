@@ -42,11 +42,21 @@ struct RenderJob {
 
 /// Renders `paths` (a scene `.ron`, character files, or the default scene when empty) at
 /// `width`×`height` into `out`. Returns what went wrong, if anything.
-pub fn render(paths: Vec<PathBuf>, out: PathBuf, width: u32, height: u32) -> Result<Vec<String>, String> {
+pub fn render(
+    paths: Vec<PathBuf>,
+    out: PathBuf,
+    width: u32,
+    height: u32,
+) -> Result<Vec<String>, String> {
     let mut app = App::new();
     app.add_plugins(
         DefaultPlugins
-            .set(WindowPlugin { primary_window: None, exit_condition: ExitCondition::DontExit, close_when_requested: false, ..default() })
+            .set(WindowPlugin {
+                primary_window: None,
+                exit_condition: ExitCondition::DontExit,
+                close_when_requested: false,
+                ..default()
+            })
             .disable::<WinitPlugin>(),
     )
     .add_plugins(ScheduleRunnerPlugin::run_loop(Duration::from_millis(2)))
@@ -55,15 +65,30 @@ pub fn render(paths: Vec<PathBuf>, out: PathBuf, width: u32, height: u32) -> Res
     .add_plugins((RigCorePlugin, SkinningPlugin, ViewPlugin));
     let target = {
         let mut images = app.world_mut().resource_mut::<Assets<Image>>();
-        let mut image = Image::new_target_texture(width, height, TextureFormat::Rgba8UnormSrgb, None);
+        let mut image =
+            Image::new_target_texture(width, height, TextureFormat::Rgba8UnormSrgb, None);
         image.texture_descriptor.usage |= TextureUsages::COPY_SRC;
         images.add(image)
     };
     let outcome = Arc::new(Mutex::new((None, Vec::new())));
-    app.insert_resource(RenderJob { out, target: target.clone(), frames: 0, started: std::time::Instant::now(), waiting: false, previous: None, done: None, outcome: outcome.clone() });
+    app.insert_resource(RenderJob {
+        out,
+        target: target.clone(),
+        frames: 0,
+        started: std::time::Instant::now(),
+        waiting: false,
+        previous: None,
+        done: None,
+        outcome: outcome.clone(),
+    });
     app.add_systems(Startup, move |mut commands: Commands| {
         let orbit = OrbitCamera::default();
-        commands.spawn((Camera3d::default(), RenderTarget::Image(target.clone().into()), orbit, orbit.transform()));
+        commands.spawn((
+            Camera3d::default(),
+            RenderTarget::Image(target.clone().into()),
+            orbit,
+            orbit.transform(),
+        ));
     });
     app.add_systems(Last, capture_when_ready);
     let exit = app.run();
@@ -73,13 +98,20 @@ pub fn render(paths: Vec<PathBuf>, out: PathBuf, width: u32, height: u32) -> Res
     match (exit, done) {
         (AppExit::Success, Some(Ok(()))) => Ok(messages),
         (_, Some(Err(e))) => Err(e),
-        _ => Err(format!("the render did not settle within {GIVE_UP_SECONDS} s")),
+        _ => Err(format!(
+            "the render did not settle within {GIVE_UP_SECONDS} s"
+        )),
     }
 }
 
 /// After the warm-up, captures the target until two captures agree, saves that one and
 /// exits (or gives up after a while).
-fn capture_when_ready(mut commands: Commands, mut job: ResMut<RenderJob>, messages: Res<Messages>, mut exit: MessageWriter<AppExit>) {
+fn capture_when_ready(
+    mut commands: Commands,
+    mut job: ResMut<RenderJob>,
+    messages: Res<Messages>,
+    mut exit: MessageWriter<AppExit>,
+) {
     job.frames += 1;
     if job.done.is_some() {
         if let Ok(mut o) = job.outcome.lock() {
@@ -97,13 +129,17 @@ fn capture_when_ready(mut commands: Commands, mut job: ResMut<RenderJob>, messag
     }
     job.waiting = true;
     let out = job.out.clone();
-    commands.spawn(Screenshot::image(job.target.clone())).observe(move |captured: On<ScreenshotCaptured>, mut job: ResMut<RenderJob>| {
-        job.waiting = false;
-        let data = captured.image.data.clone().unwrap_or_default();
-        if job.previous.as_ref() == Some(&data) {
-            job.done = Some(super::screenshot::save_png(&captured.image, &out));
-        } else {
-            job.previous = Some(data);
-        }
-    });
+    commands
+        .spawn(Screenshot::image(job.target.clone()))
+        .observe(
+            move |captured: On<ScreenshotCaptured>, mut job: ResMut<RenderJob>| {
+                job.waiting = false;
+                let data = captured.image.data.clone().unwrap_or_default();
+                if job.previous.as_ref() == Some(&data) {
+                    job.done = Some(super::screenshot::save_png(&captured.image, &out));
+                } else {
+                    job.previous = Some(data);
+                }
+            },
+        );
 }

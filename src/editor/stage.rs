@@ -15,7 +15,12 @@ pub struct StageSettings {
 
 impl Default for StageSettings {
     fn default() -> Self {
-        Self { floor: true, shadows: true, axes: false, floor_height: 0.0 }
+        Self {
+            floor: true,
+            shadows: true,
+            axes: false,
+            floor_height: 0.0,
+        }
     }
 }
 
@@ -29,29 +34,54 @@ pub struct Floor;
 pub struct Sun;
 
 /// Spawns floor and lights (writes entities).
-pub fn spawn_stage(mut commands: Commands, mut meshes: ResMut<Assets<Mesh>>, mut materials: ResMut<Assets<StandardMaterial>>, settings: Res<StageSettings>) {
+pub fn spawn_stage(
+    mut commands: Commands,
+    mut meshes: ResMut<Assets<Mesh>>,
+    mut materials: ResMut<Assets<StandardMaterial>>,
+    settings: Res<StageSettings>,
+) {
     commands.insert_resource(DirectionalLightShadowMap { size: 2048 });
-    commands.insert_resource(GlobalAmbientLight { color: Color::WHITE, brightness: 350.0, ..default() });
+    commands.insert_resource(GlobalAmbientLight {
+        color: Color::WHITE,
+        brightness: 350.0,
+        ..default()
+    });
     commands.spawn((
         Floor,
         Mesh3d(meshes.add(Plane3d::default().mesh().size(40.0, 40.0))),
-        MeshMaterial3d(materials.add(StandardMaterial { base_color: Color::srgb(0.55, 0.57, 0.6), perceptual_roughness: 0.95, ..default() })),
+        MeshMaterial3d(materials.add(StandardMaterial {
+            base_color: Color::srgb(0.55, 0.57, 0.6),
+            perceptual_roughness: 0.95,
+            ..default()
+        })),
         Transform::from_xyz(0.0, settings.floor_height, 0.0),
     ));
     commands.spawn((
         Sun,
-        DirectionalLight { illuminance: light_consts::lux::OVERCAST_DAY * 4.0, shadow_maps_enabled: settings.shadows, ..default() },
+        DirectionalLight {
+            illuminance: light_consts::lux::OVERCAST_DAY * 4.0,
+            shadow_maps_enabled: settings.shadows,
+            ..default()
+        },
         Transform::from_xyz(2.0, 4.0, 3.0).looking_at(Vec3::ZERO, Vec3::Y),
     ));
 }
 
 /// Applies floor/shadow switches (reads `StageSettings`; writes floor visibility, sun).
-pub fn apply_stage_settings(settings: Res<StageSettings>, mut floors: Query<(&mut Visibility, &mut Transform), With<Floor>>, mut suns: Query<&mut DirectionalLight, With<Sun>>) {
+pub fn apply_stage_settings(
+    settings: Res<StageSettings>,
+    mut floors: Query<(&mut Visibility, &mut Transform), With<Floor>>,
+    mut suns: Query<&mut DirectionalLight, With<Sun>>,
+) {
     if !settings.is_changed() {
         return;
     }
     for (mut visibility, mut transform) in &mut floors {
-        *visibility = if settings.floor { Visibility::Inherited } else { Visibility::Hidden };
+        *visibility = if settings.floor {
+            Visibility::Inherited
+        } else {
+            Visibility::Hidden
+        };
         transform.translation.y = settings.floor_height;
     }
     for mut sun in &mut suns {
@@ -71,6 +101,9 @@ pub fn draw_grid_and_axes(settings: Res<StageSettings>, mut gizmos: Gizmos) {
         }
     }
     if settings.axes {
-        gizmos.axes(Transform::from_xyz(0.0, settings.floor_height + 0.002, 0.0), 0.5);
+        gizmos.axes(
+            Transform::from_xyz(0.0, settings.floor_height + 0.002, 0.0),
+            0.5,
+        );
     }
 }

@@ -20,7 +20,9 @@ pub struct Token {
 /// CR all end a line; `{` and `}` are tokens of their own even when glued to a word.
 pub fn tokenize(mut reader: impl BufRead, path: &Path) -> Result<Vec<Token>, FormatError> {
     let mut bytes = Vec::new();
-    reader.read_to_end(&mut bytes).map_err(|e| FormatError::io(path, e))?;
+    reader
+        .read_to_end(&mut bytes)
+        .map_err(|e| FormatError::io(path, e))?;
     let text = String::from_utf8_lossy(&bytes);
     let mut tokens = Vec::new();
     let mut line = 1;
@@ -29,7 +31,10 @@ pub fn tokenize(mut reader: impl BufRead, path: &Path) -> Result<Vec<Token>, For
     let mut prev_cr = false;
     let flush = |current: &mut String, tokens: &mut Vec<Token>, at: usize| {
         if !current.is_empty() {
-            tokens.push(Token { text: std::mem::take(current), line: at });
+            tokens.push(Token {
+                text: std::mem::take(current),
+                line: at,
+            });
         }
     };
     for c in text.chars() {
@@ -43,7 +48,10 @@ pub fn tokenize(mut reader: impl BufRead, path: &Path) -> Result<Vec<Token>, For
             }
             '{' | '}' => {
                 flush(&mut current, &mut tokens, start_line);
-                tokens.push(Token { text: c.to_string(), line });
+                tokens.push(Token {
+                    text: c.to_string(),
+                    line,
+                });
             }
             c if c.is_whitespace() => flush(&mut current, &mut tokens, start_line),
             c => {
@@ -68,7 +76,11 @@ pub struct Tokens<'a> {
 
 impl<'a> Tokens<'a> {
     pub fn new(tokens: Vec<Token>, path: &'a Path) -> Self {
-        Self { tokens, pos: 0, path }
+        Self {
+            tokens,
+            pos: 0,
+            path,
+        }
     }
 
     pub fn peek(&self) -> Option<&Token> {
@@ -77,12 +89,21 @@ impl<'a> Tokens<'a> {
 
     /// The line of the next token (or of the last one at the end).
     pub fn line(&self) -> usize {
-        self.tokens.get(self.pos).or(self.tokens.last()).map_or(1, |t| t.line)
+        self.tokens
+            .get(self.pos)
+            .or(self.tokens.last())
+            .map_or(1, |t| t.line)
     }
 
     pub fn error(&self, expected: &str) -> FormatError {
-        let found = self.peek().map_or("the end of the file".to_string(), |t| format!("`{}`", t.text));
-        FormatError::syntax(self.path, self.line(), format!("expected {expected}, found {found}"))
+        let found = self.peek().map_or("the end of the file".to_string(), |t| {
+            format!("`{}`", t.text)
+        });
+        FormatError::syntax(
+            self.path,
+            self.line(),
+            format!("expected {expected}, found {found}"),
+        )
     }
 
     pub fn next_token(&mut self, expected: &str) -> Result<Token, FormatError> {
@@ -112,7 +133,11 @@ impl<'a> Tokens<'a> {
     }
 
     pub fn vec3(&mut self, what: &str) -> Result<Vec3, FormatError> {
-        Ok(Vec3::new(self.number(&format!("{what} x"))?, self.number(&format!("{what} y"))?, self.number(&format!("{what} z"))?))
+        Ok(Vec3::new(
+            self.number(&format!("{what} x"))?,
+            self.number(&format!("{what} y"))?,
+            self.number(&format!("{what} z"))?,
+        ))
     }
 
     pub fn at_end(&self) -> bool {
@@ -131,12 +156,18 @@ pub fn parse_skel(reader: impl BufRead, path: &Path) -> Result<Skeleton, FormatE
     }
     parse_balljoint(&mut tokens, None, &mut raw)?;
     if !tokens.at_end() {
-        return Err(tokens.error("the end of the file after the root joint (one root per skeleton)"));
+        return Err(
+            tokens.error("the end of the file after the root joint (one root per skeleton)")
+        );
     }
     Skeleton::build(raw).map_err(|e| FormatError::rig(path, e))
 }
 
-fn parse_balljoint(tokens: &mut Tokens, parent: Option<usize>, raw: &mut Vec<RawJoint>) -> Result<(), FormatError> {
+fn parse_balljoint(
+    tokens: &mut Tokens,
+    parent: Option<usize>,
+    raw: &mut Vec<RawJoint>,
+) -> Result<(), FormatError> {
     tokens.expect("balljoint")?;
     let name = tokens.next_token("a joint name")?;
     if name.text == "{" || name.text == "}" {
@@ -146,7 +177,10 @@ fn parse_balljoint(tokens: &mut Tokens, parent: Option<usize>, raw: &mut Vec<Raw
     tokens.expect("{")?;
     let index = raw.len();
     let mut joint = RawJoint::new(name.text, parent, Vec3::ZERO);
-    let mut bone_box = BoneBox { min: Vec3::splat(-0.1), max: Vec3::splat(0.1) };
+    let mut bone_box = BoneBox {
+        min: Vec3::splat(-0.1),
+        max: Vec3::splat(0.1),
+    };
     let mut limits = DofLimits::UNLIMITED;
     let mut pose = Vec3::ZERO;
     raw.push(joint.clone());
@@ -180,7 +214,9 @@ fn parse_balljoint(tokens: &mut Tokens, parent: Option<usize>, raw: &mut Vec<Raw
                 pose = tokens.vec3("pose")?;
             }
             Some("balljoint") => parse_balljoint(tokens, Some(index), raw)?,
-            _ => return Err(tokens.error("offset, boxmin, boxmax, rotxlimit, rotylimit, rotzlimit, pose, balljoint or `}`")),
+            _ => return Err(tokens.error(
+                "offset, boxmin, boxmax, rotxlimit, rotylimit, rotzlimit, pose, balljoint or `}`",
+            )),
         }
     }
     joint.limits = limits;

@@ -21,26 +21,57 @@ pub fn parse_skel(reader: impl BufRead, path: &Path) -> Result<Skeleton, FormatE
         }
         let tokens: Vec<&str> = line.split_whitespace().collect();
         if !(4..=5).contains(&tokens.len()) {
-            return Err(FormatError::syntax(path, line_no, format!("expected 4 numbers (x y z parent), found {}", tokens.len())));
+            return Err(FormatError::syntax(
+                path,
+                line_no,
+                format!("expected 4 numbers (x y z parent), found {}", tokens.len()),
+            ));
         }
-        let xyz = tokens[..3].iter().map(|t| parse_number::<f32>(t, path, line_no)).collect::<Result<Vec<_>, _>>()?;
+        let xyz = tokens[..3]
+            .iter()
+            .map(|t| parse_number::<f32>(t, path, line_no))
+            .collect::<Result<Vec<_>, _>>()?;
         let parent: i64 = tokens[3].parse().map_err(|_| {
-            FormatError::syntax(path, line_no, format!("expected an integer parent index, found `{}`", tokens[3]))
+            FormatError::syntax(
+                path,
+                line_no,
+                format!("expected an integer parent index, found `{}`", tokens[3]),
+            )
         })?;
         let index = raw.len();
         let parent = match parent {
             -1 => None,
             p if p < 0 || p as usize >= index => {
-                let what = if p >= 0 && (p as usize) == index { "itself" } else { "a joint not defined before it" };
-                return Err(FormatError::syntax(path, line_no, format!("parent index {p} of joint {index} refers to {what} (expected -1 or 0..{index})")));
+                let what = if p >= 0 && (p as usize) == index {
+                    "itself"
+                } else {
+                    "a joint not defined before it"
+                };
+                return Err(FormatError::syntax(
+                    path,
+                    line_no,
+                    format!(
+                        "parent index {p} of joint {index} refers to {what} (expected -1 or 0..{index})"
+                    ),
+                ));
             }
             p => Some(p as usize),
         };
-        let name = tokens.get(4).map_or_else(|| format!("joint{index}"), |n| n.to_string());
-        raw.push(RawJoint::new(name, parent, Vec3::new(xyz[0], xyz[1], xyz[2])));
+        let name = tokens
+            .get(4)
+            .map_or_else(|| format!("joint{index}"), |n| n.to_string());
+        raw.push(RawJoint::new(
+            name,
+            parent,
+            Vec3::new(xyz[0], xyz[1], xyz[2]),
+        ));
     }
     if raw.is_empty() {
-        return Err(FormatError::syntax(path, 1, "expected at least one joint line `x y z parent`, found none"));
+        return Err(FormatError::syntax(
+            path,
+            1,
+            "expected at least one joint line `x y z parent`, found none",
+        ));
     }
     Skeleton::build(raw).map_err(|e| FormatError::rig(path, e))
 }
@@ -49,7 +80,12 @@ pub fn parse_skel(reader: impl BufRead, path: &Path) -> Result<Skeleton, FormatE
 /// the root (column k is joint k + 1). Rows that do not sum to 1 are normalised and
 /// returned as warnings; a row of the wrong width or a count that differs from
 /// `vertex_count` is an error.
-pub fn parse_attach(reader: impl BufRead, path: &Path, joint_count: usize, vertex_count: usize) -> Result<(SkinWeights, Vec<NormalisedRow>), FormatError> {
+pub fn parse_attach(
+    reader: impl BufRead,
+    path: &Path,
+    joint_count: usize,
+    vertex_count: usize,
+) -> Result<(SkinWeights, Vec<NormalisedRow>), FormatError> {
     let columns = joint_count.saturating_sub(1);
     let mut rows = Vec::with_capacity(vertex_count);
     let mut last_line = 0;
@@ -59,18 +95,39 @@ pub fn parse_attach(reader: impl BufRead, path: &Path, joint_count: usize, verte
             continue;
         }
         if rows.len() == vertex_count {
-            return Err(FormatError::syntax(path, line_no, format!("expected {vertex_count} weight lines (one per mesh vertex), found more")));
+            return Err(FormatError::syntax(
+                path,
+                line_no,
+                format!("expected {vertex_count} weight lines (one per mesh vertex), found more"),
+            ));
         }
         let found = line.split_whitespace().count();
         if found != columns {
-            return Err(FormatError::syntax(path, line_no, format!("expected {columns} weights (one per joint except the root), found {found}")));
+            return Err(FormatError::syntax(
+                path,
+                line_no,
+                format!(
+                    "expected {columns} weights (one per joint except the root), found {found}"
+                ),
+            ));
         }
-        let weights = line.split_whitespace().map(|t| parse_number::<f32>(t, path, line_no)).collect::<Result<Vec<_>, _>>()?;
+        let weights = line
+            .split_whitespace()
+            .map(|t| parse_number::<f32>(t, path, line_no))
+            .collect::<Result<Vec<_>, _>>()?;
         if let Some(w) = weights.iter().find(|w| **w < 0.0 || !w.is_finite()) {
-            return Err(FormatError::syntax(path, line_no, format!("expected weights >= 0, found {w}")));
+            return Err(FormatError::syntax(
+                path,
+                line_no,
+                format!("expected weights >= 0, found {w}"),
+            ));
         }
         if weights.iter().all(|&w| w <= 0.0) {
-            return Err(FormatError::syntax(path, line_no, "expected at least one positive weight, found none"));
+            return Err(FormatError::syntax(
+                path,
+                line_no,
+                "expected at least one positive weight, found none",
+            ));
         }
         rows.push(weights);
     }
@@ -78,15 +135,24 @@ pub fn parse_attach(reader: impl BufRead, path: &Path, joint_count: usize, verte
         return Err(FormatError::syntax(
             path,
             last_line.max(1),
-            format!("expected {vertex_count} weight lines (one per mesh vertex), found {}", rows.len()),
+            format!(
+                "expected {vertex_count} weight lines (one per mesh vertex), found {}",
+                rows.len()
+            ),
         ));
     }
-    let sparse = rows.iter().map(|r| r.iter().enumerate().map(|(k, &w)| (k + 1, w)));
+    let sparse = rows
+        .iter()
+        .map(|r| r.iter().enumerate().map(|(k, &w)| (k + 1, w)));
     SkinWeights::from_rows(sparse, joint_count).map_err(|e| FormatError::rig(path, e))
 }
 
 /// Writes weights in the 6.837 `.attach` layout (one column per non-root joint).
-pub fn write_attach(mut out: impl std::io::Write, weights: &SkinWeights, joint_count: usize) -> std::io::Result<()> {
+pub fn write_attach(
+    mut out: impl std::io::Write,
+    weights: &SkinWeights,
+    joint_count: usize,
+) -> std::io::Result<()> {
     let mut row = vec![0.0f32; joint_count];
     for v in 0..weights.vertex_count() {
         row.fill(0.0);

@@ -11,7 +11,7 @@ pub mod off;
 pub mod scene;
 pub mod smpl;
 
-pub use character::{load_character, CharacterSource};
+pub use character::{CharacterSource, load_character};
 pub use error::FormatError;
 
 /// Writes a whole file or nothing: the content goes to a temporary file beside `path`,
@@ -21,8 +21,14 @@ pub fn write_atomically(
     write: impl FnOnce(&mut std::io::BufWriter<std::fs::File>) -> std::io::Result<()>,
 ) -> std::io::Result<()> {
     use std::io::Write;
-    let dir = path.parent().filter(|d| !d.as_os_str().is_empty()).unwrap_or(std::path::Path::new("."));
-    let name = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
+    let dir = path
+        .parent()
+        .filter(|d| !d.as_os_str().is_empty())
+        .unwrap_or(std::path::Path::new("."));
+    let name = path
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_default();
     let tmp = dir.join(format!(".{name}.{}.tmp", std::process::id()));
     let result = (|| {
         let mut w = std::io::BufWriter::new(std::fs::File::create(&tmp)?);

@@ -30,7 +30,11 @@ pub fn parse_obj(reader: impl BufRead, path: &Path) -> Result<ObjMesh, FormatErr
             Some("v") => {
                 let values: Vec<&str> = tokens.collect();
                 if !(3..=4).contains(&values.len()) && values.len() != 6 && values.len() != 7 {
-                    return Err(FormatError::syntax(path, line_no, format!("expected 3 numbers after `v`, found {}", values.len())));
+                    return Err(FormatError::syntax(
+                        path,
+                        line_no,
+                        format!("expected 3 numbers after `v`, found {}", values.len()),
+                    ));
                 }
                 let x = parse_number(values[0], path, line_no)?;
                 let y = parse_number(values[1], path, line_no)?;
@@ -41,11 +45,24 @@ pub fn parse_obj(reader: impl BufRead, path: &Path) -> Result<ObjMesh, FormatErr
                 let corners = tokens
                     .map(|t| {
                         let first = t.split('/').next().unwrap_or("");
-                        first.parse::<i64>().map_err(|_| FormatError::syntax(path, line_no, format!("expected a vertex index, found `{t}`")))
+                        first.parse::<i64>().map_err(|_| {
+                            FormatError::syntax(
+                                path,
+                                line_no,
+                                format!("expected a vertex index, found `{t}`"),
+                            )
+                        })
                     })
                     .collect::<Result<Vec<_>, _>>()?;
                 if corners.len() < 3 {
-                    return Err(FormatError::syntax(path, line_no, format!("expected at least 3 vertex indices after `f`, found {}", corners.len())));
+                    return Err(FormatError::syntax(
+                        path,
+                        line_no,
+                        format!(
+                            "expected at least 3 vertex indices after `f`, found {}",
+                            corners.len()
+                        ),
+                    ));
                 }
                 faces.push((line_no, corners));
             }
@@ -59,21 +76,30 @@ pub fn parse_obj(reader: impl BufRead, path: &Path) -> Result<ObjMesh, FormatErr
             .map(|&i| {
                 let index = if i < 0 { count as i64 + i } else { i - 1 };
                 if index < 0 || index as usize >= count {
-                    Err(FormatError::syntax(path, line_no, format!("expected a vertex index in 1..={count}, found {i}")))
+                    Err(FormatError::syntax(
+                        path,
+                        line_no,
+                        format!("expected a vertex index in 1..={count}, found {i}"),
+                    ))
                 } else {
                     Ok(index as u32)
                 }
             })
             .collect::<Result<Vec<u32>, _>>()?;
         for k in 1..resolved.len() - 1 {
-            mesh.triangles.push([resolved[0], resolved[k], resolved[k + 1]]);
+            mesh.triangles
+                .push([resolved[0], resolved[k], resolved[k + 1]]);
         }
     }
     Ok(mesh)
 }
 
 /// Writes `v` lines (one per vertex, in order) then `f` lines (1-based).
-pub fn write_obj(mut out: impl Write, positions: &[Vec3], triangles: &[[u32; 3]]) -> std::io::Result<()> {
+pub fn write_obj(
+    mut out: impl Write,
+    positions: &[Vec3],
+    triangles: &[[u32; 3]],
+) -> std::io::Result<()> {
     for p in positions {
         writeln!(out, "v {} {} {}", p.x, p.y, p.z)?;
     }

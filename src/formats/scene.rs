@@ -47,8 +47,16 @@ impl SourceDoc {
 
 /// `path` relative to `dir` (both made absolute first); `path` itself when that fails.
 pub fn relative_path(path: &Path, dir: &Path) -> PathBuf {
-    let abs = |p: &Path| if p.is_absolute() { Some(p.to_path_buf()) } else { std::env::current_dir().ok().map(|c| c.join(p)) };
-    let (Some(path_abs), Some(dir_abs)) = (abs(path), abs(dir)) else { return path.to_path_buf() };
+    let abs = |p: &Path| {
+        if p.is_absolute() {
+            Some(p.to_path_buf())
+        } else {
+            std::env::current_dir().ok().map(|c| c.join(p))
+        }
+    };
+    let (Some(path_abs), Some(dir_abs)) = (abs(path), abs(dir)) else {
+        return path.to_path_buf();
+    };
     let clean = |p: PathBuf| -> Vec<std::ffi::OsString> {
         let mut out: Vec<std::ffi::OsString> = Vec::new();
         for c in p.components() {
@@ -87,7 +95,11 @@ pub struct PlacementDoc {
 
 impl Default for PlacementDoc {
     fn default() -> Self {
-        Self { translation: [0.0; 3], yaw: 0.0, scale: 1.0 }
+        Self {
+            translation: [0.0; 3],
+            yaw: 0.0,
+            scale: 1.0,
+        }
     }
 }
 
@@ -113,7 +125,13 @@ pub struct ViewDoc {
 
 impl Default for ViewDoc {
     fn default() -> Self {
-        Self { display: DisplayDoc::Mesh, visible: true, weight_colors: false, heat_of_selected: false, tint: [0.8, 0.62, 0.45] }
+        Self {
+            display: DisplayDoc::Mesh,
+            visible: true,
+            weight_colors: false,
+            heat_of_selected: false,
+            tint: [0.8, 0.62, 0.45],
+        }
     }
 }
 
@@ -169,7 +187,12 @@ pub struct StageDoc {
 
 impl Default for StageDoc {
     fn default() -> Self {
-        Self { floor: true, shadows: true, axes: false, floor_height: 0.0 }
+        Self {
+            floor: true,
+            shadows: true,
+            axes: false,
+            floor_height: 0.0,
+        }
     }
 }
 
@@ -186,7 +209,11 @@ pub struct SceneDoc {
 /// has the same name (CSE169's dragon repeats names).
 pub fn pose_key(skeleton: &Skeleton, joint: usize) -> String {
     let name = &skeleton.joint(joint).name;
-    if skeleton.joints().iter().filter(|j| &j.name == name).count() > 1 { format!("{name}#{joint}") } else { name.clone() }
+    if skeleton.joints().iter().filter(|j| &j.name == name).count() > 1 {
+        format!("{name}#{joint}")
+    } else {
+        name.clone()
+    }
 }
 
 /// Resolves a pose key back to a joint.
@@ -204,17 +231,22 @@ pub fn joint_of_pose_key(skeleton: &Skeleton, key: &str) -> Option<usize> {
 /// Reads a scene; errors carry the line.
 pub fn parse_scene(mut reader: impl BufRead, path: &Path) -> Result<SceneDoc, FormatError> {
     let mut text = String::new();
-    reader.read_to_string(&mut text).map_err(|e| FormatError::io(path, e))?;
-    ron::from_str(&text).map_err(|e| FormatError::syntax(path, e.span.start.line, e.code.to_string()))
+    reader
+        .read_to_string(&mut text)
+        .map_err(|e| FormatError::io(path, e))?;
+    ron::from_str(&text)
+        .map_err(|e| FormatError::syntax(path, e.span.start.line, e.code.to_string()))
 }
 
 /// The scene as pretty RON text.
 pub fn scene_to_string(doc: &SceneDoc) -> String {
-    ron::ser::to_string_pretty(doc, ron::ser::PrettyConfig::default()).expect("scene documents serialise")
+    ron::ser::to_string_pretty(doc, ron::ser::PrettyConfig::default())
+        .expect("scene documents serialise")
 }
 
 /// Writes a scene whole or not at all (temporary file, then rename).
 pub fn save_scene(path: &Path, doc: &SceneDoc) -> Result<(), FormatError> {
     let text = scene_to_string(doc);
-    super::write_atomically(path, |w| std::io::Write::write_all(w, text.as_bytes())).map_err(|e| FormatError::io(path, e))
+    super::write_atomically(path, |w| std::io::Write::write_all(w, text.as_bytes()))
+        .map_err(|e| FormatError::io(path, e))
 }

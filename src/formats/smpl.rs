@@ -14,39 +14,77 @@ use crate::rig::{EulerOrder, RawJoint, Skeleton, SkinWeights};
 
 /// Data lines of a file: lines that are not blank and not `#` comments, numbered.
 fn data_lines(reader: impl BufRead, path: &Path) -> Result<Vec<(usize, String)>, FormatError> {
-    Ok(read_lines(reader, path)?.into_iter().filter(|(_, l)| !l.trim().is_empty() && !l.trim_start().starts_with('#')).collect())
+    Ok(read_lines(reader, path)?
+        .into_iter()
+        .filter(|(_, l)| !l.trim().is_empty() && !l.trim_start().starts_with('#'))
+        .collect())
 }
 
-fn numbers<T: std::str::FromStr>(line: &str, path: &Path, line_no: usize) -> Result<Vec<T>, FormatError> {
-    line.split_whitespace().map(|t| parse_number(t, path, line_no)).collect()
+fn numbers<T: std::str::FromStr>(
+    line: &str,
+    path: &Path,
+    line_no: usize,
+) -> Result<Vec<T>, FormatError> {
+    line.split_whitespace()
+        .map(|t| parse_number(t, path, line_no))
+        .collect()
 }
 
 /// `smpl_hierarchy.txt`: a count, then rows `index parent EULER_XYZ name`.
 pub fn parse_hierarchy(reader: impl BufRead, path: &Path) -> Result<Skeleton, FormatError> {
     let lines = data_lines(reader, path)?;
-    let (count_line, count) = lines.first().ok_or_else(|| FormatError::syntax(path, 1, "expected the joint count, found the end of the file"))?;
+    let (count_line, count) = lines.first().ok_or_else(|| {
+        FormatError::syntax(
+            path,
+            1,
+            "expected the joint count, found the end of the file",
+        )
+    })?;
     let count: usize = parse_number(count.trim(), path, *count_line)?;
     let rows = &lines[1..];
     if rows.len() != count {
         let at = rows.last().map_or(*count_line, |r| r.0);
-        return Err(FormatError::syntax(path, at, format!("expected {count} joint rows, found {}", rows.len())));
+        return Err(FormatError::syntax(
+            path,
+            at,
+            format!("expected {count} joint rows, found {}", rows.len()),
+        ));
     }
     let mut raw = Vec::with_capacity(count);
     for (k, (n, line)) in rows.iter().enumerate() {
         let t: Vec<&str> = line.split_whitespace().collect();
         if t.len() != 4 {
-            return Err(FormatError::syntax(path, *n, format!("expected `index parent order name`, found {} fields", t.len())));
+            return Err(FormatError::syntax(
+                path,
+                *n,
+                format!(
+                    "expected `index parent order name`, found {} fields",
+                    t.len()
+                ),
+            ));
         }
         let index: usize = parse_number(t[0], path, *n)?;
         if index != k {
-            return Err(FormatError::syntax(path, *n, format!("expected joint index {k}, found {index}")));
+            return Err(FormatError::syntax(
+                path,
+                *n,
+                format!("expected joint index {k}, found {index}"),
+            ));
         }
         let parent: i64 = parse_number(t[1], path, *n)?;
         if parent >= k as i64 || parent < -1 {
-            return Err(FormatError::syntax(path, *n, format!("expected a parent index in -1..{k}, found {parent}")));
+            return Err(FormatError::syntax(
+                path,
+                *n,
+                format!("expected a parent index in -1..{k}, found {parent}"),
+            ));
         }
         if t[2] != "EULER_XYZ" {
-            return Err(FormatError::syntax(path, *n, format!("expected rotation order EULER_XYZ, found `{}`", t[2])));
+            return Err(FormatError::syntax(
+                path,
+                *n,
+                format!("expected rotation order EULER_XYZ, found `{}`", t[2]),
+            ));
         }
         let mut joint = RawJoint::new(t[3], (parent >= 0).then_some(parent as usize), Vec3::ZERO);
         joint.initial_rotation = crate::rig::JointRotation::Euler(Vec3::ZERO, EulerOrder::Xyz);
@@ -57,50 +95,117 @@ pub fn parse_hierarchy(reader: impl BufRead, path: &Path) -> Result<Skeleton, Fo
 
 /// `smpl_skelNN.txt`: a header `frames joints` (the frame count says 0: not trusted), then
 /// one row of `joints` × (qx qy qz qw px py pz). Returns the absolute joint positions.
-pub fn parse_skeleton_positions(reader: impl BufRead, path: &Path, joint_count: usize) -> Result<Vec<Vec3>, FormatError> {
+pub fn parse_skeleton_positions(
+    reader: impl BufRead,
+    path: &Path,
+    joint_count: usize,
+) -> Result<Vec<Vec3>, FormatError> {
     let lines = data_lines(reader, path)?;
-    let (header_line, header) = lines.first().ok_or_else(|| FormatError::syntax(path, 1, "expected `frames joints`, found the end of the file"))?;
+    let (header_line, header) = lines.first().ok_or_else(|| {
+        FormatError::syntax(
+            path,
+            1,
+            "expected `frames joints`, found the end of the file",
+        )
+    })?;
     let h: Vec<usize> = numbers(header, path, *header_line)?;
     if h.len() != 2 || h[1] != joint_count {
-        return Err(FormatError::syntax(path, *header_line, format!("expected `frames {joint_count}`, found `{}`", header.trim())));
+        return Err(FormatError::syntax(
+            path,
+            *header_line,
+            format!("expected `frames {joint_count}`, found `{}`", header.trim()),
+        ));
     }
-    let (n, row) = lines.get(1).ok_or_else(|| FormatError::syntax(path, *header_line, "expected a row of joint positions, found the end of the file"))?;
+    let (n, row) = lines.get(1).ok_or_else(|| {
+        FormatError::syntax(
+            path,
+            *header_line,
+            "expected a row of joint positions, found the end of the file",
+        )
+    })?;
     let v: Vec<f32> = numbers(row, path, *n)?;
     if v.len() != 7 * joint_count {
-        return Err(FormatError::syntax(path, *n, format!("expected {} numbers ({joint_count} × qx qy qz qw px py pz), found {}", 7 * joint_count, v.len())));
+        return Err(FormatError::syntax(
+            path,
+            *n,
+            format!(
+                "expected {} numbers ({joint_count} × qx qy qz qw px py pz), found {}",
+                7 * joint_count,
+                v.len()
+            ),
+        ));
     }
-    Ok(v.chunks_exact(7).map(|c| Vec3::new(c[4], c[5], c[6])).collect())
+    Ok(v.chunks_exact(7)
+        .map(|c| Vec3::new(c[4], c[5], c[6]))
+        .collect())
 }
 
 /// `smpl_skin.txt`: header `vertices joints influences`, then per vertex `influences`
 /// pairs `joint weight` (no count prefix, whatever the file's comment says).
-pub fn parse_skin(reader: impl BufRead, path: &Path, joint_count: usize) -> Result<(SkinWeights, Vec<NormalisedRow>), FormatError> {
+pub fn parse_skin(
+    reader: impl BufRead,
+    path: &Path,
+    joint_count: usize,
+) -> Result<(SkinWeights, Vec<NormalisedRow>), FormatError> {
     let lines = data_lines(reader, path)?;
-    let (header_line, header) = lines.first().ok_or_else(|| FormatError::syntax(path, 1, "expected `vertices joints influences`, found the end of the file"))?;
+    let (header_line, header) = lines.first().ok_or_else(|| {
+        FormatError::syntax(
+            path,
+            1,
+            "expected `vertices joints influences`, found the end of the file",
+        )
+    })?;
     let h: Vec<usize> = numbers(header, path, *header_line)?;
     if h.len() != 3 {
-        return Err(FormatError::syntax(path, *header_line, format!("expected 3 numbers (vertices joints influences), found {}", h.len())));
+        return Err(FormatError::syntax(
+            path,
+            *header_line,
+            format!(
+                "expected 3 numbers (vertices joints influences), found {}",
+                h.len()
+            ),
+        ));
     }
     let (vertices, joints, per_vertex) = (h[0], h[1], h[2]);
     if joints != joint_count {
-        return Err(FormatError::syntax(path, *header_line, format!("expected {joint_count} joints (the hierarchy's), found {joints}")));
+        return Err(FormatError::syntax(
+            path,
+            *header_line,
+            format!("expected {joint_count} joints (the hierarchy's), found {joints}"),
+        ));
     }
     let rows = &lines[1..];
     if rows.len() != vertices {
         let at = rows.last().map_or(*header_line, |r| r.0);
-        return Err(FormatError::syntax(path, at, format!("expected {vertices} vertex rows, found {}", rows.len())));
+        return Err(FormatError::syntax(
+            path,
+            at,
+            format!("expected {vertices} vertex rows, found {}", rows.len()),
+        ));
     }
     let mut parsed = Vec::with_capacity(vertices);
     for (n, line) in rows {
         let tokens: Vec<&str> = line.split_whitespace().collect();
         if tokens.len() != 2 * per_vertex {
-            return Err(FormatError::syntax(path, *n, format!("expected {} numbers ({per_vertex} joint weight pairs), found {}", 2 * per_vertex, tokens.len())));
+            return Err(FormatError::syntax(
+                path,
+                *n,
+                format!(
+                    "expected {} numbers ({per_vertex} joint weight pairs), found {}",
+                    2 * per_vertex,
+                    tokens.len()
+                ),
+            ));
         }
         let mut row = Vec::with_capacity(per_vertex);
         for pair in tokens.chunks_exact(2) {
             let j: usize = parse_number(pair[0], path, *n)?;
             if j >= joint_count {
-                return Err(FormatError::syntax(path, *n, format!("expected a joint index below {joint_count}, found {j}")));
+                return Err(FormatError::syntax(
+                    path,
+                    *n,
+                    format!("expected a joint index below {joint_count}, found {j}"),
+                ));
             }
             row.push((j, parse_number::<f32>(pair[1], path, *n)?));
         }
@@ -111,27 +216,64 @@ pub fn parse_skin(reader: impl BufRead, path: &Path, joint_count: usize) -> Resu
 
 /// `smpl_quaternions_*.txt`: header `frames joints`, then per frame the root position and
 /// `joints` quaternions (x y z w).
-pub fn parse_clip(reader: impl BufRead, path: &Path, joint_count: usize) -> Result<Clip, FormatError> {
+pub fn parse_clip(
+    reader: impl BufRead,
+    path: &Path,
+    joint_count: usize,
+) -> Result<Clip, FormatError> {
     let lines = data_lines(reader, path)?;
-    let (header_line, header) = lines.first().ok_or_else(|| FormatError::syntax(path, 1, "expected `frames joints`, found the end of the file"))?;
+    let (header_line, header) = lines.first().ok_or_else(|| {
+        FormatError::syntax(
+            path,
+            1,
+            "expected `frames joints`, found the end of the file",
+        )
+    })?;
     let h: Vec<usize> = numbers(header, path, *header_line)?;
     if h.len() != 2 || h[1] != joint_count {
-        return Err(FormatError::syntax(path, *header_line, format!("expected `frames {joint_count}`, found `{}`", header.trim())));
+        return Err(FormatError::syntax(
+            path,
+            *header_line,
+            format!("expected `frames {joint_count}`, found `{}`", header.trim()),
+        ));
     }
     let rows = &lines[1..];
     if rows.len() != h[0] {
         let at = rows.last().map_or(*header_line, |r| r.0);
-        return Err(FormatError::syntax(path, at, format!("expected {} frames, found {}", h[0], rows.len())));
+        return Err(FormatError::syntax(
+            path,
+            at,
+            format!("expected {} frames, found {}", h[0], rows.len()),
+        ));
     }
     let width = 3 + 4 * joint_count;
-    let mut clip = Clip { name: path.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default(), root_positions: Vec::new(), rotations: Vec::new(), joint_count };
+    let mut clip = Clip {
+        name: path
+            .file_stem()
+            .map(|s| s.to_string_lossy().into_owned())
+            .unwrap_or_default(),
+        root_positions: Vec::new(),
+        rotations: Vec::new(),
+        joint_count,
+    };
     for (n, line) in rows {
         let v: Vec<f32> = numbers(line, path, *n)?;
         if v.len() != width {
-            return Err(FormatError::syntax(path, *n, format!("expected {width} numbers (root x y z, then {joint_count} × qx qy qz qw), found {}", v.len())));
+            return Err(FormatError::syntax(
+                path,
+                *n,
+                format!(
+                    "expected {width} numbers (root x y z, then {joint_count} × qx qy qz qw), found {}",
+                    v.len()
+                ),
+            ));
         }
         clip.root_positions.push(Vec3::new(v[0], v[1], v[2]));
-        clip.rotations.extend(v[3..].chunks_exact(4).map(|q| Quat::from_xyzw(q[0], q[1], q[2], q[3]).normalize()));
+        clip.rotations.extend(
+            v[3..]
+                .chunks_exact(4)
+                .map(|q| Quat::from_xyzw(q[0], q[1], q[2], q[3]).normalize()),
+        );
     }
     Ok(clip)
 }
@@ -144,7 +286,11 @@ pub fn is_smpl_dir(dir: &Path) -> bool {
 /// The hierarchy file, under either spelling.
 fn hierarchy_path(dir: &Path) -> PathBuf {
     let right = dir.join("smpl_hierarchy.txt");
-    if right.is_file() { right } else { dir.join("smpl_hiearchy.txt") }
+    if right.is_file() {
+        right
+    } else {
+        dir.join("smpl_hiearchy.txt")
+    }
 }
 
 /// The clips in a folder (`smpl_quaternions_*.txt`), sorted by name.
@@ -154,7 +300,11 @@ pub fn clip_paths(dir: &Path) -> Vec<PathBuf> {
         .flatten()
         .flatten()
         .map(|e| e.path())
-        .filter(|p| p.file_name().and_then(|n| n.to_str()).is_some_and(|n| n.starts_with("smpl_quaternions_") && n.ends_with(".txt")))
+        .filter(|p| {
+            p.file_name()
+                .and_then(|n| n.to_str())
+                .is_some_and(|n| n.starts_with("smpl_quaternions_") && n.ends_with(".txt"))
+        })
         .collect();
     clips.sort();
     clips
@@ -179,19 +329,54 @@ pub fn load_smpl_dir(dir: &Path) -> Result<(SmplModel, Vec<String>), FormatError
         }
         let target = parse_obj(open(&obj_path)?, &obj_path)?;
         if target.positions.len() != base.positions.len() {
-            return Err(FormatError::other(&obj_path, format!("expected {} vertices (as smpl_00.obj), found {}", base.positions.len(), target.positions.len())));
+            return Err(FormatError::other(
+                &obj_path,
+                format!(
+                    "expected {} vertices (as smpl_00.obj), found {}",
+                    base.positions.len(),
+                    target.positions.len()
+                ),
+            ));
         }
         let skel_path = dir.join(format!("smpl_skel{b:02}.txt"));
         let joints = parse_skeleton_positions(open(&skel_path)?, &skel_path, n)?;
-        vertex_deltas.push(target.positions.iter().zip(&base.positions).map(|(t, b)| *t - *b).collect());
-        joint_deltas.push(joints.iter().zip(&base_joints).map(|(t, b)| *t - *b).collect());
+        vertex_deltas.push(
+            target
+                .positions
+                .iter()
+                .zip(&base.positions)
+                .map(|(t, b)| *t - *b)
+                .collect(),
+        );
+        joint_deltas.push(
+            joints
+                .iter()
+                .zip(&base_joints)
+                .map(|(t, b)| *t - *b)
+                .collect(),
+        );
     }
     let skin_path = dir.join("smpl_skin.txt");
     let (weights, normalised) = parse_skin(open(&skin_path)?, &skin_path, n)?;
     if weights.vertex_count() != base.positions.len() {
-        return Err(FormatError::other(&skin_path, format!("expected {} weight rows (as smpl_00.obj), found {}", base.positions.len(), weights.vertex_count())));
+        return Err(FormatError::other(
+            &skin_path,
+            format!(
+                "expected {} weight rows (as smpl_00.obj), found {}",
+                base.positions.len(),
+                weights.vertex_count()
+            ),
+        ));
     }
     let warnings = super::character::normalised_warnings(&skin_path, &normalised);
-    let model = SmplModel { skeleton, base_positions: base.positions, vertex_deltas, base_joints, joint_deltas, triangles: base.triangles, weights };
+    let model = SmplModel {
+        skeleton,
+        base_positions: base.positions,
+        vertex_deltas,
+        base_joints,
+        joint_deltas,
+        triangles: base.triangles,
+        weights,
+    };
     Ok((model, warnings))
 }

@@ -29,7 +29,12 @@ pub fn fabrik(chain: &[Vec3], target: Vec3, tolerance: f32, max_iterations: usiz
     let n = p.len();
     if n < 2 {
         let distance = p.first().map_or(f32::INFINITY, |b| b.distance(target));
-        return FabrikResult { positions: p, reached: distance <= tolerance, iterations: 0, distance };
+        return FabrikResult {
+            positions: p,
+            reached: distance <= tolerance,
+            iterations: 0,
+            distance,
+        };
     }
     let lengths: Vec<f32> = p.windows(2).map(|w| w[0].distance(w[1])).collect();
     let base = p[0];
@@ -40,7 +45,12 @@ pub fn fabrik(chain: &[Vec3], target: Vec3, tolerance: f32, max_iterations: usiz
             p[i + 1] = p[i] + lengths[i] * dir;
         }
         let distance = p[n - 1].distance(target);
-        return FabrikResult { positions: p, reached: distance <= tolerance, iterations: 1, distance };
+        return FabrikResult {
+            positions: p,
+            reached: distance <= tolerance,
+            iterations: 1,
+            distance,
+        };
     }
     let mut iterations = 0;
     let mut distance = p[n - 1].distance(target);
@@ -58,7 +68,12 @@ pub fn fabrik(chain: &[Vec3], target: Vec3, tolerance: f32, max_iterations: usiz
         }
         distance = p[n - 1].distance(target);
     }
-    FabrikResult { positions: p, reached: distance <= tolerance, iterations, distance }
+    FabrikResult {
+        positions: p,
+        reached: distance <= tolerance,
+        iterations,
+        distance,
+    }
 }
 
 /// The joints from `end` up to its sub-base (the first ancestor with more than one child,
@@ -107,7 +122,14 @@ pub struct IkReport {
 /// `rounds` rounds so a limited chain gets as close as its limits allow. The sub-base does
 /// not rotate (its other branches stay put), so the chain that moves starts at the
 /// sub-base's child.
-pub fn solve_ik(skeleton: &Skeleton, pose: &mut [JointRotation], placement: Mat4, goals: &[IkGoal], tolerance: f32, rounds: usize) -> Vec<IkReport> {
+pub fn solve_ik(
+    skeleton: &Skeleton,
+    pose: &mut [JointRotation],
+    placement: Mat4,
+    goals: &[IkGoal],
+    tolerance: f32,
+    rounds: usize,
+) -> Vec<IkReport> {
     let n = skeleton.len();
     let mut world = vec![Mat4::IDENTITY; n];
     goals
@@ -115,11 +137,24 @@ pub fn solve_ik(skeleton: &Skeleton, pose: &mut [JointRotation], placement: Mat4
         .map(|goal| {
             let full = chain_to_sub_base(skeleton, goal.end);
             // Positions chain: from the sub-base's child (fixed) down to the end.
-            let chain: Vec<usize> = if full.len() > 2 { full[1..].to_vec() } else { full.clone() };
-            let mut report = IkReport { end: goal.end, chain: chain[..chain.len() - 1].to_vec(), reached: false, rounds: 0, iterations: 0, distance: f32::INFINITY, limited: false };
+            let chain: Vec<usize> = if full.len() > 2 {
+                full[1..].to_vec()
+            } else {
+                full.clone()
+            };
+            let mut report = IkReport {
+                end: goal.end,
+                chain: chain[..chain.len() - 1].to_vec(),
+                reached: false,
+                rounds: 0,
+                iterations: 0,
+                distance: f32::INFINITY,
+                limited: false,
+            };
             for _ in 0..rounds.max(1) {
                 forward_kinematics(skeleton, pose, placement, &mut world);
-                let positions: Vec<Vec3> = chain.iter().map(|&j| world[j].w_axis.truncate()).collect();
+                let positions: Vec<Vec3> =
+                    chain.iter().map(|&j| world[j].w_axis.truncate()).collect();
                 report.distance = positions[positions.len() - 1].distance(goal.target);
                 if report.distance <= tolerance {
                     report.reached = true;
@@ -140,7 +175,8 @@ pub fn solve_ik(skeleton: &Skeleton, pose: &mut [JointRotation], placement: Mat4
                     let parent_world = skeleton.parent(j).map_or(placement, |p| world[p]);
                     let parent_rotation = rotation_of(parent_world);
                     let local = pose[j].to_quat();
-                    let new_local = (parent_rotation.inverse() * delta * parent_rotation * local).normalize();
+                    let new_local =
+                        (parent_rotation.inverse() * delta * parent_rotation * local).normalize();
                     let wanted = pose[j].with_rotation_of(new_local);
                     let clamped = wanted.clamped(&skeleton.joint(j).limits);
                     if clamped != wanted {
@@ -160,5 +196,10 @@ pub fn solve_ik(skeleton: &Skeleton, pose: &mut [JointRotation], placement: Mat4
 /// The rotation part of a transform (scale removed).
 fn rotation_of(m: Mat4) -> Quat {
     let m3 = Mat3::from_mat4(m);
-    Quat::from_mat3(&Mat3::from_cols(m3.x_axis.normalize(), m3.y_axis.normalize(), m3.z_axis.normalize())).normalize()
+    Quat::from_mat3(&Mat3::from_cols(
+        m3.x_axis.normalize(),
+        m3.y_axis.normalize(),
+        m3.z_axis.normalize(),
+    ))
+    .normalize()
 }

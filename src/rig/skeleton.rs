@@ -78,18 +78,32 @@ impl Skeleton {
         for (i, j) in raw.iter().enumerate() {
             if let Some(p) = j.parent {
                 if p >= n {
-                    return Err(RigError::ParentOutOfRange { joint: i, parent: p, count: n });
+                    return Err(RigError::ParentOutOfRange {
+                        joint: i,
+                        parent: p,
+                        count: n,
+                    });
                 }
                 if p == i {
-                    return Err(RigError::Cycle { joint: j.name.clone() });
+                    return Err(RigError::Cycle {
+                        joint: j.name.clone(),
+                    });
                 }
             }
         }
         let roots: Vec<usize> = (0..n).filter(|&i| raw[i].parent.is_none()).collect();
         match roots.len() {
-            0 => return Err(RigError::Cycle { joint: raw[0].name.clone() }),
+            0 => {
+                return Err(RigError::Cycle {
+                    joint: raw[0].name.clone(),
+                });
+            }
             1 => {}
-            _ => return Err(RigError::SeveralRoots { roots: roots.iter().map(|&r| raw[r].name.clone()).collect() }),
+            _ => {
+                return Err(RigError::SeveralRoots {
+                    roots: roots.iter().map(|&r| raw[r].name.clone()).collect(),
+                });
+            }
         }
         let mut raw_children = vec![Vec::new(); n];
         for (i, j) in raw.iter().enumerate() {
@@ -108,7 +122,9 @@ impl Skeleton {
             let mut reached = vec![false; n];
             order.iter().for_each(|&j| reached[j] = true);
             let lost = (0..n).find(|&j| !reached[j]).unwrap_or(0);
-            return Err(RigError::Cycle { joint: raw[lost].name.clone() });
+            return Err(RigError::Cycle {
+                joint: raw[lost].name.clone(),
+            });
         }
         let mut new_index = vec![0; n];
         for (new, &old) in order.iter().enumerate() {
@@ -194,7 +210,12 @@ impl Skeleton {
 
     /// A joint by name, or by index written as a number.
     pub fn resolve(&self, name_or_index: &str) -> Option<usize> {
-        self.find(name_or_index).or_else(|| name_or_index.parse::<usize>().ok().filter(|&i| i < self.len()))
+        self.find(name_or_index).or_else(|| {
+            name_or_index
+                .parse::<usize>()
+                .ok()
+                .filter(|&i| i < self.len())
+        })
     }
 
     /// The initial pose the file gave (clamped).

@@ -32,18 +32,29 @@ pub struct Placement {
 
 impl Default for Placement {
     fn default() -> Self {
-        Self { translation: Vec3::ZERO, yaw: 0.0, scale: 1.0 }
+        Self {
+            translation: Vec3::ZERO,
+            yaw: 0.0,
+            scale: 1.0,
+        }
     }
 }
 
 impl Placement {
     pub fn at(translation: Vec3) -> Self {
-        Self { translation, ..default() }
+        Self {
+            translation,
+            ..default()
+        }
     }
 
     /// The model-to-world matrix.
     pub fn to_mat4(&self) -> Mat4 {
-        Mat4::from_scale_rotation_translation(Vec3::splat(self.scale), Quat::from_rotation_y(self.yaw), self.translation)
+        Mat4::from_scale_rotation_translation(
+            Vec3::splat(self.scale),
+            Quat::from_rotation_y(self.yaw),
+            self.translation,
+        )
     }
 }
 
@@ -60,12 +71,18 @@ pub struct SkinView {
 
 impl Default for SkinView {
     fn default() -> Self {
-        Self { tint: [0.8, 0.62, 0.45], weight_colors: false, heat_joint: None }
+        Self {
+            tint: [0.8, 0.62, 0.45],
+            weight_colors: false,
+            heat_joint: None,
+        }
     }
 }
 
 /// Whether a character shows its skin, its skeleton, or both.
-#[derive(Component, Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[derive(
+    Component, Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize,
+)]
 pub enum DisplayMode {
     #[default]
     Mesh,
@@ -96,12 +113,22 @@ pub struct PoseDirty {
 }
 
 impl PoseDirty {
-    pub const ALL: Self = Self { matrices: true, bind: true, colors: true };
+    pub const ALL: Self = Self {
+        matrices: true,
+        bind: true,
+        colors: true,
+    };
 }
 
 /// A joint of a character.
 #[derive(Component, Clone, Debug)]
-#[require(RestOffset, JointPose, JointLimits, BindWorldToJoint, CurrentJointToWorld)]
+#[require(
+    RestOffset,
+    JointPose,
+    JointLimits,
+    BindWorldToJoint,
+    CurrentJointToWorld
+)]
 pub struct Joint {
     /// Index in the character's skeleton (and in its weights).
     pub index: usize,

@@ -13,7 +13,12 @@ use crate::rig::{CharacterAsset, JointRotation};
 
 /// Spawns a character made from `asset` at `placement`, in the file's initial pose.
 /// Returns the character entity. Joint and skin matrices are filled by the next update.
-pub fn spawn_character(commands: &mut Commands, meshes: &mut Assets<Mesh>, asset: Arc<CharacterAsset>, placement: Placement) -> Entity {
+pub fn spawn_character(
+    commands: &mut Commands,
+    meshes: &mut Assets<Mesh>,
+    asset: Arc<CharacterAsset>,
+    placement: Placement,
+) -> Entity {
     let pose = asset.skeleton.initial_pose();
     spawn_character_posed(commands, meshes, asset, placement, &pose)
 }
@@ -22,16 +27,28 @@ pub fn spawn_character(commands: &mut Commands, meshes: &mut Assets<Mesh>, asset
 ///
 /// # Panics
 /// When `pose` does not have one entry per joint.
-pub fn spawn_character_posed(commands: &mut Commands, meshes: &mut Assets<Mesh>, asset: Arc<CharacterAsset>, placement: Placement, pose: &[JointRotation]) -> Entity {
+pub fn spawn_character_posed(
+    commands: &mut Commands,
+    meshes: &mut Assets<Mesh>,
+    asset: Arc<CharacterAsset>,
+    placement: Placement,
+    pose: &[JointRotation],
+) -> Entity {
     assert_eq!(pose.len(), asset.skeleton.len(), "one pose entry per joint");
-    let character = commands.spawn((Name::new(asset.name.clone()), placement)).id();
+    let character = commands
+        .spawn((Name::new(asset.name.clone()), placement))
+        .id();
     let skeleton = &asset.skeleton;
     let mut joints: Vec<Entity> = Vec::with_capacity(skeleton.len());
     for (index, def) in skeleton.joints().iter().enumerate() {
         let parent = def.parent.map_or(character, |p| joints[p]);
         let joint = commands
             .spawn((
-                Joint { index, name: def.name.clone(), character },
+                Joint {
+                    index,
+                    name: def.name.clone(),
+                    character,
+                },
                 Name::new(def.name.clone()),
                 RestOffset(def.rest_offset),
                 JointPose(pose[index].clamped(&def.limits)),
@@ -44,10 +61,21 @@ pub fn spawn_character_posed(commands: &mut Commands, meshes: &mut Assets<Mesh>,
     let mesh = meshes.add(empty_skin_mesh(asset.triangle_count()));
     let skin_entity = commands
         // Skinned vertices move anywhere: the bounds computed from the empty mesh would cull them.
-        .spawn((SkinMesh { character }, Mesh3d(mesh.clone()), Transform::IDENTITY, NoFrustumCulling, ChildOf(character)))
+        .spawn((
+            SkinMesh { character },
+            Mesh3d(mesh.clone()),
+            Transform::IDENTITY,
+            NoFrustumCulling,
+            ChildOf(character),
+        ))
         .id();
     commands.entity(character).insert((
-        Character { asset, joints, skin_entity, mesh },
+        Character {
+            asset,
+            joints,
+            skin_entity,
+            mesh,
+        },
         SkinScratch::default(),
         PoseDirty::ALL,
     ));
@@ -58,8 +86,11 @@ pub fn spawn_character_posed(commands: &mut Commands, meshes: &mut Assets<Mesh>,
 /// vertex colours. Kept in the main world so the skinning system can rewrite it.
 pub fn empty_skin_mesh(triangle_count: usize) -> Mesh {
     let n = triangle_count * 3;
-    Mesh::new(PrimitiveTopology::TriangleList, RenderAssetUsages::default())
-        .with_inserted_attribute(Mesh::ATTRIBUTE_POSITION, vec![[0.0f32; 3]; n])
-        .with_inserted_attribute(Mesh::ATTRIBUTE_NORMAL, vec![[0.0f32, 1.0, 0.0]; n])
-        .with_inserted_attribute(Mesh::ATTRIBUTE_COLOR, vec![[1.0f32; 4]; n])
+    Mesh::new(
+        PrimitiveTopology::TriangleList,
+        RenderAssetUsages::default(),
+    )
+    .with_inserted_attribute(Mesh::ATTRIBUTE_POSITION, vec![[0.0f32; 3]; n])
+    .with_inserted_attribute(Mesh::ATTRIBUTE_NORMAL, vec![[0.0f32, 1.0, 0.0]; n])
+    .with_inserted_attribute(Mesh::ATTRIBUTE_COLOR, vec![[1.0f32; 4]; n])
 }

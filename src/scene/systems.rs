@@ -8,7 +8,9 @@ use crate::rig::MatrixStack;
 use crate::rig::skinning::{flat_shade, heat_colors, joint_colors, skin_positions, weight_colors};
 
 /// Clamps changed joint poses to their limits (reads `JointLimits`, writes `JointPose`).
-pub fn clamp_poses_to_limits(mut joints: Query<(&mut JointPose, &JointLimits), Changed<JointPose>>) {
+pub fn clamp_poses_to_limits(
+    mut joints: Query<(&mut JointPose, &JointLimits), Changed<JointPose>>,
+) {
     for (mut pose, limits) in &mut joints {
         let clamped = pose.0.clamped(&limits.0);
         pose.set_if_neq(JointPose(clamped));
@@ -54,11 +56,17 @@ pub fn bind_rest_pose(
         if !dirty.bind {
             continue;
         }
-        walk_joint_tree(character.joints[0], &mut MatrixStack::new(), &offsets, &mut |entity, top| {
-            if let Ok(mut bind) = binds.get_mut(entity) {
-                bind.0 = top.inverse();
-            }
-        }, &|_| Mat4::IDENTITY);
+        walk_joint_tree(
+            character.joints[0],
+            &mut MatrixStack::new(),
+            &offsets,
+            &mut |entity, top| {
+                if let Ok(mut bind) = binds.get_mut(entity) {
+                    bind.0 = top.inverse();
+                }
+            },
+            &|_| Mat4::IDENTITY,
+        );
     }
 }
 
@@ -77,11 +85,21 @@ pub fn compute_joint_to_world(
         }
         let mut stack = MatrixStack::with_capacity(character.joints.len() + 1);
         stack.push(placement.to_mat4());
-        walk_joint_tree(character.joints[0], &mut stack, &offsets, &mut |entity, top| {
-            if let Ok(mut current) = currents.get_mut(entity) {
-                current.0 = top;
-            }
-        }, &|entity| poses.get(entity).map_or(Mat4::IDENTITY, |p| Mat4::from_mat3(p.0.to_mat3())));
+        walk_joint_tree(
+            character.joints[0],
+            &mut stack,
+            &offsets,
+            &mut |entity, top| {
+                if let Ok(mut current) = currents.get_mut(entity) {
+                    current.0 = top;
+                }
+            },
+            &|entity| {
+                poses
+                    .get(entity)
+                    .map_or(Mat4::IDENTITY, |p| Mat4::from_mat3(p.0.to_mat3()))
+            },
+        );
     }
 }
 
@@ -94,7 +112,9 @@ fn walk_joint_tree(
     visit: &mut impl FnMut(Entity, Mat4),
     rotation: &impl Fn(Entity) -> Mat4,
 ) {
-    let Ok((offset, children)) = offsets.get(entity) else { return };
+    let Ok((offset, children)) = offsets.get(entity) else {
+        return;
+    };
     let top = stack.push(Mat4::from_translation(offset.0) * rotation(entity));
     visit(entity, top);
     for &child in children.into_iter().flatten() {
@@ -117,18 +137,27 @@ pub fn skin_changed_characters(
             continue;
         }
         let skin = &character.asset.skin;
-        let Some(mut mesh) = meshes.get_mut(&character.mesh) else { continue };
+        let Some(mut mesh) = meshes.get_mut(&character.mesh) else {
+            continue;
+        };
         let SkinScratch { palette, positions } = &mut *scratch;
         if dirty.matrices || dirty.bind {
             palette.clear();
-            palette.extend(character.joints.iter().map(|&e| joints.get(e).map_or(Mat4::IDENTITY, |(c, b)| c.0 * b.0)));
+            palette.extend(
+                character
+                    .joints
+                    .iter()
+                    .map(|&e| joints.get(e).map_or(Mat4::IDENTITY, |(c, b)| c.0 * b.0)),
+            );
             positions.resize(skin.bind_positions.len(), Vec3::ZERO);
             skin_positions(&skin.bind_positions, &skin.weights, palette, positions);
             let mut normals = match mesh.remove_attribute(Mesh::ATTRIBUTE_NORMAL) {
                 Some(VertexAttributeValues::Float32x3(n)) => n,
                 _ => vec![[0.0; 3]; skin.triangles.len() * 3],
             };
-            if let Some(VertexAttributeValues::Float32x3(out)) = mesh.attribute_mut(Mesh::ATTRIBUTE_POSITION) {
+            if let Some(VertexAttributeValues::Float32x3(out)) =
+                mesh.attribute_mut(Mesh::ATTRIBUTE_POSITION)
+            {
                 flat_shade(positions, &skin.triangles, out, &mut normals);
             }
             mesh.insert_attribute(Mesh::ATTRIBUTE_NORMAL, normals);
@@ -148,7 +177,11 @@ fn write_colors(mesh: &mut Mesh, character: &Character, view: &SkinView) {
     if let Some(j) = view.heat_joint.filter(|&j| j < character.joints.len()) {
         heat_colors(&skin.weights, j, &mut per_vertex);
     } else if view.weight_colors {
-        weight_colors(&skin.weights, &joint_colors(character.joints.len()), &mut per_vertex);
+        weight_colors(
+            &skin.weights,
+            &joint_colors(character.joints.len()),
+            &mut per_vertex,
+        );
     }
     if let Some(VertexAttributeValues::Float32x4(out)) = mesh.attribute_mut(Mesh::ATTRIBUTE_COLOR) {
         for (corner, &v) in out.iter_mut().zip(skin.triangles.iter().flatten()) {

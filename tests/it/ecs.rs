@@ -14,7 +14,13 @@ use crate::common::data_dir;
 
 fn app() -> App {
     let mut app = App::new();
-    app.add_plugins((MinimalPlugins, AssetPlugin::default(), bevy::mesh::MeshPlugin, RigCorePlugin, SkinningPlugin));
+    app.add_plugins((
+        MinimalPlugins,
+        AssetPlugin::default(),
+        bevy::mesh::MeshPlugin,
+        RigCorePlugin,
+        SkinningPlugin,
+    ));
     app
 }
 
@@ -32,9 +38,19 @@ fn spawn(app: &mut App, asset: Arc<CharacterAsset>, placement: Placement) -> Ent
 }
 
 fn mesh_positions(app: &App, character: Entity) -> Vec<[f32; 3]> {
-    let handle = app.world().get::<Character>(character).unwrap().mesh.clone();
+    let handle = app
+        .world()
+        .get::<Character>(character)
+        .unwrap()
+        .mesh
+        .clone();
     let meshes = app.world().resource::<Assets<Mesh>>();
-    match meshes.get(&handle).unwrap().attribute(Mesh::ATTRIBUTE_POSITION).unwrap() {
+    match meshes
+        .get(&handle)
+        .unwrap()
+        .attribute(Mesh::ATTRIBUTE_POSITION)
+        .unwrap()
+    {
         VertexAttributeValues::Float32x3(p) => p.clone(),
         _ => panic!("positions are Float32x3"),
     }
@@ -51,7 +67,11 @@ fn oracle(asset: &CharacterAsset, pose: &[JointRotation], placement: &Placement)
 
 fn assert_positions_close(a: &[[f32; 3]], b: &[[f32; 3]], tol: f32) {
     assert_eq!(a.len(), b.len());
-    let worst = a.iter().zip(b).map(|(x, y)| Vec3::from(*x).distance(Vec3::from(*y))).fold(0.0f32, f32::max);
+    let worst = a
+        .iter()
+        .zip(b)
+        .map(|(x, y)| Vec3::from(*x).distance(Vec3::from(*y)))
+        .fold(0.0f32, f32::max);
     assert!(worst <= tol, "largest difference {worst}");
 }
 
@@ -86,18 +106,30 @@ fn spawning_builds_the_joint_hierarchy_as_entities() {
 #[test]
 fn posing_a_joint_reskins_the_mesh_like_the_kernel() {
     let asset = Arc::new(embedded_puppet());
-    let placement = Placement { translation: Vec3::new(1.0, 0.0, -2.0), yaw: 0.4, scale: 1.5 };
+    let placement = Placement {
+        translation: Vec3::new(1.0, 0.0, -2.0),
+        yaw: 0.4,
+        scale: 1.5,
+    };
     let mut app = app();
     let character = spawn(&mut app, asset.clone(), placement);
     app.update();
-    assert_positions_close(&mesh_positions(&app, character), &oracle(&asset, &asset.skeleton.initial_pose(), &placement), 1e-5);
+    assert_positions_close(
+        &mesh_positions(&app, character),
+        &oracle(&asset, &asset.skeleton.initial_pose(), &placement),
+        1e-5,
+    );
     let elbow = asset.skeleton.find("l_elbow").unwrap();
     let rotation = JointRotation::euler_xyz(0.2, -0.9, 0.4);
     set_joint(&mut app, character, elbow, rotation);
     app.update();
     let mut pose = asset.skeleton.initial_pose();
     pose[elbow] = rotation;
-    assert_positions_close(&mesh_positions(&app, character), &oracle(&asset, &pose, &placement), 1e-5);
+    assert_positions_close(
+        &mesh_positions(&app, character),
+        &oracle(&asset, &pose, &placement),
+        1e-5,
+    );
 }
 
 #[test]
@@ -107,33 +139,61 @@ fn only_changed_characters_are_reskinned_and_skins_are_shared() {
     let a = spawn(&mut app, asset.clone(), Placement::default());
     let b = spawn(&mut app, asset.clone(), Placement::at(Vec3::X));
     app.update();
-    assert!(Arc::ptr_eq(&app.world().get::<Character>(a).unwrap().asset, &app.world().get::<Character>(b).unwrap().asset));
+    assert!(Arc::ptr_eq(
+        &app.world().get::<Character>(a).unwrap().asset,
+        &app.world().get::<Character>(b).unwrap().asset
+    ));
     let before_b = mesh_positions(&app, b);
     set_joint(&mut app, a, 3, JointRotation::euler_xyz(0.5, 0.0, 0.0));
     app.update();
-    assert_eq!(app.world().get::<PoseDirty>(a).unwrap(), &PoseDirty::default());
+    assert_eq!(
+        app.world().get::<PoseDirty>(a).unwrap(),
+        &PoseDirty::default()
+    );
     assert_eq!(mesh_positions(&app, b), before_b);
-    assert_ne!(mesh_positions(&app, a), oracle(&asset, &asset.skeleton.initial_pose(), &Placement::default()));
+    assert_ne!(
+        mesh_positions(&app, a),
+        oracle(
+            &asset,
+            &asset.skeleton.initial_pose(),
+            &Placement::default()
+        )
+    );
 }
 
 #[test]
 fn poses_set_outside_the_limits_are_clamped() {
-    let Some(data) = data_dir("poses_set_outside_the_limits_are_clamped") else { return };
-    let asset = Arc::new(marionette::formats::load_character(&data.join("cse169/project1/test.skel")).unwrap());
+    let Some(data) = data_dir("poses_set_outside_the_limits_are_clamped") else {
+        return;
+    };
+    let asset = Arc::new(
+        marionette::formats::load_character(&data.join("cse169/project1/test.skel")).unwrap(),
+    );
     let knee = asset.skeleton.find("knee_r").unwrap();
     let mut app = app();
     let character = spawn(&mut app, asset, Placement::default());
     app.update();
-    set_joint(&mut app, character, knee, JointRotation::euler_xyz(-5.0, 1.0, 1.0));
+    set_joint(
+        &mut app,
+        character,
+        knee,
+        JointRotation::euler_xyz(-5.0, 1.0, 1.0),
+    );
     app.update();
     let entity = app.world().get::<Character>(character).unwrap().joints[knee];
-    assert_eq!(app.world().get::<JointPose>(entity).unwrap().0, JointRotation::euler_xyz(-2.0, 0.0, 0.0));
+    assert_eq!(
+        app.world().get::<JointPose>(entity).unwrap().0,
+        JointRotation::euler_xyz(-2.0, 0.0, 0.0)
+    );
 }
 
 #[test]
 fn model1_in_the_ecs_matches_the_kernel() {
-    let Some(data) = data_dir("model1_in_the_ecs_matches_the_kernel") else { return };
-    let asset = Arc::new(marionette::formats::load_character(&data.join("mit6837/Model1.skel")).unwrap());
+    let Some(data) = data_dir("model1_in_the_ecs_matches_the_kernel") else {
+        return;
+    };
+    let asset =
+        Arc::new(marionette::formats::load_character(&data.join("mit6837/Model1.skel")).unwrap());
     let mut app = app();
     let character = spawn(&mut app, asset.clone(), Placement::default());
     app.update();
@@ -142,5 +202,9 @@ fn model1_in_the_ecs_matches_the_kernel() {
     app.update();
     let mut pose = asset.skeleton.initial_pose();
     pose[6] = rotation;
-    assert_positions_close(&mesh_positions(&app, character), &oracle(&asset, &pose, &Placement::default()), 1e-5);
+    assert_positions_close(
+        &mesh_positions(&app, character),
+        &oracle(&asset, &pose, &Placement::default()),
+        1e-5,
+    );
 }

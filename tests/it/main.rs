@@ -3,5 +3,6 @@
 mod common;
 mod data;
 mod ecs;
+mod editor;
 mod formats;
 mod rig;

@@ -1,0 +1,266 @@
+//! The editor's document layer: scene files, undo history, screenshots and the headless
+//! render.
+
+use std::collections::BTreeMap;
+use std::io::Cursor;
+use std::path::PathBuf;
+use std::process::Command;
+
+use marionette::editor::document::{pose_from_doc, read_scene, write_scene};
+use marionette::editor::history::History;
+use marionette::editor::screenshot::timestamp;
+use marionette::formats::scene::{
+    CharacterDoc, PlacementDoc, SceneDoc, SourceDoc, ViewDoc, parse_scene, scene_to_string,
+};
+use marionette::rig::JointRotation;
+
+use crate::common::{data_dir, scratch};
+
+fn doc_with(source: SourceDoc, pose: &[(&str, JointRotation)]) -> SceneDoc {
+    SceneDoc {
+        characters: vec![CharacterDoc {
+            source,
+            name: "c".into(),
+            placement: PlacementDoc {
+                translation: [0.5, 0.0, -1.0],
+                yaw: 0.3,
+                scale: 1.2,
+            },
+            pose: pose
+                .iter()
+                .map(|(k, r)| (k.to_string(), *r))
+                .collect::<BTreeMap<_, _>>(),
+            view: ViewDoc {
+                weight_colors: true,
+                ..ViewDoc::default()
+            },
+            smpl: None,
+        }],
+        camera: None,
+        stage: Default::default(),
+    }
+}
+
+#[test]
+fn scenes_round_trip_with_paths_relative_to_the_scene() {
+    let dir = scratch("scene-round-trip");
+    std::fs::create_dir_all(dir.join("models")).unwrap();
+    let character = dir.join("models/m.skel");
+    std::fs::write(&character, "0 0 0 -1\n0 1 0 0\n").unwrap();
+    let doc = doc_with(
+        SourceDoc::File(character.clone()),
+        &[("joint1", JointRotation::euler_xyz(0.1, 0.2, 0.3))],
+    );
+    let path = dir.join("scene.ron");
+    write_scene(&path, &doc).unwrap();
+    let text = std::fs::read_to_string(&path).unwrap();
+    assert!(
+        text.contains("File(\"models/m.skel\")"),
+        "stored relative to the scene: {text}"
+    );
+    let back = read_scene(&path).unwrap();
+    assert_eq!(
+        back.characters[0].source,
+        SourceDoc::File(dir.join("models/m.skel"))
+    );
+    assert_eq!(back.characters[0].pose, doc.characters[0].pose);
+    assert_eq!(back.characters[0].placement, doc.characters[0].placement);
+    assert_eq!(back.characters[0].view, doc.characters[0].view);
+}
+
+#[test]
+fn a_failed_save_leaves_the_previous_file_whole() {
+    let dir = scratch("atomic-save");
+    let path = dir.join("scene.ron");
+    std::fs::write(&path, "previous").unwrap();
+    let result = marionette::formats::write_atomically(&path, |w| {
+        std::io::Write::write_all(w, b"half a scen")?;
+        Err(std::io::Error::other("disk full"))
+    });
+    assert!(result.is_err());
+    assert_eq!(std::fs::read_to_string(&path).unwrap(), "previous");
+    let leftovers: Vec<PathBuf> = std::fs::read_dir(&dir)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .collect();
+    assert_eq!(leftovers, vec![path], "no temporary file is left behind");
+}
+
+#[test]
+fn a_malformed_scene_reports_its_line() {
+    let e = parse_scene(
+        Cursor::new("(\n  characters: [\n    (source: Nowhere(\"x\"))\n  ],\n)\n"),
+        std::path::Path::new("s.ron"),
+    )
+    .unwrap_err();
+    assert!(e.to_string().starts_with("s.ron:3: "), "{e}");
+}
+
+#[test]
+fn unknown_joints_in_a_scene_pose_are_reported_not_fatal() {
+    let asset = marionette::puppet::embedded_puppet();
+    let doc = doc_with(
+        SourceDoc::Embedded("puppet".into()),
+        &[
+            ("l_elbow", JointRotation::euler_xyz(0.0, 1.0, 0.0)),
+            ("tail", JointRotation::euler_xyz(1.0, 0.0, 0.0)),
+        ],
+    );
+    let (pose, messages) = pose_from_doc(&asset, &doc.characters[0]);
+    assert_eq!(
+        pose[asset.skeleton.find("l_elbow").unwrap()],
+        JointRotation::euler_xyz(0.0, 1.0, 0.0)
+    );
+    assert_eq!(messages.len(), 1);
+    assert!(messages[0].contains("no joint `tail`"), "{}", messages[0]);
+}
+
+#[test]
+fn history_takes_one_step_per_gesture_and_redoes() {
+    let a = doc_with(SourceDoc::Embedded("puppet".into()), &[]);
+    let mut b = a.clone();
+    b.characters[0].name = "b".into();
+    let mut c = a.clone();
+    c.characters[0].name = "c2".into();
+    let mut h = History::default();
+    h.begin_edit(&a);
+    h.begin_edit(&b); // same gesture: ignored
+    h.end_gesture();
+    h.begin_edit(&b);
+    h.end_gesture();
+    assert_eq!(h.undo.len(), 2);
+    assert_eq!(h.undo(c.clone()), Some(b.clone()));
+    assert_eq!(h.undo(b.clone()), Some(a.clone()));
+    assert_eq!(h.undo(a.clone()), None);
+    assert_eq!(h.redo(a.clone()), Some(b.clone()));
+    assert_eq!(h.redo(b.clone()), Some(c.clone()));
+    h.begin_edit(&c);
+    assert!(h.redo.is_empty(), "a new edit drops the redo steps");
+}
+
+#[test]
+fn screenshot_names_carry_the_utc_date_and_time() {
+    assert_eq!(timestamp(0), "1970-01-01_00-00-00");
+    assert_eq!(timestamp(1_795_315_505), "2026-11-22_02-45-05");
+    assert_eq!(timestamp(951_782_400), "2000-02-29_00-00-00");
+}
+
+#[test]
+fn the_shipped_assets_are_what_the_generator_makes() {
+    let scene = marionette::editor::document::default_scene_doc();
+    assert_eq!(scene, marionette::editor::default_scene::generate());
+    assert!(scene.characters.len() >= 2);
+    let dir = scratch("gen-assets");
+    marionette::puppet::write_6837(&marionette::puppet::puppet(), &dir, "puppet").unwrap();
+    for ext in ["skel", "obj", "attach"] {
+        let made = std::fs::read_to_string(dir.join(format!("puppet.{ext}"))).unwrap();
+        let shipped = std::fs::read_to_string(format!(
+            "{}/assets/puppet.{ext}",
+            env!("CARGO_MANIFEST_DIR")
+        ))
+        .unwrap();
+        assert!(
+            made == shipped,
+            "assets/puppet.{ext} is stale: run `marionette gen-assets assets`"
+        );
+    }
+    let _ = scene_to_string(&scene);
+}
+
+/// Renders a small scene headlessly (Vulkan; llvmpipe without a GPU) and checks the picture.
+#[test]
+fn render_draws_characters_distinct_from_floor_and_sky_with_weight_hues() {
+    let dir = scratch("render");
+    let mut doc = doc_with(
+        SourceDoc::Embedded("puppet".into()),
+        &[("l_shoulder", JointRotation::euler_xyz(0.0, 0.0, -1.0))],
+    );
+    doc.characters[0].placement = PlacementDoc {
+        translation: [0.0, 0.0, 0.0],
+        yaw: 0.0,
+        scale: 1.0,
+    };
+    doc.camera = Some(marionette::formats::scene::CameraDoc {
+        focus: [0.0, 0.5, 0.0],
+        yaw: 0.0,
+        pitch: -0.2,
+        distance: 1.6,
+    });
+    let scene = dir.join("scene.ron");
+    write_scene(&scene, &doc).unwrap();
+    let out = dir.join("shot.png");
+    let output = Command::new(env!("CARGO_BIN_EXE_marionette"))
+        .args(["render", "--width", "200", "--height", "150", "--out"])
+        .arg(&out)
+        .arg(&scene)
+        .output()
+        .unwrap();
+    assert!(
+        output.status.success(),
+        "render failed: {}",
+        String::from_utf8_lossy(&output.stderr)
+    );
+    let img = image::open(&out).unwrap().to_rgb8();
+    assert_eq!(img.dimensions(), (200, 150));
+    let sky = *img.get_pixel(100, 2);
+    let floor = *img.get_pixel(100, 147);
+    assert_ne!(sky, floor);
+    let far = |p: &image::Rgb<u8>, q: &image::Rgb<u8>| {
+        p.0.iter()
+            .zip(q.0)
+            .map(|(a, b)| (*a as i32 - b as i32).abs())
+            .sum::<i32>()
+            > 60
+    };
+    let character: Vec<&image::Rgb<u8>> = img
+        .pixels()
+        .filter(|p| far(p, &sky) && far(p, &floor))
+        .collect();
+    assert!(
+        character.len() > 1000,
+        "only {} character pixels",
+        character.len()
+    );
+    // Weight colours: several distinct hues among saturated pixels.
+    let mut hues = std::collections::BTreeSet::new();
+    for p in &character {
+        let [r, g, b] = p.0.map(|c| c as f32 / 255.0);
+        let (max, min) = (r.max(g).max(b), r.min(g).min(b));
+        if max - min < 0.15 {
+            continue;
+        }
+        let h = if max == r {
+            ((g - b) / (max - min)).rem_euclid(6.0)
+        } else if max == g {
+            (b - r) / (max - min) + 2.0
+        } else {
+            (r - g) / (max - min) + 4.0
+        };
+        hues.insert((h * 2.0) as i32); // 12 bins of 30°
+    }
+    assert!(hues.len() >= 4, "hues seen: {hues:?}");
+}
+
+#[test]
+fn model1_and_model2_render_side_by_side() {
+    let Some(data) = data_dir("model1_and_model2_render_side_by_side") else {
+        return;
+    };
+    let out = scratch("render-models").join("models.png");
+    let output = Command::new(env!("CARGO_BIN_EXE_marionette"))
+        .args(["render", "--width", "160", "--height", "120", "--out"])
+        .arg(&out)
+        .arg(data.join("mit6837/Model1.skel"))
+        .arg(data.join("mit6837/Model2.skel"))
+        .output()
+        .unwrap();
+    assert!(
+        output.status.success(),
+        "{}",
+        String::from_utf8_lossy(&output.stderr)
+    );
+    assert_eq!(
+        image::open(&out).unwrap().to_rgb8().dimensions(),
+        (160, 120)
+    );
+}
