@@ -11,3 +11,4 @@ pub mod posing;
 pub mod puppet;
 pub mod rig;
 pub mod scene;
+pub mod smpl_tasks;

@@ -52,6 +52,38 @@ enum Command {
         #[arg(long, default_value_t = 720)]
         height: u32,
     },
+    /// The SMPL exercise: writes frame000.obj, frame001.obj, ... into --out.
+    ///
+    /// Tasks: 1 the shapes β0, β1, β2 (unskinned); 2 L_Elbow moved +0.2 in y, absolute
+    /// (descendants stay); 3 the same, relative (descendants follow); 4 L_Shoulder rotated
+    /// by (0, 0, -0.3827, 0.9239); 5 clip 7516 for β0, β1, β2 (480 frames).
+    ///
+    /// --sequence SPEC plays segments one after another: SPEC is CLIP[:FROM-TO][:BETA]
+    /// joined by commas. CLIP is a clip file or the end of its name (7516); FROM-TO an
+    /// inclusive frame range (40- runs to the end); BETA is 0, 1, 2 (the exercise's βs) or
+    /// ten numbers joined by /. Consecutive segments overlap by --transition frames with
+    /// α from 0 (first transition frame) to 1 (N-th); β blends linearly, rotations by
+    /// normalised linear interpolation (or --slerp).
+    /// Example: --sequence 7516:0-99:1,8806:20-:2 --transition 30
+    #[command(verbatim_doc_comment)]
+    Smpl {
+        /// The folder with smpl_00.obj ... smpl_skin.txt and the clips.
+        #[arg(long)]
+        data: PathBuf,
+        #[arg(long, value_parser = clap::value_parser!(u32).range(1..=5), conflicts_with = "sequence", required_unless_present = "sequence")]
+        task: Option<u32>,
+        #[arg(long, value_name = "SPEC")]
+        sequence: Option<String>,
+        #[arg(long, default_value_t = 20)]
+        transition: usize,
+        #[arg(long)]
+        slerp: bool,
+        #[arg(long)]
+        out: PathBuf,
+        /// Use the straightforward single-threaded writer (for timing against it).
+        #[arg(long)]
+        naive: bool,
+    },
     /// Rebuild the project's own characters into a folder (normally `assets`).
     GenAssets {
         #[arg(default_value = "assets")]
@@ -110,6 +142,15 @@ fn run(cli: Cli) -> Result<()> {
                 started.elapsed().as_secs_f64()
             );
         }
+        Some(Command::Smpl {
+            data,
+            task,
+            sequence,
+            transition,
+            slerp,
+            out,
+            naive,
+        }) => smpl(&data, task, sequence, transition, slerp, &out, naive)?,
         Some(Command::GenAssets { dir }) => {
             marionette::puppet::write_6837(&marionette::puppet::puppet(), &dir, "puppet")
                 .with_context(|| format!("writing {}", dir.display()))?;
@@ -125,6 +166,68 @@ fn run(cli: Cli) -> Result<()> {
             );
         }
     }
+    Ok(())
+}
+
+fn smpl(
+    data: &std::path::Path,
+    task: Option<u32>,
+    sequence: Option<String>,
+    transition: usize,
+    slerp: bool,
+    out: &std::path::Path,
+    naive: bool,
+) -> Result<()> {
+    use marionette::rig::smpl::BlendMode;
+    use marionette::smpl_tasks::{
+        parse_sequence, sequence_frames, task_frames, write_frames, write_frames_naive,
+    };
+    let started = std::time::Instant::now();
+    let (model, warnings) = marionette::formats::smpl::load_smpl_dir(data)?;
+    warnings.iter().for_each(|w| eprintln!("warning: {w}"));
+    let frames = match (task, sequence) {
+        (Some(task), _) => task_frames(&model, data, task)?,
+        (None, Some(spec)) => {
+            let segments = parse_sequence(&spec).map_err(anyhow::Error::msg)?;
+            sequence_frames(
+                &model,
+                data,
+                &segments,
+                transition,
+                if slerp {
+                    BlendMode::Slerp
+                } else {
+                    BlendMode::Nlerp
+                },
+            )?
+        }
+        (None, None) => anyhow::bail!("give --task N or --sequence SPEC"),
+    };
+    let loaded = started.elapsed();
+    let bar = indicatif::ProgressBar::new(frames.len() as u64);
+    bar.set_style(
+        indicatif::ProgressStyle::with_template(
+            "{bar:40} {pos}/{len} frames {elapsed} (eta {eta})",
+        )
+        .expect("valid template"),
+    );
+    let tick = || bar.inc(1);
+    if naive {
+        write_frames_naive(&model, &frames, out, &tick)?;
+    } else {
+        write_frames(&model, &frames, out, &tick)?;
+    }
+    bar.finish_and_clear();
+    let total = started.elapsed();
+    println!(
+        "wrote {} frames to {} in {:.2} s (loading {:.2} s, frames {:.2} s){}",
+        frames.len(),
+        out.display(),
+        total.as_secs_f64(),
+        loaded.as_secs_f64(),
+        (total - loaded).as_secs_f64(),
+        if naive { " [naive]" } else { "" }
+    );
     Ok(())
 }
 

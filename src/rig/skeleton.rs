@@ -151,22 +151,36 @@ impl Skeleton {
     /// Validates a raw joint list whose parents already precede their children and keeps
     /// its order (file indices stay joint indices, as weight files expect).
     pub fn build(raw: Vec<RawJoint>) -> Result<Self, RigError> {
+        let n = raw.len();
         for (i, j) in raw.iter().enumerate() {
             if let Some(p) = j.parent
                 && p >= i
-                && p < raw.len()
+                && p < n
             {
-                // A forward reference: either a cycle or an order the caller must fix.
-                let (skeleton, new_index) = Self::build_reordered(raw)?;
+                // A forward reference: a cycle, or an order only `build_reordered` accepts.
+                Self::build_reordered(raw.clone())?;
                 return Err(RigError::NotParentFirst {
-                    joint: skeleton.joints[new_index[i]].name.clone(),
+                    joint: j.name.clone(),
                     index: i,
                     parent: p,
                 });
             }
         }
-        let (skeleton, _) = Self::build_reordered(raw)?;
-        Ok(skeleton)
+        // Validates roots and ranges; with parents first, the depth-first order found there
+        // is only used for checking, the file order is kept.
+        Self::build_reordered(raw.clone())?;
+        let joints = raw
+            .into_iter()
+            .map(|j| JointDef {
+                initial_rotation: j.initial_rotation.clamped(&j.limits),
+                name: j.name,
+                parent: j.parent,
+                rest_offset: j.rest_offset,
+                limits: j.limits,
+                bone_box: j.bone_box,
+            })
+            .collect();
+        Ok(Self::from_ordered(joints))
     }
 
     fn from_ordered(joints: Vec<JointDef>) -> Self {

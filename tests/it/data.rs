@@ -19,7 +19,11 @@ fn all_four_6837_models_load() {
         assert_eq!(asset.skeleton.len(), 18, "Model{m}");
         assert_eq!(asset.vertex_count(), 13336, "Model{m}");
         assert_eq!(asset.triangle_count(), 26668, "Model{m}");
-        assert_eq!(asset.skeleton.parent(16), Some(15));
+        // File order is joint order (the .attach columns index it).
+        let parents: Vec<Option<usize>> = (0..18).map(|j| asset.skeleton.parent(j)).collect();
+        let expected = [-1, 0, 1, 0, 2, 4, 5, 6, 2, 8, 9, 10, 0, 12, 13, 0, 15, 16]
+            .map(|p: i32| (p >= 0).then_some(p as usize));
+        assert_eq!(parents, expected.to_vec(), "Model{m}");
         assert!(asset.skin.weights.max_influences() <= 17);
     }
 }

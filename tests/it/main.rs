@@ -6,3 +6,4 @@ mod ecs;
 mod editor;
 mod formats;
 mod rig;
+mod smpl;

@@ -178,6 +178,16 @@ fn skeleton_validation_rejects_bad_trees() {
         Skeleton::build(raw.clone()).unwrap_err(),
         RigError::NotParentFirst { .. }
     ));
+    // Parents first but not depth-first: `build` keeps the file order.
+    let kept = Skeleton::build(vec![
+        RawJoint::new("r", None, Vec3::ZERO),
+        RawJoint::new("a", Some(0), Vec3::ZERO),
+        RawJoint::new("b", Some(0), Vec3::ZERO),
+        RawJoint::new("a1", Some(1), Vec3::ZERO),
+    ])
+    .unwrap();
+    assert_eq!(kept.joint(3).name, "a1");
+    assert_eq!(kept.parent(3), Some(1));
     let (s, new_index) = Skeleton::build_reordered(raw).unwrap();
     assert_eq!(s.joint(0).name, "root");
     assert_eq!(new_index, vec![1, 0]);
