@@ -9,12 +9,14 @@ use bevy::ecs::system::SystemParam;
 use bevy::prelude::*;
 
 use super::camera::OrbitCamera;
+use super::smpl::SmplCharacter;
 use super::stage::StageSettings;
 use crate::formats::scene::{
     CameraDoc, CharacterDoc, DisplayDoc, PlacementDoc, SceneDoc, SourceDoc, ViewDoc,
     joint_of_pose_key, pose_key,
 };
 use crate::formats::{FormatError, load_character};
+use crate::rig::smpl::{Clip, SmplModel};
 use crate::rig::{CharacterAsset, JointRotation};
 use crate::scene::{Character, DisplayMode, JointPose, Placement, SkinView, spawn_character_posed};
 
@@ -33,7 +35,11 @@ pub struct SceneCharacter {
 #[derive(Resource, Default)]
 pub struct AssetLibrary {
     cache: HashMap<SourceDoc, Arc<CharacterAsset>>,
+    smpl: HashMap<PathBuf, SmplSet>,
 }
+
+/// An SMPL model and the clips of its folder.
+pub type SmplSet = (Arc<SmplModel>, Vec<(String, Arc<Clip>)>);
 
 impl AssetLibrary {
     /// The character of `source`, loaded once.
@@ -53,6 +59,31 @@ impl AssetLibrary {
         });
         self.cache.insert(source.clone(), asset.clone());
         Ok(asset)
+    }
+
+    /// The SMPL model and clips of a folder, loaded once.
+    pub fn smpl(&mut self, dir: &Path) -> Result<SmplSet, FormatError> {
+        if let Some(set) = self.smpl.get(dir) {
+            return Ok(set.clone());
+        }
+        let (model, _) = crate::formats::smpl::load_smpl_dir(dir)?;
+        let n = model.skeleton.len();
+        let clips = crate::formats::smpl::clip_paths(dir)
+            .into_iter()
+            .map(|p| {
+                let clip =
+                    crate::formats::smpl::parse_clip(crate::formats::error::open(&p)?, &p, n)?;
+                Ok((
+                    p.file_name()
+                        .map(|f| f.to_string_lossy().into_owned())
+                        .unwrap_or_default(),
+                    Arc::new(clip),
+                ))
+            })
+            .collect::<Result<Vec<_>, FormatError>>()?;
+        let set = (Arc::new(model), clips);
+        self.smpl.insert(dir.to_path_buf(), set.clone());
+        Ok(set)
     }
 }
 
@@ -90,6 +121,7 @@ pub struct SceneReader<'w, 's> {
             &'static Placement,
             &'static SkinView,
             &'static DisplayMode,
+            Option<&'static SmplCharacter>,
         ),
     >,
     pub poses: Query<'w, 's, &'static JointPose>,
@@ -103,11 +135,10 @@ impl SceneReader<'_, '_> {
         let mut characters: Vec<(u64, CharacterDoc)> = self
             .characters
             .iter()
-            .map(|(_, sc, character, placement, view, display)| {
-                (
-                    sc.id,
-                    self.character_doc(sc, character, placement, view, display),
-                )
+            .map(|(_, sc, character, placement, view, display, smpl)| {
+                let mut doc = self.character_doc(sc, character, placement, view, display);
+                doc.smpl = smpl.map(SmplCharacter::doc);
+                (sc.id, doc)
             })
             .collect();
         characters.sort_by_key(|(id, _)| *id);
@@ -240,6 +271,17 @@ pub fn spawn_from_doc(
             Visibility::Hidden
         },
     ));
+    if let SourceDoc::File(dir) = &doc.source
+        && crate::formats::smpl::is_smpl_dir(dir)
+    {
+        let (model, clips) = library.smpl(dir)?;
+        commands.entity(entity).insert(SmplCharacter::new(
+            model,
+            dir.clone(),
+            clips,
+            doc.smpl.as_ref(),
+        ));
+    }
     Ok((entity, messages))
 }
 

@@ -15,6 +15,7 @@ use super::document::{
 };
 use super::history::{History, HistoryRequest};
 use super::screenshot::ScreenshotRequest;
+use super::smpl::SmplCharacter;
 use super::stage::StageSettings;
 use super::{Messages, Selection};
 use crate::formats::scene::{CharacterDoc, PlacementDoc, SceneDoc, SourceDoc, ViewDoc};
@@ -88,6 +89,7 @@ pub struct Editable<'w, 's> {
     pub selection: ResMut<'w, Selection>,
     pub history: ResMut<'w, History>,
     pub messages: ResMut<'w, Messages>,
+    pub smpl: Query<'w, 's, &'static mut SmplCharacter>,
 }
 
 /// Adding, removing and loading characters and scenes.
@@ -313,6 +315,9 @@ fn scene_panel(
                 .checkbox(&mut sc.heat_of_selected, "weights of the selected joint")
                 .changed();
         });
+        if let Ok(mut body) = edit.smpl.get_mut(entity) {
+            edited |= smpl_panel(ui, &mut body);
+        }
     }
     if let Some(entity) = remove {
         ops.commands.entity(entity).despawn();
@@ -667,4 +672,115 @@ pub fn shortcuts(
             }
         }
     }
+}
+
+/// β sliders, clip list, timeline and blending of an SMPL body. Returns whether it edited.
+fn smpl_panel(ui: &mut egui::Ui, body: &mut Mut<SmplCharacter>) -> bool {
+    let mut edited = false;
+    egui::CollapsingHeader::new("SMPL shape and motion")
+        .default_open(true)
+        .show(ui, |ui| {
+            let mut betas = body.betas;
+            for (b, beta) in betas.iter_mut().enumerate() {
+                edited |= ui
+                    .add(
+                        egui::Slider::new(beta, -3.0..=3.0)
+                            .text(format!("β{}", b + 1))
+                            .max_decimals(3),
+                    )
+                    .changed();
+            }
+            if ui.small_button("Zero the shape").clicked() {
+                betas = [0.0; 10];
+                edited = true;
+            }
+            if betas != body.betas {
+                body.betas = betas;
+            }
+            let names: Vec<String> = body
+                .clips
+                .iter()
+                .map(|c| {
+                    c.0.trim_start_matches("smpl_quaternions_")
+                        .trim_end_matches(".txt")
+                        .to_string()
+                })
+                .collect();
+            let label = |i: Option<usize>| i.map_or("(none)".to_string(), |i| names[i].clone());
+            let mut clip = body.clip;
+            egui::ComboBox::from_label("clip")
+                .selected_text(label(clip))
+                .show_ui(ui, |ui| {
+                    ui.selectable_value(&mut clip, None, "(none)");
+                    for (i, n) in names.iter().enumerate() {
+                        ui.selectable_value(&mut clip, Some(i), n);
+                    }
+                });
+            if clip != body.clip {
+                body.clip = clip;
+                body.time = 0.0;
+                edited = true;
+            }
+            if body.clip.is_some() {
+                ui.horizontal(|ui| {
+                    let text = if body.playing { "Pause" } else { "Play" };
+                    if ui.button(text).clicked() {
+                        body.playing = !body.playing;
+                    }
+                    let mut looping = body.looping;
+                    if ui.checkbox(&mut looping, "loop").changed() {
+                        body.looping = looping;
+                    }
+                    let mut upright = body.upright;
+                    if ui.checkbox(&mut upright, "upright").changed() {
+                        body.upright = upright;
+                        edited = true;
+                    }
+                });
+                let last = body.clip_frames().saturating_sub(1) as f32;
+                let mut t = body.time;
+                if ui
+                    .add(
+                        egui::Slider::new(&mut t, 0.0..=last)
+                            .text("frame")
+                            .max_decimals(1),
+                    )
+                    .changed()
+                {
+                    body.time = t;
+                    edited = true;
+                }
+                let mut speed = body.speed;
+                if ui
+                    .add(egui::Slider::new(&mut speed, 0.1..=3.0).text("speed"))
+                    .changed()
+                {
+                    body.speed = speed;
+                }
+                let mut second = body.blend_clip;
+                egui::ComboBox::from_label("blend with")
+                    .selected_text(label(second))
+                    .show_ui(ui, |ui| {
+                        ui.selectable_value(&mut second, None, "(none)");
+                        for (i, n) in names.iter().enumerate() {
+                            ui.selectable_value(&mut second, Some(i), n);
+                        }
+                    });
+                if second != body.blend_clip {
+                    body.blend_clip = second;
+                    edited = true;
+                }
+                if body.blend_clip.is_some() {
+                    let mut blend = body.blend;
+                    if ui
+                        .add(egui::Slider::new(&mut blend, 0.0..=1.0).text("blend"))
+                        .changed()
+                    {
+                        body.blend = blend;
+                        edited = true;
+                    }
+                }
+            }
+        });
+    edited
 }

@@ -15,6 +15,7 @@ pub mod inspector;
 pub mod picking;
 pub mod render;
 pub mod screenshot;
+pub mod smpl;
 pub mod stage;
 
 use std::path::PathBuf;
@@ -72,6 +73,7 @@ impl Plugin for ViewPlugin {
             .init_resource::<AssetLibrary>()
             .init_resource::<PendingScene>()
             .init_resource::<NextCharacterId>()
+            .add_plugins(smpl::SmplEditorPlugin)
             .add_systems(
                 Startup,
                 (setup_skin_material, spawn_stage, queue_startup_scene).chain(),

@@ -136,7 +136,7 @@ impl Default for ViewDoc {
 }
 
 /// SMPL state of a character made from the SMPL folder.
-#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(default)]
 pub struct SmplDoc {
     pub betas: Vec<f32>,
@@ -150,6 +150,9 @@ pub struct SmplDoc {
     /// A second clip blended in with `blend` (0 = first clip only).
     pub blend_clip: Option<String>,
     pub blend: f32,
+    /// Stand the clip up: turn the root so the clip's first frame is upright (the mocap
+    /// clips carry a global rotation from a z-up capture).
+    pub upright: bool,
 }
 
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -203,6 +206,22 @@ pub struct SceneDoc {
     pub camera: Option<CameraDoc>,
     #[serde(default)]
     pub stage: StageDoc,
+}
+
+impl Default for SmplDoc {
+    fn default() -> Self {
+        Self {
+            betas: Vec::new(),
+            clip: None,
+            time: 0.0,
+            playing: false,
+            speed: 1.0,
+            looping: true,
+            blend_clip: None,
+            blend: 0.0,
+            upright: true,
+        }
+    }
 }
 
 /// The key a joint's pose is stored under: its name, or `name#index` when another joint
