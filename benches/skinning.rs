@@ -38,9 +38,8 @@ fn asset() -> Arc<CharacterAsset> {
 
 fn posed_palette(asset: &CharacterAsset) -> Vec<Mat4> {
     let n = asset.skeleton.len();
-    let pose: Vec<JointRotation> = (0..n)
-        .map(|i| JointRotation::euler_xyz(0.1 * i as f32, 0.05, -0.02 * i as f32))
-        .collect();
+    let pose: Vec<JointRotation> =
+        (0..n).map(|i| JointRotation::euler_xyz(0.1 * i as f32, 0.05, -0.02 * i as f32)).collect();
     let mut current = vec![Mat4::IDENTITY; n];
     forward_kinematics(&asset.skeleton, &pose, Mat4::IDENTITY, &mut current);
     let mut palette = vec![Mat4::IDENTITY; n];
@@ -55,12 +54,7 @@ fn kernel_skin_positions(bencher: Bencher) {
     let palette = posed_palette(&asset);
     let mut out = vec![Vec3::ZERO; asset.vertex_count()];
     bencher.bench_local(|| {
-        skin_positions(
-            &asset.skin.bind_positions,
-            &asset.skin.weights,
-            &palette,
-            divan::black_box(&mut out),
-        )
+        skin_positions(&asset.skin.bind_positions, &asset.skin.weights, &palette, divan::black_box(&mut out))
     });
 }
 
@@ -73,18 +67,8 @@ fn kernel_skin_and_flat_shade(bencher: Bencher) {
     let n = asset.triangle_count() * 3;
     let (mut p, mut nrm) = (vec![[0.0; 3]; n], vec![[0.0; 3]; n]);
     bencher.bench_local(|| {
-        skin_positions(
-            &asset.skin.bind_positions,
-            &asset.skin.weights,
-            &palette,
-            &mut skinned,
-        );
-        flat_shade(
-            &skinned,
-            &asset.skin.triangles,
-            &mut p,
-            divan::black_box(&mut nrm),
-        );
+        skin_positions(&asset.skin.bind_positions, &asset.skin.weights, &palette, &mut skinned);
+        flat_shade(&skinned, &asset.skin.triangles, &mut p, divan::black_box(&mut nrm));
     });
 }
 
@@ -93,13 +77,7 @@ fn kernel_skin_and_flat_shade(bencher: Bencher) {
 fn ecs_frame(bencher: Bencher, characters: usize) {
     let asset = asset();
     let mut app = App::new();
-    app.add_plugins((
-        MinimalPlugins,
-        AssetPlugin::default(),
-        bevy::mesh::MeshPlugin,
-        RigCorePlugin,
-        SkinningPlugin,
-    ));
+    app.add_plugins((MinimalPlugins, AssetPlugin::default(), bevy::mesh::MeshPlugin, RigCorePlugin, SkinningPlugin));
     let joints: Vec<Entity> = {
         let world = app.world_mut();
         let mut meshes = world.remove_resource::<Assets<Mesh>>().unwrap();
@@ -107,29 +85,19 @@ fn ecs_frame(bencher: Bencher, characters: usize) {
         let ids: Vec<Entity> = {
             let mut commands = Commands::new(&mut queue, world);
             (0..characters)
-                .map(|i| {
-                    spawn_character(
-                        &mut commands,
-                        &mut meshes,
-                        asset.clone(),
-                        Placement::at(Vec3::X * i as f32),
-                    )
-                })
+                .map(|i| spawn_character(&mut commands, &mut meshes, asset.clone(), Placement::at(Vec3::X * i as f32)))
                 .collect()
         };
         queue.apply(world);
         world.insert_resource(meshes);
-        ids.iter()
-            .map(|&c| world.get::<Character>(c).unwrap().joints[6.min(asset.skeleton.len() - 1)])
-            .collect()
+        ids.iter().map(|&c| world.get::<Character>(c).unwrap().joints[6.min(asset.skeleton.len() - 1)]).collect()
     };
     app.update();
     let mut angle = 0.0f32;
     bencher.bench_local(|| {
         angle += 0.01;
         for &j in &joints {
-            app.world_mut().get_mut::<JointPose>(j).unwrap().0 =
-                JointRotation::euler_xyz(angle, 0.0, 0.0);
+            app.world_mut().get_mut::<JointPose>(j).unwrap().0 = JointRotation::euler_xyz(angle, 0.0, 0.0);
         }
         app.update();
     });

@@ -8,14 +8,10 @@ use clap::{Parser, Subcommand};
 use glam::Mat4;
 
 use marionette::formats::{load_character, obj};
-use marionette::posing::{PoseSpec, apply_pose_specs, describe, posed_positions};
+use marionette::posing::{IkSpec, PoseSpec, apply_ik_specs, apply_pose_specs, describe, describe_ik, posed_positions};
 
 #[derive(Parser)]
-#[command(
-    name = "marionette",
-    version,
-    about = "Build scenes of skinned characters: load, pose, see and export them."
-)]
+#[command(name = "marionette", version, about = "Build scenes of skinned characters: load, pose, see and export them.")]
 struct Cli {
     #[command(subcommand)]
     command: Option<Command>,
@@ -40,6 +36,23 @@ enum Command {
         /// Angles outside the joint's limits are clamped. Repeatable.
         #[arg(long = "pose", value_name = "JOINT=rx,ry,rz")]
         poses: Vec<PoseSpec>,
+        /// `JOINT=x,y,z`: move JOINT to this world-space point by inverse kinematics
+        /// (FABRIK), after --pose. Repeatable.
+        #[arg(long = "ik", value_name = "JOINT=x,y,z")]
+        ik: Vec<IkSpec>,
+    },
+    /// Bind a mesh without weights to a skeleton (each vertex to its nearest bone, or
+    /// smoothly to the nearest few) and write 6.837-style weights.
+    Bind {
+        /// The mesh (.obj or .off).
+        mesh: PathBuf,
+        /// The skeleton (.skel of either course, or a Homer rig .json).
+        skeleton: PathBuf,
+        #[arg(long)]
+        out: PathBuf,
+        /// Blend the nearest bones' weights (falling off with distance) instead of one bone.
+        #[arg(long)]
+        smooth: bool,
     },
     /// Render a scene (.ron) or characters offscreen to a PNG, without a window.
     Render {
@@ -51,6 +64,12 @@ enum Command {
         width: u32,
         #[arg(long, default_value_t = 720)]
         height: u32,
+        /// `JOINT=rx,ry,rz` applied to every character that has the joint. Repeatable.
+        #[arg(long = "pose", value_name = "JOINT=rx,ry,rz")]
+        poses: Vec<PoseSpec>,
+        /// `JOINT=x,y,z` world-space IK target for every character that has the joint.
+        #[arg(long = "ik", value_name = "JOINT=x,y,z")]
+        ik: Vec<IkSpec>,
     },
     /// The SMPL exercise: writes frame000.obj, frame001.obj, ... into --out.
     ///
@@ -106,67 +125,90 @@ fn run(cli: Cli) -> Result<()> {
         None => marionette::editor::run(Vec::new()),
         Some(Command::Edit { paths }) => marionette::editor::run(paths),
         Some(Command::Info { path }) => print!("{}", describe(&load_character(&path)?)),
-        Some(Command::Export { path, out, poses }) => {
+        Some(Command::Export { path, out, poses, ik }) => {
             let asset = load_character(&path)?;
             for w in &asset.warnings {
                 eprintln!("warning: {w}");
             }
             let mut pose = asset.skeleton.initial_pose();
             apply_pose_specs(&asset.skeleton, &mut pose, &poses)?;
+            for report in apply_ik_specs(&asset.skeleton, &mut pose, Mat4::IDENTITY, &ik)? {
+                eprintln!("{}", describe_ik(&asset.skeleton, &report));
+            }
             let positions = posed_positions(&asset, &pose, Mat4::IDENTITY);
-            write_file(&out, |w| {
-                obj::write_obj(w, &positions, &asset.skin.triangles)
-            })?;
-            println!(
-                "wrote {} ({} vertices, {} triangles)",
-                out.display(),
-                positions.len(),
-                asset.triangle_count()
-            );
+            write_file(&out, |w| obj::write_obj(w, &positions, &asset.skin.triangles))?;
+            println!("wrote {} ({} vertices, {} triangles)", out.display(), positions.len(), asset.triangle_count());
         }
-        Some(Command::Render {
-            paths,
-            out,
-            width,
-            height,
-        }) => {
+        Some(Command::Render { paths, out, width, height, poses, ik }) => {
             let started = std::time::Instant::now();
-            let notes = marionette::editor::render::render(paths, out.clone(), width, height)
+            let edits = marionette::editor::StartupEdits { poses, ik };
+            let notes = marionette::editor::render::render(paths, edits, out.clone(), width, height)
                 .map_err(anyhow::Error::msg)?;
             for n in notes {
                 eprintln!("note: {n}");
             }
-            println!(
-                "wrote {} ({width}x{height}) in {:.2} s",
-                out.display(),
-                started.elapsed().as_secs_f64()
-            );
+            println!("wrote {} ({width}x{height}) in {:.2} s", out.display(), started.elapsed().as_secs_f64());
         }
-        Some(Command::Smpl {
-            data,
-            task,
-            sequence,
-            transition,
-            slerp,
-            out,
-            naive,
-        }) => smpl(&data, task, sequence, transition, slerp, &out, naive)?,
+        Some(Command::Bind { mesh, skeleton, out, smooth }) => bind(&mesh, &skeleton, &out, smooth)?,
+        Some(Command::Smpl { data, task, sequence, transition, slerp, out, naive }) => {
+            smpl(&data, task, sequence, transition, slerp, &out, naive)?
+        }
         Some(Command::GenAssets { dir }) => {
             marionette::puppet::write_6837(&marionette::puppet::puppet(), &dir, "puppet")
                 .with_context(|| format!("writing {}", dir.display()))?;
             let scene = dir.join("default_scene.ron");
-            marionette::formats::scene::save_scene(
-                &scene,
-                &marionette::editor::default_scene::generate(),
-            )?;
-            println!(
-                "wrote {}/puppet.{{skel,obj,attach}} and {}",
-                dir.display(),
-                scene.display()
-            );
+            marionette::formats::scene::save_scene(&scene, &marionette::editor::default_scene::generate())?;
+            println!("wrote {}/puppet.{{skel,obj,attach}} and {}", dir.display(), scene.display());
         }
     }
     Ok(())
+}
+
+fn bind(
+    mesh_path: &std::path::Path,
+    skeleton_path: &std::path::Path,
+    out: &std::path::Path,
+    smooth: bool,
+) -> Result<()> {
+    use marionette::formats::{error::open, mit6837, off};
+    use marionette::rig::bind::{bones, nearest_bone_weights, smooth_bone_weights};
+    let mesh = match mesh_path.extension().and_then(|e| e.to_str()) {
+        Some("off") => off::parse_off(open(mesh_path)?, mesh_path)?,
+        _ => obj::parse_obj(open(mesh_path)?, mesh_path)?,
+    };
+    let skeleton = match skeleton_path.extension().and_then(|e| e.to_str()) {
+        Some("json") => marionette::formats::homer::parse_rig(open(skeleton_path)?, skeleton_path)?.skeleton,
+        _ => load_character_skeleton(skeleton_path)?,
+    };
+    let mut world = vec![Mat4::IDENTITY; skeleton.len()];
+    marionette::rig::forward_kinematics(&skeleton, &skeleton.rest_pose(), Mat4::IDENTITY, &mut world);
+    let positions: Vec<glam::Vec3> = world.iter().map(|m| m.w_axis.truncate()).collect();
+    let all = bones(&skeleton, &positions);
+    let weights = if smooth {
+        smooth_bone_weights(&mesh.positions, &all, skeleton.len(), 3, 1.6)
+    } else {
+        nearest_bone_weights(&mesh.positions, &all)
+    };
+    write_file(out, |w| mit6837::write_attach(w, &weights, skeleton.len()))?;
+    println!(
+        "wrote {} ({} vertices, {} joints, {} binding)",
+        out.display(),
+        mesh.positions.len(),
+        skeleton.len(),
+        if smooth { "smooth" } else { "nearest-bone" }
+    );
+    Ok(())
+}
+
+/// The skeleton of a `.skel` of either course.
+fn load_character_skeleton(path: &std::path::Path) -> Result<marionette::rig::Skeleton> {
+    let text = std::fs::read_to_string(path).with_context(|| format!("reading {}", path.display()))?;
+    let reader = std::io::Cursor::new(text.clone());
+    Ok(if text.split_whitespace().next().is_some_and(|w| w.starts_with("balljoint")) {
+        marionette::formats::cse169::parse_skel(reader, path)?
+    } else {
+        marionette::formats::mit6837::parse_skel(reader, path)?
+    })
 }
 
 fn smpl(
@@ -179,9 +221,7 @@ fn smpl(
     naive: bool,
 ) -> Result<()> {
     use marionette::rig::smpl::BlendMode;
-    use marionette::smpl_tasks::{
-        parse_sequence, sequence_frames, task_frames, write_frames, write_frames_naive,
-    };
+    use marionette::smpl_tasks::{parse_sequence, sequence_frames, task_frames, write_frames, write_frames_naive};
     let started = std::time::Instant::now();
     let (model, warnings) = marionette::formats::smpl::load_smpl_dir(data)?;
     warnings.iter().for_each(|w| eprintln!("warning: {w}"));
@@ -194,11 +234,7 @@ fn smpl(
                 data,
                 &segments,
                 transition,
-                if slerp {
-                    BlendMode::Slerp
-                } else {
-                    BlendMode::Nlerp
-                },
+                if slerp { BlendMode::Slerp } else { BlendMode::Nlerp },
             )?
         }
         (None, None) => anyhow::bail!("give --task N or --sequence SPEC"),
@@ -206,10 +242,8 @@ fn smpl(
     let loaded = started.elapsed();
     let bar = indicatif::ProgressBar::new(frames.len() as u64);
     bar.set_style(
-        indicatif::ProgressStyle::with_template(
-            "{bar:40} {pos}/{len} frames {elapsed} (eta {eta})",
-        )
-        .expect("valid template"),
+        indicatif::ProgressStyle::with_template("{bar:40} {pos}/{len} frames {elapsed} (eta {eta})")
+            .expect("valid template"),
     );
     let tick = || bar.inc(1);
     if naive {
@@ -236,6 +270,5 @@ fn write_file(
     path: &std::path::Path,
     write: impl FnOnce(&mut std::io::BufWriter<std::fs::File>) -> std::io::Result<()>,
 ) -> Result<()> {
-    marionette::formats::write_atomically(path, write)
-        .with_context(|| format!("writing {}", path.display()))
+    marionette::formats::write_atomically(path, write).with_context(|| format!("writing {}", path.display()))
 }

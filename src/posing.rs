@@ -13,11 +13,7 @@ pub enum PoseSpecError {
     #[error("`{spec}`: expected JOINT=rx,ry,rz (radians)")]
     Syntax { spec: String },
     #[error("`{spec}`: no joint named or numbered `{joint}` (joints: {known})")]
-    UnknownJoint {
-        spec: String,
-        joint: String,
-        known: String,
-    },
+    UnknownJoint { spec: String, joint: String, known: String },
 }
 
 /// A parsed `JOINT=rx,ry,rz` (angles in radians, x applied first).
@@ -31,22 +27,14 @@ impl std::str::FromStr for PoseSpec {
     type Err = PoseSpecError;
 
     fn from_str(spec: &str) -> Result<Self, Self::Err> {
-        let err = || PoseSpecError::Syntax {
-            spec: spec.to_string(),
-        };
+        let err = || PoseSpecError::Syntax { spec: spec.to_string() };
         let (joint, angles) = spec.split_once('=').ok_or_else(err)?;
-        let a: Vec<f32> = angles
-            .split(',')
-            .map(|t| t.trim().parse::<f32>())
-            .collect::<Result<_, _>>()
-            .map_err(|_| err())?;
+        let a: Vec<f32> =
+            angles.split(',').map(|t| t.trim().parse::<f32>()).collect::<Result<_, _>>().map_err(|_| err())?;
         if joint.is_empty() || a.len() != 3 || a.iter().any(|v| !v.is_finite()) {
             return Err(err());
         }
-        Ok(Self {
-            joint: joint.to_string(),
-            angles: Vec3::new(a[0], a[1], a[2]),
-        })
+        Ok(Self { joint: joint.to_string(), angles: Vec3::new(a[0], a[1], a[2]) })
     }
 }
 
@@ -57,16 +45,11 @@ pub fn apply_pose_specs(
     specs: &[PoseSpec],
 ) -> Result<(), PoseSpecError> {
     for spec in specs {
-        let j = skeleton
-            .resolve(&spec.joint)
-            .ok_or_else(|| PoseSpecError::UnknownJoint {
-                spec: format!(
-                    "{}={},{},{}",
-                    spec.joint, spec.angles.x, spec.angles.y, spec.angles.z
-                ),
-                joint: spec.joint.clone(),
-                known: joint_list(skeleton),
-            })?;
+        let j = skeleton.resolve(&spec.joint).ok_or_else(|| PoseSpecError::UnknownJoint {
+            spec: format!("{}={},{},{}", spec.joint, spec.angles.x, spec.angles.y, spec.angles.z),
+            joint: spec.joint.clone(),
+            known: joint_list(skeleton),
+        })?;
         let order = match pose[j] {
             JointRotation::Euler(_, order) => order,
             JointRotation::Quat(_) => Default::default(),
@@ -86,23 +69,14 @@ fn joint_list(skeleton: &Skeleton) -> String {
 }
 
 /// The skin's vertices at `pose`, in source order, with the character placed by `placement`.
-pub fn posed_positions(
-    asset: &CharacterAsset,
-    pose: &[JointRotation],
-    placement: Mat4,
-) -> Vec<Vec3> {
+pub fn posed_positions(asset: &CharacterAsset, pose: &[JointRotation], placement: Mat4) -> Vec<Vec3> {
     let n = asset.skeleton.len();
     let mut current = vec![Mat4::IDENTITY; n];
     forward_kinematics(&asset.skeleton, pose, placement, &mut current);
     let mut palette = vec![Mat4::IDENTITY; n];
     skinning_palette(&current, &asset.bind_world_to_joint, &mut palette);
     let mut out = vec![Vec3::ZERO; asset.vertex_count()];
-    skin_positions(
-        &asset.skin.bind_positions,
-        &asset.skin.weights,
-        &palette,
-        &mut out,
-    );
+    skin_positions(&asset.skin.bind_positions, &asset.skin.weights, &palette, &mut out);
     out
 }
 
@@ -121,12 +95,7 @@ pub fn describe(asset: &CharacterAsset) -> String {
         } else {
             format!(
                 "  limits x[{:.3},{:.3}] y[{:.3},{:.3}] z[{:.3},{:.3}]",
-                j.limits.min.x,
-                j.limits.max.x,
-                j.limits.min.y,
-                j.limits.max.y,
-                j.limits.min.z,
-                j.limits.max.z
+                j.limits.min.x, j.limits.max.x, j.limits.min.y, j.limits.max.y, j.limits.min.z, j.limits.max.z
             )
         };
         out += &format!(
@@ -141,19 +110,9 @@ pub fn describe(asset: &CharacterAsset) -> String {
     out += &format!("skin: {kind}\n");
     out += &format!("vertices: {}\n", asset.vertex_count());
     out += &format!("triangles: {}\n", asset.triangle_count());
-    let avg = if w.vertex_count() > 0 {
-        w.total_influences() as f32 / w.vertex_count() as f32
-    } else {
-        0.0
-    };
-    out += &format!(
-        "influences per vertex: max {}, mean {avg:.2}\n",
-        w.max_influences()
-    );
-    out += &format!(
-        "bounds: ({:.3}, {:.3}, {:.3}) .. ({:.3}, {:.3}, {:.3})\n",
-        lo.x, lo.y, lo.z, hi.x, hi.y, hi.z
-    );
+    let avg = if w.vertex_count() > 0 { w.total_influences() as f32 / w.vertex_count() as f32 } else { 0.0 };
+    out += &format!("influences per vertex: max {}, mean {avg:.2}\n", w.max_influences());
+    out += &format!("bounds: ({:.3}, {:.3}, {:.3}) .. ({:.3}, {:.3}, {:.3})\n", lo.x, lo.y, lo.z, hi.x, hi.y, hi.z);
     if asset.warnings.is_empty() {
         out += "weight warnings: none\n";
     } else {
@@ -162,4 +121,61 @@ pub fn describe(asset: &CharacterAsset) -> String {
         }
     }
     out
+}
+
+/// A parsed `JOINT=x,y,z`: move the joint to a world-space target by IK.
+#[derive(Debug, Clone, PartialEq)]
+pub struct IkSpec {
+    pub joint: String,
+    pub target: Vec3,
+}
+
+impl std::str::FromStr for IkSpec {
+    type Err = PoseSpecError;
+
+    fn from_str(spec: &str) -> Result<Self, Self::Err> {
+        let pose: PoseSpec = spec
+            .parse()
+            .map_err(|_| PoseSpecError::Syntax { spec: format!("{spec} (expected JOINT=x,y,z, world space)") })?;
+        Ok(Self { joint: pose.joint, target: pose.angles })
+    }
+}
+
+/// Default IK tolerance (model units) and FK↔FABRIK rounds.
+pub const IK_TOLERANCE: f32 = 1e-4;
+pub const IK_ROUNDS: usize = 24;
+
+/// Solves the IK specs in turn on top of `pose` (after `--pose`), for a character placed
+/// by `placement`.
+pub fn apply_ik_specs(
+    skeleton: &Skeleton,
+    pose: &mut [JointRotation],
+    placement: Mat4,
+    specs: &[IkSpec],
+) -> Result<Vec<crate::rig::ik::IkReport>, PoseSpecError> {
+    let goals = specs
+        .iter()
+        .map(|s| {
+            let end = skeleton.resolve(&s.joint).ok_or_else(|| PoseSpecError::UnknownJoint {
+                spec: s.joint.clone(),
+                joint: s.joint.clone(),
+                known: joint_list(skeleton),
+            })?;
+            Ok(crate::rig::ik::IkGoal { end, target: s.target })
+        })
+        .collect::<Result<Vec<_>, PoseSpecError>>()?;
+    Ok(crate::rig::ik::solve_ik(skeleton, pose, placement, &goals, IK_TOLERANCE, IK_ROUNDS))
+}
+
+/// One line about an IK solve.
+pub fn describe_ik(skeleton: &Skeleton, r: &crate::rig::ik::IkReport) -> String {
+    format!(
+        "ik {}: {} after {} rounds ({} FABRIK iterations), distance {:.5}{}",
+        skeleton.joint(r.end).name,
+        if r.reached { "reached" } else { "not reached" },
+        r.rounds,
+        r.iterations,
+        r.distance,
+        if r.limited { ", stopped by joint limits" } else { "" }
+    )
 }

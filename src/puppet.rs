@@ -67,20 +67,13 @@ pub fn puppet() -> Generated {
 }
 
 fn generate(design: &Design) -> Generated {
-    let index_of = |name: &str| {
-        design
-            .joints
-            .iter()
-            .position(|j| j.0 == name)
-            .expect("design parents exist")
-    };
+    let index_of = |name: &str| design.joints.iter().position(|j| j.0 == name).expect("design parents exist");
     let raw: Vec<RawJoint> = design
         .joints
         .iter()
         .map(|&(name, parent, pos, _)| {
             let parent = parent.map(index_of);
-            let offset =
-                Vec3::from(pos) - parent.map_or(Vec3::ZERO, |p| Vec3::from(design.joints[p].2));
+            let offset = Vec3::from(pos) - parent.map_or(Vec3::ZERO, |p| Vec3::from(design.joints[p].2));
             RawJoint::new(name, parent, offset)
         })
         .collect();
@@ -95,42 +88,19 @@ fn generate(design: &Design) -> Generated {
             continue;
         }
         let start = joint_positions[index_of(parent)];
-        add_capsule(
-            &mut positions,
-            &mut triangles,
-            start,
-            Vec3::from(end),
-            radius,
-        );
+        add_capsule(&mut positions, &mut triangles, start, Vec3::from(end), radius);
     }
     // A pelvis block across the hips.
-    add_capsule(
-        &mut positions,
-        &mut triangles,
-        Vec3::new(-0.045, 0.53, 0.0),
-        Vec3::new(0.045, 0.53, 0.0),
-        0.075,
-    );
+    add_capsule(&mut positions, &mut triangles, Vec3::new(-0.045, 0.53, 0.0), Vec3::new(0.045, 0.53, 0.0), 0.075);
 
     let all_bones = bones(&skeleton, &joint_positions);
     let weights = smooth_bone_weights(&positions, &all_bones, skeleton.len(), 3, 1.6);
-    Generated {
-        skeleton,
-        positions,
-        triangles,
-        weights,
-    }
+    Generated { skeleton, positions, triangles, weights }
 }
 
 /// Appends a closed capsule around the segment `a`–`b`: a cylinder of `radius` with
 /// hemispherical caps, `SEGMENTS` around, counter-clockwise outward faces.
-fn add_capsule(
-    positions: &mut Vec<Vec3>,
-    triangles: &mut Vec<[u32; 3]>,
-    a: Vec3,
-    b: Vec3,
-    radius: f32,
-) {
+fn add_capsule(positions: &mut Vec<Vec3>, triangles: &mut Vec<[u32; 3]>, a: Vec3, b: Vec3, radius: f32) {
     let axis = (b - a).normalize();
     let rotation = Quat::from_rotation_arc(Vec3::Z, axis);
     let first = positions.len() as u32;
@@ -176,14 +146,7 @@ pub fn write_6837(generated: &Generated, dir: &Path, name: &str) -> std::io::Res
     let mut skel = String::new();
     for j in generated.skeleton.joints() {
         let o = j.rest_offset;
-        skel += &format!(
-            "{} {} {} {} {}\n",
-            o.x,
-            o.y,
-            o.z,
-            j.parent.map_or(-1, |p| p as i64),
-            j.name
-        );
+        skel += &format!("{} {} {} {} {}\n", o.x, o.y, o.z, j.parent.map_or(-1, |p| p as i64), j.name);
     }
     std::fs::write(dir.join(format!("{name}.skel")), skel)?;
     let mut obj_text = Vec::new();
@@ -211,11 +174,7 @@ pub fn embedded_puppet() -> crate::rig::CharacterAsset {
             skeleton.len(),
             mesh.positions.len(),
         )?;
-        let skin = crate::rig::Skin {
-            bind_positions: mesh.positions,
-            triangles: mesh.triangles,
-            weights,
-        };
+        let skin = crate::rig::Skin { bind_positions: mesh.positions, triangles: mesh.triangles, weights };
         crate::rig::CharacterAsset::new("puppet", skeleton, skin, Vec::new())
             .map_err(|e| crate::formats::FormatError::rig(Path::new("assets/puppet.obj"), e))
     };

@@ -19,14 +19,10 @@ use crate::rig::smpl::{BlendMode, Clip, SmplModel, blend_rotation};
 use crate::rig::{JointRotation, Skeleton};
 
 /// β(1) and β(2) of the exercise (β(0) is all zeros).
-pub const BETA1: [f32; 10] = [
-    -1.711935, 2.352964, 2.285835, -0.073122, 1.501402, -1.790568, -0.391194, 2.078678, 1.461037,
-    2.297462,
-];
-pub const BETA2: [f32; 10] = [
-    1.573618, 2.028960, -1.865066, 2.066879, 0.661796, -2.012298, -1.107509, 0.234408, 2.287534,
-    2.324443,
-];
+pub const BETA1: [f32; 10] =
+    [-1.711935, 2.352964, 2.285835, -0.073122, 1.501402, -1.790568, -0.391194, 2.078678, 1.461037, 2.297462];
+pub const BETA2: [f32; 10] =
+    [1.573618, 2.028960, -1.865066, 2.066879, 0.661796, -2.012298, -1.107509, 0.234408, 2.287534, 2.324443];
 
 /// β(i) for i in 0..3.
 pub fn exercise_beta(i: usize) -> [f32; 10] {
@@ -102,13 +98,7 @@ impl<'a> SmplPoser<'a> {
         for (p, q) in self.pose.iter_mut().zip(&frame.rotations) {
             *p = JointRotation::Quat(*q);
         }
-        forward_kinematics_with_offsets(
-            skeleton,
-            &self.pose,
-            Some(&offsets),
-            Mat4::IDENTITY,
-            &mut self.world,
-        );
+        forward_kinematics_with_offsets(skeleton, &self.pose, Some(&offsets), Mat4::IDENTITY, &mut self.world);
         &self.world
     }
 
@@ -128,41 +118,23 @@ impl<'a> SmplPoser<'a> {
 }
 
 /// The frames of tasks 1–5.
-pub fn task_frames(
-    model: &SmplModel,
-    data_dir: &Path,
-    task: u32,
-) -> Result<Vec<FrameSpec>, FormatError> {
+pub fn task_frames(model: &SmplModel, data_dir: &Path, task: u32) -> Result<Vec<FrameSpec>, FormatError> {
     let n = model.skeleton.len();
     let joint = |name: &str| {
-        model.skeleton.find(name).ok_or_else(|| {
-            FormatError::other(
-                data_dir,
-                format!("expected a joint named {name} in the hierarchy"),
-            )
-        })
+        model
+            .skeleton
+            .find(name)
+            .ok_or_else(|| FormatError::other(data_dir, format!("expected a joint named {name} in the hierarchy")))
     };
     let rest = vec![Quat::IDENTITY; n];
-    let spec = |b: usize| FrameSpec {
-        betas: exercise_beta(b),
-        rotations: rest.clone(),
-        translation: None,
-        skinned: true,
-    };
+    let spec =
+        |b: usize| FrameSpec { betas: exercise_beta(b), rotations: rest.clone(), translation: None, skinned: true };
     Ok(match task {
-        1 => (0..3)
-            .map(|b| FrameSpec {
-                skinned: false,
-                ..spec(b)
-            })
-            .collect(),
+        1 => (0..3).map(|b| FrameSpec { skinned: false, ..spec(b) }).collect(),
         2 | 3 => {
             let elbow = joint("L_Elbow")?;
             (0..3)
-                .map(|b| FrameSpec {
-                    translation: Some((elbow, Vec3::new(0.0, 0.2, 0.0), task == 3)),
-                    ..spec(b)
-                })
+                .map(|b| FrameSpec { translation: Some((elbow, Vec3::new(0.0, 0.2, 0.0), task == 3)), ..spec(b) })
                 .collect()
         }
         4 => {
@@ -180,17 +152,11 @@ pub fn task_frames(
             let clip = parse_clip(open(&clip_path)?, &clip_path, n)?;
             (0..3)
                 .flat_map(|b| (0..clip.frame_count()).map(move |f| (b, f)))
-                .map(|(b, f)| FrameSpec {
-                    rotations: clip.frame(f).to_vec(),
-                    ..spec(b)
-                })
+                .map(|(b, f)| FrameSpec { rotations: clip.frame(f).to_vec(), ..spec(b) })
                 .collect()
         }
         _ => {
-            return Err(FormatError::other(
-                data_dir,
-                format!("expected a task 1..=6, found {task}"),
-            ));
+            return Err(FormatError::other(data_dir, format!("expected a task 1..=6, found {task}")));
         }
     })
 }
@@ -218,32 +184,22 @@ pub fn parse_sequence(spec: &str) -> Result<Vec<Segment>, String> {
     spec.split(',')
         .map(|seg| {
             let parts: Vec<&str> = seg.trim().split(':').collect();
-            let bad = |why: &str| {
-                format!("sequence segment `{seg}`: {why} (expected CLIP[:FROM-TO][:BETA])")
-            };
+            let bad = |why: &str| format!("sequence segment `{seg}`: {why} (expected CLIP[:FROM-TO][:BETA])");
             if parts.is_empty() || parts[0].is_empty() || parts.len() > 3 {
                 return Err(bad("wrong number of fields"));
             }
             let (mut from, mut to) = (0, None);
             if let Some(range) = parts.get(1).filter(|r| !r.is_empty()) {
-                let (a, b) = range
-                    .split_once('-')
-                    .ok_or_else(|| bad("the range needs FROM-TO"))?;
+                let (a, b) = range.split_once('-').ok_or_else(|| bad("the range needs FROM-TO"))?;
                 from = a.parse().map_err(|_| bad("FROM is not a frame number"))?;
-                to = if b.is_empty() {
-                    None
-                } else {
-                    Some(b.parse().map_err(|_| bad("TO is not a frame number"))?)
-                };
+                to = if b.is_empty() { None } else { Some(b.parse().map_err(|_| bad("TO is not a frame number"))?) };
                 if to.is_some_and(|t| t < from) {
                     return Err(bad("TO is before FROM"));
                 }
             }
             let betas = match parts.get(2) {
                 None | Some(&"") => [0.0; 10],
-                Some(&b) if b.len() == 1 && "012".contains(b) => {
-                    exercise_beta(b.parse().unwrap_or(0))
-                }
+                Some(&b) if b.len() == 1 && "012".contains(b) => exercise_beta(b.parse().unwrap_or(0)),
                 Some(list) => {
                     let v: Vec<f32> = list
                         .split('/')
@@ -258,12 +214,7 @@ pub fn parse_sequence(spec: &str) -> Result<Vec<Segment>, String> {
                     b
                 }
             };
-            Ok(Segment {
-                clip: parts[0].to_string(),
-                from,
-                to,
-                betas,
-            })
+            Ok(Segment { clip: parts[0].to_string(), from, to, betas })
         })
         .collect()
 }
@@ -285,26 +236,12 @@ pub fn sequence_frames(
     let mut plays: Vec<Vec<FrameSpec>> = Vec::new();
     for seg in segments {
         let path = find_clip(&clips, &seg.clip).ok_or_else(|| {
-            FormatError::other(
-                data_dir,
-                format!(
-                    "no clip matches `{}` (clips: {})",
-                    seg.clip,
-                    clip_names(&clips)
-                ),
-            )
+            FormatError::other(data_dir, format!("no clip matches `{}` (clips: {})", seg.clip, clip_names(&clips)))
         })?;
         if !loaded.iter().any(|(p, _)| *p == path.display().to_string()) {
-            loaded.push((
-                path.display().to_string(),
-                parse_clip(open(&path)?, &path, n)?,
-            ));
+            loaded.push((path.display().to_string(), parse_clip(open(&path)?, &path, n)?));
         }
-        let clip = &loaded
-            .iter()
-            .find(|(p, _)| *p == path.display().to_string())
-            .expect("just loaded")
-            .1;
+        let clip = &loaded.iter().find(|(p, _)| *p == path.display().to_string()).expect("just loaded").1;
         let last = clip.frame_count().saturating_sub(1);
         let to = seg.to.unwrap_or(last);
         if seg.from > last || to > last {
@@ -329,11 +266,7 @@ pub fn sequence_frames(
         let overlap = transition.min(frames.len()).min(play.len());
         let start = frames.len() - overlap;
         for k in 0..overlap {
-            let alpha = if overlap <= 1 {
-                1.0
-            } else {
-                k as f32 / (overlap - 1) as f32
-            };
+            let alpha = if overlap <= 1 { 1.0 } else { k as f32 / (overlap - 1) as f32 };
             let out = &mut frames[start + k];
             let inc = &play[k];
             for (b, bi) in out.betas.iter_mut().zip(inc.betas) {
@@ -353,19 +286,13 @@ fn find_clip(clips: &[PathBuf], name: &str) -> Option<PathBuf> {
         .iter()
         .find(|p| {
             p.file_name().is_some_and(|f| f == name)
-                || p.file_stem()
-                    .is_some_and(|s| s.to_string_lossy().ends_with(name))
+                || p.file_stem().is_some_and(|s| s.to_string_lossy().ends_with(name))
         })
         .cloned()
 }
 
 fn clip_names(clips: &[PathBuf]) -> String {
-    clips
-        .iter()
-        .filter_map(|p| p.file_name())
-        .map(|n| n.to_string_lossy().into_owned())
-        .collect::<Vec<_>>()
-        .join(", ")
+    clips.iter().filter_map(|p| p.file_name()).map(|n| n.to_string_lossy().into_owned()).collect::<Vec<_>>().join(", ")
 }
 
 /// Writes `frame000.obj`, `frame001.obj`, ... into `out_dir` (created), one `v` per vertex
@@ -379,9 +306,7 @@ pub fn write_frames(
 ) -> Result<(), FormatError> {
     std::fs::create_dir_all(out_dir).map_err(|e| FormatError::io(out_dir, e))?;
     let faces = faces_text(&model.triangles);
-    let threads = std::thread::available_parallelism()
-        .map_or(1, |n| n.get())
-        .min(frames.len().max(1));
+    let threads = std::thread::available_parallelism().map_or(1, |n| n.get()).min(frames.len().max(1));
     let chunk = frames.len().div_ceil(threads.max(1)).max(1);
     std::thread::scope(|scope| {
         let handles: Vec<_> = frames
@@ -399,18 +324,16 @@ pub fn write_frames(
                         vertices_text(&positions, &mut text);
                         text.extend_from_slice(faces);
                         let path = out_dir.join(format!("frame{:03}.obj", c * chunk + k));
-                        write_atomically(&path, |w| w.write_all(&text))
-                            .map_err(|e| FormatError::io(&path, e))?;
+                        write_atomically(&path, |w| w.write_all(&text)).map_err(|e| FormatError::io(&path, e))?;
                         tick();
                     }
                     Ok(())
                 })
             })
             .collect();
-        handles.into_iter().try_for_each(|h| {
-            h.join()
-                .unwrap_or_else(|_| Err(FormatError::other(out_dir, "a writer thread panicked")))
-        })
+        handles
+            .into_iter()
+            .try_for_each(|h| h.join().unwrap_or_else(|_| Err(FormatError::other(out_dir, "a writer thread panicked"))))
     })
 }
 
@@ -455,18 +378,12 @@ pub fn write_frames_naive(
         let n = joints.len();
         let mut world = vec![Mat4::IDENTITY; n];
         for j in 0..n {
-            let local = Mat4::from_translation(
-                model
-                    .skeleton
-                    .parent(j)
-                    .map_or(joints[j], |p| joints[j] - joints[p]),
-            ) * Mat4::from_quat(frame.rotations[j]);
+            let local = Mat4::from_translation(model.skeleton.parent(j).map_or(joints[j], |p| joints[j] - joints[p]))
+                * Mat4::from_quat(frame.rotations[j]);
             world[j] = model.skeleton.parent(j).map_or(local, |p| world[p] * local);
         }
         let path = out_dir.join(format!("frame{k:03}.obj"));
-        let mut file = std::io::BufWriter::new(
-            std::fs::File::create(&path).map_err(|e| FormatError::io(&path, e))?,
-        );
+        let mut file = std::io::BufWriter::new(std::fs::File::create(&path).map_err(|e| FormatError::io(&path, e))?);
         for (v, x) in shaped.iter().enumerate() {
             let mut m = Mat4::ZERO;
             for inf in model.weights.of_vertex(v) {
@@ -477,8 +394,7 @@ pub fn write_frames_naive(
             writeln!(file, "v {} {} {}", p.x, p.y, p.z).map_err(|e| FormatError::io(&path, e))?;
         }
         for t in &model.triangles {
-            writeln!(file, "f {} {} {}", t[0] + 1, t[1] + 1, t[2] + 1)
-                .map_err(|e| FormatError::io(&path, e))?;
+            writeln!(file, "f {} {} {}", t[0] + 1, t[1] + 1, t[2] + 1).map_err(|e| FormatError::io(&path, e))?;
         }
         tick();
     }

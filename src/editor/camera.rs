@@ -14,12 +14,7 @@ pub struct OrbitCamera {
 
 impl Default for OrbitCamera {
     fn default() -> Self {
-        Self {
-            focus: Vec3::new(0.0, 0.5, 0.0),
-            yaw: 0.0,
-            pitch: -0.25,
-            distance: 3.0,
-        }
+        Self { focus: Vec3::new(0.0, 0.5, 0.0), yaw: 0.0, pitch: -0.25, distance: 3.0 }
     }
 }
 
@@ -28,12 +23,7 @@ impl OrbitCamera {
     pub fn framing(lo: Vec3, hi: Vec3) -> Self {
         let center = (lo + hi) / 2.0;
         let radius = ((hi - lo).length() / 2.0).max(0.05);
-        Self {
-            focus: center,
-            yaw: 0.35,
-            pitch: -0.25,
-            distance: radius * 2.6,
-        }
+        Self { focus: center, yaw: 0.35, pitch: -0.25, distance: radius * 2.6 }
     }
 
     pub fn transform(&self) -> Transform {
@@ -89,9 +79,7 @@ pub fn orbit_camera_input(
 }
 
 /// Places cameras from their orbit (reads `OrbitCamera`; writes `Transform`).
-pub fn apply_orbit_camera(
-    mut cameras: Query<(&OrbitCamera, &mut Transform), Changed<OrbitCamera>>,
-) {
+pub fn apply_orbit_camera(mut cameras: Query<(&OrbitCamera, &mut Transform), Changed<OrbitCamera>>) {
     for (orbit, mut transform) in &mut cameras {
         *transform = orbit.transform();
     }

@@ -10,10 +10,7 @@ use crate::formats::scene::{
 use crate::rig::JointRotation;
 
 fn pose(specs: &[(&str, [f32; 3])]) -> BTreeMap<String, JointRotation> {
-    specs
-        .iter()
-        .map(|(j, [x, y, z])| (j.to_string(), JointRotation::euler_xyz(*x, *y, *z)))
-        .collect()
+    specs.iter().map(|(j, [x, y, z])| (j.to_string(), JointRotation::euler_xyz(*x, *y, *z))).collect()
 }
 
 fn puppet(
@@ -26,11 +23,7 @@ fn puppet(
     CharacterDoc {
         source: SourceDoc::Embedded("puppet".into()),
         name: name.into(),
-        placement: PlacementDoc {
-            translation,
-            yaw,
-            scale: 1.0,
-        },
+        placement: PlacementDoc { translation, yaw, scale: 1.0 },
         pose,
         view,
         smpl: None,
@@ -75,27 +68,15 @@ pub fn generate() -> SceneDoc {
         ("r_elbow", [0.0, 0.8, 0.0]),
         ("spine", [-0.15, 0.0, 0.0]),
     ]);
-    let weights = ViewDoc {
-        weight_colors: true,
-        display: DisplayDoc::Both,
-        ..ViewDoc::default()
-    };
-    let blue = ViewDoc {
-        tint: [0.45, 0.6, 0.8],
-        ..ViewDoc::default()
-    };
+    let weights = ViewDoc { weight_colors: true, display: DisplayDoc::Both, ..ViewDoc::default() };
+    let blue = ViewDoc { tint: [0.45, 0.6, 0.8], ..ViewDoc::default() };
     SceneDoc {
         characters: vec![
             puppet("Ada", [-0.4, 0.0, 0.0], 0.9, waving, ViewDoc::default()),
             puppet("Bo", [0.4, 0.0, 0.05], -0.9, reaching, blue),
             puppet("Cy", [0.0, -0.29, -0.95], 0.0, sitting, weights),
         ],
-        camera: Some(CameraDoc {
-            focus: [0.0, 0.42, -0.3],
-            yaw: 0.0,
-            pitch: -0.32,
-            distance: 2.9,
-        }),
+        camera: Some(CameraDoc { focus: [0.0, 0.42, -0.3], yaw: 0.0, pitch: -0.32, distance: 2.9 }),
         stage: StageDoc::default(),
     }
 }

@@ -12,8 +12,7 @@ use super::camera::OrbitCamera;
 use super::smpl::SmplCharacter;
 use super::stage::StageSettings;
 use crate::formats::scene::{
-    CameraDoc, CharacterDoc, DisplayDoc, PlacementDoc, SceneDoc, SourceDoc, ViewDoc,
-    joint_of_pose_key, pose_key,
+    CameraDoc, CharacterDoc, DisplayDoc, PlacementDoc, SceneDoc, SourceDoc, ViewDoc, joint_of_pose_key, pose_key,
 };
 use crate::formats::{FormatError, load_character};
 use crate::rig::smpl::{Clip, SmplModel};
@@ -71,14 +70,8 @@ impl AssetLibrary {
         let clips = crate::formats::smpl::clip_paths(dir)
             .into_iter()
             .map(|p| {
-                let clip =
-                    crate::formats::smpl::parse_clip(crate::formats::error::open(&p)?, &p, n)?;
-                Ok((
-                    p.file_name()
-                        .map(|f| f.to_string_lossy().into_owned())
-                        .unwrap_or_default(),
-                    Arc::new(clip),
-                ))
+                let clip = crate::formats::smpl::parse_clip(crate::formats::error::open(&p)?, &p, n)?;
+                Ok((p.file_name().map(|f| f.to_string_lossy().into_owned()).unwrap_or_default(), Arc::new(clip)))
             })
             .collect::<Result<Vec<_>, FormatError>>()?;
         let set = (Arc::new(model), clips);
@@ -210,20 +203,15 @@ impl SceneReader<'_, '_> {
 
 /// The pose a document gives a character: the source's pose with the listed joints
 /// replaced. Keys that name no joint are returned as messages.
-pub fn pose_from_doc(
-    asset: &CharacterAsset,
-    doc: &CharacterDoc,
-) -> (Vec<JointRotation>, Vec<String>) {
+pub fn pose_from_doc(asset: &CharacterAsset, doc: &CharacterDoc) -> (Vec<JointRotation>, Vec<String>) {
     let mut pose = asset.skeleton.initial_pose();
     let mut unknown = Vec::new();
     for (key, rotation) in &doc.pose {
         match joint_of_pose_key(&asset.skeleton, key) {
             Some(j) => pose[j] = rotation.clamped(&asset.skeleton.joint(j).limits),
-            None => unknown.push(format!(
-                "{}: no joint `{key}` in {}; its pose was skipped",
-                doc.name,
-                doc.source.label()
-            )),
+            None => {
+                unknown.push(format!("{}: no joint `{key}` in {}; its pose was skipped", doc.name, doc.source.label()))
+            }
         }
     }
     (pose, unknown)
@@ -240,11 +228,7 @@ pub fn spawn_from_doc(
     let asset = library.load(&doc.source)?;
     let (pose, messages) = pose_from_doc(&asset, doc);
     let p = doc.placement;
-    let placement = Placement {
-        translation: Vec3::from(p.translation),
-        yaw: p.yaw,
-        scale: p.scale,
-    };
+    let placement = Placement { translation: Vec3::from(p.translation), yaw: p.yaw, scale: p.scale };
     let entity = spawn_character_posed(commands, meshes, asset, placement, &pose);
     let display = match doc.view.display {
         DisplayDoc::Mesh => DisplayMode::Mesh,
@@ -259,38 +243,21 @@ pub fn spawn_from_doc(
             visible: doc.view.visible,
             heat_of_selected: doc.view.heat_of_selected,
         },
-        SkinView {
-            tint: doc.view.tint,
-            weight_colors: doc.view.weight_colors,
-            heat_joint: None,
-        },
+        SkinView { tint: doc.view.tint, weight_colors: doc.view.weight_colors, heat_joint: None },
         display,
-        if doc.view.visible {
-            Visibility::Inherited
-        } else {
-            Visibility::Hidden
-        },
+        if doc.view.visible { Visibility::Inherited } else { Visibility::Hidden },
     ));
     if let SourceDoc::File(dir) = &doc.source
         && crate::formats::smpl::is_smpl_dir(dir)
     {
         let (model, clips) = library.smpl(dir)?;
-        commands.entity(entity).insert(SmplCharacter::new(
-            model,
-            dir.clone(),
-            clips,
-            doc.smpl.as_ref(),
-        ));
+        commands.entity(entity).insert(SmplCharacter::new(model, dir.clone(), clips, doc.smpl.as_ref()));
     }
     Ok((entity, messages))
 }
 
 /// A document of characters placed side by side along x, each standing on y = 0.
-pub fn doc_side_by_side(
-    library: &mut AssetLibrary,
-    sources: Vec<SourceDoc>,
-    messages: &mut Vec<String>,
-) -> SceneDoc {
+pub fn doc_side_by_side(library: &mut AssetLibrary, sources: Vec<SourceDoc>, messages: &mut Vec<String>) -> SceneDoc {
     let gap = 0.15;
     let loaded: Vec<(SourceDoc, Arc<CharacterAsset>)> = sources
         .into_iter()
@@ -336,11 +303,7 @@ pub fn doc_side_by_side(
             doc
         })
         .collect();
-    SceneDoc {
-        characters,
-        camera: None,
-        stage: Default::default(),
-    }
+    SceneDoc { characters, camera: None, stage: Default::default() }
 }
 
 /// The embedded default scene (`assets/default_scene.ron`).
@@ -354,11 +317,7 @@ pub fn default_scene_doc() -> SceneDoc {
 
 /// What the command line asked to open, as a document: a `.ron` scene (sources relative
 /// to it), character paths side by side, or the default scene.
-pub fn startup_doc(
-    paths: &[PathBuf],
-    library: &mut AssetLibrary,
-    messages: &mut Vec<String>,
-) -> Option<SceneDoc> {
+pub fn startup_doc(paths: &[PathBuf], library: &mut AssetLibrary, messages: &mut Vec<String>) -> Option<SceneDoc> {
     if paths.is_empty() {
         return Some(default_scene_doc());
     }
@@ -371,11 +330,7 @@ pub fn startup_doc(
             }
         };
     }
-    Some(doc_side_by_side(
-        library,
-        paths.iter().map(|p| SourceDoc::File(p.clone())).collect(),
-        messages,
-    ))
+    Some(doc_side_by_side(library, paths.iter().map(|p| SourceDoc::File(p.clone())).collect(), messages))
 }
 
 /// Reads a scene file and resolves its sources against its folder.
@@ -391,10 +346,7 @@ pub fn read_scene(path: &Path) -> Result<SceneDoc, FormatError> {
 /// Writes a scene file with sources relative to its folder.
 pub fn write_scene(path: &Path, doc: &SceneDoc) -> Result<(), FormatError> {
     let mut doc = doc.clone();
-    let dir = path
-        .parent()
-        .filter(|d| !d.as_os_str().is_empty())
-        .unwrap_or(Path::new("."));
+    let dir = path.parent().filter(|d| !d.as_os_str().is_empty()).unwrap_or(Path::new("."));
     for c in &mut doc.characters {
         c.source = c.source.relative_to(dir);
     }

@@ -29,13 +29,7 @@ const SELECTED_COLOR: Color = Color::srgb(1.0, 0.15, 0.3);
 /// Draws skeletons of characters in skeleton or both view, and the selected joints of
 /// any character (reads joint matrices, `Selection`; draws gizmos).
 pub fn draw_skeletons(
-    characters: Query<(
-        &Character,
-        &DisplayMode,
-        &Placement,
-        Option<&SceneCharacter>,
-        &InheritedVisibility,
-    )>,
+    characters: Query<(&Character, &DisplayMode, &Placement, Option<&SceneCharacter>, &InheritedVisibility)>,
     joints: Query<&CurrentJointToWorld>,
     selection: Res<Selection>,
     mut gizmos: Gizmos<SkeletonGizmos>,
@@ -44,25 +38,13 @@ pub fn draw_skeletons(
         if !visible.get() {
             continue;
         }
-        let selected: &[usize] = if sc.is_some_and(|s| Some(s.id) == selection.character) {
-            &selection.joints
-        } else {
-            &[]
-        };
+        let selected: &[usize] =
+            if sc.is_some_and(|s| Some(s.id) == selection.character) { &selection.joints } else { &[] };
         let size = character_size(character) * placement.scale;
         let radius = (size * 0.012).max(0.003);
-        let world = |j: usize| {
-            joints
-                .get(character.joints[j])
-                .map(|c| c.0)
-                .unwrap_or(Mat4::IDENTITY)
-        };
+        let world = |j: usize| joints.get(character.joints[j]).map(|c| c.0).unwrap_or(Mat4::IDENTITY);
         for &j in selected {
-            gizmos.sphere(
-                Isometry3d::from_translation(world(j).w_axis.truncate()),
-                radius * 2.2,
-                SELECTED_COLOR,
-            );
+            gizmos.sphere(Isometry3d::from_translation(world(j).w_axis.truncate()), radius * 2.2, SELECTED_COLOR);
         }
         if *mode == DisplayMode::Mesh {
             continue;

@@ -65,8 +65,7 @@ pub struct HistoryPlugin;
 
 impl Plugin for HistoryPlugin {
     fn build(&self, app: &mut App) {
-        app.init_resource::<History>()
-            .add_systems(Update, (end_gestures, apply_history_requests));
+        app.init_resource::<History>().add_systems(Update, (end_gestures, apply_history_requests));
     }
 }
 
@@ -79,11 +78,7 @@ fn end_gestures(buttons: Res<ButtonInput<MouseButton>>, mut history: ResMut<Hist
 
 /// Serves undo/redo requests by rebuilding the scene from a snapshot, keeping the camera
 /// (reads the scene; writes `History`, `PendingScene`).
-fn apply_history_requests(
-    mut history: ResMut<History>,
-    reader: SceneReader,
-    mut pending: ResMut<PendingScene>,
-) {
+fn apply_history_requests(mut history: ResMut<History>, reader: SceneReader, mut pending: ResMut<PendingScene>) {
     let Some(request) = history.request.take() else {
         return;
     };
@@ -93,10 +88,6 @@ fn apply_history_requests(
         HistoryRequest::Redo => history.redo(current),
     };
     if let Some(doc) = target {
-        *pending = PendingScene {
-            doc: Some(doc),
-            with_camera: false,
-            frame: false,
-        };
+        *pending = PendingScene { doc: Some(doc), with_camera: false, frame: false };
     }
 }

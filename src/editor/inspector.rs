@@ -10,8 +10,7 @@ use bevy_egui::{EguiContexts, EguiPrimaryContextPass, egui};
 
 use super::camera::OrbitCamera;
 use super::document::{
-    AssetLibrary, NextCharacterId, PendingScene, SceneCharacter, SceneReader, read_scene,
-    spawn_from_doc, write_scene,
+    AssetLibrary, NextCharacterId, PendingScene, SceneCharacter, SceneReader, read_scene, spawn_from_doc, write_scene,
 };
 use super::history::{History, HistoryRequest};
 use super::screenshot::ScreenshotRequest;
@@ -20,9 +19,7 @@ use super::stage::StageSettings;
 use super::{Messages, Selection};
 use crate::formats::scene::{CharacterDoc, PlacementDoc, SceneDoc, SourceDoc, ViewDoc};
 use crate::rig::{EulerOrder, JointRotation, Skeleton};
-use crate::scene::{
-    Character, CurrentJointToWorld, DisplayMode, JointLimits, JointPose, Placement, SkinView,
-};
+use crate::scene::{Character, CurrentJointToWorld, DisplayMode, JointLimits, JointPose, Placement, SkinView};
 
 /// Text fields and transient state of the inspector.
 #[derive(Resource)]
@@ -36,9 +33,7 @@ pub struct InspectorState {
 
 impl Default for InspectorState {
     fn default() -> Self {
-        let cwd = std::env::current_dir()
-            .map(|d| d.display().to_string())
-            .unwrap_or_default();
+        let cwd = std::env::current_dir().map(|d| d.display().to_string()).unwrap_or_default();
         Self {
             add_path: format!("{cwd}/"),
             recent: Vec::new(),
@@ -118,36 +113,24 @@ fn inspector_ui(
     let mut ui = egui::Ui::new(
         ctx.clone(),
         "viewport".into(),
-        egui::UiBuilder::new()
-            .layer_id(egui::LayerId::background())
-            .max_rect(ctx.viewport_rect()),
+        egui::UiBuilder::new().layer_id(egui::LayerId::background()).max_rect(ctx.viewport_rect()),
     );
     let mut edited = false;
     state.active_dof = None;
-    egui::Panel::left("scene_panel")
-        .resizable(true)
-        .default_size(250.0)
-        .show(&mut ui, |ui| {
-            egui::ScrollArea::vertical().show(ui, |ui| {
-                edited |= scene_panel(ui, &mut state, &mut edit, &mut ops, &mut shot);
-            });
+    egui::Panel::left("scene_panel").resizable(true).default_size(250.0).show(&mut ui, |ui| {
+        egui::ScrollArea::vertical().show(ui, |ui| {
+            edited |= scene_panel(ui, &mut state, &mut edit, &mut ops, &mut shot);
         });
-    egui::Panel::right("joint_panel")
-        .resizable(true)
-        .default_size(250.0)
-        .show(&mut ui, |ui| {
-            egui::ScrollArea::vertical().show(ui, |ui| {
-                edited |= joint_panel(ui, &mut state, &mut edit);
-            });
+    });
+    egui::Panel::right("joint_panel").resizable(true).default_size(250.0).show(&mut ui, |ui| {
+        egui::ScrollArea::vertical().show(ui, |ui| {
+            edited |= joint_panel(ui, &mut state, &mut edit);
         });
+    });
     if let Some(text) = &state.active_dof {
-        egui::Area::new("active_dof".into())
-            .anchor(egui::Align2::CENTER_TOP, [0.0, 12.0])
-            .show(&ctx, |ui| {
-                egui::Frame::popup(ui.style()).show(ui, |ui| {
-                    ui.label(egui::RichText::new(text).size(20.0).strong())
-                });
-            });
+        egui::Area::new("active_dof".into()).anchor(egui::Align2::CENTER_TOP, [0.0, 12.0]).show(&ctx, |ui| {
+            egui::Frame::popup(ui.style()).show(ui, |ui| ui.label(egui::RichText::new(text).size(20.0).strong()));
+        });
     }
     if edited {
         let before = ops.snapshot.0.clone();
@@ -175,11 +158,7 @@ fn scene_panel(
         }
     });
     ui.horizontal(|ui| {
-        if ui
-            .add_enabled(!edit.history.undo.is_empty(), egui::Button::new("Undo"))
-            .on_hover_text("Ctrl+Z")
-            .clicked()
-        {
+        if ui.add_enabled(!edit.history.undo.is_empty(), egui::Button::new("Undo")).on_hover_text("Ctrl+Z").clicked() {
             edit.history.request = Some(HistoryRequest::Undo);
         }
         if ui
@@ -203,9 +182,7 @@ fn scene_panel(
         ui.horizontal_wrapped(|ui| {
             ui.label("Recent:");
             for r in state.recent.clone() {
-                let label = Path::new(&r)
-                    .file_name()
-                    .map_or(r.clone(), |n| n.to_string_lossy().into_owned());
+                let label = Path::new(&r).file_name().map_or(r.clone(), |n| n.to_string_lossy().into_owned());
                 if ui.small_button(label).on_hover_text(&r).clicked() {
                     edited |= add_character(&r, state, edit, ops);
                 }
@@ -215,28 +192,18 @@ fn scene_panel(
     ui.separator();
     let mut remove = None;
     let mut duplicate = None;
-    let mut list: Vec<(Entity, u64, String)> = edit
-        .characters
-        .iter()
-        .map(|c| (c.0, c.1.id, c.1.name.clone()))
-        .collect();
+    let mut list: Vec<(Entity, u64, String)> =
+        edit.characters.iter().map(|c| (c.0, c.1.id, c.1.name.clone())).collect();
     list.sort_by_key(|c| c.1);
     for (entity, id, name) in list {
         let selected = edit.selection.character == Some(id);
         ui.horizontal(|ui| {
             if ui.selectable_label(selected, &name).clicked() && !selected {
-                *edit.selection = Selection {
-                    character: Some(id),
-                    joints: Vec::new(),
-                };
+                *edit.selection = Selection { character: Some(id), joints: Vec::new() };
             }
             if let Ok(mut c) = edit.characters.get_mut(entity) {
                 let mut visible = c.1.visible;
-                if ui
-                    .checkbox(&mut visible, "")
-                    .on_hover_text("show")
-                    .changed()
-                {
+                if ui.checkbox(&mut visible, "").on_hover_text("show").changed() {
                     c.1.visible = visible;
                     edited = true;
                 }
@@ -245,9 +212,7 @@ fn scene_panel(
         if !selected {
             continue;
         }
-        let Ok((_, mut sc, character, mut placement, mut view, mut display)) =
-            edit.characters.get_mut(entity)
-        else {
+        let Ok((_, mut sc, character, mut placement, mut view, mut display)) = edit.characters.get_mut(entity) else {
             continue;
         };
         egui::Frame::group(ui.style()).show(ui, |ui| {
@@ -256,11 +221,7 @@ fn scene_panel(
                 edited |= ui.text_edit_singleline(&mut sc.name).changed();
             });
             ui.label(egui::RichText::new(sc.source.label()).small());
-            ui.label(format!(
-                "{} joints, {} vertices",
-                character.asset.skeleton.len(),
-                character.asset.vertex_count()
-            ));
+            ui.label(format!("{} joints, {} vertices", character.asset.skeleton.len(), character.asset.vertex_count()));
             ui.horizontal(|ui| {
                 if ui.button("Duplicate").clicked() {
                     duplicate = Some(id);
@@ -273,11 +234,7 @@ fn scene_panel(
             ui.horizontal(|ui| {
                 ui.label("Position");
                 for k in 0..3 {
-                    ui.add(
-                        egui::DragValue::new(&mut p.translation[k])
-                            .speed(0.01)
-                            .max_decimals(3),
-                    );
+                    ui.add(egui::DragValue::new(&mut p.translation[k]).speed(0.01).max_decimals(3));
                 }
             });
             let mut yaw_deg = p.yaw.to_degrees();
@@ -285,11 +242,7 @@ fn scene_panel(
                 ui.label("Turn");
                 ui.add(egui::DragValue::new(&mut yaw_deg).speed(1.0).suffix("°"));
                 ui.label("Scale");
-                ui.add(
-                    egui::DragValue::new(&mut p.scale)
-                        .speed(0.01)
-                        .range(0.01..=100.0),
-                );
+                ui.add(egui::DragValue::new(&mut p.scale).speed(0.01).range(0.01..=100.0));
             });
             p.yaw = yaw_deg.to_radians();
             if p != *placement {
@@ -311,9 +264,7 @@ fn scene_panel(
                 view.weight_colors = colors;
                 edited = true;
             }
-            edited |= ui
-                .checkbox(&mut sc.heat_of_selected, "weights of the selected joint")
-                .changed();
+            edited |= ui.checkbox(&mut sc.heat_of_selected, "weights of the selected joint").changed();
         });
         if let Ok(mut body) = edit.smpl.get_mut(entity) {
             edited |= smpl_panel(ui, &mut body);
@@ -344,9 +295,7 @@ fn scene_panel(
     if s != *edit.stage {
         *edit.stage = s;
     }
-    ui.label(
-        "S cycles mesh / skeleton / both; F frames the selection; click a joint to select it.",
-    );
+    ui.label("S cycles mesh / skeleton / both; F frames the selection; click a joint to select it.");
     ui.separator();
     ui.heading("Screenshot");
     ui.horizontal(|ui| {
@@ -379,12 +328,7 @@ fn character_doc(snapshot: &SceneDoc, edit: &Editable, id: u64) -> Option<Charac
 }
 
 /// Loads and adds a character beside the others; errors go to the messages.
-fn add_character(
-    path: &str,
-    state: &mut InspectorState,
-    edit: &mut Editable,
-    ops: &mut SceneOps,
-) -> bool {
+fn add_character(path: &str, state: &mut InspectorState, edit: &mut Editable, ops: &mut SceneOps) -> bool {
     if path.is_empty() {
         return false;
     }
@@ -397,26 +341,14 @@ fn add_character(
         }
     };
     edit.messages.0.extend(asset.warnings.iter().cloned());
-    let right = edit
-        .characters
-        .iter()
-        .map(|c| c.3.translation.x)
-        .fold(f32::NEG_INFINITY, f32::max);
+    let right = edit.characters.iter().map(|c| c.3.translation.x).fold(f32::NEG_INFINITY, f32::max);
     let (lo, hi) = asset.bounds();
-    let x = if right.is_finite() {
-        right + 0.3 + (hi.x - lo.x)
-    } else {
-        0.0
-    };
+    let x = if right.is_finite() { right + 0.3 + (hi.x - lo.x) } else { 0.0 };
     let center = (lo + hi) / 2.0;
     let doc = CharacterDoc {
         source,
         name: asset.name.clone(),
-        placement: PlacementDoc {
-            translation: [x - center.x, -lo.y, -center.z],
-            yaw: 0.0,
-            scale: 1.0,
-        },
+        placement: PlacementDoc { translation: [x - center.x, -lo.y, -center.z], yaw: 0.0, scale: 1.0 },
         pose: Default::default(),
         view: ViewDoc::default(),
         smpl: None,
@@ -432,19 +364,10 @@ fn add_character(
 
 fn spawn_doc(doc: &CharacterDoc, edit: &mut Editable, ops: &mut SceneOps) -> bool {
     let id = ops.ids.take();
-    match spawn_from_doc(
-        &mut ops.commands,
-        &mut ops.meshes,
-        &mut ops.library,
-        doc,
-        id,
-    ) {
+    match spawn_from_doc(&mut ops.commands, &mut ops.meshes, &mut ops.library, doc, id) {
         Ok((_, notes)) => {
             notes.into_iter().for_each(|m| edit.messages.push(m));
-            *edit.selection = Selection {
-                character: Some(id),
-                joints: Vec::new(),
-            };
+            *edit.selection = Selection { character: Some(id), joints: Vec::new() };
             true
         }
         Err(e) => {
@@ -463,13 +386,7 @@ fn save_scene(path: &str, doc: &SceneDoc, messages: &mut Messages) {
 
 fn open_scene(path: &str, pending: &mut PendingScene, messages: &mut Messages) {
     match read_scene(Path::new(path)) {
-        Ok(doc) => {
-            *pending = PendingScene {
-                frame: doc.camera.is_none(),
-                doc: Some(doc),
-                with_camera: true,
-            }
-        }
+        Ok(doc) => *pending = PendingScene { frame: doc.camera.is_none(), doc: Some(doc), with_camera: true },
         Err(e) => messages.push(e.to_string()),
     }
 }
@@ -524,9 +441,7 @@ fn joint_panel(ui: &mut egui::Ui, state: &mut InspectorState, edit: &mut Editabl
         if changed {
             let rotation = match pose.0 {
                 JointRotation::Euler(..) => JointRotation::Euler(angles, order),
-                JointRotation::Quat(_) => {
-                    JointRotation::Quat(JointRotation::Euler(angles, EulerOrder::Xyz).to_quat())
-                }
+                JointRotation::Quat(_) => JointRotation::Quat(JointRotation::Euler(angles, EulerOrder::Xyz).to_quat()),
             };
             pose.0 = rotation.clamped(&limits.0);
             edited = true;
@@ -543,14 +458,7 @@ fn joint_panel(ui: &mut egui::Ui, state: &mut InspectorState, edit: &mut Editabl
 }
 
 /// The joint tree, collapsible by name; a click selects, Shift/Ctrl-click adds.
-fn joint_tree(
-    ui: &mut egui::Ui,
-    skeleton: &Skeleton,
-    j: usize,
-    id: u64,
-    selection: &mut Selection,
-    additive: bool,
-) {
+fn joint_tree(ui: &mut egui::Ui, skeleton: &Skeleton, j: usize, id: u64, selection: &mut Selection, additive: bool) {
     let is_selected = selection.character == Some(id) && selection.joints.contains(&j);
     let label = format!("{} ({j})", skeleton.joint(j).name);
     let children = skeleton.children(j);
@@ -599,23 +507,14 @@ pub fn shortcuts(
     if wants.is_some_and(|w| w.wants_any_keyboard_input()) {
         return;
     }
-    let ctrl = keys.any_pressed([
-        KeyCode::ControlLeft,
-        KeyCode::ControlRight,
-        KeyCode::SuperLeft,
-        KeyCode::SuperRight,
-    ]);
+    let ctrl = keys.any_pressed([KeyCode::ControlLeft, KeyCode::ControlRight, KeyCode::SuperLeft, KeyCode::SuperRight]);
     let shift = keys.any_pressed([KeyCode::ShiftLeft, KeyCode::ShiftRight]);
     if keys.just_pressed(KeyCode::F12) {
         shot.request();
     }
     if ctrl {
         if keys.just_pressed(KeyCode::KeyZ) {
-            history.request = Some(if shift {
-                HistoryRequest::Redo
-            } else {
-                HistoryRequest::Undo
-            });
+            history.request = Some(if shift { HistoryRequest::Redo } else { HistoryRequest::Undo });
         }
         if let (Some(state), Some(snapshot)) = (&state, &snapshot) {
             if keys.just_pressed(KeyCode::KeyS) {
@@ -630,9 +529,7 @@ pub fn shortcuts(
     if keys.just_pressed(KeyCode::KeyA) {
         stage.axes = !stage.axes;
     }
-    let selected = characters
-        .iter_mut()
-        .find(|c| Some(c.0.id) == selection.character);
+    let selected = characters.iter_mut().find(|c| Some(c.0.id) == selection.character);
     if keys.just_pressed(KeyCode::KeyS) {
         if let Some((.., mut display)) = selected {
             *display = display.next();
@@ -646,12 +543,11 @@ pub fn shortcuts(
             .iter()
             .filter(|c| selection.character.is_none() || Some(c.0.id) == selection.character)
             .flat_map(|(_, character, _)| {
-                let chosen: Vec<usize> =
-                    if selection.joints.is_empty() || selection.character.is_none() {
-                        (0..character.joints.len()).collect()
-                    } else {
-                        selection.joints.clone()
-                    };
+                let chosen: Vec<usize> = if selection.joints.is_empty() || selection.character.is_none() {
+                    (0..character.joints.len()).collect()
+                } else {
+                    selection.joints.clone()
+                };
                 chosen
                     .into_iter()
                     .filter_map(|j| joints.get(character.joints[j]).ok().map(|m| m.position()))
@@ -659,12 +555,8 @@ pub fn shortcuts(
             })
             .collect();
         if !points.is_empty() {
-            let lo = points
-                .iter()
-                .fold(Vec3::splat(f32::INFINITY), |a, p| a.min(*p));
-            let hi = points
-                .iter()
-                .fold(Vec3::splat(f32::NEG_INFINITY), |a, p| a.max(*p));
+            let lo = points.iter().fold(Vec3::splat(f32::INFINITY), |a, p| a.min(*p));
+            let hi = points.iter().fold(Vec3::splat(f32::NEG_INFINITY), |a, p| a.max(*p));
             for mut orbit in &mut cameras {
                 let framed = OrbitCamera::framing(lo, hi + Vec3::splat(0.15));
                 orbit.focus = (lo + hi) / 2.0;
@@ -677,110 +569,81 @@ pub fn shortcuts(
 /// β sliders, clip list, timeline and blending of an SMPL body. Returns whether it edited.
 fn smpl_panel(ui: &mut egui::Ui, body: &mut Mut<SmplCharacter>) -> bool {
     let mut edited = false;
-    egui::CollapsingHeader::new("SMPL shape and motion")
-        .default_open(true)
-        .show(ui, |ui| {
-            let mut betas = body.betas;
-            for (b, beta) in betas.iter_mut().enumerate() {
-                edited |= ui
-                    .add(
-                        egui::Slider::new(beta, -3.0..=3.0)
-                            .text(format!("β{}", b + 1))
-                            .max_decimals(3),
-                    )
-                    .changed();
-            }
-            if ui.small_button("Zero the shape").clicked() {
-                betas = [0.0; 10];
-                edited = true;
-            }
-            if betas != body.betas {
-                body.betas = betas;
-            }
-            let names: Vec<String> = body
-                .clips
-                .iter()
-                .map(|c| {
-                    c.0.trim_start_matches("smpl_quaternions_")
-                        .trim_end_matches(".txt")
-                        .to_string()
-                })
-                .collect();
-            let label = |i: Option<usize>| i.map_or("(none)".to_string(), |i| names[i].clone());
-            let mut clip = body.clip;
-            egui::ComboBox::from_label("clip")
-                .selected_text(label(clip))
-                .show_ui(ui, |ui| {
-                    ui.selectable_value(&mut clip, None, "(none)");
-                    for (i, n) in names.iter().enumerate() {
-                        ui.selectable_value(&mut clip, Some(i), n);
-                    }
-                });
-            if clip != body.clip {
-                body.clip = clip;
-                body.time = 0.0;
-                edited = true;
-            }
-            if body.clip.is_some() {
-                ui.horizontal(|ui| {
-                    let text = if body.playing { "Pause" } else { "Play" };
-                    if ui.button(text).clicked() {
-                        body.playing = !body.playing;
-                    }
-                    let mut looping = body.looping;
-                    if ui.checkbox(&mut looping, "loop").changed() {
-                        body.looping = looping;
-                    }
-                    let mut upright = body.upright;
-                    if ui.checkbox(&mut upright, "upright").changed() {
-                        body.upright = upright;
-                        edited = true;
-                    }
-                });
-                let last = body.clip_frames().saturating_sub(1) as f32;
-                let mut t = body.time;
-                if ui
-                    .add(
-                        egui::Slider::new(&mut t, 0.0..=last)
-                            .text("frame")
-                            .max_decimals(1),
-                    )
-                    .changed()
-                {
-                    body.time = t;
-                    edited = true;
-                }
-                let mut speed = body.speed;
-                if ui
-                    .add(egui::Slider::new(&mut speed, 0.1..=3.0).text("speed"))
-                    .changed()
-                {
-                    body.speed = speed;
-                }
-                let mut second = body.blend_clip;
-                egui::ComboBox::from_label("blend with")
-                    .selected_text(label(second))
-                    .show_ui(ui, |ui| {
-                        ui.selectable_value(&mut second, None, "(none)");
-                        for (i, n) in names.iter().enumerate() {
-                            ui.selectable_value(&mut second, Some(i), n);
-                        }
-                    });
-                if second != body.blend_clip {
-                    body.blend_clip = second;
-                    edited = true;
-                }
-                if body.blend_clip.is_some() {
-                    let mut blend = body.blend;
-                    if ui
-                        .add(egui::Slider::new(&mut blend, 0.0..=1.0).text("blend"))
-                        .changed()
-                    {
-                        body.blend = blend;
-                        edited = true;
-                    }
-                }
+    egui::CollapsingHeader::new("SMPL shape and motion").default_open(true).show(ui, |ui| {
+        let mut betas = body.betas;
+        for (b, beta) in betas.iter_mut().enumerate() {
+            edited |= ui.add(egui::Slider::new(beta, -3.0..=3.0).text(format!("β{}", b + 1)).max_decimals(3)).changed();
+        }
+        if ui.small_button("Zero the shape").clicked() {
+            betas = [0.0; 10];
+            edited = true;
+        }
+        if betas != body.betas {
+            body.betas = betas;
+        }
+        let names: Vec<String> = body
+            .clips
+            .iter()
+            .map(|c| c.0.trim_start_matches("smpl_quaternions_").trim_end_matches(".txt").to_string())
+            .collect();
+        let label = |i: Option<usize>| i.map_or("(none)".to_string(), |i| names[i].clone());
+        let mut clip = body.clip;
+        egui::ComboBox::from_label("clip").selected_text(label(clip)).show_ui(ui, |ui| {
+            ui.selectable_value(&mut clip, None, "(none)");
+            for (i, n) in names.iter().enumerate() {
+                ui.selectable_value(&mut clip, Some(i), n);
             }
         });
+        if clip != body.clip {
+            body.clip = clip;
+            body.time = 0.0;
+            edited = true;
+        }
+        if body.clip.is_some() {
+            ui.horizontal(|ui| {
+                let text = if body.playing { "Pause" } else { "Play" };
+                if ui.button(text).clicked() {
+                    body.playing = !body.playing;
+                }
+                let mut looping = body.looping;
+                if ui.checkbox(&mut looping, "loop").changed() {
+                    body.looping = looping;
+                }
+                let mut upright = body.upright;
+                if ui.checkbox(&mut upright, "upright").changed() {
+                    body.upright = upright;
+                    edited = true;
+                }
+            });
+            let last = body.clip_frames().saturating_sub(1) as f32;
+            let mut t = body.time;
+            if ui.add(egui::Slider::new(&mut t, 0.0..=last).text("frame").max_decimals(1)).changed() {
+                body.time = t;
+                edited = true;
+            }
+            let mut speed = body.speed;
+            if ui.add(egui::Slider::new(&mut speed, 0.1..=3.0).text("speed")).changed() {
+                body.speed = speed;
+            }
+            let mut second = body.blend_clip;
+            egui::ComboBox::from_label("blend with").selected_text(label(second)).show_ui(ui, |ui| {
+                ui.selectable_value(&mut second, None, "(none)");
+                for (i, n) in names.iter().enumerate() {
+                    ui.selectable_value(&mut second, Some(i), n);
+                }
+            });
+            if second != body.blend_clip {
+                body.blend_clip = second;
+                edited = true;
+            }
+            if body.blend_clip.is_some() {
+                let mut blend = body.blend;
+                if ui.add(egui::Slider::new(&mut blend, 0.0..=1.0).text("blend")).changed() {
+                    body.blend = blend;
+                    edited = true;
+                }
+            }
+        }
+    });
     edited
 }

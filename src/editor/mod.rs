@@ -23,18 +23,22 @@ use std::path::PathBuf;
 use bevy::prelude::*;
 use bevy::window::WindowResolution;
 
-use crate::scene::{
-    Character, DisplayMode, MarionetteSystems, RigCorePlugin, SkinMesh, SkinView, SkinningPlugin,
-};
+use crate::scene::{Character, DisplayMode, MarionetteSystems, RigCorePlugin, SkinMesh, SkinView, SkinningPlugin};
 use camera::{OrbitCamera, apply_orbit_camera, orbit_camera_input};
-use document::{
-    AssetLibrary, NextCharacterId, PendingScene, SceneCharacter, spawn_from_doc, startup_doc,
-};
+use document::{AssetLibrary, NextCharacterId, PendingScene, SceneCharacter, spawn_from_doc, startup_doc};
 use stage::{StageSettings, apply_stage_settings, draw_grid_and_axes, spawn_stage};
 
 /// What the app opens with: a scene file, character files, or (empty) the default scene.
 #[derive(Resource, Clone, Debug, Default)]
 pub struct StartupPaths(pub Vec<PathBuf>);
+
+/// Pose and IK edits from the command line, applied to every character of the startup
+/// scene that has the named joint (`--pose`, then `--ik`).
+#[derive(Resource, Clone, Debug, Default)]
+pub struct StartupEdits {
+    pub poses: Vec<crate::posing::PoseSpec>,
+    pub ik: Vec<crate::posing::IkSpec>,
+}
 
 /// Messages for the user (load errors, warnings, where files went), newest last.
 #[derive(Resource, Clone, Debug, Default)]
@@ -69,20 +73,16 @@ impl Plugin for ViewPlugin {
         app.init_resource::<StageSettings>()
             .init_resource::<Messages>()
             .init_resource::<StartupPaths>()
+            .init_resource::<StartupEdits>()
             .init_resource::<Selection>()
             .init_resource::<AssetLibrary>()
             .init_resource::<PendingScene>()
             .init_resource::<NextCharacterId>()
             .add_plugins(smpl::SmplEditorPlugin)
-            .add_systems(
-                Startup,
-                (setup_skin_material, spawn_stage, queue_startup_scene).chain(),
-            )
+            .add_systems(Startup, (setup_skin_material, spawn_stage, queue_startup_scene).chain())
             .add_systems(
                 PostUpdate,
-                (apply_pending_scene, sync_character_views)
-                    .chain()
-                    .in_set(MarionetteSystems::Animate),
+                (apply_pending_scene, sync_character_views).chain().in_set(MarionetteSystems::Animate),
             )
             .add_systems(
                 PostUpdate,
@@ -104,18 +104,11 @@ pub struct InteractionPlugin;
 
 impl Plugin for InteractionPlugin {
     fn build(&self, app: &mut App) {
-        app.init_resource::<camera::ViewportHasPointer>()
-            .init_resource::<picking::PointerPress>()
-            .add_systems(
-                Update,
-                (
-                    camera::track_egui_pointer,
-                    orbit_camera_input,
-                    picking::pick_joint_on_click,
-                    inspector::shortcuts,
-                )
-                    .chain(),
-            );
+        app.init_resource::<camera::ViewportHasPointer>().init_resource::<picking::PointerPress>().add_systems(
+            Update,
+            (camera::track_egui_pointer, orbit_camera_input, picking::pick_joint_on_click, inspector::shortcuts)
+                .chain(),
+        );
     }
 }
 
@@ -152,17 +145,15 @@ fn spawn_window_camera(mut commands: Commands) {
 }
 
 fn setup_skin_material(mut commands: Commands, mut materials: ResMut<Assets<StandardMaterial>>) {
-    let material = materials.add(StandardMaterial {
-        base_color: Color::WHITE,
-        perceptual_roughness: 0.75,
-        ..default()
-    });
+    let material =
+        materials.add(StandardMaterial { base_color: Color::WHITE, perceptual_roughness: 0.75, ..default() });
     commands.insert_resource(SkinMaterial(material));
 }
 
 /// Turns the startup paths into the first scene (writes `PendingScene`, `Messages`).
 fn queue_startup_scene(
     paths: Res<StartupPaths>,
+    edits: Res<StartupEdits>,
     mut library: ResMut<AssetLibrary>,
     mut messages: ResMut<Messages>,
     mut pending: ResMut<PendingScene>,
@@ -170,10 +161,46 @@ fn queue_startup_scene(
     let mut notes = Vec::new();
     let doc = startup_doc(&paths.0, &mut library, &mut notes);
     notes.into_iter().for_each(|m| messages.push(m));
-    if let Some(doc) = doc {
+    if let Some(mut doc) = doc {
+        apply_startup_edits(&mut doc, &edits, &mut library, &mut messages);
         pending.frame = doc.camera.is_none();
         pending.with_camera = true;
         pending.doc = Some(doc);
+    }
+}
+
+/// Applies `--pose` and `--ik` to every character of `doc` that has the joints.
+fn apply_startup_edits(
+    doc: &mut crate::formats::scene::SceneDoc,
+    edits: &StartupEdits,
+    library: &mut AssetLibrary,
+    messages: &mut Messages,
+) {
+    use crate::formats::scene::pose_key;
+    if edits.poses.is_empty() && edits.ik.is_empty() {
+        return;
+    }
+    for c in &mut doc.characters {
+        let Ok(asset) = library.load(&c.source) else { continue };
+        let skeleton = &asset.skeleton;
+        let (mut pose, _) = document::pose_from_doc(&asset, c);
+        let poses: Vec<_> = edits.poses.iter().filter(|p| skeleton.resolve(&p.joint).is_some()).cloned().collect();
+        let ik: Vec<_> = edits.ik.iter().filter(|p| skeleton.resolve(&p.joint).is_some()).cloned().collect();
+        let _ = crate::posing::apply_pose_specs(skeleton, &mut pose, &poses);
+        let p = c.placement;
+        let placement = Mat4::from_scale_rotation_translation(
+            Vec3::splat(p.scale),
+            Quat::from_rotation_y(p.yaw),
+            Vec3::from(p.translation),
+        );
+        if let Ok(reports) = crate::posing::apply_ik_specs(skeleton, &mut pose, placement, &ik) {
+            reports
+                .iter()
+                .for_each(|r| messages.push(format!("{}: {}", c.name, crate::posing::describe_ik(skeleton, r))));
+        }
+        let initial = skeleton.initial_pose();
+        c.pose =
+            (0..skeleton.len()).filter(|&j| pose[j] != initial[j]).map(|j| (pose_key(skeleton, j), pose[j])).collect();
     }
 }
 
@@ -224,20 +251,10 @@ pub fn apply_pending_scene(
     ids.0 = ids.0.max(doc.characters.len() as u64);
     if pending.with_camera {
         let s = doc.stage;
-        *stage = StageSettings {
-            floor: s.floor,
-            shadows: s.shadows,
-            axes: s.axes,
-            floor_height: s.floor_height,
-        };
+        *stage = StageSettings { floor: s.floor, shadows: s.shadows, axes: s.axes, floor_height: s.floor_height };
         for mut orbit in &mut cameras {
             if let Some(c) = doc.camera {
-                *orbit = OrbitCamera {
-                    focus: Vec3::from(c.focus),
-                    yaw: c.yaw,
-                    pitch: c.pitch,
-                    distance: c.distance,
-                };
+                *orbit = OrbitCamera { focus: Vec3::from(c.focus), yaw: c.yaw, pitch: c.pitch, distance: c.distance };
             } else if pending.frame && lo.x <= hi.x {
                 *orbit = OrbitCamera::framing(lo, hi);
             }
@@ -258,11 +275,7 @@ fn sync_character_views(
         if view.heat_joint != heat {
             view.heat_joint = heat;
         }
-        let wanted = if sc.visible {
-            Visibility::Inherited
-        } else {
-            Visibility::Hidden
-        };
+        let wanted = if sc.visible { Visibility::Inherited } else { Visibility::Hidden };
         visibility.set_if_neq(wanted);
     }
 }
@@ -274,9 +287,7 @@ fn attach_skin_material(
     new_skins: Query<Entity, Added<SkinMesh>>,
 ) {
     for entity in &new_skins {
-        commands
-            .entity(entity)
-            .insert(MeshMaterial3d(material.0.clone()));
+        commands.entity(entity).insert(MeshMaterial3d(material.0.clone()));
     }
 }
 
@@ -287,11 +298,7 @@ fn apply_display_mode(
 ) {
     for (character, mode) in &characters {
         if let Ok(mut v) = visibility.get_mut(character.skin_entity) {
-            *v = if *mode == DisplayMode::Skeleton {
-                Visibility::Hidden
-            } else {
-                Visibility::Inherited
-            };
+            *v = if *mode == DisplayMode::Skeleton { Visibility::Hidden } else { Visibility::Inherited };
         }
     }
 }

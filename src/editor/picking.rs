@@ -63,12 +63,8 @@ pub fn pick_joint_on_click(
             }
         }
     }
-    let additive = keys.any_pressed([
-        KeyCode::ShiftLeft,
-        KeyCode::ShiftRight,
-        KeyCode::ControlLeft,
-        KeyCode::ControlRight,
-    ]);
+    let additive =
+        keys.any_pressed([KeyCode::ShiftLeft, KeyCode::ShiftRight, KeyCode::ControlLeft, KeyCode::ControlRight]);
     match best {
         Some((_, id, j)) => select_joint(&mut selection, id, j, additive),
         None if !additive => selection.joints.clear(),

@@ -44,6 +44,7 @@ struct RenderJob {
 /// `width`×`height` into `out`. Returns what went wrong, if anything.
 pub fn render(
     paths: Vec<PathBuf>,
+    edits: super::StartupEdits,
     out: PathBuf,
     width: u32,
     height: u32,
@@ -62,11 +63,11 @@ pub fn render(
     .add_plugins(ScheduleRunnerPlugin::run_loop(Duration::from_millis(2)))
     .insert_resource(ClearColor(stage::SKY))
     .insert_resource(StartupPaths(paths))
+    .insert_resource(edits)
     .add_plugins((RigCorePlugin, SkinningPlugin, ViewPlugin));
     let target = {
         let mut images = app.world_mut().resource_mut::<Assets<Image>>();
-        let mut image =
-            Image::new_target_texture(width, height, TextureFormat::Rgba8UnormSrgb, None);
+        let mut image = Image::new_target_texture(width, height, TextureFormat::Rgba8UnormSrgb, None);
         image.texture_descriptor.usage |= TextureUsages::COPY_SRC;
         images.add(image)
     };
@@ -83,12 +84,7 @@ pub fn render(
     });
     app.add_systems(Startup, move |mut commands: Commands| {
         let orbit = OrbitCamera::default();
-        commands.spawn((
-            Camera3d::default(),
-            RenderTarget::Image(target.clone().into()),
-            orbit,
-            orbit.transform(),
-        ));
+        commands.spawn((Camera3d::default(), RenderTarget::Image(target.clone().into()), orbit, orbit.transform()));
     });
     app.add_systems(Last, capture_when_ready);
     let exit = app.run();
@@ -98,9 +94,7 @@ pub fn render(
     match (exit, done) {
         (AppExit::Success, Some(Ok(()))) => Ok(messages),
         (_, Some(Err(e))) => Err(e),
-        _ => Err(format!(
-            "the render did not settle within {GIVE_UP_SECONDS} s"
-        )),
+        _ => Err(format!("the render did not settle within {GIVE_UP_SECONDS} s")),
     }
 }
 
@@ -129,17 +123,15 @@ fn capture_when_ready(
     }
     job.waiting = true;
     let out = job.out.clone();
-    commands
-        .spawn(Screenshot::image(job.target.clone()))
-        .observe(
-            move |captured: On<ScreenshotCaptured>, mut job: ResMut<RenderJob>| {
-                job.waiting = false;
-                let data = captured.image.data.clone().unwrap_or_default();
-                if job.previous.as_ref() == Some(&data) {
-                    job.done = Some(super::screenshot::save_png(&captured.image, &out));
-                } else {
-                    job.previous = Some(data);
-                }
-            },
-        );
+    commands.spawn(Screenshot::image(job.target.clone())).observe(
+        move |captured: On<ScreenshotCaptured>, mut job: ResMut<RenderJob>| {
+            job.waiting = false;
+            let data = captured.image.data.clone().unwrap_or_default();
+            if job.previous.as_ref() == Some(&data) {
+                job.done = Some(super::screenshot::save_png(&captured.image, &out));
+            } else {
+                job.previous = Some(data);
+            }
+        },
+    );
 }

@@ -20,14 +20,9 @@ pub struct ScreenshotRequest {
 
 impl Default for ScreenshotRequest {
     fn default() -> Self {
-        let dir = std::env::current_dir()
-            .map(|d| d.join("screenshots"))
-            .unwrap_or_else(|_| PathBuf::from("screenshots"));
-        Self {
-            dir_text: dir.display().to_string(),
-            with_panels: false,
-            countdown: None,
-        }
+        let dir =
+            std::env::current_dir().map(|d| d.join("screenshots")).unwrap_or_else(|_| PathBuf::from("screenshots"));
+        Self { dir_text: dir.display().to_string(), with_panels: false, countdown: None }
     }
 }
 
@@ -47,8 +42,7 @@ pub struct ScreenshotPlugin;
 
 impl Plugin for ScreenshotPlugin {
     fn build(&self, app: &mut App) {
-        app.init_resource::<ScreenshotRequest>()
-            .add_systems(Last, take_requested_screenshot);
+        app.init_resource::<ScreenshotRequest>().add_systems(Last, take_requested_screenshot);
     }
 }
 
@@ -66,12 +60,7 @@ pub fn timestamp(unix_seconds: u64) -> String {
     let day = doy - (153 * mp + 2) / 5 + 1;
     let month = if mp < 10 { mp + 3 } else { mp - 9 };
     let year = yoe + era * 400 + i64::from(month <= 2);
-    format!(
-        "{year:04}-{month:02}-{day:02}_{:02}-{:02}-{:02}",
-        secs / 3600,
-        secs / 60 % 60,
-        secs % 60
-    )
+    format!("{year:04}-{month:02}-{day:02}_{:02}-{:02}-{:02}", secs / 3600, secs / 60 % 60, secs % 60)
 }
 
 /// Counts down a request and captures the window (writes a `Screenshot` entity).
@@ -88,21 +77,13 @@ fn take_requested_screenshot(
     request.countdown = None;
     let dir = PathBuf::from(request.dir_text.trim());
     if let Err(e) = std::fs::create_dir_all(&dir) {
-        messages.push(format!(
-            "no screenshot: cannot create {}: {e}",
-            dir.display()
-        ));
+        messages.push(format!("no screenshot: cannot create {}: {e}", dir.display()));
         return;
     }
-    let now = std::time::SystemTime::now()
-        .duration_since(std::time::UNIX_EPOCH)
-        .map_or(0, |d| d.as_secs());
+    let now = std::time::SystemTime::now().duration_since(std::time::UNIX_EPOCH).map_or(0, |d| d.as_secs());
     let path = dir.join(format!("marionette_{}.png", timestamp(now)));
     commands.spawn(Screenshot::primary_window()).observe(
-        move |captured: On<ScreenshotCaptured>, mut messages: ResMut<Messages>| match save_png(
-            &captured.image,
-            &path,
-        ) {
+        move |captured: On<ScreenshotCaptured>, mut messages: ResMut<Messages>| match save_png(&captured.image, &path) {
             Ok(()) => messages.push(format!("saved screenshot {}", path.display())),
             Err(e) => messages.push(format!("no screenshot: {e}")),
         },
@@ -111,17 +92,9 @@ fn take_requested_screenshot(
 
 /// Writes a captured image as PNG (RGB), whole or not at all.
 pub fn save_png(image: &Image, path: &Path) -> Result<(), String> {
-    let rgb = image
-        .clone()
-        .try_into_dynamic()
-        .map_err(|e| format!("unreadable capture: {e}"))?
-        .to_rgb8();
+    let rgb = image.clone().try_into_dynamic().map_err(|e| format!("unreadable capture: {e}"))?.to_rgb8();
     let mut bytes = Vec::new();
-    rgb.write_to(
-        &mut std::io::Cursor::new(&mut bytes),
-        image::ImageFormat::Png,
-    )
-    .map_err(|e| e.to_string())?;
+    rgb.write_to(&mut std::io::Cursor::new(&mut bytes), image::ImageFormat::Png).map_err(|e| e.to_string())?;
     crate::formats::write_atomically(path, |w| std::io::Write::write_all(w, &bytes))
         .map_err(|e| format!("{}: {e}", path.display()))
 }

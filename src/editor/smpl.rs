@@ -37,16 +37,8 @@ pub struct SmplCharacter {
 }
 
 impl SmplCharacter {
-    pub fn new(
-        model: Arc<SmplModel>,
-        dir: PathBuf,
-        clips: Vec<(String, Arc<Clip>)>,
-        doc: Option<&SmplDoc>,
-    ) -> Self {
-        let index = |name: &Option<String>| {
-            name.as_ref()
-                .and_then(|n| clips.iter().position(|c| &c.0 == n))
-        };
+    pub fn new(model: Arc<SmplModel>, dir: PathBuf, clips: Vec<(String, Arc<Clip>)>, doc: Option<&SmplDoc>) -> Self {
+        let index = |name: &Option<String>| name.as_ref().and_then(|n| clips.iter().position(|c| &c.0 == n));
         let mut betas = [0.0; 10];
         if let Some(d) = doc {
             for (b, v) in betas.iter_mut().zip(&d.betas) {
@@ -159,9 +151,7 @@ fn pose_from_clips(
     let mut mixed = Vec::new();
     for (body, character) in &bodies {
         let Some(c) = body.clip else { continue };
-        body.clips[c]
-            .1
-            .sample(body.time, body.looping, BlendMode::Nlerp, &mut a);
+        body.clips[c].1.sample(body.time, body.looping, BlendMode::Nlerp, &mut a);
         let rotations = match body.blend_clip {
             Some(k) if body.blend > 0.0 => {
                 let other = &body.clips[k].1;

@@ -15,12 +15,7 @@ pub struct StageSettings {
 
 impl Default for StageSettings {
     fn default() -> Self {
-        Self {
-            floor: true,
-            shadows: true,
-            axes: false,
-            floor_height: 0.0,
-        }
+        Self { floor: true, shadows: true, axes: false, floor_height: 0.0 }
     }
 }
 
@@ -41,11 +36,7 @@ pub fn spawn_stage(
     settings: Res<StageSettings>,
 ) {
     commands.insert_resource(DirectionalLightShadowMap { size: 2048 });
-    commands.insert_resource(GlobalAmbientLight {
-        color: Color::WHITE,
-        brightness: 350.0,
-        ..default()
-    });
+    commands.insert_resource(GlobalAmbientLight { color: Color::WHITE, brightness: 350.0, ..default() });
     commands.spawn((
         Floor,
         Mesh3d(meshes.add(Plane3d::default().mesh().size(40.0, 40.0))),
@@ -77,11 +68,7 @@ pub fn apply_stage_settings(
         return;
     }
     for (mut visibility, mut transform) in &mut floors {
-        *visibility = if settings.floor {
-            Visibility::Inherited
-        } else {
-            Visibility::Hidden
-        };
+        *visibility = if settings.floor { Visibility::Inherited } else { Visibility::Hidden };
         transform.translation.y = settings.floor_height;
     }
     for mut sun in &mut suns {
@@ -101,9 +88,6 @@ pub fn draw_grid_and_axes(settings: Res<StageSettings>, mut gizmos: Gizmos) {
         }
     }
     if settings.axes {
-        gizmos.axes(
-            Transform::from_xyz(0.0, settings.floor_height + 0.002, 0.0),
-            0.5,
-        );
+        gizmos.axes(Transform::from_xyz(0.0, settings.floor_height + 0.002, 0.0), 0.5);
     }
 }

@@ -11,55 +11,40 @@ use crate::rig::{CharacterAsset, Skeleton, Skin};
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub enum CharacterSource {
     /// 6.837 `.skel` (+ `.obj` + `.attach` beside it, when present).
-    Mit6837 {
-        skel: PathBuf,
-        obj: Option<PathBuf>,
-        attach: Option<PathBuf>,
-    },
+    Mit6837 { skel: PathBuf, obj: Option<PathBuf>, attach: Option<PathBuf> },
     /// CSE169 `.skel` (drawn as bone boxes).
     Cse169 { skel: PathBuf },
     /// A folder with the SMPL exercise's files.
     Smpl { dir: PathBuf },
+    /// Homer's rig JSON (+ an OFF mesh beside it).
+    Homer { json: PathBuf },
 }
 
 impl CharacterSource {
     /// Recognises a path by its extension and content, and finds its companions.
     pub fn detect(path: &Path) -> Result<Self, FormatError> {
-        let ext = path
-            .extension()
-            .and_then(|e| e.to_str())
-            .map(str::to_ascii_lowercase);
+        let ext = path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase);
         match ext.as_deref() {
             Some("skel") => {
                 if is_cse169_skel(path)? {
-                    Ok(Self::Cse169 {
-                        skel: path.to_path_buf(),
-                    })
+                    Ok(Self::Cse169 { skel: path.to_path_buf() })
                 } else {
                     let sibling = |e: &str| Some(path.with_extension(e)).filter(|p| p.is_file());
-                    Ok(Self::Mit6837 {
-                        skel: path.to_path_buf(),
-                        obj: sibling("obj"),
-                        attach: sibling("attach"),
-                    })
+                    Ok(Self::Mit6837 { skel: path.to_path_buf(), obj: sibling("obj"), attach: sibling("attach") })
                 }
             }
+            Some("json") => Ok(Self::Homer { json: path.to_path_buf() }),
             Some("obj") | Some("attach") => {
                 let skel = path.with_extension("skel");
                 if !skel.is_file() {
                     return Err(FormatError::other(
                         path,
-                        format!(
-                            "expected a skeleton beside it at {}, found none",
-                            skel.display()
-                        ),
+                        format!("expected a skeleton beside it at {}, found none", skel.display()),
                     ));
                 }
                 Self::detect(&skel)
             }
-            _ if super::smpl::is_smpl_dir(path) => Ok(Self::Smpl {
-                dir: path.to_path_buf(),
-            }),
+            _ if super::smpl::is_smpl_dir(path) => Ok(Self::Smpl { dir: path.to_path_buf() }),
             _ if path.is_dir() => Err(FormatError::other(
                 path,
                 "expected a character file (.skel, .obj), found a folder without one (nor the SMPL files smpl_00.obj, smpl_skin.txt)",
@@ -76,52 +61,36 @@ impl CharacterSource {
 fn is_cse169_skel(path: &Path) -> Result<bool, FormatError> {
     let text = std::fs::read(path).map_err(|e| FormatError::io(path, e))?;
     let text = String::from_utf8_lossy(&text);
-    Ok(text
-        .split_whitespace()
-        .next()
-        .is_some_and(|w| w.starts_with("balljoint")))
+    Ok(text.split_whitespace().next().is_some_and(|w| w.starts_with("balljoint")))
 }
 
 /// Loads whatever character `path` names.
 pub fn load_character(path: &Path) -> Result<CharacterAsset, FormatError> {
-    let name = path
-        .file_stem()
-        .and_then(|s| s.to_str())
-        .unwrap_or("character")
-        .to_string();
+    let name = path.file_stem().and_then(|s| s.to_str()).unwrap_or("character").to_string();
     match CharacterSource::detect(path)? {
         CharacterSource::Cse169 { skel } => {
             let skeleton = cse169::parse_skel(open(&skel)?, &skel)?;
             Ok(CharacterAsset::with_bone_boxes(name, skeleton, Vec::new()))
         }
+        CharacterSource::Homer { json } => super::homer::load_homer(&json),
         CharacterSource::Smpl { dir } => {
             let (model, warnings) = super::smpl::load_smpl_dir(&dir)?;
-            let mut asset = model
-                .asset(&name, &[])
-                .map_err(|e| FormatError::rig(&dir, e))?;
+            let mut asset = model.asset(&name, &[]).map_err(|e| FormatError::rig(&dir, e))?;
             asset.warnings = warnings;
             Ok(asset)
         }
         CharacterSource::Mit6837 { skel, obj, attach } => {
             let skeleton = mit6837::parse_skel(open(&skel)?, &skel)?;
             match (obj, attach) {
-                (Some(obj_path), Some(attach_path)) => {
-                    load_6837_skin(name, skeleton, &obj_path, &attach_path)
-                }
+                (Some(obj_path), Some(attach_path)) => load_6837_skin(name, skeleton, &obj_path, &attach_path),
                 (None, _) => Ok(CharacterAsset::with_bone_boxes(
                     name,
                     skeleton,
-                    vec![format!(
-                        "no {} beside it: drawing bone boxes",
-                        skel.with_extension("obj").display()
-                    )],
+                    vec![format!("no {} beside it: drawing bone boxes", skel.with_extension("obj").display())],
                 )),
                 (Some(_), None) => Err(FormatError::other(
                     &skel,
-                    format!(
-                        "expected weights at {}, found none",
-                        skel.with_extension("attach").display()
-                    ),
+                    format!("expected weights at {}, found none", skel.with_extension("attach").display()),
                 )),
             }
         }
@@ -135,34 +104,19 @@ fn load_6837_skin(
     attach_path: &Path,
 ) -> Result<CharacterAsset, FormatError> {
     let mesh = obj::parse_obj(open(obj_path)?, obj_path)?;
-    let (weights, normalised) = mit6837::parse_attach(
-        open(attach_path)?,
-        attach_path,
-        skeleton.len(),
-        mesh.positions.len(),
-    )?;
+    let (weights, normalised) =
+        mit6837::parse_attach(open(attach_path)?, attach_path, skeleton.len(), mesh.positions.len())?;
     let warnings = normalised_warnings(attach_path, &normalised);
-    let skin = Skin {
-        bind_positions: mesh.positions,
-        triangles: mesh.triangles,
-        weights,
-    };
+    let skin = Skin { bind_positions: mesh.positions, triangles: mesh.triangles, weights };
     CharacterAsset::new(name, skeleton, skin, warnings).map_err(|e| FormatError::rig(obj_path, e))
 }
 
 /// One warning line for a set of normalised weight rows.
-pub fn normalised_warnings(
-    path: &Path,
-    rows: &[crate::rig::skinning::NormalisedRow],
-) -> Vec<String> {
+pub fn normalised_warnings(path: &Path, rows: &[crate::rig::skinning::NormalisedRow]) -> Vec<String> {
     if rows.is_empty() {
         return Vec::new();
     }
-    let (lo, hi) = rows
-        .iter()
-        .fold((f32::INFINITY, f32::NEG_INFINITY), |(lo, hi), r| {
-            (lo.min(r.sum), hi.max(r.sum))
-        });
+    let (lo, hi) = rows.iter().fold((f32::INFINITY, f32::NEG_INFINITY), |(lo, hi), r| (lo.min(r.sum), hi.max(r.sum)));
     vec![format!(
         "{}: {} weight rows did not sum to 1 (sums {lo:.4}..{hi:.4}; first at vertex {}) and were normalised",
         path.display(),

@@ -20,9 +20,7 @@ pub struct Token {
 /// CR all end a line; `{` and `}` are tokens of their own even when glued to a word.
 pub fn tokenize(mut reader: impl BufRead, path: &Path) -> Result<Vec<Token>, FormatError> {
     let mut bytes = Vec::new();
-    reader
-        .read_to_end(&mut bytes)
-        .map_err(|e| FormatError::io(path, e))?;
+    reader.read_to_end(&mut bytes).map_err(|e| FormatError::io(path, e))?;
     let text = String::from_utf8_lossy(&bytes);
     let mut tokens = Vec::new();
     let mut line = 1;
@@ -31,10 +29,7 @@ pub fn tokenize(mut reader: impl BufRead, path: &Path) -> Result<Vec<Token>, For
     let mut prev_cr = false;
     let flush = |current: &mut String, tokens: &mut Vec<Token>, at: usize| {
         if !current.is_empty() {
-            tokens.push(Token {
-                text: std::mem::take(current),
-                line: at,
-            });
+            tokens.push(Token { text: std::mem::take(current), line: at });
         }
     };
     for c in text.chars() {
@@ -48,10 +43,7 @@ pub fn tokenize(mut reader: impl BufRead, path: &Path) -> Result<Vec<Token>, For
             }
             '{' | '}' => {
                 flush(&mut current, &mut tokens, start_line);
-                tokens.push(Token {
-                    text: c.to_string(),
-                    line,
-                });
+                tokens.push(Token { text: c.to_string(), line });
             }
             c if c.is_whitespace() => flush(&mut current, &mut tokens, start_line),
             c => {
@@ -76,11 +68,7 @@ pub struct Tokens<'a> {
 
 impl<'a> Tokens<'a> {
     pub fn new(tokens: Vec<Token>, path: &'a Path) -> Self {
-        Self {
-            tokens,
-            pos: 0,
-            path,
-        }
+        Self { tokens, pos: 0, path }
     }
 
     pub fn peek(&self) -> Option<&Token> {
@@ -89,21 +77,12 @@ impl<'a> Tokens<'a> {
 
     /// The line of the next token (or of the last one at the end).
     pub fn line(&self) -> usize {
-        self.tokens
-            .get(self.pos)
-            .or(self.tokens.last())
-            .map_or(1, |t| t.line)
+        self.tokens.get(self.pos).or(self.tokens.last()).map_or(1, |t| t.line)
     }
 
     pub fn error(&self, expected: &str) -> FormatError {
-        let found = self.peek().map_or("the end of the file".to_string(), |t| {
-            format!("`{}`", t.text)
-        });
-        FormatError::syntax(
-            self.path,
-            self.line(),
-            format!("expected {expected}, found {found}"),
-        )
+        let found = self.peek().map_or("the end of the file".to_string(), |t| format!("`{}`", t.text));
+        FormatError::syntax(self.path, self.line(), format!("expected {expected}, found {found}"))
     }
 
     pub fn next_token(&mut self, expected: &str) -> Result<Token, FormatError> {
@@ -156,18 +135,12 @@ pub fn parse_skel(reader: impl BufRead, path: &Path) -> Result<Skeleton, FormatE
     }
     parse_balljoint(&mut tokens, None, &mut raw)?;
     if !tokens.at_end() {
-        return Err(
-            tokens.error("the end of the file after the root joint (one root per skeleton)")
-        );
+        return Err(tokens.error("the end of the file after the root joint (one root per skeleton)"));
     }
     Skeleton::build(raw).map_err(|e| FormatError::rig(path, e))
 }
 
-fn parse_balljoint(
-    tokens: &mut Tokens,
-    parent: Option<usize>,
-    raw: &mut Vec<RawJoint>,
-) -> Result<(), FormatError> {
+fn parse_balljoint(tokens: &mut Tokens, parent: Option<usize>, raw: &mut Vec<RawJoint>) -> Result<(), FormatError> {
     tokens.expect("balljoint")?;
     let name = tokens.next_token("a joint name")?;
     if name.text == "{" || name.text == "}" {
@@ -177,10 +150,7 @@ fn parse_balljoint(
     tokens.expect("{")?;
     let index = raw.len();
     let mut joint = RawJoint::new(name.text, parent, Vec3::ZERO);
-    let mut bone_box = BoneBox {
-        min: Vec3::splat(-0.1),
-        max: Vec3::splat(0.1),
-    };
+    let mut bone_box = BoneBox { min: Vec3::splat(-0.1), max: Vec3::splat(0.1) };
     let mut limits = DofLimits::UNLIMITED;
     let mut pose = Vec3::ZERO;
     raw.push(joint.clone());
@@ -214,9 +184,11 @@ fn parse_balljoint(
                 pose = tokens.vec3("pose")?;
             }
             Some("balljoint") => parse_balljoint(tokens, Some(index), raw)?,
-            _ => return Err(tokens.error(
-                "offset, boxmin, boxmax, rotxlimit, rotylimit, rotzlimit, pose, balljoint or `}`",
-            )),
+            _ => {
+                return Err(
+                    tokens.error("offset, boxmin, boxmax, rotxlimit, rotylimit, rotzlimit, pose, balljoint or `}`")
+                );
+            }
         }
     }
     joint.limits = limits;

@@ -10,20 +10,13 @@ use crate::rig::RigError;
 pub enum FormatError {
     /// `path:line: message` — the input is not what the format expects.
     #[error("{}:{line}: {message}", path.display())]
-    Syntax {
-        path: PathBuf,
-        line: usize,
-        message: String,
-    },
+    Syntax { path: PathBuf, line: usize, message: String },
     /// The file parsed, but the rig it describes is invalid.
     #[error("{}: {source}", path.display())]
     Rig { path: PathBuf, source: RigError },
     /// The file could not be read or written.
     #[error("{}: {source}", path.display())]
-    Io {
-        path: PathBuf,
-        source: std::io::Error,
-    },
+    Io { path: PathBuf, source: std::io::Error },
     /// Something else about the file (missing companion files, unknown kind).
     #[error("{}: {message}", path.display())]
     Other { path: PathBuf, message: String },
@@ -31,32 +24,19 @@ pub enum FormatError {
 
 impl FormatError {
     pub fn syntax(path: &Path, line: usize, message: impl fmt::Display) -> Self {
-        Self::Syntax {
-            path: path.to_path_buf(),
-            line,
-            message: message.to_string(),
-        }
+        Self::Syntax { path: path.to_path_buf(), line, message: message.to_string() }
     }
 
     pub fn rig(path: &Path, source: RigError) -> Self {
-        Self::Rig {
-            path: path.to_path_buf(),
-            source,
-        }
+        Self::Rig { path: path.to_path_buf(), source }
     }
 
     pub fn io(path: &Path, source: std::io::Error) -> Self {
-        Self::Io {
-            path: path.to_path_buf(),
-            source,
-        }
+        Self::Io { path: path.to_path_buf(), source }
     }
 
     pub fn other(path: &Path, message: impl fmt::Display) -> Self {
-        Self::Other {
-            path: path.to_path_buf(),
-            message: message.to_string(),
-        }
+        Self::Other { path: path.to_path_buf(), message: message.to_string() }
     }
 
     /// The line the error is on, when it has one.
@@ -70,26 +50,15 @@ impl FormatError {
 
 /// Opens a file for buffered reading, with the path in the error.
 pub fn open(path: &Path) -> Result<std::io::BufReader<std::fs::File>, FormatError> {
-    std::fs::File::open(path)
-        .map(std::io::BufReader::new)
-        .map_err(|e| FormatError::io(path, e))
+    std::fs::File::open(path).map(std::io::BufReader::new).map_err(|e| FormatError::io(path, e))
 }
 
 /// Reads lines (LF, CRLF, or bare CR line ends), numbered from 1, with the path in errors.
-pub fn read_lines(
-    mut reader: impl std::io::BufRead,
-    path: &Path,
-) -> Result<Vec<(usize, String)>, FormatError> {
+pub fn read_lines(mut reader: impl std::io::BufRead, path: &Path) -> Result<Vec<(usize, String)>, FormatError> {
     let mut text = String::new();
-    reader
-        .read_to_string(&mut text)
-        .map_err(|e| FormatError::io(path, e))?;
+    reader.read_to_string(&mut text).map_err(|e| FormatError::io(path, e))?;
     let text = text.replace("\r\n", "\n").replace('\r', "\n");
-    Ok(text
-        .lines()
-        .enumerate()
-        .map(|(i, l)| (i + 1, l.to_string()))
-        .collect())
+    Ok(text.lines().enumerate().map(|(i, l)| (i + 1, l.to_string())).collect())
 }
 
 /// Parses whitespace-separated numbers of one line, `expected` of them (or at least
@@ -102,25 +71,12 @@ pub fn parse_numbers<T: std::str::FromStr>(
 ) -> Result<Vec<T>, FormatError> {
     let tokens: Vec<&str> = line.split_whitespace().collect();
     if tokens.len() != expected {
-        return Err(FormatError::syntax(
-            path,
-            line_no,
-            format!("expected {expected} numbers, found {}", tokens.len()),
-        ));
+        return Err(FormatError::syntax(path, line_no, format!("expected {expected} numbers, found {}", tokens.len())));
     }
-    tokens
-        .iter()
-        .map(|t| parse_number(t, path, line_no))
-        .collect()
+    tokens.iter().map(|t| parse_number(t, path, line_no)).collect()
 }
 
 /// One number, or `path:line: expected a number, found "tok"`.
-pub fn parse_number<T: std::str::FromStr>(
-    token: &str,
-    path: &Path,
-    line_no: usize,
-) -> Result<T, FormatError> {
-    token.parse().map_err(|_| {
-        FormatError::syntax(path, line_no, format!("expected a number, found `{token}`"))
-    })
+pub fn parse_number<T: std::str::FromStr>(token: &str, path: &Path, line_no: usize) -> Result<T, FormatError> {
+    token.parse().map_err(|_| FormatError::syntax(path, line_no, format!("expected a number, found `{token}`")))
 }

@@ -46,11 +46,7 @@ pub fn parse_obj(reader: impl BufRead, path: &Path) -> Result<ObjMesh, FormatErr
                     .map(|t| {
                         let first = t.split('/').next().unwrap_or("");
                         first.parse::<i64>().map_err(|_| {
-                            FormatError::syntax(
-                                path,
-                                line_no,
-                                format!("expected a vertex index, found `{t}`"),
-                            )
+                            FormatError::syntax(path, line_no, format!("expected a vertex index, found `{t}`"))
                         })
                     })
                     .collect::<Result<Vec<_>, _>>()?;
@@ -58,10 +54,7 @@ pub fn parse_obj(reader: impl BufRead, path: &Path) -> Result<ObjMesh, FormatErr
                     return Err(FormatError::syntax(
                         path,
                         line_no,
-                        format!(
-                            "expected at least 3 vertex indices after `f`, found {}",
-                            corners.len()
-                        ),
+                        format!("expected at least 3 vertex indices after `f`, found {}", corners.len()),
                     ));
                 }
                 faces.push((line_no, corners));
@@ -87,19 +80,14 @@ pub fn parse_obj(reader: impl BufRead, path: &Path) -> Result<ObjMesh, FormatErr
             })
             .collect::<Result<Vec<u32>, _>>()?;
         for k in 1..resolved.len() - 1 {
-            mesh.triangles
-                .push([resolved[0], resolved[k], resolved[k + 1]]);
+            mesh.triangles.push([resolved[0], resolved[k], resolved[k + 1]]);
         }
     }
     Ok(mesh)
 }
 
 /// Writes `v` lines (one per vertex, in order) then `f` lines (1-based).
-pub fn write_obj(
-    mut out: impl Write,
-    positions: &[Vec3],
-    triangles: &[[u32; 3]],
-) -> std::io::Result<()> {
+pub fn write_obj(mut out: impl Write, positions: &[Vec3], triangles: &[[u32; 3]]) -> std::io::Result<()> {
     for p in positions {
         writeln!(out, "v {} {} {}", p.x, p.y, p.z)?;
     }

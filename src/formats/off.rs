@@ -16,31 +16,19 @@ pub fn parse_off(reader: impl BufRead, path: &Path) -> Result<ObjMesh, FormatErr
         let t = l.trim();
         !t.is_empty() && !t.starts_with('#')
     });
-    let (n, header) = lines
-        .next()
-        .ok_or_else(|| FormatError::syntax(path, 1, "expected `OFF`, found an empty file"))?;
+    let (n, header) =
+        lines.next().ok_or_else(|| FormatError::syntax(path, 1, "expected `OFF`, found an empty file"))?;
     let mut header_tokens = header.split_whitespace();
     if header_tokens.next() != Some("OFF") {
-        return Err(FormatError::syntax(
-            path,
-            n,
-            format!("expected `OFF`, found `{}`", header.trim()),
-        ));
+        return Err(FormatError::syntax(path, n, format!("expected `OFF`, found `{}`", header.trim())));
     }
     // The counts may follow OFF on the same line.
     let rest: Vec<&str> = header_tokens.collect();
     let (counts_line, counts) = if rest.is_empty() {
         let (n, l) = lines.next().ok_or_else(|| {
-            FormatError::syntax(
-                path,
-                n + 1,
-                "expected `vertices faces edges`, found the end of the file",
-            )
+            FormatError::syntax(path, n + 1, "expected `vertices faces edges`, found the end of the file")
         })?;
-        (
-            n,
-            l.split_whitespace().map(str::to_string).collect::<Vec<_>>(),
-        )
+        (n, l.split_whitespace().map(str::to_string).collect::<Vec<_>>())
     } else {
         (n, rest.iter().map(|s| s.to_string()).collect())
     };
@@ -48,10 +36,7 @@ pub fn parse_off(reader: impl BufRead, path: &Path) -> Result<ObjMesh, FormatErr
         return Err(FormatError::syntax(
             path,
             counts_line,
-            format!(
-                "expected 3 counts (vertices faces edges), found {}",
-                counts.len()
-            ),
+            format!("expected 3 counts (vertices faces edges), found {}", counts.len()),
         ));
     }
     let vertex_count: usize = parse_number(&counts[0], path, counts_line)?;
@@ -62,19 +47,12 @@ pub fn parse_off(reader: impl BufRead, path: &Path) -> Result<ObjMesh, FormatErr
             FormatError::syntax(
                 path,
                 counts_line,
-                format!(
-                    "expected {vertex_count} vertices, found {} before the end of the file",
-                    mesh.positions.len()
-                ),
+                format!("expected {vertex_count} vertices, found {} before the end of the file", mesh.positions.len()),
             )
         })?;
         let t: Vec<&str> = l.split_whitespace().collect();
         if t.len() < 3 {
-            return Err(FormatError::syntax(
-                path,
-                n,
-                format!("expected 3 numbers (x y z), found {}", t.len()),
-            ));
+            return Err(FormatError::syntax(path, n, format!("expected 3 numbers (x y z), found {}", t.len())));
         }
         mesh.positions.push(Vec3::new(
             parse_number(t[0], path, n)?,
@@ -96,10 +74,7 @@ pub fn parse_off(reader: impl BufRead, path: &Path) -> Result<ObjMesh, FormatErr
             return Err(FormatError::syntax(
                 path,
                 n,
-                format!(
-                    "expected a polygon `k i0 .. i(k-1)` with k >= 3, found `{}`",
-                    l.trim()
-                ),
+                format!("expected a polygon `k i0 .. i(k-1)` with k >= 3, found `{}`", l.trim()),
             ));
         }
         let idx = t[1..=k]

@@ -48,11 +48,7 @@ impl SourceDoc {
 /// `path` relative to `dir` (both made absolute first); `path` itself when that fails.
 pub fn relative_path(path: &Path, dir: &Path) -> PathBuf {
     let abs = |p: &Path| {
-        if p.is_absolute() {
-            Some(p.to_path_buf())
-        } else {
-            std::env::current_dir().ok().map(|c| c.join(p))
-        }
+        if p.is_absolute() { Some(p.to_path_buf()) } else { std::env::current_dir().ok().map(|c| c.join(p)) }
     };
     let (Some(path_abs), Some(dir_abs)) = (abs(path), abs(dir)) else {
         return path.to_path_buf();
@@ -95,11 +91,7 @@ pub struct PlacementDoc {
 
 impl Default for PlacementDoc {
     fn default() -> Self {
-        Self {
-            translation: [0.0; 3],
-            yaw: 0.0,
-            scale: 1.0,
-        }
+        Self { translation: [0.0; 3], yaw: 0.0, scale: 1.0 }
     }
 }
 
@@ -190,12 +182,7 @@ pub struct StageDoc {
 
 impl Default for StageDoc {
     fn default() -> Self {
-        Self {
-            floor: true,
-            shadows: true,
-            axes: false,
-            floor_height: 0.0,
-        }
+        Self { floor: true, shadows: true, axes: false, floor_height: 0.0 }
     }
 }
 
@@ -250,17 +237,13 @@ pub fn joint_of_pose_key(skeleton: &Skeleton, key: &str) -> Option<usize> {
 /// Reads a scene; errors carry the line.
 pub fn parse_scene(mut reader: impl BufRead, path: &Path) -> Result<SceneDoc, FormatError> {
     let mut text = String::new();
-    reader
-        .read_to_string(&mut text)
-        .map_err(|e| FormatError::io(path, e))?;
-    ron::from_str(&text)
-        .map_err(|e| FormatError::syntax(path, e.span.start.line, e.code.to_string()))
+    reader.read_to_string(&mut text).map_err(|e| FormatError::io(path, e))?;
+    ron::from_str(&text).map_err(|e| FormatError::syntax(path, e.span.start.line, e.code.to_string()))
 }
 
 /// The scene as pretty RON text.
 pub fn scene_to_string(doc: &SceneDoc) -> String {
-    ron::ser::to_string_pretty(doc, ron::ser::PrettyConfig::default())
-        .expect("scene documents serialise")
+    ron::ser::to_string_pretty(doc, ron::ser::PrettyConfig::default()).expect("scene documents serialise")
 }
 
 /// Writes a scene whole or not at all (temporary file, then rename).

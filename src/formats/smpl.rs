@@ -20,35 +20,21 @@ fn data_lines(reader: impl BufRead, path: &Path) -> Result<Vec<(usize, String)>,
         .collect())
 }
 
-fn numbers<T: std::str::FromStr>(
-    line: &str,
-    path: &Path,
-    line_no: usize,
-) -> Result<Vec<T>, FormatError> {
-    line.split_whitespace()
-        .map(|t| parse_number(t, path, line_no))
-        .collect()
+fn numbers<T: std::str::FromStr>(line: &str, path: &Path, line_no: usize) -> Result<Vec<T>, FormatError> {
+    line.split_whitespace().map(|t| parse_number(t, path, line_no)).collect()
 }
 
 /// `smpl_hierarchy.txt`: a count, then rows `index parent EULER_XYZ name`.
 pub fn parse_hierarchy(reader: impl BufRead, path: &Path) -> Result<Skeleton, FormatError> {
     let lines = data_lines(reader, path)?;
-    let (count_line, count) = lines.first().ok_or_else(|| {
-        FormatError::syntax(
-            path,
-            1,
-            "expected the joint count, found the end of the file",
-        )
-    })?;
+    let (count_line, count) = lines
+        .first()
+        .ok_or_else(|| FormatError::syntax(path, 1, "expected the joint count, found the end of the file"))?;
     let count: usize = parse_number(count.trim(), path, *count_line)?;
     let rows = &lines[1..];
     if rows.len() != count {
         let at = rows.last().map_or(*count_line, |r| r.0);
-        return Err(FormatError::syntax(
-            path,
-            at,
-            format!("expected {count} joint rows, found {}", rows.len()),
-        ));
+        return Err(FormatError::syntax(path, at, format!("expected {count} joint rows, found {}", rows.len())));
     }
     let mut raw = Vec::with_capacity(count);
     for (k, (n, line)) in rows.iter().enumerate() {
@@ -57,34 +43,19 @@ pub fn parse_hierarchy(reader: impl BufRead, path: &Path) -> Result<Skeleton, Fo
             return Err(FormatError::syntax(
                 path,
                 *n,
-                format!(
-                    "expected `index parent order name`, found {} fields",
-                    t.len()
-                ),
+                format!("expected `index parent order name`, found {} fields", t.len()),
             ));
         }
         let index: usize = parse_number(t[0], path, *n)?;
         if index != k {
-            return Err(FormatError::syntax(
-                path,
-                *n,
-                format!("expected joint index {k}, found {index}"),
-            ));
+            return Err(FormatError::syntax(path, *n, format!("expected joint index {k}, found {index}")));
         }
         let parent: i64 = parse_number(t[1], path, *n)?;
         if parent >= k as i64 || parent < -1 {
-            return Err(FormatError::syntax(
-                path,
-                *n,
-                format!("expected a parent index in -1..{k}, found {parent}"),
-            ));
+            return Err(FormatError::syntax(path, *n, format!("expected a parent index in -1..{k}, found {parent}")));
         }
         if t[2] != "EULER_XYZ" {
-            return Err(FormatError::syntax(
-                path,
-                *n,
-                format!("expected rotation order EULER_XYZ, found `{}`", t[2]),
-            ));
+            return Err(FormatError::syntax(path, *n, format!("expected rotation order EULER_XYZ, found `{}`", t[2])));
         }
         let mut joint = RawJoint::new(t[3], (parent >= 0).then_some(parent as usize), Vec3::ZERO);
         joint.initial_rotation = crate::rig::JointRotation::Euler(Vec3::ZERO, EulerOrder::Xyz);
@@ -101,13 +72,9 @@ pub fn parse_skeleton_positions(
     joint_count: usize,
 ) -> Result<Vec<Vec3>, FormatError> {
     let lines = data_lines(reader, path)?;
-    let (header_line, header) = lines.first().ok_or_else(|| {
-        FormatError::syntax(
-            path,
-            1,
-            "expected `frames joints`, found the end of the file",
-        )
-    })?;
+    let (header_line, header) = lines
+        .first()
+        .ok_or_else(|| FormatError::syntax(path, 1, "expected `frames joints`, found the end of the file"))?;
     let h: Vec<usize> = numbers(header, path, *header_line)?;
     if h.len() != 2 || h[1] != joint_count {
         return Err(FormatError::syntax(
@@ -117,27 +84,17 @@ pub fn parse_skeleton_positions(
         ));
     }
     let (n, row) = lines.get(1).ok_or_else(|| {
-        FormatError::syntax(
-            path,
-            *header_line,
-            "expected a row of joint positions, found the end of the file",
-        )
+        FormatError::syntax(path, *header_line, "expected a row of joint positions, found the end of the file")
     })?;
     let v: Vec<f32> = numbers(row, path, *n)?;
     if v.len() != 7 * joint_count {
         return Err(FormatError::syntax(
             path,
             *n,
-            format!(
-                "expected {} numbers ({joint_count} × qx qy qz qw px py pz), found {}",
-                7 * joint_count,
-                v.len()
-            ),
+            format!("expected {} numbers ({joint_count} × qx qy qz qw px py pz), found {}", 7 * joint_count, v.len()),
         ));
     }
-    Ok(v.chunks_exact(7)
-        .map(|c| Vec3::new(c[4], c[5], c[6]))
-        .collect())
+    Ok(v.chunks_exact(7).map(|c| Vec3::new(c[4], c[5], c[6])).collect())
 }
 
 /// `smpl_skin.txt`: header `vertices joints influences`, then per vertex `influences`
@@ -149,21 +106,14 @@ pub fn parse_skin(
 ) -> Result<(SkinWeights, Vec<NormalisedRow>), FormatError> {
     let lines = data_lines(reader, path)?;
     let (header_line, header) = lines.first().ok_or_else(|| {
-        FormatError::syntax(
-            path,
-            1,
-            "expected `vertices joints influences`, found the end of the file",
-        )
+        FormatError::syntax(path, 1, "expected `vertices joints influences`, found the end of the file")
     })?;
     let h: Vec<usize> = numbers(header, path, *header_line)?;
     if h.len() != 3 {
         return Err(FormatError::syntax(
             path,
             *header_line,
-            format!(
-                "expected 3 numbers (vertices joints influences), found {}",
-                h.len()
-            ),
+            format!("expected 3 numbers (vertices joints influences), found {}", h.len()),
         ));
     }
     let (vertices, joints, per_vertex) = (h[0], h[1], h[2]);
@@ -177,11 +127,7 @@ pub fn parse_skin(
     let rows = &lines[1..];
     if rows.len() != vertices {
         let at = rows.last().map_or(*header_line, |r| r.0);
-        return Err(FormatError::syntax(
-            path,
-            at,
-            format!("expected {vertices} vertex rows, found {}", rows.len()),
-        ));
+        return Err(FormatError::syntax(path, at, format!("expected {vertices} vertex rows, found {}", rows.len())));
     }
     let mut parsed = Vec::with_capacity(vertices);
     for (n, line) in rows {
@@ -216,19 +162,11 @@ pub fn parse_skin(
 
 /// `smpl_quaternions_*.txt`: header `frames joints`, then per frame the root position and
 /// `joints` quaternions (x y z w).
-pub fn parse_clip(
-    reader: impl BufRead,
-    path: &Path,
-    joint_count: usize,
-) -> Result<Clip, FormatError> {
+pub fn parse_clip(reader: impl BufRead, path: &Path, joint_count: usize) -> Result<Clip, FormatError> {
     let lines = data_lines(reader, path)?;
-    let (header_line, header) = lines.first().ok_or_else(|| {
-        FormatError::syntax(
-            path,
-            1,
-            "expected `frames joints`, found the end of the file",
-        )
-    })?;
+    let (header_line, header) = lines
+        .first()
+        .ok_or_else(|| FormatError::syntax(path, 1, "expected `frames joints`, found the end of the file"))?;
     let h: Vec<usize> = numbers(header, path, *header_line)?;
     if h.len() != 2 || h[1] != joint_count {
         return Err(FormatError::syntax(
@@ -240,18 +178,11 @@ pub fn parse_clip(
     let rows = &lines[1..];
     if rows.len() != h[0] {
         let at = rows.last().map_or(*header_line, |r| r.0);
-        return Err(FormatError::syntax(
-            path,
-            at,
-            format!("expected {} frames, found {}", h[0], rows.len()),
-        ));
+        return Err(FormatError::syntax(path, at, format!("expected {} frames, found {}", h[0], rows.len())));
     }
     let width = 3 + 4 * joint_count;
     let mut clip = Clip {
-        name: path
-            .file_stem()
-            .map(|s| s.to_string_lossy().into_owned())
-            .unwrap_or_default(),
+        name: path.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default(),
         root_positions: Vec::new(),
         rotations: Vec::new(),
         joint_count,
@@ -262,18 +193,11 @@ pub fn parse_clip(
             return Err(FormatError::syntax(
                 path,
                 *n,
-                format!(
-                    "expected {width} numbers (root x y z, then {joint_count} × qx qy qz qw), found {}",
-                    v.len()
-                ),
+                format!("expected {width} numbers (root x y z, then {joint_count} × qx qy qz qw), found {}", v.len()),
             ));
         }
         clip.root_positions.push(Vec3::new(v[0], v[1], v[2]));
-        clip.rotations.extend(
-            v[3..]
-                .chunks_exact(4)
-                .map(|q| Quat::from_xyzw(q[0], q[1], q[2], q[3]).normalize()),
-        );
+        clip.rotations.extend(v[3..].chunks_exact(4).map(|q| Quat::from_xyzw(q[0], q[1], q[2], q[3]).normalize()));
     }
     Ok(clip)
 }
@@ -286,11 +210,7 @@ pub fn is_smpl_dir(dir: &Path) -> bool {
 /// The hierarchy file, under either spelling.
 fn hierarchy_path(dir: &Path) -> PathBuf {
     let right = dir.join("smpl_hierarchy.txt");
-    if right.is_file() {
-        right
-    } else {
-        dir.join("smpl_hiearchy.txt")
-    }
+    if right.is_file() { right } else { dir.join("smpl_hiearchy.txt") }
 }
 
 /// The clips in a folder (`smpl_quaternions_*.txt`), sorted by name.
@@ -340,32 +260,15 @@ pub fn load_smpl_dir(dir: &Path) -> Result<(SmplModel, Vec<String>), FormatError
         }
         let skel_path = dir.join(format!("smpl_skel{b:02}.txt"));
         let joints = parse_skeleton_positions(open(&skel_path)?, &skel_path, n)?;
-        vertex_deltas.push(
-            target
-                .positions
-                .iter()
-                .zip(&base.positions)
-                .map(|(t, b)| *t - *b)
-                .collect(),
-        );
-        joint_deltas.push(
-            joints
-                .iter()
-                .zip(&base_joints)
-                .map(|(t, b)| *t - *b)
-                .collect(),
-        );
+        vertex_deltas.push(target.positions.iter().zip(&base.positions).map(|(t, b)| *t - *b).collect());
+        joint_deltas.push(joints.iter().zip(&base_joints).map(|(t, b)| *t - *b).collect());
     }
     let skin_path = dir.join("smpl_skin.txt");
     let (weights, normalised) = parse_skin(open(&skin_path)?, &skin_path, n)?;
     if weights.vertex_count() != base.positions.len() {
         return Err(FormatError::other(
             &skin_path,
-            format!(
-                "expected {} weight rows (as smpl_00.obj), found {}",
-                base.positions.len(),
-                weights.vertex_count()
-            ),
+            format!("expected {} weight rows (as smpl_00.obj), found {}", base.positions.len(), weights.vertex_count()),
         ));
     }
     let warnings = super::character::normalised_warnings(&skin_path, &normalised);

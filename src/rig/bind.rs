@@ -21,11 +21,7 @@ pub fn bones(skeleton: &Skeleton, joint_positions: &[Vec3]) -> Vec<Bone> {
         .filter_map(|c| {
             let p = skeleton.parent(c)?;
             let (start, end) = (joint_positions[p], joint_positions[c]);
-            (start.distance_squared(end) > 1e-12).then_some(Bone {
-                joint: p,
-                start,
-                end,
-            })
+            (start.distance_squared(end) > 1e-12).then_some(Bone { joint: p, start, end })
         })
         .collect()
 }
@@ -44,10 +40,7 @@ pub fn nearest_bone_weights(positions: &[Vec3], bones: &[Bone]) -> SkinWeights {
         .map(|&p| {
             bones
                 .iter()
-                .min_by(|x, y| {
-                    segment_distance(p, x.start, x.end)
-                        .total_cmp(&segment_distance(p, y.start, y.end))
-                })
+                .min_by(|x, y| segment_distance(p, x.start, x.end).total_cmp(&segment_distance(p, y.start, y.end)))
                 .map_or(0, |b| b.joint as u16)
         })
         .collect();
@@ -65,23 +58,14 @@ pub fn smooth_bone_weights(
     max_bones: usize,
     falloff: f32,
 ) -> SkinWeights {
-    let size = bones
-        .iter()
-        .map(|b| b.start.distance(b.end))
-        .fold(0.0f32, f32::max)
-        .max(1e-6);
+    let size = bones.iter().map(|b| b.start.distance(b.end)).fold(0.0f32, f32::max).max(1e-6);
     let eps = (0.02 * size).powi(2);
     let mut distances: Vec<(f32, usize)> = Vec::with_capacity(bones.len());
     let rows: Vec<Vec<(usize, f32)>> = positions
         .iter()
         .map(|&p| {
             distances.clear();
-            distances.extend(
-                bones
-                    .iter()
-                    .enumerate()
-                    .map(|(i, b)| (segment_distance(p, b.start, b.end), i)),
-            );
+            distances.extend(bones.iter().enumerate().map(|(i, b)| (segment_distance(p, b.start, b.end), i)));
             distances.sort_by(|a, b| a.0.total_cmp(&b.0));
             let nearest = distances.first().map_or(0.0, |d| d.0);
             let mut row: Vec<(usize, f32)> = Vec::new();
@@ -98,7 +82,5 @@ pub fn smooth_bone_weights(
             row
         })
         .collect();
-    SkinWeights::from_rows(rows, joint_count)
-        .expect("distance weights are positive and in range")
-        .0
+    SkinWeights::from_rows(rows, joint_count).expect("distance weights are positive and in range").0
 }

@@ -24,18 +24,11 @@ impl Skin {
     pub fn validate(&self) -> Result<(), RigError> {
         let count = self.bind_positions.len();
         if self.weights.vertex_count() != count {
-            return Err(RigError::WeightCountMismatch {
-                mesh: count,
-                weights: self.weights.vertex_count(),
-            });
+            return Err(RigError::WeightCountMismatch { mesh: count, weights: self.weights.vertex_count() });
         }
         for (t, tri) in self.triangles.iter().enumerate() {
             if let Some(&index) = tri.iter().find(|&&i| i as usize >= count) {
-                return Err(RigError::TriangleIndexOutOfRange {
-                    triangle: t,
-                    index,
-                    count,
-                });
+                return Err(RigError::TriangleIndexOutOfRange { triangle: t, index, count });
             }
         }
         Ok(())
@@ -74,33 +67,15 @@ impl CharacterAsset {
     ) -> Result<Self, RigError> {
         skin.validate()?;
         let bind_world_to_joint = bind_world_to_joint(&skeleton, None);
-        Ok(Self {
-            name: name.into(),
-            skeleton,
-            skin,
-            skin_kind: SkinKind::Mesh,
-            bind_world_to_joint,
-            warnings,
-        })
+        Ok(Self { name: name.into(), skeleton, skin, skin_kind: SkinKind::Mesh, bind_world_to_joint, warnings })
     }
 
     /// A character without a mesh: each joint's bone box (its own, or ±0.1) rigidly
     /// bound to that joint.
-    pub fn with_bone_boxes(
-        name: impl Into<String>,
-        skeleton: Skeleton,
-        warnings: Vec<String>,
-    ) -> Self {
+    pub fn with_bone_boxes(name: impl Into<String>, skeleton: Skeleton, warnings: Vec<String>) -> Self {
         let skin = bone_box_skin(&skeleton);
         let bind_world_to_joint = bind_world_to_joint(&skeleton, None);
-        Self {
-            name: name.into(),
-            skeleton,
-            skin,
-            skin_kind: SkinKind::BoneBoxes,
-            bind_world_to_joint,
-            warnings,
-        }
+        Self { name: name.into(), skeleton, skin, skin_kind: SkinKind::BoneBoxes, bind_world_to_joint, warnings }
     }
 
     pub fn vertex_count(&self) -> usize {
@@ -119,11 +94,7 @@ impl CharacterAsset {
             lo = lo.min(*p);
             hi = hi.max(*p);
         }
-        if lo.x > hi.x {
-            (Vec3::ZERO, Vec3::ZERO)
-        } else {
-            (lo, hi)
-        }
+        if lo.x > hi.x { (Vec3::ZERO, Vec3::ZERO) } else { (lo, hi) }
     }
 }
 
@@ -161,17 +132,12 @@ fn bone_box_skin(skeleton: &Skeleton) -> Skin {
     forward_kinematics(skeleton, &skeleton.rest_pose(), Mat4::IDENTITY, &mut rest);
     let mut skin = Skin::default();
     let mut joint_of_vertex = Vec::new();
-    let default_box = BoneBox {
-        min: Vec3::splat(-0.1),
-        max: Vec3::splat(0.1),
-    };
+    let default_box = BoneBox { min: Vec3::splat(-0.1), max: Vec3::splat(0.1) };
     for (j, joint) in skeleton.joints().iter().enumerate() {
         let first = skin.bind_positions.len() as u32;
         let b = joint.bone_box.unwrap_or(default_box);
-        skin.bind_positions
-            .extend(box_corners(&b).iter().map(|c| rest[j].transform_point3(*c)));
-        skin.triangles
-            .extend(BOX_TRIANGLES.iter().map(|t| t.map(|i| first + i)));
+        skin.bind_positions.extend(box_corners(&b).iter().map(|c| rest[j].transform_point3(*c)));
+        skin.triangles.extend(BOX_TRIANGLES.iter().map(|t| t.map(|i| first + i)));
         joint_of_vertex.extend(std::iter::repeat_n(j as u16, 8));
     }
     skin.weights = SkinWeights::rigid(&joint_of_vertex);

@@ -12,12 +12,7 @@ use super::skeleton::Skeleton;
 ///
 /// # Panics
 /// When `pose` or `joint_to_world` is not one entry per joint.
-pub fn forward_kinematics(
-    skeleton: &Skeleton,
-    pose: &[JointRotation],
-    placement: Mat4,
-    joint_to_world: &mut [Mat4],
-) {
+pub fn forward_kinematics(skeleton: &Skeleton, pose: &[JointRotation], placement: Mat4, joint_to_world: &mut [Mat4]) {
     forward_kinematics_with_offsets(skeleton, pose, None, placement, joint_to_world)
 }
 
@@ -56,13 +51,7 @@ pub fn forward_kinematics_with_offsets(
 /// joint-to-world), in model space (identity placement).
 pub fn bind_world_to_joint(skeleton: &Skeleton, offsets: Option<&[Vec3]>) -> Vec<Mat4> {
     let mut rest = vec![Mat4::IDENTITY; skeleton.len()];
-    forward_kinematics_with_offsets(
-        skeleton,
-        &skeleton.rest_pose(),
-        offsets,
-        Mat4::IDENTITY,
-        &mut rest,
-    );
+    forward_kinematics_with_offsets(skeleton, &skeleton.rest_pose(), offsets, Mat4::IDENTITY, &mut rest);
     rest.iter().map(Mat4::inverse).collect()
 }
 
@@ -72,18 +61,10 @@ pub fn joint_positions(joint_to_world: &[Mat4]) -> Vec<Vec3> {
 }
 
 /// Skinning palette: `current_joint_to_world[j] · bind_world_to_joint[j]`.
-pub fn skinning_palette(
-    current_joint_to_world: &[Mat4],
-    bind_world_to_joint: &[Mat4],
-    palette: &mut [Mat4],
-) {
+pub fn skinning_palette(current_joint_to_world: &[Mat4], bind_world_to_joint: &[Mat4], palette: &mut [Mat4]) {
     assert_eq!(current_joint_to_world.len(), bind_world_to_joint.len());
     assert_eq!(palette.len(), bind_world_to_joint.len());
-    for ((p, c), b) in palette
-        .iter_mut()
-        .zip(current_joint_to_world)
-        .zip(bind_world_to_joint)
-    {
+    for ((p, c), b) in palette.iter_mut().zip(current_joint_to_world).zip(bind_world_to_joint) {
         *p = *c * *b;
     }
 }

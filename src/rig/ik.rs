@@ -29,12 +29,7 @@ pub fn fabrik(chain: &[Vec3], target: Vec3, tolerance: f32, max_iterations: usiz
     let n = p.len();
     if n < 2 {
         let distance = p.first().map_or(f32::INFINITY, |b| b.distance(target));
-        return FabrikResult {
-            positions: p,
-            reached: distance <= tolerance,
-            iterations: 0,
-            distance,
-        };
+        return FabrikResult { positions: p, reached: distance <= tolerance, iterations: 0, distance };
     }
     let lengths: Vec<f32> = p.windows(2).map(|w| w[0].distance(w[1])).collect();
     let base = p[0];
@@ -45,12 +40,7 @@ pub fn fabrik(chain: &[Vec3], target: Vec3, tolerance: f32, max_iterations: usiz
             p[i + 1] = p[i] + lengths[i] * dir;
         }
         let distance = p[n - 1].distance(target);
-        return FabrikResult {
-            positions: p,
-            reached: distance <= tolerance,
-            iterations: 1,
-            distance,
-        };
+        return FabrikResult { positions: p, reached: distance <= tolerance, iterations: 1, distance };
     }
     let mut iterations = 0;
     let mut distance = p[n - 1].distance(target);
@@ -68,12 +58,7 @@ pub fn fabrik(chain: &[Vec3], target: Vec3, tolerance: f32, max_iterations: usiz
         }
         distance = p[n - 1].distance(target);
     }
-    FabrikResult {
-        positions: p,
-        reached: distance <= tolerance,
-        iterations,
-        distance,
-    }
+    FabrikResult { positions: p, reached: distance <= tolerance, iterations, distance }
 }
 
 /// The joints from `end` up to its sub-base (the first ancestor with more than one child,
@@ -137,11 +122,7 @@ pub fn solve_ik(
         .map(|goal| {
             let full = chain_to_sub_base(skeleton, goal.end);
             // Positions chain: from the sub-base's child (fixed) down to the end.
-            let chain: Vec<usize> = if full.len() > 2 {
-                full[1..].to_vec()
-            } else {
-                full.clone()
-            };
+            let chain: Vec<usize> = if full.len() > 2 { full[1..].to_vec() } else { full.clone() };
             let mut report = IkReport {
                 end: goal.end,
                 chain: chain[..chain.len() - 1].to_vec(),
@@ -153,8 +134,7 @@ pub fn solve_ik(
             };
             for _ in 0..rounds.max(1) {
                 forward_kinematics(skeleton, pose, placement, &mut world);
-                let positions: Vec<Vec3> =
-                    chain.iter().map(|&j| world[j].w_axis.truncate()).collect();
+                let positions: Vec<Vec3> = chain.iter().map(|&j| world[j].w_axis.truncate()).collect();
                 report.distance = positions[positions.len() - 1].distance(goal.target);
                 if report.distance <= tolerance {
                     report.reached = true;
@@ -175,8 +155,7 @@ pub fn solve_ik(
                     let parent_world = skeleton.parent(j).map_or(placement, |p| world[p]);
                     let parent_rotation = rotation_of(parent_world);
                     let local = pose[j].to_quat();
-                    let new_local =
-                        (parent_rotation.inverse() * delta * parent_rotation * local).normalize();
+                    let new_local = (parent_rotation.inverse() * delta * parent_rotation * local).normalize();
                     let wanted = pose[j].with_rotation_of(new_local);
                     let clamped = wanted.clamped(&skeleton.joint(j).limits);
                     if clamped != wanted {
@@ -196,10 +175,5 @@ pub fn solve_ik(
 /// The rotation part of a transform (scale removed).
 fn rotation_of(m: Mat4) -> Quat {
     let m3 = Mat3::from_mat4(m);
-    Quat::from_mat3(&Mat3::from_cols(
-        m3.x_axis.normalize(),
-        m3.y_axis.normalize(),
-        m3.z_axis.normalize(),
-    ))
-    .normalize()
+    Quat::from_mat3(&Mat3::from_cols(m3.x_axis.normalize(), m3.y_axis.normalize(), m3.z_axis.normalize())).normalize()
 }

@@ -17,9 +17,7 @@ impl MatrixStack {
 
     /// An empty stack whose storage is reserved for `depth` pushes.
     pub fn with_capacity(depth: usize) -> Self {
-        Self {
-            stack: Vec::with_capacity(depth),
-        }
+        Self { stack: Vec::with_capacity(depth) }
     }
 
     /// The accumulated transform (identity when empty).

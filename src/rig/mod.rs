@@ -23,44 +23,22 @@ pub use skinning::{Influence, SkinWeights};
 pub enum RigError {
     #[error("the skeleton has no joints")]
     EmptySkeleton,
-    #[error(
-        "joint {joint}: parent index {parent} is out of range (the skeleton has {count} joints)"
-    )]
-    ParentOutOfRange {
-        joint: usize,
-        parent: usize,
-        count: usize,
-    },
+    #[error("joint {joint}: parent index {parent} is out of range (the skeleton has {count} joints)")]
+    ParentOutOfRange { joint: usize, parent: usize, count: usize },
     #[error("the skeleton has several roots: {}", roots.join(", "))]
     SeveralRoots { roots: Vec<String> },
     #[error("joint `{joint}` is on a cycle of parents")]
     Cycle { joint: String },
     #[error("joint `{joint}` (index {index}) comes before its parent {parent}")]
-    NotParentFirst {
-        joint: String,
-        index: usize,
-        parent: usize,
-    },
+    NotParentFirst { joint: String, index: usize, parent: usize },
     #[error("vertex {vertex}: joint {joint} is out of range (the skeleton has {count} joints)")]
-    InfluenceJointOutOfRange {
-        vertex: usize,
-        joint: usize,
-        count: usize,
-    },
+    InfluenceJointOutOfRange { vertex: usize, joint: usize, count: usize },
     #[error("vertex {vertex}: weight {weight} for joint {joint} is negative or not a number")]
-    BadWeight {
-        vertex: usize,
-        joint: usize,
-        weight: f32,
-    },
+    BadWeight { vertex: usize, joint: usize, weight: f32 },
     #[error("vertex {vertex} has no positive weight")]
     NoInfluence { vertex: usize },
     #[error("the mesh has {mesh} vertices but the weights cover {weights}")]
     WeightCountMismatch { mesh: usize, weights: usize },
     #[error("triangle {triangle} uses vertex {index}, but the mesh has {count}")]
-    TriangleIndexOutOfRange {
-        triangle: usize,
-        index: u32,
-        count: usize,
-    },
+    TriangleIndexOutOfRange { triangle: usize, index: u32, count: usize },
 }

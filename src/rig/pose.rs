@@ -60,10 +60,7 @@ pub struct DofLimits {
 }
 
 impl DofLimits {
-    pub const UNLIMITED: Self = Self {
-        min: Vec3::splat(f32::NEG_INFINITY),
-        max: Vec3::splat(f32::INFINITY),
-    };
+    pub const UNLIMITED: Self = Self { min: Vec3::splat(f32::NEG_INFINITY), max: Vec3::splat(f32::INFINITY) };
 
     pub fn is_unlimited(&self) -> bool {
         self.min.cmple(Vec3::splat(-1e30)).all() && self.max.cmpge(Vec3::splat(1e30)).all()
@@ -121,9 +118,7 @@ impl JointRotation {
         match *self {
             JointRotation::Euler(a, order) => {
                 let [first, second, third] = order.axes();
-                axis_rotation(third, a[third])
-                    * axis_rotation(second, a[second])
-                    * axis_rotation(first, a[first])
+                axis_rotation(third, a[third]) * axis_rotation(second, a[second]) * axis_rotation(first, a[first])
             }
             JointRotation::Quat(q) => Mat3::from_quat(q.normalize()),
         }
@@ -156,9 +151,7 @@ impl JointRotation {
     /// The same rotation expressed like `self` (Euler stays Euler in its order).
     pub fn with_rotation_of(&self, q: Quat) -> Self {
         match *self {
-            JointRotation::Euler(_, order) => {
-                JointRotation::Euler(JointRotation::Quat(q).to_euler(order), order)
-            }
+            JointRotation::Euler(_, order) => JointRotation::Euler(JointRotation::Quat(q).to_euler(order), order),
             JointRotation::Quat(_) => JointRotation::Quat(q.normalize()),
         }
     }

@@ -78,31 +78,21 @@ impl Skeleton {
         for (i, j) in raw.iter().enumerate() {
             if let Some(p) = j.parent {
                 if p >= n {
-                    return Err(RigError::ParentOutOfRange {
-                        joint: i,
-                        parent: p,
-                        count: n,
-                    });
+                    return Err(RigError::ParentOutOfRange { joint: i, parent: p, count: n });
                 }
                 if p == i {
-                    return Err(RigError::Cycle {
-                        joint: j.name.clone(),
-                    });
+                    return Err(RigError::Cycle { joint: j.name.clone() });
                 }
             }
         }
         let roots: Vec<usize> = (0..n).filter(|&i| raw[i].parent.is_none()).collect();
         match roots.len() {
             0 => {
-                return Err(RigError::Cycle {
-                    joint: raw[0].name.clone(),
-                });
+                return Err(RigError::Cycle { joint: raw[0].name.clone() });
             }
             1 => {}
             _ => {
-                return Err(RigError::SeveralRoots {
-                    roots: roots.iter().map(|&r| raw[r].name.clone()).collect(),
-                });
+                return Err(RigError::SeveralRoots { roots: roots.iter().map(|&r| raw[r].name.clone()).collect() });
             }
         }
         let mut raw_children = vec![Vec::new(); n];
@@ -122,9 +112,7 @@ impl Skeleton {
             let mut reached = vec![false; n];
             order.iter().for_each(|&j| reached[j] = true);
             let lost = (0..n).find(|&j| !reached[j]).unwrap_or(0);
-            return Err(RigError::Cycle {
-                joint: raw[lost].name.clone(),
-            });
+            return Err(RigError::Cycle { joint: raw[lost].name.clone() });
         }
         let mut new_index = vec![0; n];
         for (new, &old) in order.iter().enumerate() {
@@ -159,11 +147,7 @@ impl Skeleton {
             {
                 // A forward reference: a cycle, or an order only `build_reordered` accepts.
                 Self::build_reordered(raw.clone())?;
-                return Err(RigError::NotParentFirst {
-                    joint: j.name.clone(),
-                    index: i,
-                    parent: p,
-                });
+                return Err(RigError::NotParentFirst { joint: j.name.clone(), index: i, parent: p });
             }
         }
         // Validates roots and ranges; with parents first, the depth-first order found there
@@ -224,12 +208,7 @@ impl Skeleton {
 
     /// A joint by name, or by index written as a number.
     pub fn resolve(&self, name_or_index: &str) -> Option<usize> {
-        self.find(name_or_index).or_else(|| {
-            name_or_index
-                .parse::<usize>()
-                .ok()
-                .filter(|&i| i < self.len())
-        })
+        self.find(name_or_index).or_else(|| name_or_index.parse::<usize>().ok().filter(|&i| i < self.len()))
     }
 
     /// The initial pose the file gave (clamped).

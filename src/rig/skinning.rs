@@ -35,41 +35,24 @@ impl SkinWeights {
     /// are normalised to sum to 1 and those off by more than [`WEIGHT_SUM_TOLERANCE`]
     /// are returned. A row with no positive weight, a negative weight or a joint out of
     /// range is an error.
-    pub fn from_rows<I, R>(
-        rows: I,
-        joint_count: usize,
-    ) -> Result<(Self, Vec<NormalisedRow>), RigError>
+    pub fn from_rows<I, R>(rows: I, joint_count: usize) -> Result<(Self, Vec<NormalisedRow>), RigError>
     where
         I: IntoIterator<Item = R>,
         R: IntoIterator<Item = (usize, f32)>,
     {
-        let mut weights = SkinWeights {
-            offsets: vec![0],
-            influences: Vec::new(),
-        };
+        let mut weights = SkinWeights { offsets: vec![0], influences: Vec::new() };
         let mut normalised = Vec::new();
         for (vertex, row) in rows.into_iter().enumerate() {
             let start = weights.influences.len();
             for (joint, weight) in row {
                 if joint >= joint_count {
-                    return Err(RigError::InfluenceJointOutOfRange {
-                        vertex,
-                        joint,
-                        count: joint_count,
-                    });
+                    return Err(RigError::InfluenceJointOutOfRange { vertex, joint, count: joint_count });
                 }
                 if !(weight >= 0.0) || !weight.is_finite() {
-                    return Err(RigError::BadWeight {
-                        vertex,
-                        joint,
-                        weight,
-                    });
+                    return Err(RigError::BadWeight { vertex, joint, weight });
                 }
                 if weight > 0.0 {
-                    weights.influences.push(Influence {
-                        joint: joint as u16,
-                        weight,
-                    });
+                    weights.influences.push(Influence { joint: joint as u16, weight });
                 }
             }
             let row = &mut weights.influences[start..];
@@ -90,10 +73,7 @@ impl SkinWeights {
     pub fn rigid(joint_of_vertex: &[u16]) -> Self {
         Self {
             offsets: (0..=joint_of_vertex.len() as u32).collect(),
-            influences: joint_of_vertex
-                .iter()
-                .map(|&joint| Influence { joint, weight: 1.0 })
-                .collect(),
+            influences: joint_of_vertex.iter().map(|&joint| Influence { joint, weight: 1.0 }).collect(),
         }
     }
 
@@ -107,11 +87,7 @@ impl SkinWeights {
 
     /// Largest number of influences on one vertex.
     pub fn max_influences(&self) -> usize {
-        self.offsets
-            .windows(2)
-            .map(|w| (w[1] - w[0]) as usize)
-            .max()
-            .unwrap_or(0)
+        self.offsets.windows(2).map(|w| (w[1] - w[0]) as usize).max().unwrap_or(0)
     }
 
     pub fn total_influences(&self) -> usize {
@@ -120,11 +96,7 @@ impl SkinWeights {
 
     /// The weight of `joint` on vertex `v` (0 when it has none).
     pub fn weight(&self, v: usize, joint: usize) -> f32 {
-        self.of_vertex(v)
-            .iter()
-            .filter(|i| i.joint as usize == joint)
-            .map(|i| i.weight)
-            .sum()
+        self.of_vertex(v).iter().filter(|i| i.joint as usize == joint).map(|i| i.weight).sum()
     }
 }
 
@@ -136,17 +108,8 @@ impl SkinWeights {
 /// # Panics
 /// When the lengths of `bind_positions`, `weights` and `out` differ, or an influence names
 /// a joint beyond the palette.
-pub fn skin_positions(
-    bind_positions: &[Vec3],
-    weights: &SkinWeights,
-    palette: &[Mat4],
-    out: &mut [Vec3],
-) {
-    assert_eq!(
-        bind_positions.len(),
-        weights.vertex_count(),
-        "one weight row per vertex"
-    );
+pub fn skin_positions(bind_positions: &[Vec3], weights: &SkinWeights, palette: &[Mat4], out: &mut [Vec3]) {
+    assert_eq!(bind_positions.len(), weights.vertex_count(), "one weight row per vertex");
     assert_eq!(out.len(), bind_positions.len(), "one output per vertex");
     let offsets = &weights.offsets;
     for (v, (p, o)) in bind_positions.iter().zip(out.iter_mut()).enumerate() {
@@ -185,9 +148,7 @@ pub fn flat_shade(
 
 /// A distinct colour per joint: hues spaced by the golden angle, saturated, bright.
 pub fn joint_colors(joint_count: usize) -> Vec<[f32; 3]> {
-    (0..joint_count)
-        .map(|j| hsv_to_rgb((j as f32 * 0.618_034).fract(), 0.75, 0.95))
-        .collect()
+    (0..joint_count).map(|j| hsv_to_rgb((j as f32 * 0.618_034).fract(), 0.75, 0.95)).collect()
 }
 
 /// Each vertex's colour is the weight-blended colour of its joints.

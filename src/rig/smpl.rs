@@ -57,13 +57,7 @@ impl SmplModel {
     /// Rest offsets from absolute joint positions: the root's is its position, every
     /// other joint's is its position minus its parent's.
     pub fn rest_offsets(&self, joints: &[Vec3]) -> Vec<Vec3> {
-        (0..joints.len())
-            .map(|j| {
-                self.skeleton
-                    .parent(j)
-                    .map_or(joints[j], |p| joints[j] - joints[p])
-            })
-            .collect()
+        (0..joints.len()).map(|j| self.skeleton.parent(j).map_or(joints[j], |p| joints[j] - joints[p])).collect()
     }
 
     /// A character of shape β: shaped mesh, shaped skeleton, bind at the shaped rest pose.
@@ -72,11 +66,7 @@ impl SmplModel {
         skeleton.set_rest_offsets(&self.rest_offsets(&self.shaped_joints(betas)));
         let mut positions = Vec::new();
         self.shaped_positions(betas, &mut positions);
-        let skin = Skin {
-            bind_positions: positions,
-            triangles: self.triangles.clone(),
-            weights: self.weights.clone(),
-        };
+        let skin = Skin { bind_positions: positions, triangles: self.triangles.clone(), weights: self.weights.clone() };
         CharacterAsset::new(name, skeleton, skin, Vec::new())
     }
 }
@@ -111,17 +101,9 @@ impl Clip {
             out.resize(self.joint_count, Quat::IDENTITY);
             return;
         }
-        let t = if looping {
-            time_frames.rem_euclid(n as f32)
-        } else {
-            time_frames.clamp(0.0, (n - 1) as f32)
-        };
+        let t = if looping { time_frames.rem_euclid(n as f32) } else { time_frames.clamp(0.0, (n - 1) as f32) };
         let f0 = t.floor() as usize % n;
-        let f1 = if looping {
-            (f0 + 1) % n
-        } else {
-            (f0 + 1).min(n - 1)
-        };
+        let f1 = if looping { (f0 + 1) % n } else { (f0 + 1).min(n - 1) };
         blend_rotations(self.frame(f0), self.frame(f1), t.fract(), mode, out);
     }
 }
@@ -139,11 +121,7 @@ pub enum BlendMode {
 /// `out[j]` = the blend of `a[j]` and `b[j]` at `alpha` (0 gives a, 1 gives b).
 pub fn blend_rotations(a: &[Quat], b: &[Quat], alpha: f32, mode: BlendMode, out: &mut Vec<Quat>) {
     out.clear();
-    out.extend(
-        a.iter()
-            .zip(b)
-            .map(|(&qa, &qb)| blend_rotation(qa, qb, alpha, mode)),
-    );
+    out.extend(a.iter().zip(b).map(|(&qa, &qb)| blend_rotation(qa, qb, alpha, mode)));
 }
 
 /// One rotation blend (shorter arc).

@@ -32,20 +32,13 @@ pub struct Placement {
 
 impl Default for Placement {
     fn default() -> Self {
-        Self {
-            translation: Vec3::ZERO,
-            yaw: 0.0,
-            scale: 1.0,
-        }
+        Self { translation: Vec3::ZERO, yaw: 0.0, scale: 1.0 }
     }
 }
 
 impl Placement {
     pub fn at(translation: Vec3) -> Self {
-        Self {
-            translation,
-            ..default()
-        }
+        Self { translation, ..default() }
     }
 
     /// The model-to-world matrix.
@@ -71,18 +64,12 @@ pub struct SkinView {
 
 impl Default for SkinView {
     fn default() -> Self {
-        Self {
-            tint: [0.8, 0.62, 0.45],
-            weight_colors: false,
-            heat_joint: None,
-        }
+        Self { tint: [0.8, 0.62, 0.45], weight_colors: false, heat_joint: None }
     }
 }
 
 /// Whether a character shows its skin, its skeleton, or both.
-#[derive(
-    Component, Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize,
-)]
+#[derive(Component, Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 pub enum DisplayMode {
     #[default]
     Mesh,
@@ -113,22 +100,12 @@ pub struct PoseDirty {
 }
 
 impl PoseDirty {
-    pub const ALL: Self = Self {
-        matrices: true,
-        bind: true,
-        colors: true,
-    };
+    pub const ALL: Self = Self { matrices: true, bind: true, colors: true };
 }
 
 /// A joint of a character.
 #[derive(Component, Clone, Debug)]
-#[require(
-    RestOffset,
-    JointPose,
-    JointLimits,
-    BindWorldToJoint,
-    CurrentJointToWorld
-)]
+#[require(RestOffset, JointPose, JointLimits, BindWorldToJoint, CurrentJointToWorld)]
 pub struct Joint {
     /// Index in the character's skeleton (and in its weights).
     pub index: usize,

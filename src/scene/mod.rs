@@ -47,17 +47,10 @@ impl Plugin for RigCorePlugin {
                 .chain()
                 .before(bevy::transform::TransformSystems::Propagate),
         )
+        .add_systems(PostUpdate, systems::clamp_poses_to_limits.in_set(MarionetteSystems::Solve))
         .add_systems(
             PostUpdate,
-            systems::clamp_poses_to_limits.in_set(MarionetteSystems::Solve),
-        )
-        .add_systems(
-            PostUpdate,
-            (
-                systems::mark_changed_characters,
-                systems::bind_rest_pose,
-                systems::compute_joint_to_world,
-            )
+            (systems::mark_changed_characters, systems::bind_rest_pose, systems::compute_joint_to_world)
                 .chain()
                 .in_set(MarionetteSystems::MatrixStack),
         );
@@ -69,9 +62,6 @@ pub struct SkinningPlugin;
 
 impl Plugin for SkinningPlugin {
     fn build(&self, app: &mut App) {
-        app.add_systems(
-            PostUpdate,
-            systems::skin_changed_characters.in_set(MarionetteSystems::Skin),
-        );
+        app.add_systems(PostUpdate, systems::skin_changed_characters.in_set(MarionetteSystems::Skin));
     }
 }

@@ -35,20 +35,14 @@ pub fn spawn_character_posed(
     pose: &[JointRotation],
 ) -> Entity {
     assert_eq!(pose.len(), asset.skeleton.len(), "one pose entry per joint");
-    let character = commands
-        .spawn((Name::new(asset.name.clone()), placement))
-        .id();
+    let character = commands.spawn((Name::new(asset.name.clone()), placement)).id();
     let skeleton = &asset.skeleton;
     let mut joints: Vec<Entity> = Vec::with_capacity(skeleton.len());
     for (index, def) in skeleton.joints().iter().enumerate() {
         let parent = def.parent.map_or(character, |p| joints[p]);
         let joint = commands
             .spawn((
-                Joint {
-                    index,
-                    name: def.name.clone(),
-                    character,
-                },
+                Joint { index, name: def.name.clone(), character },
                 Name::new(def.name.clone()),
                 RestOffset(def.rest_offset),
                 JointPose(pose[index].clamped(&def.limits)),
@@ -70,12 +64,7 @@ pub fn spawn_character_posed(
         ))
         .id();
     commands.entity(character).insert((
-        Character {
-            asset,
-            joints,
-            skin_entity,
-            mesh,
-        },
+        Character { asset, joints, skin_entity, mesh },
         SkinScratch::default(),
         PoseDirty::ALL,
     ));
@@ -86,11 +75,8 @@ pub fn spawn_character_posed(
 /// vertex colours. Kept in the main world so the skinning system can rewrite it.
 pub fn empty_skin_mesh(triangle_count: usize) -> Mesh {
     let n = triangle_count * 3;
-    Mesh::new(
-        PrimitiveTopology::TriangleList,
-        RenderAssetUsages::default(),
-    )
-    .with_inserted_attribute(Mesh::ATTRIBUTE_POSITION, vec![[0.0f32; 3]; n])
-    .with_inserted_attribute(Mesh::ATTRIBUTE_NORMAL, vec![[0.0f32, 1.0, 0.0]; n])
-    .with_inserted_attribute(Mesh::ATTRIBUTE_COLOR, vec![[1.0f32; 4]; n])
+    Mesh::new(PrimitiveTopology::TriangleList, RenderAssetUsages::default())
+        .with_inserted_attribute(Mesh::ATTRIBUTE_POSITION, vec![[0.0f32; 3]; n])
+        .with_inserted_attribute(Mesh::ATTRIBUTE_NORMAL, vec![[0.0f32, 1.0, 0.0]; n])
+        .with_inserted_attribute(Mesh::ATTRIBUTE_COLOR, vec![[1.0f32; 4]; n])
 }

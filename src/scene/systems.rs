@@ -8,9 +8,7 @@ use crate::rig::MatrixStack;
 use crate::rig::skinning::{flat_shade, heat_colors, joint_colors, skin_positions, weight_colors};
 
 /// Clamps changed joint poses to their limits (reads `JointLimits`, writes `JointPose`).
-pub fn clamp_poses_to_limits(
-    mut joints: Query<(&mut JointPose, &JointLimits), Changed<JointPose>>,
-) {
+pub fn clamp_poses_to_limits(mut joints: Query<(&mut JointPose, &JointLimits), Changed<JointPose>>) {
     for (mut pose, limits) in &mut joints {
         let clamped = pose.0.clamped(&limits.0);
         pose.set_if_neq(JointPose(clamped));
@@ -94,11 +92,7 @@ pub fn compute_joint_to_world(
                     current.0 = top;
                 }
             },
-            &|entity| {
-                poses
-                    .get(entity)
-                    .map_or(Mat4::IDENTITY, |p| Mat4::from_mat3(p.0.to_mat3()))
-            },
+            &|entity| poses.get(entity).map_or(Mat4::IDENTITY, |p| Mat4::from_mat3(p.0.to_mat3())),
         );
     }
 }
@@ -143,21 +137,14 @@ pub fn skin_changed_characters(
         let SkinScratch { palette, positions } = &mut *scratch;
         if dirty.matrices || dirty.bind {
             palette.clear();
-            palette.extend(
-                character
-                    .joints
-                    .iter()
-                    .map(|&e| joints.get(e).map_or(Mat4::IDENTITY, |(c, b)| c.0 * b.0)),
-            );
+            palette.extend(character.joints.iter().map(|&e| joints.get(e).map_or(Mat4::IDENTITY, |(c, b)| c.0 * b.0)));
             positions.resize(skin.bind_positions.len(), Vec3::ZERO);
             skin_positions(&skin.bind_positions, &skin.weights, palette, positions);
             let mut normals = match mesh.remove_attribute(Mesh::ATTRIBUTE_NORMAL) {
                 Some(VertexAttributeValues::Float32x3(n)) => n,
                 _ => vec![[0.0; 3]; skin.triangles.len() * 3],
             };
-            if let Some(VertexAttributeValues::Float32x3(out)) =
-                mesh.attribute_mut(Mesh::ATTRIBUTE_POSITION)
-            {
+            if let Some(VertexAttributeValues::Float32x3(out)) = mesh.attribute_mut(Mesh::ATTRIBUTE_POSITION) {
                 flat_shade(positions, &skin.triangles, out, &mut normals);
             }
             mesh.insert_attribute(Mesh::ATTRIBUTE_NORMAL, normals);
@@ -177,11 +164,7 @@ fn write_colors(mesh: &mut Mesh, character: &Character, view: &SkinView) {
     if let Some(j) = view.heat_joint.filter(|&j| j < character.joints.len()) {
         heat_colors(&skin.weights, j, &mut per_vertex);
     } else if view.weight_colors {
-        weight_colors(
-            &skin.weights,
-            &joint_colors(character.joints.len()),
-            &mut per_vertex,
-        );
+        weight_colors(&skin.weights, &joint_colors(character.joints.len()), &mut per_vertex);
     }
     if let Some(VertexAttributeValues::Float32x4(out)) = mesh.attribute_mut(Mesh::ATTRIBUTE_COLOR) {
         for (corner, &v) in out.iter_mut().zip(skin.triangles.iter().flatten()) {

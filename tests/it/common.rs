@@ -10,11 +10,7 @@ pub fn data_dir(test: &str) -> Option<PathBuf> {
     match std::env::var_os("MARIONETTE_DATA") {
         Some(dir) => {
             let dir = PathBuf::from(dir);
-            assert!(
-                dir.is_dir(),
-                "MARIONETTE_DATA={} is not a folder",
-                dir.display()
-            );
+            assert!(dir.is_dir(), "MARIONETTE_DATA={} is not a folder", dir.display());
             Some(dir)
         }
         None => {
@@ -31,19 +27,12 @@ pub fn path(s: &str) -> &Path {
 pub fn assert_mat_close(a: Mat4, b: Mat4, tol: f32) {
     let (a, b) = (a.to_cols_array(), b.to_cols_array());
     for k in 0..16 {
-        assert!(
-            (a[k] - b[k]).abs() <= tol,
-            "matrices differ at {k}: {a:?} vs {b:?}"
-        );
+        assert!((a[k] - b[k]).abs() <= tol, "matrices differ at {k}: {a:?} vs {b:?}");
     }
 }
 
 pub fn assert_vec_close(a: Vec3, b: Vec3, tol: f32) {
-    assert!(
-        a.distance(b) <= tol,
-        "{a} vs {b} (distance {})",
-        a.distance(b)
-    );
+    assert!(a.distance(b) <= tol, "{a} vs {b} (distance {})", a.distance(b));
 }
 
 /// A unique scratch folder for one test.

@@ -14,13 +14,7 @@ use crate::common::data_dir;
 
 fn app() -> App {
     let mut app = App::new();
-    app.add_plugins((
-        MinimalPlugins,
-        AssetPlugin::default(),
-        bevy::mesh::MeshPlugin,
-        RigCorePlugin,
-        SkinningPlugin,
-    ));
+    app.add_plugins((MinimalPlugins, AssetPlugin::default(), bevy::mesh::MeshPlugin, RigCorePlugin, SkinningPlugin));
     app
 }
 
@@ -38,19 +32,9 @@ fn spawn(app: &mut App, asset: Arc<CharacterAsset>, placement: Placement) -> Ent
 }
 
 fn mesh_positions(app: &App, character: Entity) -> Vec<[f32; 3]> {
-    let handle = app
-        .world()
-        .get::<Character>(character)
-        .unwrap()
-        .mesh
-        .clone();
+    let handle = app.world().get::<Character>(character).unwrap().mesh.clone();
     let meshes = app.world().resource::<Assets<Mesh>>();
-    match meshes
-        .get(&handle)
-        .unwrap()
-        .attribute(Mesh::ATTRIBUTE_POSITION)
-        .unwrap()
-    {
+    match meshes.get(&handle).unwrap().attribute(Mesh::ATTRIBUTE_POSITION).unwrap() {
         VertexAttributeValues::Float32x3(p) => p.clone(),
         _ => panic!("positions are Float32x3"),
     }
@@ -67,11 +51,7 @@ fn oracle(asset: &CharacterAsset, pose: &[JointRotation], placement: &Placement)
 
 fn assert_positions_close(a: &[[f32; 3]], b: &[[f32; 3]], tol: f32) {
     assert_eq!(a.len(), b.len());
-    let worst = a
-        .iter()
-        .zip(b)
-        .map(|(x, y)| Vec3::from(*x).distance(Vec3::from(*y)))
-        .fold(0.0f32, f32::max);
+    let worst = a.iter().zip(b).map(|(x, y)| Vec3::from(*x).distance(Vec3::from(*y))).fold(0.0f32, f32::max);
     assert!(worst <= tol, "largest difference {worst}");
 }
 
@@ -106,11 +86,7 @@ fn spawning_builds_the_joint_hierarchy_as_entities() {
 #[test]
 fn posing_a_joint_reskins_the_mesh_like_the_kernel() {
     let asset = Arc::new(embedded_puppet());
-    let placement = Placement {
-        translation: Vec3::new(1.0, 0.0, -2.0),
-        yaw: 0.4,
-        scale: 1.5,
-    };
+    let placement = Placement { translation: Vec3::new(1.0, 0.0, -2.0), yaw: 0.4, scale: 1.5 };
     let mut app = app();
     let character = spawn(&mut app, asset.clone(), placement);
     app.update();
@@ -125,11 +101,7 @@ fn posing_a_joint_reskins_the_mesh_like_the_kernel() {
     app.update();
     let mut pose = asset.skeleton.initial_pose();
     pose[elbow] = rotation;
-    assert_positions_close(
-        &mesh_positions(&app, character),
-        &oracle(&asset, &pose, &placement),
-        1e-5,
-    );
+    assert_positions_close(&mesh_positions(&app, character), &oracle(&asset, &pose, &placement), 1e-5);
 }
 
 #[test]
@@ -146,19 +118,9 @@ fn only_changed_characters_are_reskinned_and_skins_are_shared() {
     let before_b = mesh_positions(&app, b);
     set_joint(&mut app, a, 3, JointRotation::euler_xyz(0.5, 0.0, 0.0));
     app.update();
-    assert_eq!(
-        app.world().get::<PoseDirty>(a).unwrap(),
-        &PoseDirty::default()
-    );
+    assert_eq!(app.world().get::<PoseDirty>(a).unwrap(), &PoseDirty::default());
     assert_eq!(mesh_positions(&app, b), before_b);
-    assert_ne!(
-        mesh_positions(&app, a),
-        oracle(
-            &asset,
-            &asset.skeleton.initial_pose(),
-            &Placement::default()
-        )
-    );
+    assert_ne!(mesh_positions(&app, a), oracle(&asset, &asset.skeleton.initial_pose(), &Placement::default()));
 }
 
 #[test]
@@ -166,25 +128,15 @@ fn poses_set_outside_the_limits_are_clamped() {
     let Some(data) = data_dir("poses_set_outside_the_limits_are_clamped") else {
         return;
     };
-    let asset = Arc::new(
-        marionette::formats::load_character(&data.join("cse169/project1/test.skel")).unwrap(),
-    );
+    let asset = Arc::new(marionette::formats::load_character(&data.join("cse169/project1/test.skel")).unwrap());
     let knee = asset.skeleton.find("knee_r").unwrap();
     let mut app = app();
     let character = spawn(&mut app, asset, Placement::default());
     app.update();
-    set_joint(
-        &mut app,
-        character,
-        knee,
-        JointRotation::euler_xyz(-5.0, 1.0, 1.0),
-    );
+    set_joint(&mut app, character, knee, JointRotation::euler_xyz(-5.0, 1.0, 1.0));
     app.update();
     let entity = app.world().get::<Character>(character).unwrap().joints[knee];
-    assert_eq!(
-        app.world().get::<JointPose>(entity).unwrap().0,
-        JointRotation::euler_xyz(-2.0, 0.0, 0.0)
-    );
+    assert_eq!(app.world().get::<JointPose>(entity).unwrap().0, JointRotation::euler_xyz(-2.0, 0.0, 0.0));
 }
 
 #[test]
@@ -192,8 +144,7 @@ fn model1_in_the_ecs_matches_the_kernel() {
     let Some(data) = data_dir("model1_in_the_ecs_matches_the_kernel") else {
         return;
     };
-    let asset =
-        Arc::new(marionette::formats::load_character(&data.join("mit6837/Model1.skel")).unwrap());
+    let asset = Arc::new(marionette::formats::load_character(&data.join("mit6837/Model1.skel")).unwrap());
     let mut app = app();
     let character = spawn(&mut app, asset.clone(), Placement::default());
     app.update();
@@ -202,9 +153,5 @@ fn model1_in_the_ecs_matches_the_kernel() {
     app.update();
     let mut pose = asset.skeleton.initial_pose();
     pose[6] = rotation;
-    assert_positions_close(
-        &mesh_positions(&app, character),
-        &oracle(&asset, &pose, &Placement::default()),
-        1e-5,
-    );
+    assert_positions_close(&mesh_positions(&app, character), &oracle(&asset, &pose, &Placement::default()), 1e-5);
 }

@@ -21,19 +21,9 @@ fn doc_with(source: SourceDoc, pose: &[(&str, JointRotation)]) -> SceneDoc {
         characters: vec![CharacterDoc {
             source,
             name: "c".into(),
-            placement: PlacementDoc {
-                translation: [0.5, 0.0, -1.0],
-                yaw: 0.3,
-                scale: 1.2,
-            },
-            pose: pose
-                .iter()
-                .map(|(k, r)| (k.to_string(), *r))
-                .collect::<BTreeMap<_, _>>(),
-            view: ViewDoc {
-                weight_colors: true,
-                ..ViewDoc::default()
-            },
+            placement: PlacementDoc { translation: [0.5, 0.0, -1.0], yaw: 0.3, scale: 1.2 },
+            pose: pose.iter().map(|(k, r)| (k.to_string(), *r)).collect::<BTreeMap<_, _>>(),
+            view: ViewDoc { weight_colors: true, ..ViewDoc::default() },
             smpl: None,
         }],
         camera: None,
@@ -47,22 +37,13 @@ fn scenes_round_trip_with_paths_relative_to_the_scene() {
     std::fs::create_dir_all(dir.join("models")).unwrap();
     let character = dir.join("models/m.skel");
     std::fs::write(&character, "0 0 0 -1\n0 1 0 0\n").unwrap();
-    let doc = doc_with(
-        SourceDoc::File(character.clone()),
-        &[("joint1", JointRotation::euler_xyz(0.1, 0.2, 0.3))],
-    );
+    let doc = doc_with(SourceDoc::File(character.clone()), &[("joint1", JointRotation::euler_xyz(0.1, 0.2, 0.3))]);
     let path = dir.join("scene.ron");
     write_scene(&path, &doc).unwrap();
     let text = std::fs::read_to_string(&path).unwrap();
-    assert!(
-        text.contains("File(\"models/m.skel\")"),
-        "stored relative to the scene: {text}"
-    );
+    assert!(text.contains("File(\"models/m.skel\")"), "stored relative to the scene: {text}");
     let back = read_scene(&path).unwrap();
-    assert_eq!(
-        back.characters[0].source,
-        SourceDoc::File(dir.join("models/m.skel"))
-    );
+    assert_eq!(back.characters[0].source, SourceDoc::File(dir.join("models/m.skel")));
     assert_eq!(back.characters[0].pose, doc.characters[0].pose);
     assert_eq!(back.characters[0].placement, doc.characters[0].placement);
     assert_eq!(back.characters[0].view, doc.characters[0].view);
@@ -79,10 +60,7 @@ fn a_failed_save_leaves_the_previous_file_whole() {
     });
     assert!(result.is_err());
     assert_eq!(std::fs::read_to_string(&path).unwrap(), "previous");
-    let leftovers: Vec<PathBuf> = std::fs::read_dir(&dir)
-        .unwrap()
-        .map(|e| e.unwrap().path())
-        .collect();
+    let leftovers: Vec<PathBuf> = std::fs::read_dir(&dir).unwrap().map(|e| e.unwrap().path()).collect();
     assert_eq!(leftovers, vec![path], "no temporary file is left behind");
 }
 
@@ -101,16 +79,10 @@ fn unknown_joints_in_a_scene_pose_are_reported_not_fatal() {
     let asset = marionette::puppet::embedded_puppet();
     let doc = doc_with(
         SourceDoc::Embedded("puppet".into()),
-        &[
-            ("l_elbow", JointRotation::euler_xyz(0.0, 1.0, 0.0)),
-            ("tail", JointRotation::euler_xyz(1.0, 0.0, 0.0)),
-        ],
+        &[("l_elbow", JointRotation::euler_xyz(0.0, 1.0, 0.0)), ("tail", JointRotation::euler_xyz(1.0, 0.0, 0.0))],
     );
     let (pose, messages) = pose_from_doc(&asset, &doc.characters[0]);
-    assert_eq!(
-        pose[asset.skeleton.find("l_elbow").unwrap()],
-        JointRotation::euler_xyz(0.0, 1.0, 0.0)
-    );
+    assert_eq!(pose[asset.skeleton.find("l_elbow").unwrap()], JointRotation::euler_xyz(0.0, 1.0, 0.0));
     assert_eq!(messages.len(), 1);
     assert!(messages[0].contains("no joint `tail`"), "{}", messages[0]);
 }
@@ -154,15 +126,8 @@ fn the_shipped_assets_are_what_the_generator_makes() {
     marionette::puppet::write_6837(&marionette::puppet::puppet(), &dir, "puppet").unwrap();
     for ext in ["skel", "obj", "attach"] {
         let made = std::fs::read_to_string(dir.join(format!("puppet.{ext}"))).unwrap();
-        let shipped = std::fs::read_to_string(format!(
-            "{}/assets/puppet.{ext}",
-            env!("CARGO_MANIFEST_DIR")
-        ))
-        .unwrap();
-        assert!(
-            made == shipped,
-            "assets/puppet.{ext} is stale: run `marionette gen-assets assets`"
-        );
+        let shipped = std::fs::read_to_string(format!("{}/assets/puppet.{ext}", env!("CARGO_MANIFEST_DIR"))).unwrap();
+        assert!(made == shipped, "assets/puppet.{ext} is stale: run `marionette gen-assets assets`");
     }
     let _ = scene_to_string(&scene);
 }
@@ -171,21 +136,11 @@ fn the_shipped_assets_are_what_the_generator_makes() {
 #[test]
 fn render_draws_characters_distinct_from_floor_and_sky_with_weight_hues() {
     let dir = scratch("render");
-    let mut doc = doc_with(
-        SourceDoc::Embedded("puppet".into()),
-        &[("l_shoulder", JointRotation::euler_xyz(0.0, 0.0, -1.0))],
-    );
-    doc.characters[0].placement = PlacementDoc {
-        translation: [0.0, 0.0, 0.0],
-        yaw: 0.0,
-        scale: 1.0,
-    };
-    doc.camera = Some(marionette::formats::scene::CameraDoc {
-        focus: [0.0, 0.5, 0.0],
-        yaw: 0.0,
-        pitch: -0.2,
-        distance: 1.6,
-    });
+    let mut doc =
+        doc_with(SourceDoc::Embedded("puppet".into()), &[("l_shoulder", JointRotation::euler_xyz(0.0, 0.0, -1.0))]);
+    doc.characters[0].placement = PlacementDoc { translation: [0.0, 0.0, 0.0], yaw: 0.0, scale: 1.0 };
+    doc.camera =
+        Some(marionette::formats::scene::CameraDoc { focus: [0.0, 0.5, 0.0], yaw: 0.0, pitch: -0.2, distance: 1.6 });
     let scene = dir.join("scene.ron");
     write_scene(&scene, &doc).unwrap();
     let out = dir.join("shot.png");
@@ -195,32 +150,17 @@ fn render_draws_characters_distinct_from_floor_and_sky_with_weight_hues() {
         .arg(&scene)
         .output()
         .unwrap();
-    assert!(
-        output.status.success(),
-        "render failed: {}",
-        String::from_utf8_lossy(&output.stderr)
-    );
+    assert!(output.status.success(), "render failed: {}", String::from_utf8_lossy(&output.stderr));
     let img = image::open(&out).unwrap().to_rgb8();
     assert_eq!(img.dimensions(), (200, 150));
     let sky = *img.get_pixel(100, 2);
     let floor = *img.get_pixel(100, 147);
     assert_ne!(sky, floor);
     let far = |p: &image::Rgb<u8>, q: &image::Rgb<u8>| {
-        p.0.iter()
-            .zip(q.0)
-            .map(|(a, b)| (*a as i32 - b as i32).abs())
-            .sum::<i32>()
-            > 60
+        p.0.iter().zip(q.0).map(|(a, b)| (*a as i32 - b as i32).abs()).sum::<i32>() > 60
     };
-    let character: Vec<&image::Rgb<u8>> = img
-        .pixels()
-        .filter(|p| far(p, &sky) && far(p, &floor))
-        .collect();
-    assert!(
-        character.len() > 1000,
-        "only {} character pixels",
-        character.len()
-    );
+    let character: Vec<&image::Rgb<u8>> = img.pixels().filter(|p| far(p, &sky) && far(p, &floor)).collect();
+    assert!(character.len() > 1000, "only {} character pixels", character.len());
     // Weight colours: several distinct hues among saturated pixels.
     let mut hues = std::collections::BTreeSet::new();
     for p in &character {
@@ -254,13 +194,6 @@ fn model1_and_model2_render_side_by_side() {
         .arg(data.join("mit6837/Model2.skel"))
         .output()
         .unwrap();
-    assert!(
-        output.status.success(),
-        "{}",
-        String::from_utf8_lossy(&output.stderr)
-    );
-    assert_eq!(
-        image::open(&out).unwrap().to_rgb8().dimensions(),
-        (160, 120)
-    );
+    assert!(output.status.success(), "{}", String::from_utf8_lossy(&output.stderr));
+    assert_eq!(image::open(&out).unwrap().to_rgb8().dimensions(), (160, 120));
 }

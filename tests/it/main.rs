@@ -5,5 +5,6 @@ mod data;
 mod ecs;
 mod editor;
 mod formats;
+mod ik;
 mod rig;
 mod smpl;

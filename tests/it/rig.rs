@@ -5,9 +5,7 @@ use std::f32::consts::{FRAC_PI_2, PI};
 use glam::{Mat3, Mat4, Quat, Vec3};
 use marionette::rig::fk::{bind_world_to_joint, forward_kinematics, skinning_palette};
 use marionette::rig::skinning::{flat_shade, joint_colors, skin_positions, weight_colors};
-use marionette::rig::{
-    DofLimits, EulerOrder, JointRotation, MatrixStack, RawJoint, RigError, Skeleton, SkinWeights,
-};
+use marionette::rig::{DofLimits, EulerOrder, JointRotation, MatrixStack, RawJoint, RigError, Skeleton, SkinWeights};
 
 use crate::common::{assert_mat_close, assert_vec_close};
 
@@ -52,14 +50,8 @@ fn euler_xyz_applies_x_first_then_y_then_z() {
 #[test]
 fn every_euler_order_round_trips_through_quaternions() {
     let angles = Vec3::new(0.4, -0.3, 0.9);
-    for order in [
-        EulerOrder::Xyz,
-        EulerOrder::Xzy,
-        EulerOrder::Yxz,
-        EulerOrder::Yzx,
-        EulerOrder::Zxy,
-        EulerOrder::Zyx,
-    ] {
+    for order in [EulerOrder::Xyz, EulerOrder::Xzy, EulerOrder::Yxz, EulerOrder::Yzx, EulerOrder::Zxy, EulerOrder::Zyx]
+    {
         let rot = JointRotation::Euler(angles, order);
         let back = JointRotation::Quat(rot.to_quat()).to_euler(order);
         assert_vec_close(back, angles, 1e-5);
@@ -76,10 +68,7 @@ fn every_euler_order_round_trips_through_quaternions() {
 
 #[test]
 fn clamping_respects_limits_and_locked_axes() {
-    let limits = DofLimits {
-        min: Vec3::new(-2.0, 0.0, -0.5),
-        max: Vec3::new(0.0, 0.0, 0.5),
-    };
+    let limits = DofLimits { min: Vec3::new(-2.0, 0.0, -0.5), max: Vec3::new(0.0, 0.0, 0.5) };
     let clamped = JointRotation::euler_xyz(-3.0, 1.0, 0.2).clamped(&limits);
     assert_eq!(clamped, JointRotation::euler_xyz(-2.0, 0.0, 0.2));
     assert!(limits.is_locked(1));
@@ -139,24 +128,11 @@ fn fk_starts_from_the_placement() {
 
 #[test]
 fn skeleton_validation_rejects_bad_trees() {
-    let e = Skeleton::build(vec![
-        RawJoint::new("a", None, Vec3::ZERO),
-        RawJoint::new("b", Some(7), Vec3::ZERO),
-    ])
-    .unwrap_err();
-    assert_eq!(
-        e,
-        RigError::ParentOutOfRange {
-            joint: 1,
-            parent: 7,
-            count: 2
-        }
-    );
-    let e = Skeleton::build(vec![
-        RawJoint::new("a", None, Vec3::ZERO),
-        RawJoint::new("b", None, Vec3::ZERO),
-    ])
-    .unwrap_err();
+    let e = Skeleton::build(vec![RawJoint::new("a", None, Vec3::ZERO), RawJoint::new("b", Some(7), Vec3::ZERO)])
+        .unwrap_err();
+    assert_eq!(e, RigError::ParentOutOfRange { joint: 1, parent: 7, count: 2 });
+    let e =
+        Skeleton::build(vec![RawJoint::new("a", None, Vec3::ZERO), RawJoint::new("b", None, Vec3::ZERO)]).unwrap_err();
     assert!(matches!(e, RigError::SeveralRoots { .. }));
     let e = Skeleton::build(vec![
         RawJoint::new("r", None, Vec3::ZERO),
@@ -165,19 +141,10 @@ fn skeleton_validation_rejects_bad_trees() {
     ])
     .unwrap_err();
     assert!(matches!(e, RigError::Cycle { .. }), "{e:?}");
-    assert_eq!(
-        Skeleton::build(vec![]).unwrap_err(),
-        RigError::EmptySkeleton
-    );
+    assert_eq!(Skeleton::build(vec![]).unwrap_err(), RigError::EmptySkeleton);
     // A forward reference without a cycle can be reordered, but `build` keeps file order.
-    let raw = vec![
-        RawJoint::new("child", Some(1), Vec3::ZERO),
-        RawJoint::new("root", None, Vec3::ZERO),
-    ];
-    assert!(matches!(
-        Skeleton::build(raw.clone()).unwrap_err(),
-        RigError::NotParentFirst { .. }
-    ));
+    let raw = vec![RawJoint::new("child", Some(1), Vec3::ZERO), RawJoint::new("root", None, Vec3::ZERO)];
+    assert!(matches!(Skeleton::build(raw.clone()).unwrap_err(), RigError::NotParentFirst { .. }));
     // Parents first but not depth-first: `build` keeps the file order.
     let kept = Skeleton::build(vec![
         RawJoint::new("r", None, Vec3::ZERO),
@@ -194,57 +161,28 @@ fn skeleton_validation_rejects_bad_trees() {
 }
 
 fn two_bone_weights() -> SkinWeights {
-    SkinWeights::from_rows(
-        vec![vec![(0, 1.0)], vec![(0, 0.5), (1, 0.5)], vec![(1, 1.0)]],
-        2,
-    )
-    .unwrap()
-    .0
+    SkinWeights::from_rows(vec![vec![(0, 1.0)], vec![(0, 0.5), (1, 0.5)], vec![(1, 1.0)]], 2).unwrap().0
 }
 
 #[test]
 fn skinning_blends_the_palette_by_weight() {
-    let bind = [
-        Vec3::new(0.0, 0.0, 0.0),
-        Vec3::new(1.0, 0.0, 0.0),
-        Vec3::new(2.0, 0.0, 0.0),
-    ];
-    let palette = [
-        Mat4::IDENTITY,
-        Mat4::from_translation(Vec3::new(0.0, 2.0, 0.0)),
-    ];
+    let bind = [Vec3::new(0.0, 0.0, 0.0), Vec3::new(1.0, 0.0, 0.0), Vec3::new(2.0, 0.0, 0.0)];
+    let palette = [Mat4::IDENTITY, Mat4::from_translation(Vec3::new(0.0, 2.0, 0.0))];
     let mut out = [Vec3::ZERO; 3];
     skin_positions(&bind, &two_bone_weights(), &palette, &mut out);
-    assert_eq!(
-        out,
-        [
-            Vec3::new(0.0, 0.0, 0.0),
-            Vec3::new(1.0, 1.0, 0.0),
-            Vec3::new(2.0, 2.0, 0.0)
-        ]
-    );
+    assert_eq!(out, [Vec3::new(0.0, 0.0, 0.0), Vec3::new(1.0, 1.0, 0.0), Vec3::new(2.0, 2.0, 0.0)]);
 }
 
 #[test]
 fn weights_are_normalised_and_reported() {
-    let (w, normalised) =
-        SkinWeights::from_rows(vec![vec![(0, 0.5), (1, 0.3)], vec![(1, 1.0)]], 2).unwrap();
+    let (w, normalised) = SkinWeights::from_rows(vec![vec![(0, 0.5), (1, 0.3)], vec![(1, 1.0)]], 2).unwrap();
     assert_eq!(normalised.len(), 1);
     assert_eq!(normalised[0].vertex, 0);
     assert!((w.weight(0, 0) - 0.625).abs() < 1e-6);
     assert!((w.weight(0, 1) - 0.375).abs() < 1e-6);
-    assert!(matches!(
-        SkinWeights::from_rows(vec![vec![(0, 0.0)]], 1),
-        Err(RigError::NoInfluence { vertex: 0 })
-    ));
-    assert!(matches!(
-        SkinWeights::from_rows(vec![vec![(3, 1.0)]], 2),
-        Err(RigError::InfluenceJointOutOfRange { .. })
-    ));
-    assert!(matches!(
-        SkinWeights::from_rows(vec![vec![(0, -1.0), (1, 2.0)]], 2),
-        Err(RigError::BadWeight { .. })
-    ));
+    assert!(matches!(SkinWeights::from_rows(vec![vec![(0, 0.0)]], 1), Err(RigError::NoInfluence { vertex: 0 })));
+    assert!(matches!(SkinWeights::from_rows(vec![vec![(3, 1.0)]], 2), Err(RigError::InfluenceJointOutOfRange { .. })));
+    assert!(matches!(SkinWeights::from_rows(vec![vec![(0, -1.0), (1, 2.0)]], 2), Err(RigError::BadWeight { .. })));
 }
 
 #[test]
@@ -255,13 +193,8 @@ fn skinning_at_the_bind_pose_returns_the_input() {
     forward_kinematics(&s, &s.rest_pose(), Mat4::IDENTITY, &mut current);
     let mut palette = vec![Mat4::IDENTITY; 4];
     skinning_palette(&current, &bind, &mut palette);
-    let verts: Vec<Vec3> = (0..20)
-        .map(|i| Vec3::new(i as f32 * 0.1, (i * 7 % 5) as f32, (i % 3) as f32))
-        .collect();
-    let weights =
-        SkinWeights::from_rows((0..20).map(|i| vec![(i % 4, 0.25), ((i + 1) % 4, 0.75)]), 4)
-            .unwrap()
-            .0;
+    let verts: Vec<Vec3> = (0..20).map(|i| Vec3::new(i as f32 * 0.1, (i * 7 % 5) as f32, (i % 3) as f32)).collect();
+    let weights = SkinWeights::from_rows((0..20).map(|i| vec![(i % 4, 0.25), ((i + 1) % 4, 0.75)]), 4).unwrap().0;
     let mut out = vec![Vec3::ZERO; 20];
     skin_positions(&verts, &weights, &palette, &mut out);
     for (a, b) in verts.iter().zip(&out) {
@@ -286,10 +219,7 @@ fn flat_shading_unshares_vertices_with_one_unit_normal_per_triangle() {
     assert_eq!(out_n[3], out_n[4]);
     assert_eq!(out_n[4], out_n[5]);
     // Perpendicular to the triangle's edges.
-    assert!(
-        n.dot(Vec3::new(0.0, 1.0, 1.0)).abs() < 1e-6
-            && n.dot(Vec3::new(-1.0, 1.0, 0.0)).abs() < 1e-6
-    );
+    assert!(n.dot(Vec3::new(0.0, 1.0, 1.0)).abs() < 1e-6 && n.dot(Vec3::new(-1.0, 1.0, 0.0)).abs() < 1e-6);
 }
 
 #[test]
@@ -311,13 +241,8 @@ fn weight_colours_are_distinct_per_joint_and_blended() {
 #[test]
 fn quaternion_poses_drive_fk_like_euler_poses() {
     let s = chain();
-    let euler: Vec<JointRotation> = (0..4)
-        .map(|i| JointRotation::euler_xyz(0.1 * i as f32, -0.2, 0.3))
-        .collect();
-    let quats: Vec<JointRotation> = euler
-        .iter()
-        .map(|r| JointRotation::Quat(r.to_quat()))
-        .collect();
+    let euler: Vec<JointRotation> = (0..4).map(|i| JointRotation::euler_xyz(0.1 * i as f32, -0.2, 0.3)).collect();
+    let quats: Vec<JointRotation> = euler.iter().map(|r| JointRotation::Quat(r.to_quat())).collect();
     let (mut a, mut b) = (vec![Mat4::IDENTITY; 4], vec![Mat4::IDENTITY; 4]);
     forward_kinematics(&s, &euler, Mat4::IDENTITY, &mut a);
     forward_kinematics(&s, &quats, Mat4::IDENTITY, &mut b);
@@ -325,8 +250,5 @@ fn quaternion_poses_drive_fk_like_euler_poses() {
         assert_mat_close(a[j], b[j], 1e-5);
     }
     let q = Quat::from_rotation_y(0.5);
-    assert_eq!(
-        JointRotation::Quat(q).with_rotation_of(Quat::IDENTITY),
-        JointRotation::Quat(Quat::IDENTITY)
-    );
+    assert_eq!(JointRotation::Quat(q).with_rotation_of(Quat::IDENTITY), JointRotation::Quat(Quat::IDENTITY));
 }

@@ -7,8 +7,7 @@ use glam::{Mat3, Quat, Vec3};
 use marionette::formats::smpl::{load_smpl_dir, parse_clip, parse_skin};
 use marionette::rig::smpl::BlendMode;
 use marionette::smpl_tasks::{
-    FrameSpec, SmplPoser, exercise_beta, parse_sequence, sequence_frames, task_frames,
-    task4_rotation,
+    FrameSpec, SmplPoser, exercise_beta, parse_sequence, sequence_frames, task_frames, task4_rotation,
 };
 
 use crate::common::{assert_vec_close, data_dir, path, scratch};
@@ -63,17 +62,11 @@ fn task4_joint_matrices_match_the_exercise_to_4_decimals() {
         }
     };
     let identity = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
-    let rotated = [
-        [0.7071, 0.7071, 0.0],
-        [-0.7071, 0.7071, 0.0],
-        [0.0, 0.0, 1.0],
-    ];
+    let rotated = [[0.7071, 0.7071, 0.0], [-0.7071, 0.7071, 0.0], [0.0, 0.0, 1.0]];
     check("L_Collar", identity, [0.0762, 0.1916, 0.0010]);
     check("L_Shoulder", rotated, [0.1991, 0.2368, -0.0181]);
     check("L_Wrist", rotated, [0.5655, -0.1337, -0.0484]);
-    assert!(
-        task4_rotation().abs_diff_eq(Quat::from_rotation_z(-std::f32::consts::FRAC_PI_4), 1e-4)
-    );
+    assert!(task4_rotation().abs_diff_eq(Quat::from_rotation_z(-std::f32::consts::FRAC_PI_4), 1e-4));
 }
 
 #[test]
@@ -89,13 +82,7 @@ fn task2_moves_only_elbow_weighted_vertices_by_its_weight() {
             let mut poser = SmplPoser::new(&model);
             let (mut moved, mut rest) = (Vec::new(), Vec::new());
             poser.frame(frame, &mut moved);
-            poser.frame(
-                &FrameSpec {
-                    translation: None,
-                    ..frame.clone()
-                },
-                &mut rest,
-            );
+            poser.frame(&FrameSpec { translation: None, ..frame.clone() }, &mut rest);
             for v in 0..moved.len() {
                 let w: f32 = if follows {
                     // The elbow's whole subtree follows it.
@@ -129,9 +116,7 @@ fn is_in_subtree(s: &marionette::rig::Skeleton, mut j: usize, root: usize) -> bo
 
 #[test]
 fn shapes_follow_the_blendshape_formula_and_rest_skinning_returns_them() {
-    let Some(data) =
-        data_dir("shapes_follow_the_blendshape_formula_and_rest_skinning_returns_them")
-    else {
+    let Some(data) = data_dir("shapes_follow_the_blendshape_formula_and_rest_skinning_returns_them") else {
         return;
     };
     let dir = data.join("smpl");
@@ -152,12 +137,7 @@ fn shapes_follow_the_blendshape_formula_and_rest_skinning_returns_them() {
     // Skinning at rest returns the shaped mesh, for each β.
     for b in 0..3 {
         let betas = exercise_beta(b);
-        let frame = FrameSpec {
-            betas,
-            rotations: vec![Quat::IDENTITY; 24],
-            translation: None,
-            skinned: true,
-        };
+        let frame = FrameSpec { betas, rotations: vec![Quat::IDENTITY; 24], translation: None, skinned: true };
         let mut poser = SmplPoser::new(&model);
         let mut out = Vec::new();
         poser.frame(&frame, &mut out);
@@ -189,10 +169,8 @@ fn task5_has_480_frames_and_the_cli_writes_numbered_objs() {
         .unwrap();
     assert!(status.success());
     let names: Vec<String> = {
-        let mut v: Vec<String> = std::fs::read_dir(&out)
-            .unwrap()
-            .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
-            .collect();
+        let mut v: Vec<String> =
+            std::fs::read_dir(&out).unwrap().map(|e| e.unwrap().file_name().to_string_lossy().into_owned()).collect();
         v.sort();
         v
     };
@@ -204,10 +182,7 @@ fn task5_has_480_frames_and_the_cli_writes_numbered_objs() {
     .unwrap();
     let mut shaped = Vec::new();
     model.shaped_positions(&exercise_beta(1), &mut shaped);
-    assert_eq!(
-        f1.positions, shaped,
-        "the OBJ writer round-trips f32 exactly"
-    );
+    assert_eq!(f1.positions, shaped, "the OBJ writer round-trips f32 exactly");
     assert_eq!(f1.triangles, model.triangles);
 }
 
@@ -215,16 +190,9 @@ fn task5_has_480_frames_and_the_cli_writes_numbered_objs() {
 fn sequences_parse_and_transitions_go_from_the_outgoing_to_the_incoming_clip() {
     let segs = parse_sequence("7516:0-99:1,8806:20-:2").unwrap();
     assert_eq!(segs.len(), 2);
-    assert_eq!(
-        (segs[0].from, segs[0].to, segs[0].betas),
-        (0, Some(99), exercise_beta(1))
-    );
+    assert_eq!((segs[0].from, segs[0].to, segs[0].betas), (0, Some(99), exercise_beta(1)));
     assert_eq!((segs[1].from, segs[1].to), (20, None));
-    assert!(
-        parse_sequence("7516:9-3")
-            .unwrap_err()
-            .contains("TO is before FROM")
-    );
+    assert!(parse_sequence("7516:9-3").unwrap_err().contains("TO is before FROM"));
     assert!(parse_sequence("7516:0-3:x").is_err());
     let Some(data) = data_dir("sequences_parse_and_transitions") else {
         return;
@@ -232,17 +200,13 @@ fn sequences_parse_and_transitions_go_from_the_outgoing_to_the_incoming_clip() {
     let dir = data.join("smpl");
     let (model, _) = load_smpl_dir(&dir).unwrap();
     let a = parse_clip(
-        std::io::BufReader::new(
-            std::fs::File::open(dir.join("smpl_quaternions_mosh_cmu_7516.txt")).unwrap(),
-        ),
+        std::io::BufReader::new(std::fs::File::open(dir.join("smpl_quaternions_mosh_cmu_7516.txt")).unwrap()),
         path("a"),
         24,
     )
     .unwrap();
     let b = parse_clip(
-        std::io::BufReader::new(
-            std::fs::File::open(dir.join("smpl_quaternions_mosh_cmu_8806.txt")).unwrap(),
-        ),
+        std::io::BufReader::new(std::fs::File::open(dir.join("smpl_quaternions_mosh_cmu_8806.txt")).unwrap()),
         path("b"),
         24,
     )
@@ -268,30 +232,16 @@ fn sequences_parse_and_transitions_go_from_the_outgoing_to_the_incoming_clip() {
 
 #[test]
 fn smpl_skin_rows_of_the_wrong_width_are_errors() {
-    let e = parse_skin(
-        Cursor::new("# c\n2 3 2\n0 0.5 1 0.5\n0 1\n"),
-        path("skin.txt"),
-        3,
-    )
-    .unwrap_err();
-    assert_eq!(
-        e.to_string(),
-        "skin.txt:4: expected 4 numbers (2 joint weight pairs), found 2"
-    );
+    let e = parse_skin(Cursor::new("# c\n2 3 2\n0 0.5 1 0.5\n0 1\n"), path("skin.txt"), 3).unwrap_err();
+    assert_eq!(e.to_string(), "skin.txt:4: expected 4 numbers (2 joint weight pairs), found 2");
     let e = parse_skin(Cursor::new("2 3 2\n0 0.5 1 0.5\n"), path("skin.txt"), 3).unwrap_err();
     assert_eq!(e.to_string(), "skin.txt:2: expected 2 vertex rows, found 1");
     let e = parse_skin(Cursor::new("1 4 1\n0 1\n"), path("skin.txt"), 3).unwrap_err();
-    assert_eq!(
-        e.to_string(),
-        "skin.txt:1: expected 3 joints (the hierarchy's), found 4"
-    );
+    assert_eq!(e.to_string(), "skin.txt:1: expected 3 joints (the hierarchy's), found 4");
 }
 
 #[test]
 fn smpl_clips_with_short_rows_are_errors() {
     let e = parse_clip(Cursor::new("1 2\n0 0 0 0 0 0 1\n"), path("clip.txt"), 2).unwrap_err();
-    assert_eq!(
-        e.to_string(),
-        "clip.txt:2: expected 11 numbers (root x y z, then 2 × qx qy qz qw), found 7"
-    );
+    assert_eq!(e.to_string(), "clip.txt:2: expected 11 numbers (root x y z, then 2 × qx qy qz qw), found 7");
 }

@@ -1,0 +1,136 @@
+//! Homer's rig (Ursinus CS 476 character-animation exercise): a JSON object mapping joint
+//! names to `{"pos": [x, y, z], "children": [...], "weights": {"vertex": w, ...}}`
+//! (absolute positions; keys not in hierarchy order; weights optional, sparse, and not
+//! normalised), with an OFF mesh beside it.
+
+use std::collections::BTreeMap;
+use std::io::BufRead;
+use std::path::{Path, PathBuf};
+
+use glam::Vec3;
+use serde::Deserialize;
+
+use super::error::{FormatError, open};
+use super::off::parse_off;
+use crate::rig::bind::{bones, smooth_bone_weights};
+use crate::rig::{CharacterAsset, RawJoint, Skeleton, Skin, SkinWeights};
+
+#[derive(Debug, Deserialize)]
+struct RawHomerJoint {
+    pos: [f32; 3],
+    #[serde(default)]
+    children: Vec<String>,
+    #[serde(default)]
+    weights: Option<BTreeMap<String, f32>>,
+}
+
+/// A parsed rig: the skeleton (depth-first from the root, children in file order), the
+/// absolute joint positions in that order, and the sparse weights per joint if present.
+#[derive(Debug, Clone)]
+pub struct HomerRig {
+    pub skeleton: Skeleton,
+    pub positions: Vec<Vec3>,
+    /// `(joint, vertex, weight)` triples.
+    pub weights: Option<Vec<(usize, usize, f32)>>,
+}
+
+/// Parses a Homer rig JSON.
+pub fn parse_rig(mut reader: impl BufRead, path: &Path) -> Result<HomerRig, FormatError> {
+    let mut text = String::new();
+    reader.read_to_string(&mut text).map_err(|e| FormatError::io(path, e))?;
+    let raw: BTreeMap<String, RawHomerJoint> =
+        serde_json::from_str(&text).map_err(|e| FormatError::syntax(path, e.line(), e.to_string()))?;
+    let names: Vec<&String> = raw.keys().collect();
+    let index = |n: &str| names.iter().position(|k| k.as_str() == n);
+    let mut parent: Vec<Option<usize>> = vec![None; names.len()];
+    for (p, joint) in raw.values().enumerate() {
+        for child in &joint.children {
+            let c = index(child).ok_or_else(|| {
+                FormatError::other(path, format!("joint `{}` lists a child `{child}` that is not defined", names[p]))
+            })?;
+            if let Some(other) = parent[c] {
+                return Err(FormatError::other(
+                    path,
+                    format!("joint `{child}` is a child of both `{}` and `{}`", names[other], names[p]),
+                ));
+            }
+            parent[c] = Some(p);
+        }
+    }
+    let joints: Vec<RawJoint> = raw
+        .iter()
+        .enumerate()
+        .map(|(i, (name, j))| {
+            let pos = Vec3::from(j.pos);
+            let offset = parent[i].map_or(pos, |p| pos - Vec3::from(raw[names[p]].pos));
+            RawJoint::new(name.clone(), parent[i], offset)
+        })
+        .collect();
+    let (skeleton, new_index) = Skeleton::build_reordered(joints).map_err(|e| FormatError::rig(path, e))?;
+    let mut positions = vec![Vec3::ZERO; names.len()];
+    let mut weights: Option<Vec<(usize, usize, f32)>> = None;
+    for (old, (name, j)) in raw.iter().enumerate() {
+        positions[new_index[old]] = Vec3::from(j.pos);
+        if let Some(w) = &j.weights {
+            let list = weights.get_or_insert_with(Vec::new);
+            for (vertex, weight) in w {
+                let v: usize = vertex.parse().map_err(|_| {
+                    FormatError::other(
+                        path,
+                        format!("joint `{name}`: expected a vertex index as weight key, found `{vertex}`"),
+                    )
+                })?;
+                list.push((new_index[old], v, *weight));
+            }
+        }
+    }
+    Ok(HomerRig { skeleton, positions, weights })
+}
+
+/// The mesh beside a rig: `homer.off` for a rig with weights, otherwise the denser
+/// `homer3x.off` when present.
+pub fn mesh_beside(rig_path: &Path, has_weights: bool) -> Option<PathBuf> {
+    let dir = rig_path.parent().unwrap_or(Path::new("."));
+    let candidates: &[&str] = if has_weights { &["homer.off"] } else { &["homer3x.off", "homer.off"] };
+    let stem = rig_path.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
+    std::iter::once(rig_path.with_extension("off"))
+        .chain(candidates.iter().map(|c| dir.join(c)))
+        .find(|p| p.is_file() && !p.ends_with(format!("{stem}.json")))
+}
+
+/// Loads a Homer rig and its mesh. Without weights in the file, the skin is bound
+/// smoothly from the distance to the bones (and a warning says so).
+pub fn load_homer(path: &Path) -> Result<CharacterAsset, FormatError> {
+    let rig = parse_rig(open(path)?, path)?;
+    let mesh_path = mesh_beside(path, rig.weights.is_some()).ok_or_else(|| {
+        FormatError::other(path, "expected an OFF mesh beside it (homer.off or homer3x.off), found none")
+    })?;
+    let mesh = parse_off(open(&mesh_path)?, &mesh_path)?;
+    let n = mesh.positions.len();
+    let mut warnings = Vec::new();
+    let weights = match &rig.weights {
+        Some(triples) => {
+            let mut rows: Vec<Vec<(usize, f32)>> = vec![Vec::new(); n];
+            for &(j, v, w) in triples {
+                let row = rows.get_mut(v).ok_or_else(|| {
+                    FormatError::other(path, format!("a weight names vertex {v}, but {} has {n}", mesh_path.display()))
+                })?;
+                row.push((j, w));
+            }
+            let (weights, normalised) =
+                SkinWeights::from_rows(rows, rig.skeleton.len()).map_err(|e| FormatError::rig(path, e))?;
+            warnings.extend(super::character::normalised_warnings(path, &normalised));
+            weights
+        }
+        None => {
+            warnings.push(format!(
+                "{}: no weights in the rig; bound smoothly from the distance to the bones",
+                path.display()
+            ));
+            smooth_bone_weights(&mesh.positions, &bones(&rig.skeleton, &rig.positions), rig.skeleton.len(), 3, 1.6)
+        }
+    };
+    let name = path.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_else(|| "homer".into());
+    let skin = Skin { bind_positions: mesh.positions, triangles: mesh.triangles, weights };
+    CharacterAsset::new(name, rig.skeleton, skin, warnings).map_err(|e| FormatError::rig(path, e))
+}

@@ -1,0 +1,215 @@
+//! FABRIK, rotation-space IK, binding meshes without weights, Homer's rig.
+
+use std::process::Command;
+
+use glam::{Mat4, Vec3};
+use marionette::formats::load_character;
+use marionette::posing::posed_positions;
+use marionette::rig::fk::forward_kinematics;
+use marionette::rig::ik::{IkGoal, chain_to_sub_base, fabrik, solve_ik};
+use marionette::rig::{JointRotation, RawJoint, Skeleton};
+
+use crate::common::{data_dir, scratch};
+
+fn lengths(p: &[Vec3]) -> Vec<f32> {
+    p.windows(2).map(|w| w[0].distance(w[1])).collect()
+}
+
+fn assert_lengths_kept(before: &[Vec3], after: &[Vec3]) {
+    for (a, b) in lengths(before).iter().zip(lengths(after)) {
+        assert!((a - b).abs() <= 1e-5 * a.max(1e-3), "bone length {a} became {b}");
+    }
+}
+
+#[test]
+fn fabrik_reaches_reachable_targets_keeping_lengths() {
+    let chain = [Vec3::ZERO, Vec3::new(0.0, 1.0, 0.0), Vec3::new(0.0, 2.0, 0.0), Vec3::new(0.0, 2.5, 0.0)];
+    for target in [Vec3::new(1.0, 1.0, 0.5), Vec3::new(-0.5, 0.2, 1.2), Vec3::new(0.3, 2.0, 0.0)] {
+        let r = fabrik(&chain, target, 1e-4, 100);
+        assert!(r.reached, "{target}: distance {}", r.distance);
+        assert!(r.iterations <= 100);
+        assert!(r.positions[3].distance(target) <= 1e-4);
+        assert_eq!(r.positions[0], chain[0], "the base stays");
+        assert_lengths_kept(&chain, &r.positions);
+    }
+}
+
+#[test]
+fn fabrik_straightens_the_chain_towards_unreachable_targets() {
+    let chain = [Vec3::ZERO, Vec3::new(1.0, 0.0, 0.0), Vec3::new(1.0, 1.0, 0.0)];
+    let target = Vec3::new(0.0, 10.0, 0.0);
+    let r = fabrik(&chain, target, 1e-4, 50);
+    assert!(!r.reached);
+    assert!((r.distance - 8.0).abs() < 1e-4);
+    for p in &r.positions {
+        assert!(p.x.abs() < 1e-5, "on the line to the target: {p}");
+    }
+    assert_lengths_kept(&chain, &r.positions);
+}
+
+fn arm() -> Skeleton {
+    Skeleton::build(vec![
+        RawJoint::new("root", None, Vec3::ZERO),
+        RawJoint::new("shoulder", Some(0), Vec3::new(0.0, 1.0, 0.0)),
+        RawJoint::new("elbow", Some(1), Vec3::new(1.0, 0.0, 0.0)),
+        RawJoint::new("wrist", Some(2), Vec3::new(1.0, 0.0, 0.0)),
+        RawJoint::new("hand", Some(3), Vec3::new(0.3, 0.0, 0.0)),
+        RawJoint::new("leg", Some(0), Vec3::new(0.0, -1.0, 0.0)),
+    ])
+    .unwrap()
+}
+
+#[test]
+fn chains_run_up_to_the_sub_base() {
+    let s = arm();
+    assert_eq!(chain_to_sub_base(&s, 4), vec![0, 1, 2, 3, 4]);
+    assert_eq!(chain_to_sub_base(&s, 5), vec![0, 5]);
+}
+
+#[test]
+fn solving_to_a_posed_end_position_lands_there() {
+    let s = arm();
+    let mut posed = s.rest_pose();
+    posed[1] = JointRotation::euler_xyz(0.3, 0.2, 0.5);
+    posed[2] = JointRotation::euler_xyz(0.0, 0.4, 0.9);
+    posed[3] = JointRotation::euler_xyz(-0.2, 0.1, 0.3);
+    let mut world = vec![Mat4::IDENTITY; s.len()];
+    forward_kinematics(&s, &posed, Mat4::IDENTITY, &mut world);
+    let target = world[4].w_axis.truncate();
+    let mut pose = s.rest_pose();
+    let reports = solve_ik(&s, &mut pose, Mat4::IDENTITY, &[IkGoal { end: 4, target }], 1e-4, 24);
+    assert!(reports[0].reached, "{:?}", reports[0]);
+    forward_kinematics(&s, &pose, Mat4::IDENTITY, &mut world);
+    assert!(world[4].w_axis.truncate().distance(target) <= 1e-4);
+    // The leg (another branch of the sub-base) did not move.
+    assert_eq!(pose[5], JointRotation::IDENTITY);
+    assert_eq!(pose[0], JointRotation::IDENTITY, "the sub-base does not rotate");
+}
+
+#[test]
+fn joint_limits_stop_the_knee_of_test_skel() {
+    let Some(data) = data_dir("joint_limits_stop_the_knee_of_test_skel") else { return };
+    let asset = load_character(&data.join("cse169/project1/test.skel")).unwrap();
+    let s = &asset.skeleton;
+    let knee = s.find("knee_r").unwrap();
+    // Drag the knee forward and up: the solve rotates what its chain allows and the knee's
+    // own rotation stays within x in [-2, 0], y = z = 0.
+    let mut pose = s.initial_pose();
+    let mut world = vec![Mat4::IDENTITY; s.len()];
+    forward_kinematics(s, &pose, Mat4::IDENTITY, &mut world);
+    let target = world[knee].w_axis.truncate() + Vec3::new(0.0, 0.1, 0.25);
+    let reports = solve_ik(s, &mut pose, Mat4::IDENTITY, &[IkGoal { end: knee, target }], 1e-4, 24);
+    let a = pose[knee].to_euler(marionette::rig::EulerOrder::Xyz);
+    assert!((-2.0 - 1e-5..=1e-5).contains(&a.x) && a.y.abs() < 1e-5 && a.z.abs() < 1e-5, "knee {a}");
+    assert!(reports[0].distance.is_finite());
+}
+
+#[test]
+fn homer_exercise_examples_give_length_preserving_poses() {
+    let Some(data) = data_dir("homer_exercise_examples_give_length_preserving_poses") else { return };
+    let asset = load_character(&data.join("homer/homerskel.json")).unwrap();
+    let s = &asset.skeleton;
+    let mut world = vec![Mat4::IDENTITY; s.len()];
+    forward_kinematics(s, &s.rest_pose(), Mat4::IDENTITY, &mut world);
+    let rest: Vec<Vec3> = world.iter().map(|m| m.w_axis.truncate()).collect();
+    for (joint, delta) in [("Right_Forearm", Vec3::new(0.0, 0.2, 0.0)), ("Left_Shin", Vec3::new(-0.2, 0.1, 0.0))] {
+        let end = s.find(joint).unwrap();
+        let target = rest[end] + delta;
+        let mut pose = s.rest_pose();
+        let reports = solve_ik(s, &mut pose, Mat4::IDENTITY, &[IkGoal { end, target }], 1e-4, 24);
+        let mut after = vec![Mat4::IDENTITY; s.len()];
+        forward_kinematics(s, &pose, Mat4::IDENTITY, &mut after);
+        let chain = chain_to_sub_base(s, end);
+        let before_p: Vec<Vec3> = chain.iter().map(|&j| rest[j]).collect();
+        let after_p: Vec<Vec3> = chain.iter().map(|&j| after[j].w_axis.truncate()).collect();
+        assert_lengths_kept(&before_p, &after_p);
+        let reachable = lengths(&before_p[1..]).iter().sum::<f32>() >= before_p[1].distance(target);
+        if reachable {
+            assert!(reports[0].reached, "{joint}: {:?}", reports[0]);
+        } else {
+            // Straightened towards the target: closer than at rest.
+            assert!(after_p.last().unwrap().distance(target) < rest[end].distance(target));
+        }
+        // Joints outside the chain did not move.
+        for j in 0..s.len() {
+            if !chain.contains(&j) && !is_below(s, j, end) {
+                assert!(after[j].w_axis.truncate().distance(rest[j]) < 1e-5, "{} moved", s.joint(j).name);
+            }
+        }
+    }
+}
+
+fn is_below(s: &Skeleton, mut j: usize, root: usize) -> bool {
+    while let Some(p) = s.parent(j) {
+        if p == root {
+            return true;
+        }
+        j = p;
+    }
+    false
+}
+
+#[test]
+fn bind_output_loads_back_and_poses_without_tearing() {
+    let Some(data) = data_dir("bind_output_loads_back_and_poses_without_tearing") else { return };
+    let dir = scratch("bind");
+    for f in ["Model1.skel", "Model1.obj"] {
+        std::fs::copy(data.join("mit6837").join(f), dir.join(f)).unwrap();
+    }
+    for smooth in [false, true] {
+        let out = dir.join("Model1.attach");
+        let mut cmd = Command::new(env!("CARGO_BIN_EXE_marionette"));
+        cmd.arg("bind").arg(dir.join("Model1.obj")).arg(dir.join("Model1.skel")).arg("--out").arg(&out);
+        if smooth {
+            cmd.arg("--smooth");
+        }
+        assert!(cmd.status().unwrap().success());
+        let asset = load_character(&dir.join("Model1.skel")).unwrap();
+        assert_eq!(asset.vertex_count(), 13336);
+        if smooth {
+            assert!(asset.skin.weights.max_influences() > 1);
+        } else {
+            assert_eq!(asset.skin.weights.max_influences(), 1);
+        }
+        // Bend an elbow (joint 6 in the 6.837 layout) and measure the worst edge stretch.
+        let mut pose = asset.skeleton.rest_pose();
+        pose[6] = JointRotation::euler_xyz(0.0, 0.0, 1.2);
+        let posed = posed_positions(&asset, &pose, Mat4::IDENTITY);
+        let rest = &asset.skin.bind_positions;
+        let worst = asset
+            .skin
+            .triangles
+            .iter()
+            .flat_map(|t| [(t[0], t[1]), (t[1], t[2]), (t[2], t[0])])
+            .map(|(a, b)| {
+                let (a, b) = (a as usize, b as usize);
+                posed[a].distance(posed[b]) / rest[a].distance(rest[b]).max(1e-6)
+            })
+            .fold(0.0f32, f32::max);
+        if smooth {
+            assert!(worst < 4.0, "smooth binding stretches an edge {worst}×");
+        }
+        eprintln!("bind smooth={smooth}: worst edge stretch {worst:.2}×");
+    }
+}
+
+#[test]
+fn homer_rig_with_weights_loads_normalised() {
+    let Some(data) = data_dir("homer_rig_with_weights_loads_normalised") else { return };
+    let asset = load_character(&data.join("homer/homer.json")).unwrap();
+    assert_eq!(asset.skeleton.len(), 18);
+    assert_eq!(asset.skeleton.joint(0).name, "Root");
+    assert_eq!(asset.vertex_count(), 10002);
+    assert!(asset.warnings.iter().any(|w| w.contains("normalised")), "{:?}", asset.warnings);
+    for v in 0..asset.vertex_count() {
+        let sum: f32 = asset.skin.weights.of_vertex(v).iter().map(|i| i.weight).sum();
+        assert!((sum - 1.0).abs() < 1e-5);
+    }
+    let skel = load_character(&data.join("homer/homerskel.json")).unwrap();
+    assert_eq!(skel.skeleton.len(), 17);
+    assert_eq!(skel.vertex_count(), 24421, "homerskel.json takes homer3x.off");
+    // Parents come before children although the file's keys are not in that order.
+    for j in 1..skel.skeleton.len() {
+        assert!(skel.skeleton.parent(j).unwrap() < j);
+    }
+}
