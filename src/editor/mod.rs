@@ -11,6 +11,7 @@ pub mod default_scene;
 pub mod document;
 pub mod draw;
 pub mod history;
+pub mod ik_drag;
 pub mod inspector;
 pub mod picking;
 pub mod render;
@@ -104,6 +105,7 @@ pub struct InteractionPlugin;
 
 impl Plugin for InteractionPlugin {
     fn build(&self, app: &mut App) {
+        app.add_plugins(ik_drag::IkDragPlugin);
         app.init_resource::<camera::ViewportHasPointer>().init_resource::<picking::PointerPress>().add_systems(
             Update,
             (camera::track_egui_pointer, orbit_camera_input, picking::pick_joint_on_click, inspector::shortcuts)

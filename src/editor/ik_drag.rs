@@ -1,0 +1,214 @@
+//! Posing by dragging: grab a joint in the viewport and move it in the plane facing the
+//! camera; FABRIK moves its chain every frame (for a non-leaf joint this turns its parent
+//! towards the cursor). Pinned joints (P) hold their place meanwhile. The edits are
+//! ordinary pose edits (undo, scene files).
+
+use std::collections::BTreeMap;
+
+use bevy::prelude::*;
+use bevy::window::PrimaryWindow;
+
+use super::Selection;
+use super::camera::ViewportHasPointer;
+use super::document::SceneCharacter;
+use super::draw::SkeletonGizmos;
+use super::history::History;
+use super::inspector::SceneSnapshot;
+use super::picking::PICK_RADIUS_PX;
+use crate::posing::{IK_ROUNDS, IK_TOLERANCE};
+use crate::rig::ik::{IkGoal, solve_ik};
+use crate::scene::{Character, CurrentJointToWorld, JointPose, Placement};
+
+/// A drag under way.
+#[derive(Debug, Clone)]
+pub struct Drag {
+    pub character: u64,
+    pub joint: usize,
+    /// The drag plane: through the joint, facing the camera.
+    pub plane_point: Vec3,
+    pub plane_normal: Vec3,
+    /// Pinned joints of that character and where they must stay (world).
+    pub pins: Vec<(usize, Vec3)>,
+}
+
+#[derive(Resource, Default)]
+pub struct JointDrag {
+    pub active: Option<Drag>,
+    /// The last solve's note (reached or not, limited), shown in the panel.
+    pub note: String,
+}
+
+/// Pinned joints per character id.
+#[derive(Resource, Default)]
+pub struct Pins(pub BTreeMap<u64, Vec<usize>>);
+
+pub struct IkDragPlugin;
+
+impl Plugin for IkDragPlugin {
+    fn build(&self, app: &mut App) {
+        app.init_resource::<JointDrag>()
+            .init_resource::<Pins>()
+            .add_systems(
+                Update,
+                (toggle_pins, start_drag, drag_joint)
+                    .chain()
+                    .after(super::camera::track_egui_pointer)
+                    .before(super::camera::orbit_camera_input),
+            )
+            .add_systems(PostUpdate, draw_handles.in_set(crate::scene::MarionetteSystems::Draw));
+    }
+}
+
+/// P pins or unpins the selected joints (reads keys, `Selection`; writes `Pins`).
+fn toggle_pins(
+    keys: Res<ButtonInput<KeyCode>>,
+    wants: Option<Res<bevy_egui::input::EguiWantsInput>>,
+    selection: Res<Selection>,
+    mut pins: ResMut<Pins>,
+) {
+    if !keys.just_pressed(KeyCode::KeyP) || wants.is_some_and(|w| w.wants_any_keyboard_input()) {
+        return;
+    }
+    let Some(id) = selection.character else { return };
+    let list = pins.0.entry(id).or_default();
+    for &j in &selection.joints {
+        match list.iter().position(|&p| p == j) {
+            Some(k) => {
+                list.remove(k);
+            }
+            None => list.push(j),
+        }
+    }
+}
+
+/// On a left press near a joint, starts dragging it (reads input, joints; writes
+/// `JointDrag`, `Selection`, `History`).
+#[allow(clippy::too_many_arguments)]
+fn start_drag(
+    buttons: Res<ButtonInput<MouseButton>>,
+    windows: Query<&Window, With<PrimaryWindow>>,
+    cameras: Query<(&Camera, &GlobalTransform)>,
+    characters: Query<(&SceneCharacter, &Character, &InheritedVisibility)>,
+    joints: Query<&CurrentJointToWorld>,
+    pointer: Res<ViewportHasPointer>,
+    pins: Res<Pins>,
+    snapshot: Option<Res<SceneSnapshot>>,
+    mut history: ResMut<History>,
+    mut drag: ResMut<JointDrag>,
+) {
+    if !buttons.just_pressed(MouseButton::Left) || !pointer.0 {
+        return;
+    }
+    let (Ok(window), Ok((camera, camera_transform))) = (windows.single(), cameras.single()) else { return };
+    let Some(cursor) = window.cursor_position() else { return };
+    let mut best: Option<(f32, u64, usize, Vec3, &Character)> = None;
+    for (sc, character, visible) in &characters {
+        if !visible.get() {
+            continue;
+        }
+        for (j, &e) in character.joints.iter().enumerate() {
+            let Ok(m) = joints.get(e) else { continue };
+            let Ok(screen) = camera.world_to_viewport(camera_transform, m.position()) else { continue };
+            let d = screen.distance(cursor);
+            if d < PICK_RADIUS_PX * 0.5 && best.as_ref().is_none_or(|b| d < b.0 - 0.5) {
+                best = Some((d, sc.id, j, m.position(), character));
+            }
+        }
+    }
+    let Some((_, id, joint, at, character)) = best else { return };
+    if character.asset.skeleton.parent(joint).is_none() {
+        return;
+    }
+    let pins = pins.0.get(&id).map_or(Vec::new(), |list| {
+        list.iter()
+            .filter(|&&p| p != joint)
+            .filter_map(|&p| joints.get(character.joints[p]).ok().map(|m| (p, m.position())))
+            .collect()
+    });
+    if let Some(s) = snapshot {
+        history.begin_edit(&s.0);
+    }
+    drag.active =
+        Some(Drag { character: id, joint, plane_point: at, plane_normal: camera_transform.forward().as_vec3(), pins });
+}
+
+/// While the button is held, moves the dragged joint to the cursor in its plane by IK;
+/// ends the drag on release (reads input, poses; writes `JointPose`, `JointDrag`).
+#[allow(clippy::too_many_arguments)]
+fn drag_joint(
+    buttons: Res<ButtonInput<MouseButton>>,
+    windows: Query<&Window, With<PrimaryWindow>>,
+    cameras: Query<(&Camera, &GlobalTransform)>,
+    characters: Query<(&SceneCharacter, &Character, &Placement)>,
+    mut poses: Query<&mut JointPose>,
+    mut drag: ResMut<JointDrag>,
+    mut selection: ResMut<Selection>,
+) {
+    let Some(active) = drag.active.clone() else { return };
+    if !buttons.pressed(MouseButton::Left) {
+        drag.active = None;
+        return;
+    }
+    let (Ok(window), Ok((camera, camera_transform))) = (windows.single(), cameras.single()) else { return };
+    let Some(cursor) = window.cursor_position() else { return };
+    let Ok(ray) = camera.viewport_to_world(camera_transform, cursor) else { return };
+    let denom = ray.direction.dot(active.plane_normal);
+    if denom.abs() < 1e-6 {
+        return;
+    }
+    let t = (active.plane_point - ray.origin).dot(active.plane_normal) / denom;
+    let target = ray.origin + *ray.direction * t;
+    let Some((_, character, placement)) = characters.iter().find(|c| c.0.id == active.character) else { return };
+    if selection.character != Some(active.character) || selection.joints.first() != Some(&active.joint) {
+        *selection = Selection { character: Some(active.character), joints: vec![active.joint] };
+    }
+    let skeleton = &character.asset.skeleton;
+    let mut pose: Vec<_> = character.joints.iter().map(|&e| poses.get(e).map_or(Default::default(), |p| p.0)).collect();
+    let mut goals = vec![IkGoal { end: active.joint, target }];
+    goals.extend(active.pins.iter().map(|&(end, target)| IkGoal { end, target }));
+    let reports = solve_ik(skeleton, &mut pose, placement.to_mat4(), &goals, IK_TOLERANCE, IK_ROUNDS.min(8));
+    drag.note = reports.first().map(|r| crate::posing::describe_ik(skeleton, r)).unwrap_or_default();
+    for (&e, p) in character.joints.iter().zip(pose) {
+        if let Ok(mut current) = poses.get_mut(e) {
+            current.set_if_neq(JointPose(p));
+        }
+    }
+}
+
+/// Handles on the leaf joints of the selected character, pins in orange, the dragged joint
+/// in red (draws gizmos).
+fn draw_handles(
+    selection: Res<Selection>,
+    pins: Res<Pins>,
+    drag: Res<JointDrag>,
+    characters: Query<(&SceneCharacter, &Character)>,
+    joints: Query<&CurrentJointToWorld>,
+    mut gizmos: Gizmos<SkeletonGizmos>,
+) {
+    for (sc, character) in &characters {
+        let pinned = pins.0.get(&sc.id);
+        let selected = selection.character == Some(sc.id);
+        if !selected && pinned.is_none_or(|p| p.is_empty()) {
+            continue;
+        }
+        let size = super::draw::character_size(character) * 0.02;
+        let skeleton = &character.asset.skeleton;
+        for j in 0..skeleton.len() {
+            let is_pin = pinned.is_some_and(|p| p.contains(&j));
+            let is_leaf = skeleton.children(j).is_empty();
+            if !(is_pin || (selected && is_leaf)) {
+                continue;
+            }
+            let Ok(m) = joints.get(character.joints[j]) else { continue };
+            let dragged = drag.active.as_ref().is_some_and(|d| d.character == sc.id && d.joint == j);
+            let color = if dragged {
+                Color::srgb(1.0, 0.1, 0.1)
+            } else if is_pin {
+                Color::srgb(1.0, 0.55, 0.0)
+            } else {
+                Color::srgb(0.2, 0.9, 1.0)
+            };
+            gizmos.cube(Transform::from_translation(m.position()).with_scale(Vec3::splat(size)), color);
+        }
+    }
+}
