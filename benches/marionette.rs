@@ -1,7 +1,8 @@
-//! Skinning benchmarks: the pure kernel, and one frame of the ECS systems for 1 and 16
-//! characters (one joint changed per character per frame, so every character re-skins).
+//! Benchmarks: the skinning kernel; one frame of the ECS systems for 1 and 16 characters
+//! (one joint changed per character per frame, so every character re-skins); FABRIK on
+//! 3-, 6- and 20-joint chains; the rotation-space IK solve of the CSE169 dragon's tail.
 //!
-//! Run: `cargo bench --profile dev --bench skinning` (with `MARIONETTE_DATA` set, the
+//! Run: `cargo bench --profile dev --bench marionette` (with `MARIONETTE_DATA` set, the
 //! 6.837 Model1 is used; otherwise the project's puppet).
 
 use std::sync::{Arc, OnceLock};
@@ -100,5 +101,57 @@ fn ecs_frame(bencher: Bencher, characters: usize) {
             app.world_mut().get_mut::<JointPose>(j).unwrap().0 = JointRotation::euler_xyz(angle, 0.0, 0.0);
         }
         app.update();
+    });
+}
+
+/// A zig-zag chain of `n` joints (unit bones), and a reachable target off its line.
+fn chain(n: usize) -> (Vec<Vec3>, Vec3) {
+    let points: Vec<Vec3> = (0..n).map(|i| Vec3::new(i as f32, if i % 2 == 0 { 0.0 } else { 0.3 }, 0.0)).collect();
+    let reach = (n - 1) as f32 * 0.7;
+    (points, Vec3::new(reach * 0.5, reach * 0.6, reach * 0.3))
+}
+
+/// FABRIK alone on position chains of 3, 6 and 20 joints, tolerance 1e-4.
+#[divan::bench(args = [3, 6, 20])]
+fn ik_fabrik(bencher: Bencher, joints: usize) {
+    let (points, target) = chain(joints);
+    let r = marionette::rig::ik::fabrik(&points, target, 1e-4, 200);
+    eprintln!(
+        "fabrik {joints} joints: reached {} in {} iterations (distance {:.2e})",
+        r.reached, r.iterations, r.distance
+    );
+    bencher.bench_local(|| marionette::rig::ik::fabrik(divan::black_box(&points), target, 1e-4, 200));
+}
+
+/// The full rotation-space solve (FABRIK ↔ FK, limits) of the CSE169 dragon's tail
+/// (tail_12 up to the root: 13 joints) when `MARIONETTE_DATA` is set.
+#[divan::bench]
+fn ik_solve_dragon_tail(bencher: Bencher) {
+    let Some(path) =
+        std::env::var_os("MARIONETTE_DATA").map(|d| std::path::PathBuf::from(d).join("cse169/project1/dragon.skel"))
+    else {
+        return;
+    };
+    let asset = marionette::formats::load_character(&path).unwrap();
+    let s = &asset.skeleton;
+    let end = s.find("tail_12").unwrap();
+    let mut world = vec![Mat4::IDENTITY; s.len()];
+    forward_kinematics(s, &s.initial_pose(), Mat4::IDENTITY, &mut world);
+    let target = world[end].w_axis.truncate() + Vec3::new(4.0, 3.0, 2.0);
+    let goal = [marionette::rig::ik::IkGoal { end, target }];
+    let mut pose = s.initial_pose();
+    let r = marionette::rig::ik::solve_ik(s, &mut pose, Mat4::IDENTITY, &goal, 1e-3, 24);
+    eprintln!(
+        "dragon tail ({} joints): reached {} after {} rounds, {} FABRIK iterations, distance {:.4}, limited {}",
+        marionette::rig::ik::chain_to_sub_base(s, end).len(),
+        r[0].reached,
+        r[0].rounds,
+        r[0].iterations,
+        r[0].distance,
+        r[0].limited
+    );
+    bencher.bench_local(|| {
+        let mut pose = s.initial_pose();
+        marionette::rig::ik::solve_ik(s, &mut pose, Mat4::IDENTITY, &goal, 1e-3, 24)
     });
 }
