@@ -27,6 +27,7 @@ fn puppet(
         pose,
         view,
         smpl: None,
+        binding: None,
     }
 }
 

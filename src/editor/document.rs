@@ -12,7 +12,8 @@ use super::camera::OrbitCamera;
 use super::smpl::SmplCharacter;
 use super::stage::StageSettings;
 use crate::formats::scene::{
-    CameraDoc, CharacterDoc, DisplayDoc, PlacementDoc, SceneDoc, SourceDoc, ViewDoc, joint_of_pose_key, pose_key,
+    BindingDoc, CameraDoc, CharacterDoc, DisplayDoc, PlacementDoc, SceneDoc, SourceDoc, ViewDoc, joint_of_pose_key,
+    pose_key,
 };
 use crate::formats::{FormatError, load_character};
 use crate::rig::smpl::{Clip, SmplModel};
@@ -28,6 +29,7 @@ pub struct SceneCharacter {
     pub name: String,
     pub visible: bool,
     pub heat_of_selected: bool,
+    pub binding: Option<BindingDoc>,
 }
 
 /// Loaded characters by source, shared by every scene character made from them.
@@ -35,6 +37,24 @@ pub struct SceneCharacter {
 pub struct AssetLibrary {
     cache: HashMap<SourceDoc, Arc<CharacterAsset>>,
     smpl: HashMap<PathBuf, SmplSet>,
+    bound: HashMap<(SourceDoc, BindingDoc), Arc<CharacterAsset>>,
+}
+
+/// A copy of `asset` whose weights come from the distance to its bones at rest.
+pub fn rebind(asset: &CharacterAsset, binding: BindingDoc) -> CharacterAsset {
+    use crate::rig::bind::{bones, nearest_bone_weights, smooth_bone_weights};
+    let s = &asset.skeleton;
+    let mut world = vec![Mat4::IDENTITY; s.len()];
+    crate::rig::forward_kinematics(s, &s.rest_pose(), Mat4::IDENTITY, &mut world);
+    let positions: Vec<Vec3> = world.iter().map(|m| m.w_axis.truncate()).collect();
+    let all = bones(s, &positions);
+    let mut out = asset.clone();
+    out.skin.weights = match binding {
+        BindingDoc::Nearest => nearest_bone_weights(&asset.skin.bind_positions, &all),
+        BindingDoc::Smooth => smooth_bone_weights(&asset.skin.bind_positions, &all, s.len(), 3, 1.6),
+    };
+    out.warnings.push(format!("weights computed ({binding:?}) from the bones"));
+    out
 }
 
 /// An SMPL model and the clips of its folder.
@@ -58,6 +78,22 @@ impl AssetLibrary {
         });
         self.cache.insert(source.clone(), asset.clone());
         Ok(asset)
+    }
+
+    /// The character of `source` with weights computed from its bones (cached).
+    pub fn load_bound(
+        &mut self,
+        source: &SourceDoc,
+        binding: Option<BindingDoc>,
+    ) -> Result<Arc<CharacterAsset>, FormatError> {
+        let asset = self.load(source)?;
+        let Some(binding) = binding else { return Ok(asset) };
+        if let Some(bound) = self.bound.get(&(source.clone(), binding)) {
+            return Ok(bound.clone());
+        }
+        let bound = Arc::new(rebind(&asset, binding));
+        self.bound.insert((source.clone(), binding), bound.clone());
+        Ok(bound)
     }
 
     /// The SMPL model and clips of a folder, loaded once.
@@ -192,6 +228,7 @@ impl SceneReader<'_, '_> {
                 tint: view.tint,
             },
             smpl: None,
+            binding: sc.binding,
         }
     }
 
@@ -225,7 +262,7 @@ pub fn spawn_from_doc(
     doc: &CharacterDoc,
     id: u64,
 ) -> Result<(Entity, Vec<String>), FormatError> {
-    let asset = library.load(&doc.source)?;
+    let asset = library.load_bound(&doc.source, doc.binding)?;
     let (pose, messages) = pose_from_doc(&asset, doc);
     let p = doc.placement;
     let placement = Placement { translation: Vec3::from(p.translation), yaw: p.yaw, scale: p.scale };
@@ -242,6 +279,7 @@ pub fn spawn_from_doc(
             name: doc.name.clone(),
             visible: doc.view.visible,
             heat_of_selected: doc.view.heat_of_selected,
+            binding: doc.binding,
         },
         SkinView { tint: doc.view.tint, weight_colors: doc.view.weight_colors, heat_joint: None },
         display,
@@ -298,6 +336,7 @@ pub fn doc_side_by_side(library: &mut AssetLibrary, sources: Vec<SourceDoc>, mes
                 pose: Default::default(),
                 view: ViewDoc::default(),
                 smpl: None,
+                binding: None,
             };
             x += w + gap;
             doc

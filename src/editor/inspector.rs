@@ -17,7 +17,7 @@ use super::screenshot::ScreenshotRequest;
 use super::smpl::SmplCharacter;
 use super::stage::StageSettings;
 use super::{Messages, Selection};
-use crate::formats::scene::{CharacterDoc, PlacementDoc, SceneDoc, SourceDoc, ViewDoc};
+use crate::formats::scene::{BindingDoc, CharacterDoc, PlacementDoc, SceneDoc, SourceDoc, ViewDoc};
 use crate::rig::{EulerOrder, JointRotation, Skeleton};
 use crate::scene::{Character, CurrentJointToWorld, DisplayMode, JointLimits, JointPose, Placement, SkinView};
 
@@ -191,6 +191,7 @@ fn scene_panel(
     }
     ui.separator();
     let mut remove = None;
+    let mut rebind_request: Option<(u64, Option<BindingDoc>)> = None;
     let mut duplicate = None;
     let mut list: Vec<(Entity, u64, String)> =
         edit.characters.iter().map(|c| (c.0, c.1.id, c.1.name.clone())).collect();
@@ -266,8 +267,32 @@ fn scene_panel(
             }
             edited |= ui.checkbox(&mut sc.heat_of_selected, "weights of the selected joint").changed();
         });
+        let binding = sc.binding;
+        ui.horizontal(|ui| {
+            ui.label("Weights:");
+            for (label, b) in [
+                ("from the file", None),
+                ("nearest bone", Some(BindingDoc::Nearest)),
+                ("smooth", Some(BindingDoc::Smooth)),
+            ] {
+                if ui.selectable_label(binding == b, label).clicked() && binding != b {
+                    rebind_request = Some((id, b));
+                }
+            }
+        });
         if let Ok(mut body) = edit.smpl.get_mut(entity) {
             edited |= smpl_panel(ui, &mut body);
+        }
+    }
+    if let Some((id, binding)) = rebind_request {
+        // Rebuild the scene from this frame's document with the new binding (undoable).
+        let mut ids: Vec<u64> = edit.characters.iter().map(|c| c.1.id).collect();
+        ids.sort();
+        if let Some(k) = ids.iter().position(|&i| i == id) {
+            let mut doc = ops.snapshot.0.clone();
+            doc.characters[k].binding = binding;
+            *ops.pending = PendingScene { doc: Some(doc), with_camera: false, frame: false };
+            edited = true;
         }
     }
     if let Some(entity) = remove {
@@ -352,6 +377,7 @@ fn add_character(path: &str, state: &mut InspectorState, edit: &mut Editable, op
         pose: Default::default(),
         view: ViewDoc::default(),
         smpl: None,
+        binding: None,
     };
     state.recent.retain(|r| r != path);
     state.recent.insert(0, path.to_string());

@@ -161,6 +161,18 @@ pub struct CharacterDoc {
     pub view: ViewDoc,
     #[serde(default)]
     pub smpl: Option<SmplDoc>,
+    /// Weights computed from the bones instead of the source's.
+    #[serde(default)]
+    pub binding: Option<BindingDoc>,
+}
+
+/// How to bind a skin from its skeleton's bones.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
+pub enum BindingDoc {
+    /// Each vertex rigidly to its nearest bone.
+    Nearest,
+    /// The nearest few bones, falling off with distance.
+    Smooth,
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]

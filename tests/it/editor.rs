@@ -25,6 +25,7 @@ fn doc_with(source: SourceDoc, pose: &[(&str, JointRotation)]) -> SceneDoc {
             pose: pose.iter().map(|(k, r)| (k.to_string(), *r)).collect::<BTreeMap<_, _>>(),
             view: ViewDoc { weight_colors: true, ..ViewDoc::default() },
             smpl: None,
+            binding: None,
         }],
         camera: None,
         stage: Default::default(),

@@ -213,3 +213,16 @@ fn homer_rig_with_weights_loads_normalised() {
         assert!(skel.skeleton.parent(j).unwrap() < j);
     }
 }
+
+#[test]
+fn rebinding_in_the_editor_replaces_the_weights_only() {
+    use marionette::editor::document::rebind;
+    use marionette::formats::scene::BindingDoc;
+    let puppet = marionette::puppet::embedded_puppet();
+    let rigid = rebind(&puppet, BindingDoc::Nearest);
+    assert_eq!(rigid.skin.weights.max_influences(), 1);
+    assert_eq!(rigid.skin.bind_positions, puppet.skin.bind_positions);
+    assert_eq!(rigid.skeleton, puppet.skeleton);
+    let smooth = rebind(&puppet, BindingDoc::Smooth);
+    assert!(smooth.skin.weights.max_influences() > 1);
+}
