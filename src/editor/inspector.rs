@@ -612,14 +612,8 @@ fn smpl_panel(ui: &mut egui::Ui, body: &mut Mut<SmplCharacter>) -> bool {
             .iter()
             .map(|c| c.0.trim_start_matches("smpl_quaternions_").trim_end_matches(".txt").to_string())
             .collect();
-        let label = |i: Option<usize>| i.map_or("(none)".to_string(), |i| names[i].clone());
         let mut clip = body.clip;
-        egui::ComboBox::from_label("clip").selected_text(label(clip)).show_ui(ui, |ui| {
-            ui.selectable_value(&mut clip, None, "(none)");
-            for (i, n) in names.iter().enumerate() {
-                ui.selectable_value(&mut clip, Some(i), n);
-            }
-        });
+        clip_choice(ui, "clip", &names, &mut clip);
         if clip != body.clip {
             body.clip = clip;
             body.time = 0.0;
@@ -652,12 +646,7 @@ fn smpl_panel(ui: &mut egui::Ui, body: &mut Mut<SmplCharacter>) -> bool {
                 body.speed = speed;
             }
             let mut second = body.blend_clip;
-            egui::ComboBox::from_label("blend with").selected_text(label(second)).show_ui(ui, |ui| {
-                ui.selectable_value(&mut second, None, "(none)");
-                for (i, n) in names.iter().enumerate() {
-                    ui.selectable_value(&mut second, Some(i), n);
-                }
-            });
+            clip_choice(ui, "blend with", &names, &mut second);
             if second != body.blend_clip {
                 body.blend_clip = second;
                 edited = true;
@@ -672,4 +661,15 @@ fn smpl_panel(ui: &mut egui::Ui, body: &mut Mut<SmplCharacter>) -> bool {
         }
     });
     edited
+}
+
+/// A drop-down of clip names (or none).
+fn clip_choice(ui: &mut egui::Ui, label: &str, names: &[String], choice: &mut Option<usize>) {
+    let shown = choice.map_or("(none)".to_string(), |i| names[i].clone());
+    egui::ComboBox::from_label(label).selected_text(shown).show_ui(ui, |ui| {
+        ui.selectable_value(choice, None, "(none)");
+        for (i, n) in names.iter().enumerate() {
+            ui.selectable_value(choice, Some(i), n);
+        }
+    });
 }
