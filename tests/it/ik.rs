@@ -226,3 +226,34 @@ fn rebinding_in_the_editor_replaces_the_weights_only() {
     let smooth = rebind(&puppet, BindingDoc::Smooth);
     assert!(smooth.skin.weights.max_influences() > 1);
 }
+
+#[test]
+fn a_limited_knee_stays_in_its_range_and_the_solve_says_so() {
+    use marionette::rig::DofLimits;
+    let mut knee = RawJoint::new("knee", Some(1), Vec3::new(0.0, -1.0, 0.0));
+    // As test.skel's knee_r: x in [-2, 0], y and z locked.
+    knee.limits = DofLimits { min: Vec3::new(-2.0, 0.0, 0.0), max: Vec3::new(0.0, 0.0, 0.0) };
+    let s = Skeleton::build(vec![
+        RawJoint::new("root", None, Vec3::ZERO),
+        RawJoint::new("hip", Some(0), Vec3::new(0.1, 0.0, 0.0)),
+        knee,
+        RawJoint::new("ankle", Some(2), Vec3::new(0.0, -1.0, 0.0)),
+        RawJoint::new("other_hip", Some(0), Vec3::new(-0.1, 0.0, 0.0)),
+    ])
+    .unwrap();
+    // Reachable only by bending the knee forwards (positive x), which its limits forbid.
+    for target in [Vec3::new(0.1, -1.2, 1.0), Vec3::new(0.1, -0.8, -0.9)] {
+        let mut pose = s.rest_pose();
+        let reports = solve_ik(&s, &mut pose, Mat4::IDENTITY, &[IkGoal { end: 3, target }], 1e-4, 24);
+        let a = pose[2].to_euler(marionette::rig::EulerOrder::Xyz);
+        assert!((-2.0 - 1e-5..=1e-5).contains(&a.x), "knee x {a}");
+        assert!(a.y.abs() < 1e-5 && a.z.abs() < 1e-5, "locked axes moved: {a}");
+        let mut world = vec![Mat4::IDENTITY; s.len()];
+        forward_kinematics(&s, &pose, Mat4::IDENTITY, &mut world);
+        let reached = world[3].w_axis.truncate().distance(target) <= 1e-4;
+        assert_eq!(reached, reports[0].reached);
+        if !reached {
+            assert!(reports[0].limited, "a miss is explained by the limits: {:?}", reports[0]);
+        }
+    }
+}
