@@ -67,16 +67,13 @@ pub fn draw_skeletons(
                 let from = world(parent).w_axis.truncate();
                 let length = from.distance(p);
                 if length > 1e-6 {
+                    // The classic recipe: a unit box in the bone's frame [u v w c], scaled to
+                    // the bone's length along w.
+                    let up = skeleton.parent(parent).map(|g| from - world(g).w_axis.truncate());
+                    let frame = crate::rig::bind::bone_frame(from, p, up);
                     let thickness = (length * 0.12).min(radius * 1.5);
-                    let rotation = Quat::from_rotation_arc(Vec3::Z, (p - from) / length);
-                    gizmos.cube(
-                        Transform {
-                            translation: (from + p) / 2.0,
-                            rotation,
-                            scale: Vec3::new(thickness, thickness, length),
-                        },
-                        BONE_COLOR,
-                    );
+                    let scale = Mat4::from_scale(Vec3::new(thickness, thickness, length));
+                    gizmos.cube(Transform::from_matrix(frame * scale), BONE_COLOR);
                 }
             }
         }

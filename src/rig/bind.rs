@@ -84,3 +84,22 @@ pub fn smooth_bone_weights(
         .collect();
     SkinWeights::from_rows(rows, joint_count).expect("distance weights are positive and in range").0
 }
+
+/// The frame of a bone from `a` to `b`, as in the FABRIK/skinning exercise: centre
+/// `c = (a + b) / 2`, `w` = the unit bone direction, `v` = the part of the parent bone's
+/// direction perpendicular to `w` (normalised; `(0, 1, 0)` at the root or when parallel),
+/// `u = v × w`; the matrix has columns `[u v w c]` (bone space → model space).
+pub fn bone_frame(a: Vec3, b: Vec3, parent_direction: Option<Vec3>) -> glam::Mat4 {
+    let w = (b - a).normalize_or(Vec3::Z);
+    let perpendicular = |d: Vec3| {
+        let v = d - d.dot(w) * w;
+        (v.length_squared() > 1e-10).then(|| v.normalize())
+    };
+    let v = parent_direction
+        .and_then(perpendicular)
+        .or_else(|| perpendicular(Vec3::Y))
+        .or_else(|| perpendicular(Vec3::X))
+        .unwrap_or(Vec3::X);
+    let u = v.cross(w);
+    glam::Mat4::from_cols(u.extend(0.0), v.extend(0.0), w.extend(0.0), ((a + b) / 2.0).extend(1.0))
+}

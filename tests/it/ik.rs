@@ -257,3 +257,20 @@ fn a_limited_knee_stays_in_its_range_and_the_solve_says_so() {
         }
     }
 }
+
+#[test]
+fn bone_frames_follow_the_exercise() {
+    use marionette::rig::bind::bone_frame;
+    let (a, b) = (Vec3::new(1.0, 0.0, 0.0), Vec3::new(1.0, 0.0, 2.0));
+    let m = bone_frame(a, b, Some(Vec3::new(0.0, 1.0, 1.0)));
+    let (u, v, w, c) = (m.x_axis.truncate(), m.y_axis.truncate(), m.z_axis.truncate(), m.w_axis.truncate());
+    assert!(w.abs_diff_eq(Vec3::Z, 1e-6), "w along the bone");
+    assert!(v.abs_diff_eq(Vec3::Y, 1e-6), "v: the parent direction without its part along w");
+    assert!(u.abs_diff_eq(v.cross(w), 1e-6) && u.abs_diff_eq(Vec3::X, 1e-6));
+    assert!(c.abs_diff_eq(Vec3::new(1.0, 0.0, 1.0), 1e-6), "c the middle");
+    assert_eq!(m.w_axis.w, 1.0);
+    // At the root v comes from (0, 1, 0).
+    let root = bone_frame(Vec3::ZERO, Vec3::new(1.0, 1.0, 0.0), None);
+    let v = root.y_axis.truncate();
+    assert!(v.dot(root.z_axis.truncate()).abs() < 1e-6 && v.y > 0.0 && (v.length() - 1.0).abs() < 1e-6);
+}
