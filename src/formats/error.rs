@@ -12,11 +12,12 @@ pub enum FormatError {
     #[error("{}:{line}: {message}", path.display())]
     Syntax { path: PathBuf, line: usize, message: String },
     /// The file parsed, but the rig it describes is invalid.
-    #[error("{}: {source}", path.display())]
-    Rig { path: PathBuf, source: RigError },
+    // The cause is part of the message (not an error `source`), so chains print it once.
+    #[error("{}: {cause}", path.display())]
+    Rig { path: PathBuf, cause: RigError },
     /// The file could not be read or written.
-    #[error("{}: {source}", path.display())]
-    Io { path: PathBuf, source: std::io::Error },
+    #[error("{}: {cause}", path.display())]
+    Io { path: PathBuf, cause: std::io::Error },
     /// Something else about the file (missing companion files, unknown kind).
     #[error("{}: {message}", path.display())]
     Other { path: PathBuf, message: String },
@@ -28,11 +29,11 @@ impl FormatError {
     }
 
     pub fn rig(path: &Path, source: RigError) -> Self {
-        Self::Rig { path: path.to_path_buf(), source }
+        Self::Rig { path: path.to_path_buf(), cause: source }
     }
 
     pub fn io(path: &Path, source: std::io::Error) -> Self {
-        Self::Io { path: path.to_path_buf(), source }
+        Self::Io { path: path.to_path_buf(), cause: source }
     }
 
     pub fn other(path: &Path, message: impl fmt::Display) -> Self {
