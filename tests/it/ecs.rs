@@ -155,3 +155,52 @@ fn model1_in_the_ecs_matches_the_kernel() {
     pose[6] = rotation;
     assert_positions_close(&mesh_positions(&app, character), &oracle(&asset, &pose, &Placement::default()), 1e-5);
 }
+
+/// SMPL in the ECS (shape change, clip pose) against the pure SMPL poser.
+#[test]
+fn smpl_body_in_the_ecs_matches_the_poser() {
+    use marionette::editor::smpl::{SmplCharacter, SmplEditorPlugin};
+    use marionette::formats::scene::SmplDoc;
+    use marionette::smpl_tasks::{FrameSpec, SmplPoser, exercise_beta};
+    let Some(data) = data_dir("smpl_body_in_the_ecs_matches_the_poser") else { return };
+    let dir = data.join("smpl");
+    let (model, _) = marionette::formats::smpl::load_smpl_dir(&dir).unwrap();
+    let model = Arc::new(model);
+    let clip_path = dir.join("smpl_quaternions_mosh_cmu_7516.txt");
+    let clip = Arc::new(
+        marionette::formats::smpl::parse_clip(
+            std::io::BufReader::new(std::fs::File::open(&clip_path).unwrap()),
+            &clip_path,
+            24,
+        )
+        .unwrap(),
+    );
+    let asset = Arc::new(model.asset("smpl", &[]).unwrap());
+    let mut app = app();
+    app.add_plugins(SmplEditorPlugin);
+    let character = spawn(&mut app, asset.clone(), Placement::default());
+    let doc = SmplDoc {
+        betas: exercise_beta(2).to_vec(),
+        clip: Some("c".into()),
+        time: 42.0,
+        upright: false,
+        ..SmplDoc::default()
+    };
+    app.world_mut().entity_mut(character).insert(SmplCharacter::new(
+        model.clone(),
+        dir.clone(),
+        vec![("c".into(), clip.clone())],
+        Some(&doc),
+    ));
+    app.update();
+    app.update();
+    let frame =
+        FrameSpec { betas: exercise_beta(2), rotations: clip.frame(42).to_vec(), translation: None, skinned: true };
+    let mut expected = Vec::new();
+    SmplPoser::new(&model).frame(&frame, &mut expected);
+    let current = app.world().get::<Character>(character).unwrap().asset.clone();
+    let n = current.triangle_count() * 3;
+    let (mut p, mut nrm) = (vec![[0.0; 3]; n], vec![[0.0; 3]; n]);
+    flat_shade(&expected, &current.skin.triangles, &mut p, &mut nrm);
+    assert_positions_close(&mesh_positions(&app, character), &p, 1e-5);
+}
