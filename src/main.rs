@@ -171,24 +171,13 @@ fn bind(
     smooth: bool,
 ) -> Result<()> {
     use marionette::formats::{error::open, mit6837, off};
-    use marionette::rig::bind::{bones, nearest_bone_weights, smooth_bone_weights};
+    use marionette::rig::bind::{Binding, bind_to_skeleton};
     let mesh = match mesh_path.extension().and_then(|e| e.to_str()) {
         Some("off") => off::parse_off(open(mesh_path)?, mesh_path)?,
         _ => obj::parse_obj(open(mesh_path)?, mesh_path)?,
     };
-    let skeleton = match skeleton_path.extension().and_then(|e| e.to_str()) {
-        Some("json") => marionette::formats::homer::parse_rig(open(skeleton_path)?, skeleton_path)?.skeleton,
-        _ => load_character_skeleton(skeleton_path)?,
-    };
-    let mut world = vec![Mat4::IDENTITY; skeleton.len()];
-    marionette::rig::forward_kinematics(&skeleton, &skeleton.rest_pose(), Mat4::IDENTITY, &mut world);
-    let positions: Vec<glam::Vec3> = world.iter().map(|m| m.w_axis.truncate()).collect();
-    let all = bones(&skeleton, &positions);
-    let weights = if smooth {
-        smooth_bone_weights(&mesh.positions, &all, skeleton.len(), 3, 1.6)
-    } else {
-        nearest_bone_weights(&mesh.positions, &all)
-    };
+    let skeleton = marionette::formats::character::load_skeleton(skeleton_path)?;
+    let weights = bind_to_skeleton(&skeleton, &mesh.positions, if smooth { Binding::Smooth } else { Binding::Nearest });
     write_file(out, |w| mit6837::write_attach(w, &weights, skeleton.len()))?;
     println!(
         "wrote {} ({} vertices, {} joints, {} binding)",
@@ -198,17 +187,6 @@ fn bind(
         if smooth { "smooth" } else { "nearest-bone" }
     );
     Ok(())
-}
-
-/// The skeleton of a `.skel` of either course.
-fn load_character_skeleton(path: &std::path::Path) -> Result<marionette::rig::Skeleton> {
-    let text = std::fs::read_to_string(path).with_context(|| format!("reading {}", path.display()))?;
-    let reader = std::io::Cursor::new(text.clone());
-    Ok(if text.split_whitespace().next().is_some_and(|w| w.starts_with("balljoint")) {
-        marionette::formats::cse169::parse_skel(reader, path)?
-    } else {
-        marionette::formats::mit6837::parse_skel(reader, path)?
-    })
 }
 
 fn smpl(

@@ -8,7 +8,7 @@ use std::path::Path;
 use glam::{Quat, Vec3};
 
 use crate::formats::{mit6837, obj};
-use crate::rig::bind::{bones, smooth_bone_weights};
+use crate::rig::bind::{Binding, bind_to_bones, bones};
 use crate::rig::{RawJoint, Skeleton, SkinWeights};
 
 /// A joint of a design: name, parent name, absolute position, and the radius of the
@@ -93,8 +93,7 @@ fn generate(design: &Design) -> Generated {
     // A pelvis block across the hips.
     add_capsule(&mut positions, &mut triangles, Vec3::new(-0.045, 0.53, 0.0), Vec3::new(0.045, 0.53, 0.0), 0.075);
 
-    let all_bones = bones(&skeleton, &joint_positions);
-    let weights = smooth_bone_weights(&positions, &all_bones, skeleton.len(), 3, 1.6);
+    let weights = bind_to_bones(&positions, &bones(&skeleton, &joint_positions), skeleton.len(), Binding::Smooth);
     Generated { skeleton, positions, triangles, weights }
 }
 

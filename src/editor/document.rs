@@ -42,23 +42,20 @@ pub struct AssetLibrary {
 
 /// A copy of `asset` whose weights come from the distance to its bones at rest.
 pub fn rebind(asset: &CharacterAsset, binding: BindingDoc) -> CharacterAsset {
-    use crate::rig::bind::{bones, nearest_bone_weights, smooth_bone_weights};
-    let s = &asset.skeleton;
-    let mut world = vec![Mat4::IDENTITY; s.len()];
-    crate::rig::forward_kinematics(s, &s.rest_pose(), Mat4::IDENTITY, &mut world);
-    let positions: Vec<Vec3> = world.iter().map(|m| m.w_axis.truncate()).collect();
-    let all = bones(s, &positions);
     let mut out = asset.clone();
-    out.skin.weights = match binding {
-        BindingDoc::Nearest => nearest_bone_weights(&asset.skin.bind_positions, &all),
-        BindingDoc::Smooth => smooth_bone_weights(&asset.skin.bind_positions, &all, s.len(), 3, 1.6),
-    };
+    out.skin.weights = crate::rig::bind::bind_to_skeleton(&asset.skeleton, &asset.skin.bind_positions, binding);
     out.warnings.push(format!("weights computed ({binding:?}) from the bones"));
     out
 }
 
 /// An SMPL model and the clips of its folder.
-pub type SmplSet = (Arc<SmplModel>, Vec<(String, Arc<Clip>)>);
+#[derive(Clone)]
+pub struct SmplSet {
+    pub model: Arc<SmplModel>,
+    pub clips: Vec<(String, Arc<Clip>)>,
+    /// What the loader fixed (normalised weight rows).
+    pub warnings: Vec<String>,
+}
 
 impl AssetLibrary {
     /// The character of `source`, loaded once.
@@ -73,6 +70,14 @@ impl AssetLibrary {
                     Path::new(name),
                     "expected a built-in character (`puppet`), found an unknown name",
                 ));
+            }
+            // An SMPL folder is read once, for the body and for its clips.
+            SourceDoc::File(dir) if crate::formats::smpl::is_smpl_dir(dir) => {
+                let set = self.smpl(dir)?;
+                let name = dir.file_stem().and_then(|s| s.to_str()).unwrap_or("smpl");
+                let mut asset = set.model.asset(name, &[]).map_err(|e| FormatError::rig(dir, e))?;
+                asset.warnings = set.warnings;
+                asset
             }
             SourceDoc::File(path) => load_character(path)?,
         });
@@ -101,7 +106,7 @@ impl AssetLibrary {
         if let Some(set) = self.smpl.get(dir) {
             return Ok(set.clone());
         }
-        let (model, _) = crate::formats::smpl::load_smpl_dir(dir)?;
+        let (model, warnings) = crate::formats::smpl::load_smpl_dir(dir)?;
         let n = model.skeleton.len();
         let clips = crate::formats::smpl::clip_paths(dir)
             .into_iter()
@@ -110,7 +115,7 @@ impl AssetLibrary {
                 Ok((p.file_name().map(|f| f.to_string_lossy().into_owned()).unwrap_or_default(), Arc::new(clip)))
             })
             .collect::<Result<Vec<_>, FormatError>>()?;
-        let set = (Arc::new(model), clips);
+        let set = SmplSet { model: Arc::new(model), clips, warnings };
         self.smpl.insert(dir.to_path_buf(), set.clone());
         Ok(set)
     }
@@ -231,11 +236,6 @@ impl SceneReader<'_, '_> {
             binding: sc.binding,
         }
     }
-
-    /// The entity of a character id.
-    pub fn entity_of(&self, id: u64) -> Option<Entity> {
-        self.characters.iter().find(|c| c.1.id == id).map(|c| c.0)
-    }
 }
 
 /// The pose a document gives a character: the source's pose with the listed joints
@@ -288,8 +288,8 @@ pub fn spawn_from_doc(
     if let SourceDoc::File(dir) = &doc.source
         && crate::formats::smpl::is_smpl_dir(dir)
     {
-        let (model, clips) = library.smpl(dir)?;
-        commands.entity(entity).insert(SmplCharacter::new(model, dir.clone(), clips, doc.smpl.as_ref()));
+        let set = library.smpl(dir)?;
+        commands.entity(entity).insert(SmplCharacter::new(set.model, dir.clone(), set.clips, doc.smpl.as_ref()));
     }
     Ok((entity, messages))
 }

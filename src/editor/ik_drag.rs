@@ -14,7 +14,7 @@ use super::document::SceneCharacter;
 use super::draw::SkeletonGizmos;
 use super::history::History;
 use super::inspector::SceneSnapshot;
-use super::picking::PICK_RADIUS_PX;
+use super::picking::{PICK_RADIUS_PX, nearest_joint_on_screen};
 use crate::posing::{IK_ROUNDS, IK_TOLERANCE};
 use crate::rig::ik::{IkGoal, solve_ik};
 use crate::scene::{Character, CurrentJointToWorld, JointPose, Placement};
@@ -88,7 +88,7 @@ fn start_drag(
     buttons: Res<ButtonInput<MouseButton>>,
     windows: Query<&Window, With<PrimaryWindow>>,
     cameras: Query<(&Camera, &GlobalTransform)>,
-    characters: Query<(&SceneCharacter, &Character, &InheritedVisibility)>,
+    characters: Query<(Entity, &SceneCharacter, &Character, &InheritedVisibility)>,
     joints: Query<&CurrentJointToWorld>,
     pointer: Res<ViewportHasPointer>,
     pins: Res<Pins>,
@@ -101,21 +101,13 @@ fn start_drag(
     }
     let (Ok(window), Ok((camera, camera_transform))) = (windows.single(), cameras.single()) else { return };
     let Some(cursor) = window.cursor_position() else { return };
-    let mut best: Option<(f32, u64, usize, Vec3, &Character)> = None;
-    for (sc, character, visible) in &characters {
-        if !visible.get() {
-            continue;
-        }
-        for (j, &e) in character.joints.iter().enumerate() {
-            let Ok(m) = joints.get(e) else { continue };
-            let Ok(screen) = camera.world_to_viewport(camera_transform, m.position()) else { continue };
-            let d = screen.distance(cursor);
-            if d < PICK_RADIUS_PX * 0.5 && best.as_ref().is_none_or(|b| d < b.0 - 0.5) {
-                best = Some((d, sc.id, j, m.position(), character));
-            }
-        }
-    }
-    let Some((_, id, joint, at, character)) = best else { return };
+    let Some(hit) =
+        nearest_joint_on_screen(camera, camera_transform, cursor, PICK_RADIUS_PX * 0.5, &characters, &joints)
+    else {
+        return;
+    };
+    let (id, joint, at) = (hit.id, hit.joint, hit.position);
+    let Ok((_, _, character, _)) = characters.get(hit.entity) else { return };
     if character.asset.skeleton.parent(joint).is_none() {
         return;
     }

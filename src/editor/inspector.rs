@@ -133,8 +133,7 @@ fn inspector_ui(
         });
     }
     if edited {
-        let before = ops.snapshot.0.clone();
-        edit.history.begin_edit(&before);
+        edit.history.begin_edit(&ops.snapshot.0);
     }
     Ok(())
 }

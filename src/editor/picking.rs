@@ -23,7 +23,7 @@ pub fn pick_joint_on_click(
     keys: Res<ButtonInput<KeyCode>>,
     windows: Query<&Window, With<PrimaryWindow>>,
     cameras: Query<(&Camera, &GlobalTransform)>,
-    characters: Query<(&SceneCharacter, &Character, &InheritedVisibility)>,
+    characters: Query<(Entity, &SceneCharacter, &Character, &InheritedVisibility)>,
     joints: Query<&CurrentJointToWorld>,
     pointer: Res<ViewportHasPointer>,
     mut press: ResMut<PointerPress>,
@@ -46,30 +46,51 @@ pub fn pick_joint_on_click(
     let Ok((camera, camera_transform)) = cameras.single() else {
         return;
     };
-    let mut best: Option<(f32, u64, usize)> = None;
-    for (sc, character, visible) in &characters {
+    let best = nearest_joint_on_screen(camera, camera_transform, cursor, PICK_RADIUS_PX, &characters, &joints);
+    let additive =
+        keys.any_pressed([KeyCode::ShiftLeft, KeyCode::ShiftRight, KeyCode::ControlLeft, KeyCode::ControlRight]);
+    match best {
+        Some(hit) => select_joint(&mut selection, hit.id, hit.joint, additive),
+        None if !additive => selection.joints.clear(),
+        None => {}
+    }
+}
+
+/// A joint found under the cursor.
+#[derive(Debug, Clone, Copy)]
+pub struct JointHit {
+    pub entity: Entity,
+    pub id: u64,
+    pub joint: usize,
+    /// World position.
+    pub position: Vec3,
+}
+
+/// The visible joint nearest to `cursor` on screen, within `radius` pixels; deeper joints
+/// win ties (zero-length bones stack joints on one point).
+pub fn nearest_joint_on_screen(
+    camera: &Camera,
+    camera_transform: &GlobalTransform,
+    cursor: Vec2,
+    radius: f32,
+    characters: &Query<(Entity, &SceneCharacter, &Character, &InheritedVisibility)>,
+    joints: &Query<&CurrentJointToWorld>,
+) -> Option<JointHit> {
+    let mut best: Option<(f32, JointHit)> = None;
+    for (entity, sc, character, visible) in characters {
         if !visible.get() {
             continue;
         }
         for (j, &e) in character.joints.iter().enumerate() {
             let Ok(m) = joints.get(e) else { continue };
-            let Ok(screen) = camera.world_to_viewport(camera_transform, m.position()) else {
-                continue;
-            };
+            let Ok(screen) = camera.world_to_viewport(camera_transform, m.position()) else { continue };
             let d = screen.distance(cursor);
-            // Deeper joints win ties (zero-length bones stack joints on one point).
-            if d < PICK_RADIUS_PX && best.is_none_or(|b| d < b.0 - 0.5) {
-                best = Some((d, sc.id, j));
+            if d < radius && best.is_none_or(|b| d < b.0 - 0.5) {
+                best = Some((d, JointHit { entity, id: sc.id, joint: j, position: m.position() }));
             }
         }
     }
-    let additive =
-        keys.any_pressed([KeyCode::ShiftLeft, KeyCode::ShiftRight, KeyCode::ControlLeft, KeyCode::ControlRight]);
-    match best {
-        Some((_, id, j)) => select_joint(&mut selection, id, j, additive),
-        None if !additive => selection.joints.clear(),
-        None => {}
-    }
+    best.map(|b| b.1)
 }
 
 /// Selects joint `j` of character `id`; `additive` toggles it within the selection.

@@ -64,6 +64,16 @@ fn is_cse169_skel(path: &Path) -> Result<bool, FormatError> {
     Ok(text.split_whitespace().next().is_some_and(|w| w.starts_with("balljoint")))
 }
 
+/// The skeleton alone of a `.skel` of either course or of a Homer rig `.json`.
+pub fn load_skeleton(path: &Path) -> Result<Skeleton, FormatError> {
+    match CharacterSource::detect(path)? {
+        CharacterSource::Cse169 { skel } => cse169::parse_skel(open(&skel)?, &skel),
+        CharacterSource::Mit6837 { skel, .. } => mit6837::parse_skel(open(&skel)?, &skel),
+        CharacterSource::Homer { json } => Ok(super::homer::parse_rig(open(&json)?, &json)?.skeleton),
+        CharacterSource::Smpl { dir } => Ok(super::smpl::load_smpl_dir(&dir)?.0.skeleton),
+    }
+}
+
 /// Loads whatever character `path` names.
 pub fn load_character(path: &Path) -> Result<CharacterAsset, FormatError> {
     let name = path.file_stem().and_then(|s| s.to_str()).unwrap_or("character").to_string();

@@ -39,14 +39,6 @@ impl FormatError {
     pub fn other(path: &Path, message: impl fmt::Display) -> Self {
         Self::Other { path: path.to_path_buf(), message: message.to_string() }
     }
-
-    /// The line the error is on, when it has one.
-    pub fn line(&self) -> Option<usize> {
-        match self {
-            Self::Syntax { line, .. } => Some(*line),
-            _ => None,
-        }
-    }
 }
 
 /// Opens a file for buffered reading, with the path in the error.
@@ -60,21 +52,6 @@ pub fn read_lines(mut reader: impl std::io::BufRead, path: &Path) -> Result<Vec<
     reader.read_to_string(&mut text).map_err(|e| FormatError::io(path, e))?;
     let text = text.replace("\r\n", "\n").replace('\r', "\n");
     Ok(text.lines().enumerate().map(|(i, l)| (i + 1, l.to_string())).collect())
-}
-
-/// Parses whitespace-separated numbers of one line, `expected` of them (or at least
-/// `expected` when `at_least`), or says `path:line: expected N numbers, found M`.
-pub fn parse_numbers<T: std::str::FromStr>(
-    line: &str,
-    path: &Path,
-    line_no: usize,
-    expected: usize,
-) -> Result<Vec<T>, FormatError> {
-    let tokens: Vec<&str> = line.split_whitespace().collect();
-    if tokens.len() != expected {
-        return Err(FormatError::syntax(path, line_no, format!("expected {expected} numbers, found {}", tokens.len())));
-    }
-    tokens.iter().map(|t| parse_number(t, path, line_no)).collect()
 }
 
 /// One number, or `path:line: expected a number, found "tok"`.

@@ -12,7 +12,7 @@ use serde::Deserialize;
 
 use super::error::{FormatError, open};
 use super::off::parse_off;
-use crate::rig::bind::{bones, smooth_bone_weights};
+use crate::rig::bind::{Binding, bind_to_bones, bones};
 use crate::rig::{CharacterAsset, RawJoint, Skeleton, Skin, SkinWeights};
 
 #[derive(Debug, Deserialize)]
@@ -127,7 +127,7 @@ pub fn load_homer(path: &Path) -> Result<CharacterAsset, FormatError> {
                 "{}: no weights in the rig; bound smoothly from the distance to the bones",
                 path.display()
             ));
-            smooth_bone_weights(&mesh.positions, &bones(&rig.skeleton, &rig.positions), rig.skeleton.len(), 3, 1.6)
+            bind_to_bones(&mesh.positions, &bones(&rig.skeleton, &rig.positions), rig.skeleton.len(), Binding::Smooth)
         }
     };
     let name = path.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_else(|| "homer".into());

@@ -166,14 +166,8 @@ pub struct CharacterDoc {
     pub binding: Option<BindingDoc>,
 }
 
-/// How to bind a skin from its skeleton's bones.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
-pub enum BindingDoc {
-    /// Each vertex rigidly to its nearest bone.
-    Nearest,
-    /// The nearest few bones, falling off with distance.
-    Smooth,
-}
+/// How to bind a skin from its skeleton's bones (stored as `Nearest` or `Smooth`).
+pub use crate::rig::bind::Binding as BindingDoc;
 
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct CameraDoc {

@@ -1,6 +1,6 @@
 //! Skin binding from geometry: weights from each vertex's distance to the bones.
 
-use glam::Vec3;
+use glam::{Mat4, Vec3};
 
 use super::skeleton::Skeleton;
 use super::skinning::SkinWeights;
@@ -102,4 +102,32 @@ pub fn bone_frame(a: Vec3, b: Vec3, parent_direction: Option<Vec3>) -> glam::Mat
         .unwrap_or(Vec3::X);
     let u = v.cross(w);
     glam::Mat4::from_cols(u.extend(0.0), v.extend(0.0), w.extend(0.0), ((a + b) / 2.0).extend(1.0))
+}
+
+/// How a skin is bound from its skeleton's bones.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize)]
+pub enum Binding {
+    /// Each vertex rigidly to its nearest bone.
+    Nearest,
+    /// The nearest few bones, falling off with distance.
+    Smooth,
+}
+
+/// Bones blended by the smooth binding, and how much farther than the nearest a bone may be.
+pub const SMOOTH_MAX_BONES: usize = 3;
+pub const SMOOTH_FALLOFF: f32 = 1.6;
+
+/// Weights for `vertices` (model space) from the bones of `skeleton` at its rest pose.
+pub fn bind_to_skeleton(skeleton: &Skeleton, vertices: &[Vec3], binding: Binding) -> SkinWeights {
+    let mut world = vec![Mat4::IDENTITY; skeleton.len()];
+    super::fk::forward_kinematics(skeleton, &skeleton.rest_pose(), Mat4::IDENTITY, &mut world);
+    bind_to_bones(vertices, &bones(skeleton, &super::fk::joint_positions(&world)), skeleton.len(), binding)
+}
+
+/// Weights for `vertices` from given bones (when the joint positions are known exactly).
+pub fn bind_to_bones(vertices: &[Vec3], bones: &[Bone], joint_count: usize, binding: Binding) -> SkinWeights {
+    match binding {
+        Binding::Nearest => nearest_bone_weights(vertices, bones),
+        Binding::Smooth => smooth_bone_weights(vertices, bones, joint_count, SMOOTH_MAX_BONES, SMOOTH_FALLOFF),
+    }
 }

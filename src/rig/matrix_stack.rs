@@ -40,8 +40,4 @@ impl MatrixStack {
     pub fn depth(&self) -> usize {
         self.stack.len()
     }
-
-    pub fn clear(&mut self) {
-        self.stack.clear();
-    }
 }

@@ -71,50 +71,8 @@ impl Skeleton {
     /// (depth-first, children in file order). Returns the skeleton and, for each raw index,
     /// its new index.
     pub fn build_reordered(raw: Vec<RawJoint>) -> Result<(Self, Vec<usize>), RigError> {
-        let n = raw.len();
-        if n == 0 {
-            return Err(RigError::EmptySkeleton);
-        }
-        for (i, j) in raw.iter().enumerate() {
-            if let Some(p) = j.parent {
-                if p >= n {
-                    return Err(RigError::ParentOutOfRange { joint: i, parent: p, count: n });
-                }
-                if p == i {
-                    return Err(RigError::Cycle { joint: j.name.clone() });
-                }
-            }
-        }
-        let roots: Vec<usize> = (0..n).filter(|&i| raw[i].parent.is_none()).collect();
-        match roots.len() {
-            0 => {
-                return Err(RigError::Cycle { joint: raw[0].name.clone() });
-            }
-            1 => {}
-            _ => {
-                return Err(RigError::SeveralRoots { roots: roots.iter().map(|&r| raw[r].name.clone()).collect() });
-            }
-        }
-        let mut raw_children = vec![Vec::new(); n];
-        for (i, j) in raw.iter().enumerate() {
-            if let Some(p) = j.parent {
-                raw_children[p].push(i);
-            }
-        }
-        // Depth-first order from the root; joints never reached sit on a cycle.
-        let mut order = Vec::with_capacity(n);
-        let mut todo = vec![roots[0]];
-        while let Some(j) = todo.pop() {
-            order.push(j);
-            todo.extend(raw_children[j].iter().rev());
-        }
-        if order.len() != n {
-            let mut reached = vec![false; n];
-            order.iter().for_each(|&j| reached[j] = true);
-            let lost = (0..n).find(|&j| !reached[j]).unwrap_or(0);
-            return Err(RigError::Cycle { joint: raw[lost].name.clone() });
-        }
-        let mut new_index = vec![0; n];
+        let order = depth_first_order(&raw)?;
+        let mut new_index = vec![0; raw.len()];
         for (new, &old) in order.iter().enumerate() {
             new_index[old] = new;
         }
@@ -123,14 +81,7 @@ impl Skeleton {
             .iter()
             .map(|&old| {
                 let j = raw[old].take().expect("each joint is visited once");
-                JointDef {
-                    initial_rotation: j.initial_rotation.clamped(&j.limits),
-                    name: j.name,
-                    parent: j.parent.map(|p| new_index[p]),
-                    rest_offset: j.rest_offset,
-                    limits: j.limits,
-                    bone_box: j.bone_box,
-                }
+                joint_def(j, |p| new_index[p])
             })
             .collect();
         Ok((Self::from_ordered(joints), new_index))
@@ -139,32 +90,13 @@ impl Skeleton {
     /// Validates a raw joint list whose parents already precede their children and keeps
     /// its order (file indices stay joint indices, as weight files expect).
     pub fn build(raw: Vec<RawJoint>) -> Result<Self, RigError> {
-        let n = raw.len();
-        for (i, j) in raw.iter().enumerate() {
-            if let Some(p) = j.parent
-                && p >= i
-                && p < n
-            {
-                // A forward reference: a cycle, or an order only `build_reordered` accepts.
-                Self::build_reordered(raw.clone())?;
-                return Err(RigError::NotParentFirst { joint: j.name.clone(), index: i, parent: p });
-            }
+        // Roots, ranges and cycles first, so a forward reference on a cycle says "cycle".
+        depth_first_order(&raw)?;
+        if let Some((i, j)) = raw.iter().enumerate().find(|(i, j)| j.parent.is_some_and(|p| p >= *i)) {
+            let parent = j.parent.expect("found by its parent");
+            return Err(RigError::NotParentFirst { joint: j.name.clone(), index: i, parent });
         }
-        // Validates roots and ranges; with parents first, the depth-first order found there
-        // is only used for checking, the file order is kept.
-        Self::build_reordered(raw.clone())?;
-        let joints = raw
-            .into_iter()
-            .map(|j| JointDef {
-                initial_rotation: j.initial_rotation.clamped(&j.limits),
-                name: j.name,
-                parent: j.parent,
-                rest_offset: j.rest_offset,
-                limits: j.limits,
-                bone_box: j.bone_box,
-            })
-            .collect();
-        Ok(Self::from_ordered(joints))
+        Ok(Self::from_ordered(raw.into_iter().map(|j| joint_def(j, |p| p)).collect()))
     }
 
     fn from_ordered(joints: Vec<JointDef>) -> Self {
@@ -227,4 +159,61 @@ impl Skeleton {
             j.rest_offset = o;
         }
     }
+}
+
+/// A validated joint, its parent index mapped by `parent_index`; the pose clamped.
+fn joint_def(j: RawJoint, parent_index: impl Fn(usize) -> usize) -> JointDef {
+    JointDef {
+        initial_rotation: j.initial_rotation.clamped(&j.limits),
+        name: j.name,
+        parent: j.parent.map(parent_index),
+        rest_offset: j.rest_offset,
+        limits: j.limits,
+        bone_box: j.bone_box,
+    }
+}
+
+/// Checks a raw tree (joints present, parents in range, one root, no cycles) and returns
+/// its depth-first order from the root, children in file order.
+fn depth_first_order(raw: &[RawJoint]) -> Result<Vec<usize>, RigError> {
+    let n = raw.len();
+    if n == 0 {
+        return Err(RigError::EmptySkeleton);
+    }
+    for (i, j) in raw.iter().enumerate() {
+        if let Some(p) = j.parent {
+            if p >= n {
+                return Err(RigError::ParentOutOfRange { joint: i, parent: p, count: n });
+            }
+            if p == i {
+                return Err(RigError::Cycle { joint: j.name.clone() });
+            }
+        }
+    }
+    let roots: Vec<usize> = (0..n).filter(|&i| raw[i].parent.is_none()).collect();
+    match roots.len() {
+        0 => return Err(RigError::Cycle { joint: raw[0].name.clone() }),
+        1 => {}
+        _ => return Err(RigError::SeveralRoots { roots: roots.iter().map(|&r| raw[r].name.clone()).collect() }),
+    }
+    let mut children = vec![Vec::new(); n];
+    for (i, j) in raw.iter().enumerate() {
+        if let Some(p) = j.parent {
+            children[p].push(i);
+        }
+    }
+    // Joints never reached from the root sit on a cycle.
+    let mut order = Vec::with_capacity(n);
+    let mut todo = vec![roots[0]];
+    while let Some(j) = todo.pop() {
+        order.push(j);
+        todo.extend(children[j].iter().rev());
+    }
+    if order.len() != n {
+        let mut reached = vec![false; n];
+        order.iter().for_each(|&j| reached[j] = true);
+        let lost = (0..n).find(|&j| !reached[j]).unwrap_or(0);
+        return Err(RigError::Cycle { joint: raw[lost].name.clone() });
+    }
+    Ok(order)
 }
