@@ -10,6 +10,9 @@ use glam::Mat4;
 use marionette::formats::{load_character, obj};
 use marionette::posing::{IkSpec, PoseSpec, apply_ik_specs, apply_pose_specs, describe, describe_ik, posed_positions};
 
+/// The largest picture side `render` accepts (the texture limit of common GPUs).
+const MAX_PICTURE_SIDE: i64 = 8192;
+
 #[derive(Parser)]
 #[command(name = "marionette", version, about = "Build scenes of skinned characters: load, pose, see and export them.")]
 struct Cli {
@@ -60,9 +63,9 @@ enum Command {
         paths: Vec<PathBuf>,
         #[arg(long)]
         out: PathBuf,
-        #[arg(long, default_value_t = 1280)]
+        #[arg(long, default_value_t = 1280, value_parser = clap::value_parser!(u32).range(1..=MAX_PICTURE_SIDE))]
         width: u32,
-        #[arg(long, default_value_t = 720)]
+        #[arg(long, default_value_t = 720, value_parser = clap::value_parser!(u32).range(1..=MAX_PICTURE_SIDE))]
         height: u32,
         /// `JOINT=rx,ry,rz` applied to every character that has the joint. Repeatable.
         #[arg(long = "pose", value_name = "JOINT=rx,ry,rz")]

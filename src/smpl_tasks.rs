@@ -19,8 +19,11 @@ use crate::rig::smpl::{BlendMode, Clip, SmplModel, blend_rotation};
 use crate::rig::{JointRotation, Skeleton};
 
 /// β(1) and β(2) of the exercise (β(0) is all zeros).
+// The exercise's printed digits, kept as printed (f32 rounds the last one).
+#[allow(clippy::excessive_precision)]
 pub const BETA1: [f32; 10] =
     [-1.711935, 2.352964, 2.285835, -0.073122, 1.501402, -1.790568, -0.391194, 2.078678, 1.461037, 2.297462];
+#[allow(clippy::excessive_precision)]
 pub const BETA2: [f32; 10] =
     [1.573618, 2.028960, -1.865066, 2.066879, 0.661796, -2.012298, -1.107509, 0.234408, 2.287534, 2.324443];
 
@@ -203,9 +206,9 @@ pub fn parse_sequence(spec: &str) -> Result<Vec<Segment>, String> {
                 Some(list) => {
                     let v: Vec<f32> = list
                         .split('/')
-                        .map(|x| x.parse::<f32>())
-                        .collect::<Result<_, _>>()
-                        .map_err(|_| bad("BETA is 0, 1, 2 or ten numbers joined by /"))?;
+                        .map(|x| x.parse::<f32>().ok().filter(|b| b.is_finite()))
+                        .collect::<Option<_>>()
+                        .ok_or_else(|| bad("BETA is 0, 1, 2 or ten finite numbers joined by /"))?;
                     let mut b = [0.0; 10];
                     if v.len() > 10 {
                         return Err(bad("more than ten betas"));

@@ -99,3 +99,45 @@ pub fn track_egui_pointer(
         pointer.0 = !egui_wants;
     }
 }
+
+/// The cursor in the camera's viewport (logical pixels from its top-left corner), as
+/// `Camera::viewport_to_world` and `world_to_viewport` expect; `None` outside the window.
+pub fn cursor_in_viewport(window: &Window, camera: &Camera) -> Option<Vec2> {
+    let cursor = window.cursor_position()?;
+    let origin = camera.logical_viewport_rect().map_or(Vec2::ZERO, |r| r.min);
+    Some(cursor - origin)
+}
+
+/// The part of the window between the side panels (logical pixels), set by the inspector;
+/// `None` leaves the camera on the whole window.
+#[derive(Resource, Clone, Copy, Debug, Default, PartialEq)]
+pub struct ViewportArea(pub Option<Rect>);
+
+/// Gives the window's camera the area between the panels as its viewport, so the view is
+/// centred (and F frames) in the visible middle (reads `ViewportArea`, the window; writes
+/// `Camera::viewport`).
+pub fn fit_camera_viewport(
+    area: Res<ViewportArea>,
+    windows: Query<&Window, With<bevy::window::PrimaryWindow>>,
+    mut cameras: Query<&mut Camera, With<OrbitCamera>>,
+) {
+    let Ok(window) = windows.single() else { return };
+    let viewport = area.0.and_then(|rect| {
+        let scale = window.scale_factor();
+        let size = window.physical_size().as_vec2();
+        let min = (rect.min * scale).round().clamp(Vec2::ZERO, size);
+        let max = (rect.max * scale).round().clamp(Vec2::ZERO, size);
+        (max.x - min.x >= 1.0 && max.y - min.y >= 1.0).then(|| bevy::camera::Viewport {
+            physical_position: min.as_uvec2(),
+            physical_size: (max - min).as_uvec2(),
+            ..default()
+        })
+    });
+    for mut camera in &mut cameras {
+        if camera.viewport.as_ref().map(|v| (v.physical_position, v.physical_size))
+            != viewport.as_ref().map(|v| (v.physical_position, v.physical_size))
+        {
+            camera.viewport = viewport.clone();
+        }
+    }
+}

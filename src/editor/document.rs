@@ -161,6 +161,7 @@ pub struct SceneReader<'w, 's> {
     pub poses: Query<'w, 's, &'static JointPose>,
     pub cameras: Query<'w, 's, &'static OrbitCamera>,
     pub stage: Res<'w, StageSettings>,
+    pub unloaded: Res<'w, super::UnloadedCharacters>,
 }
 
 impl SceneReader<'_, '_> {
@@ -177,7 +178,8 @@ impl SceneReader<'_, '_> {
             .collect();
         characters.sort_by_key(|(id, _)| *id);
         SceneDoc {
-            characters: characters.into_iter().map(|(_, d)| d).collect(),
+            // Characters that failed to load stay in the document as they were.
+            characters: characters.into_iter().map(|(_, d)| d).chain(self.unloaded.0.iter().cloned()).collect(),
             camera: self.cameras.iter().next().map(|o| CameraDoc {
                 focus: o.focus.to_array(),
                 yaw: o.yaw,
@@ -360,8 +362,8 @@ pub fn startup_doc(paths: &[PathBuf], library: &mut AssetLibrary, messages: &mut
     if paths.is_empty() {
         return Some(default_scene_doc());
     }
-    if paths.len() == 1 && paths[0].extension().is_some_and(|e| e == "ron") {
-        return match read_scene(&paths[0]) {
+    if let Some(scene) = scene_path(paths) {
+        return match read_scene(scene) {
             Ok(doc) => Some(doc),
             Err(e) => {
                 messages.push(e.to_string());
@@ -370,6 +372,14 @@ pub fn startup_doc(paths: &[PathBuf], library: &mut AssetLibrary, messages: &mut
         };
     }
     Some(doc_side_by_side(library, paths.iter().map(|p| SourceDoc::File(p.clone())).collect(), messages))
+}
+
+/// The scene file among startup paths: a single `.ron`.
+pub fn scene_path(paths: &[PathBuf]) -> Option<&Path> {
+    match paths {
+        [one] if one.extension().is_some_and(|e| e == "ron") => Some(one),
+        _ => None,
+    }
 }
 
 /// Reads a scene file and resolves its sources against its folder.

@@ -15,6 +15,10 @@ pub struct History {
     pub editing: bool,
     /// Requests from keys or buttons, served by `apply_history_requests`.
     pub request: Option<HistoryRequest>,
+    /// The redo steps a gesture cleared, given back if it turns out to change nothing.
+    redo_before_gesture: Vec<SceneDoc>,
+    /// Whether this gesture pushed an undo step.
+    pushed: bool,
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -33,18 +37,27 @@ impl History {
             return;
         }
         self.editing = true;
-        if self.undo.last() != Some(before) {
+        self.pushed = self.undo.last() != Some(before);
+        if self.pushed {
             self.undo.push(before.clone());
             if self.undo.len() > HISTORY_DEPTH {
                 self.undo.remove(0);
             }
         }
-        self.redo.clear();
+        self.redo_before_gesture = std::mem::take(&mut self.redo);
     }
 
-    /// Ends the gesture (no button held any more).
-    pub fn end_gesture(&mut self) {
+    /// Ends the gesture (no button held any more). A gesture that left the scene as it
+    /// was (a click that only selected) is no undo step: its entry is dropped and the redo
+    /// steps come back.
+    pub fn end_gesture(&mut self, now: &SceneDoc) {
         self.editing = false;
+        if self.pushed && self.undo.last() == Some(now) {
+            self.undo.pop();
+            self.redo = std::mem::take(&mut self.redo_before_gesture);
+        }
+        self.pushed = false;
+        self.redo_before_gesture.clear();
     }
 
     /// The state to restore for undo, given the current one.
@@ -69,10 +82,11 @@ impl Plugin for HistoryPlugin {
     }
 }
 
-/// Ends an edit gesture when no mouse button is held (reads input; writes `History`).
-fn end_gestures(buttons: Res<ButtonInput<MouseButton>>, mut history: ResMut<History>) {
+/// Ends an edit gesture when no mouse button is held (reads input and the scene; writes
+/// `History`).
+fn end_gestures(buttons: Res<ButtonInput<MouseButton>>, reader: SceneReader, mut history: ResMut<History>) {
     if history.editing && !buttons.get_pressed().any(|_| true) {
-        history.end_gesture();
+        history.end_gesture(&reader.capture());
     }
 }
 

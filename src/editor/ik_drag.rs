@@ -100,7 +100,7 @@ fn start_drag(
         return;
     }
     let (Ok(window), Ok((camera, camera_transform))) = (windows.single(), cameras.single()) else { return };
-    let Some(cursor) = window.cursor_position() else { return };
+    let Some(cursor) = super::camera::cursor_in_viewport(window, camera) else { return };
     let Some(hit) =
         nearest_joint_on_screen(camera, camera_transform, cursor, PICK_RADIUS_PX * 0.5, &characters, &joints)
     else {
@@ -114,7 +114,7 @@ fn start_drag(
     let pins = pins.0.get(&id).map_or(Vec::new(), |list| {
         list.iter()
             .filter(|&&p| p != joint)
-            .filter_map(|&p| joints.get(character.joints[p]).ok().map(|m| (p, m.position())))
+            .filter_map(|&p| Some((p, joints.get(*character.joints.get(p)?).ok()?.position())))
             .collect()
     });
     if let Some(s) = snapshot {
@@ -142,7 +142,7 @@ fn drag_joint(
         return;
     }
     let (Ok(window), Ok((camera, camera_transform))) = (windows.single(), cameras.single()) else { return };
-    let Some(cursor) = window.cursor_position() else { return };
+    let Some(cursor) = super::camera::cursor_in_viewport(window, camera) else { return };
     let Ok(ray) = camera.viewport_to_world(camera_transform, cursor) else { return };
     let denom = ray.direction.dot(active.plane_normal);
     if denom.abs() < 1e-6 {

@@ -8,7 +8,7 @@ use bevy::ecs::system::SystemParam;
 use bevy::prelude::*;
 use bevy_egui::{EguiContexts, EguiPrimaryContextPass, egui};
 
-use super::camera::OrbitCamera;
+use super::camera::{OrbitCamera, ViewportArea, fit_camera_viewport};
 use super::document::{
     AssetLibrary, NextCharacterId, PendingScene, SceneCharacter, SceneReader, read_scene, spawn_from_doc, write_scene,
 };
@@ -53,6 +53,8 @@ pub struct InspectorPlugin;
 impl Plugin for InspectorPlugin {
     fn build(&self, app: &mut App) {
         app.init_resource::<InspectorState>()
+            .init_resource::<ViewportArea>()
+            .add_systems(PostUpdate, fit_camera_viewport)
             .init_resource::<SceneSnapshot>()
             .add_systems(Update, capture_snapshot.before(shortcuts))
             .add_systems(EguiPrimaryContextPass, inspector_ui);
@@ -105,8 +107,11 @@ fn inspector_ui(
     mut edit: Editable,
     mut ops: SceneOps,
     mut shot: ResMut<ScreenshotRequest>,
+    mut viewport_area: ResMut<ViewportArea>,
 ) -> Result {
     if shot.hide_ui() {
+        // A screenshot without panels shows the whole window.
+        viewport_area.set_if_neq(ViewportArea(None));
         return Ok(());
     }
     let ctx = contexts.ctx_mut()?.clone();
@@ -127,6 +132,9 @@ fn inspector_ui(
             edited |= joint_panel(ui, &mut state, &mut edit);
         });
     });
+    let central = ui.available_rect_before_wrap();
+    let area = ViewportArea(Some(Rect::new(central.min.x, central.min.y, central.max.x, central.max.y)));
+    viewport_area.set_if_neq(area);
     if let Some(text) = &state.active_dof {
         egui::Area::new("active_dof".into()).anchor(egui::Align2::CENTER_TOP, [0.0, 12.0]).show(&ctx, |ui| {
             egui::Frame::popup(ui.style()).show(ui, |ui| ui.label(egui::RichText::new(text).size(20.0).strong()));
@@ -294,8 +302,8 @@ fn scene_panel(
             edited = true;
         }
     }
-    if let Some(entity) = remove {
-        ops.commands.entity(entity).despawn();
+    if let Some((entity, character)) = remove.and_then(|e| Some((e, edit.characters.get(e).ok()?.2.clone()))) {
+        crate::scene::despawn_character(&mut ops.commands, entity, &character);
         edit.selection.character = None;
         edit.selection.joints.clear();
         edited = true;
@@ -441,7 +449,7 @@ fn joint_panel(ui: &mut egui::Ui, state: &mut InspectorState, edit: &mut Editabl
     ui.separator();
     let selected = edit.selection.joints.clone();
     for &j in &selected {
-        let Ok((mut pose, limits)) = edit.poses.get_mut(character.joints[j]) else {
+        let Some(Ok((mut pose, limits))) = character.joints.get(j).map(|&e| edit.poses.get_mut(e)) else {
             continue;
         };
         let name = &skeleton.joint(j).name;
@@ -482,33 +490,34 @@ fn joint_panel(ui: &mut egui::Ui, state: &mut InspectorState, edit: &mut Editabl
     edited
 }
 
-/// The joint tree, collapsible by name; a click selects, Shift/Ctrl-click adds.
-fn joint_tree(ui: &mut egui::Ui, skeleton: &Skeleton, j: usize, id: u64, selection: &mut Selection, additive: bool) {
-    let is_selected = selection.character == Some(id) && selection.joints.contains(&j);
-    let label = format!("{} ({j})", skeleton.joint(j).name);
-    let children = skeleton.children(j);
-    if children.is_empty() {
-        if ui.selectable_label(is_selected, label).clicked() {
-            super::picking::select_joint(selection, id, j, additive);
-        }
-        return;
-    }
-    let state = egui::collapsing_header::CollapsingState::load_with_default_open(
-        ui.ctx(),
-        ui.make_persistent_id(("joint", id, j)),
-        true,
-    );
-    state
-        .show_header(ui, |ui| {
+/// Indentation of one tree level, and the deepest level indented further.
+const TREE_INDENT: f32 = 12.0;
+const TREE_MAX_INDENT_LEVELS: usize = 24;
+
+/// The joint tree as indented rows, collapsible per joint (▸/▾); a click selects,
+/// Shift/Ctrl-click adds. Walked with an explicit stack, so any depth shows.
+fn joint_tree(ui: &mut egui::Ui, skeleton: &Skeleton, root: usize, id: u64, selection: &mut Selection, additive: bool) {
+    let mut todo = vec![(root, 0usize)];
+    while let Some((j, depth)) = todo.pop() {
+        let children = skeleton.children(j);
+        let key = ui.make_persistent_id(("joint-collapsed", id, j));
+        let mut collapsed = ui.data(|d| d.get_temp::<bool>(key)).unwrap_or(false);
+        ui.horizontal(|ui| {
+            ui.add_space(TREE_INDENT * depth.min(TREE_MAX_INDENT_LEVELS) as f32);
+            if !children.is_empty() && ui.small_button(if collapsed { "▸" } else { "▾" }).clicked() {
+                collapsed = !collapsed;
+                ui.data_mut(|d| d.insert_temp(key, collapsed));
+            }
+            let is_selected = selection.character == Some(id) && selection.joints.contains(&j);
+            let label = format!("{} ({j})", skeleton.joint(j).name);
             if ui.selectable_label(is_selected, label).clicked() {
                 super::picking::select_joint(selection, id, j, additive);
             }
-        })
-        .body(|ui| {
-            for &c in children {
-                joint_tree(ui, skeleton, c, id, selection, additive);
-            }
         });
+        if !collapsed {
+            todo.extend(children.iter().rev().map(|&c| (c, depth + 1)));
+        }
+    }
 }
 
 /// Keyboard shortcuts in the viewport: S display mode, A axes, F frame selection,
@@ -575,7 +584,7 @@ pub fn shortcuts(
                 };
                 chosen
                     .into_iter()
-                    .filter_map(|j| joints.get(character.joints[j]).ok().map(|m| m.position()))
+                    .filter_map(|j| Some(joints.get(*character.joints.get(j)?).ok()?.position()))
                     .collect::<Vec<_>>()
             })
             .collect();

@@ -14,6 +14,7 @@ pub mod history;
 pub mod ik_drag;
 pub mod inspector;
 pub mod picking;
+pub mod readiness;
 pub mod render;
 pub mod screenshot;
 pub mod smpl;
@@ -76,10 +77,11 @@ impl Plugin for ViewPlugin {
             .init_resource::<StartupPaths>()
             .init_resource::<StartupEdits>()
             .init_resource::<Selection>()
+            .init_resource::<UnloadedCharacters>()
             .init_resource::<AssetLibrary>()
             .init_resource::<PendingScene>()
             .init_resource::<NextCharacterId>()
-            .add_plugins(smpl::SmplEditorPlugin)
+            .add_plugins((smpl::SmplEditorPlugin, readiness::ReadinessPlugin))
             .add_systems(Startup, (setup_skin_material, spawn_stage, queue_startup_scene).chain())
             .add_systems(
                 PostUpdate,
@@ -218,14 +220,20 @@ pub fn apply_pending_scene(
     mut ids: ResMut<NextCharacterId>,
     mut messages: ResMut<Messages>,
     mut stage: ResMut<StageSettings>,
-    existing: Query<Entity, With<SceneCharacter>>,
+    existing: Query<(Entity, &Character), With<SceneCharacter>>,
     mut cameras: Query<&mut OrbitCamera>,
+    mut reset: SceneReset,
 ) {
     let Some(doc) = pending.doc.take() else {
         return;
     };
-    for e in &existing {
-        commands.entity(e).despawn();
+    if pending.with_camera {
+        // A new scene (Open, startup): nothing selected, pinned or undoable refers to it.
+        reset.clear();
+    }
+    reset.unloaded.0.clear();
+    for (e, character) in &existing {
+        crate::scene::despawn_character(&mut commands, e, character);
     }
     let (mut lo, mut hi) = (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY));
     for (k, c) in doc.characters.iter().enumerate() {
@@ -247,7 +255,10 @@ pub fn apply_pending_scene(
                     }
                 }
             }
-            Err(e) => messages.push(e.to_string()),
+            Err(e) => {
+                messages.push(format!("{e} (`{}` is kept in the scene file as it was)", c.name));
+                reset.unloaded.0.push(c.clone());
+            }
         }
     }
     ids.0 = ids.0.max(doc.characters.len() as u64);
@@ -260,6 +271,33 @@ pub fn apply_pending_scene(
             } else if pending.frame && lo.x <= hi.x {
                 *orbit = OrbitCamera::framing(lo, hi);
             }
+        }
+    }
+}
+
+/// Characters of the current scene that failed to load: kept as their documents were, so
+/// saving writes them back unchanged.
+#[derive(Resource, Clone, Debug, Default)]
+pub struct UnloadedCharacters(pub Vec<crate::formats::scene::CharacterDoc>);
+
+/// What a newly opened scene resets: the selection, the pins, the history, the characters
+/// that did not load.
+#[derive(bevy::ecs::system::SystemParam)]
+pub struct SceneReset<'w> {
+    selection: ResMut<'w, Selection>,
+    pins: Option<ResMut<'w, ik_drag::Pins>>,
+    history: Option<ResMut<'w, history::History>>,
+    unloaded: ResMut<'w, UnloadedCharacters>,
+}
+
+impl SceneReset<'_> {
+    fn clear(&mut self) {
+        *self.selection = Selection::default();
+        if let Some(pins) = &mut self.pins {
+            pins.0.clear();
+        }
+        if let Some(history) = &mut self.history {
+            **history = history::History::default();
         }
     }
 }

@@ -4,7 +4,7 @@ use bevy::prelude::*;
 use bevy::window::PrimaryWindow;
 
 use super::Selection;
-use super::camera::ViewportHasPointer;
+use super::camera::{ViewportHasPointer, cursor_in_viewport};
 use super::document::SceneCharacter;
 use crate::scene::{Character, CurrentJointToWorld};
 
@@ -18,6 +18,7 @@ pub const PICK_RADIUS_PX: f32 = 40.0;
 /// On a left click (press and release within a few pixels) in the viewport, selects the
 /// visible joint nearest to the cursor on screen; Shift or Ctrl adds to the selection
 /// (reads input, joint matrices; writes `Selection`).
+#[allow(clippy::too_many_arguments)]
 pub fn pick_joint_on_click(
     buttons: Res<ButtonInput<MouseButton>>,
     keys: Res<ButtonInput<KeyCode>>,
@@ -29,8 +30,8 @@ pub fn pick_joint_on_click(
     mut press: ResMut<PointerPress>,
     mut selection: ResMut<Selection>,
 ) {
-    let Ok(window) = windows.single() else { return };
-    let cursor = window.cursor_position();
+    let (Ok(window), Ok((camera, camera_transform))) = (windows.single(), cameras.single()) else { return };
+    let cursor = cursor_in_viewport(window, camera);
     if buttons.just_pressed(MouseButton::Left) {
         press.0 = cursor.filter(|_| pointer.0);
     }
@@ -43,9 +44,6 @@ pub fn pick_joint_on_click(
     if start.distance(cursor) > 4.0 {
         return;
     }
-    let Ok((camera, camera_transform)) = cameras.single() else {
-        return;
-    };
     let best = nearest_joint_on_screen(camera, camera_transform, cursor, PICK_RADIUS_PX, &characters, &joints);
     let additive =
         keys.any_pressed([KeyCode::ShiftLeft, KeyCode::ShiftRight, KeyCode::ControlLeft, KeyCode::ControlRight]);

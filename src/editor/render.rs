@@ -14,26 +14,24 @@ use bevy::window::ExitCondition;
 use bevy::winit::WinitPlugin;
 
 use super::camera::OrbitCamera;
+use super::document::{AssetLibrary, read_scene, scene_path};
+use super::readiness::CaptureGate;
 use super::{Messages, StartupPaths, ViewPlugin, stage};
+use crate::formats::scene::{BindingDoc, SourceDoc};
 use crate::scene::{RigCorePlugin, SkinningPlugin};
 
-/// Frames rendered before the first capture.
-const WARMUP_FRAMES: u32 = 4;
-/// Seconds after which the render gives up.
+/// Seconds after which the render gives up, saying what was still pending.
 const GIVE_UP_SECONDS: u64 = 300;
 
-/// The render in progress. Pipelines compile asynchronously over the first frames, so the
-/// scene is captured again and again until two captures in a row are identical; that one
-/// is saved.
+/// The render in progress: it waits for [`CaptureGate`] (every pipeline compiled, every
+/// mesh on the GPU, every character skinned), then captures once and saves.
 #[derive(Resource)]
 struct RenderJob {
     out: PathBuf,
     target: Handle<Image>,
-    frames: u32,
     started: std::time::Instant,
-    /// A capture is under way.
-    waiting: bool,
-    previous: Option<Vec<u8>>,
+    /// The capture was requested.
+    requested: bool,
     /// The result of saving, once done.
     done: Option<Result<(), String>>,
     /// Where the result and the messages are left for the caller.
@@ -49,6 +47,7 @@ pub fn render(
     width: u32,
     height: u32,
 ) -> Result<Vec<String>, String> {
+    let library = preload(&paths)?;
     let mut app = App::new();
     app.add_plugins(
         DefaultPlugins
@@ -63,6 +62,7 @@ pub fn render(
     .add_plugins(ScheduleRunnerPlugin::run_loop(Duration::from_millis(2)))
     .insert_resource(ClearColor(stage::SKY))
     .insert_resource(StartupPaths(paths))
+    .insert_resource(library)
     .insert_resource(edits)
     .add_plugins((RigCorePlugin, SkinningPlugin, ViewPlugin));
     let target = {
@@ -75,10 +75,8 @@ pub fn render(
     app.insert_resource(RenderJob {
         out,
         target: target.clone(),
-        frames: 0,
         started: std::time::Instant::now(),
-        waiting: false,
-        previous: None,
+        requested: false,
         done: None,
         outcome: outcome.clone(),
     });
@@ -86,7 +84,7 @@ pub fn render(
         let orbit = OrbitCamera::default();
         commands.spawn((Camera3d::default(), RenderTarget::Image(target.clone().into()), orbit, orbit.transform()));
     });
-    app.add_systems(Last, capture_when_ready);
+    app.add_systems(Last, capture_when_ready.after(super::readiness::UpdateCaptureGate));
     let exit = app.run();
     // `App::run` hands the world to the runner: the outcome comes back through `outcome`.
     let (done, messages) = outcome.lock().map(|o| o.clone()).unwrap_or_default();
@@ -94,44 +92,65 @@ pub fn render(
     match (exit, done) {
         (AppExit::Success, Some(Ok(()))) => Ok(messages),
         (_, Some(Err(e))) => Err(e),
-        _ => Err(format!("the render did not settle within {GIVE_UP_SECONDS} s")),
+        _ => Err("the render stopped before a picture was captured".to_string()),
     }
 }
 
-/// After the warm-up, captures the target until two captures agree, saves that one and
-/// exits (or gives up after a while).
+/// Loads everything the render will show before any window or GPU work, so that a missing
+/// file, an unparsable scene or a character that fails to load is an error (and no picture
+/// is written). Returns the loaded assets for the app to reuse.
+fn preload(paths: &[PathBuf]) -> Result<AssetLibrary, String> {
+    let sources: Vec<(SourceDoc, Option<BindingDoc>)> = match scene_path(paths) {
+        Some(scene) => read_scene(scene)
+            .map_err(|e| e.to_string())?
+            .characters
+            .into_iter()
+            .map(|c| (c.source, c.binding))
+            .collect(),
+        None => paths.iter().map(|p| (SourceDoc::File(p.clone()), None)).collect(),
+    };
+    let mut library = AssetLibrary::default();
+    let errors: Vec<String> = sources
+        .iter()
+        .filter_map(|(source, binding)| library.load_bound(source, *binding).err())
+        .map(|e| e.to_string())
+        .collect();
+    if errors.is_empty() { Ok(library) } else { Err(errors.join("\n")) }
+}
+
+/// Once the gate opens, captures the target once, saves it and exits; gives up after
+/// [`GIVE_UP_SECONDS`] or when a pipeline failed, saying what was pending.
 fn capture_when_ready(
     mut commands: Commands,
     mut job: ResMut<RenderJob>,
+    gate: Res<CaptureGate>,
     messages: Res<Messages>,
     mut exit: MessageWriter<AppExit>,
 ) {
-    job.frames += 1;
-    if job.done.is_some() {
+    if let Some(done) = job.done.clone() {
         if let Ok(mut o) = job.outcome.lock() {
-            *o = (job.done.clone(), messages.0.clone());
+            *o = (Some(done), messages.0.clone());
         }
         exit.write(AppExit::Success);
         return;
     }
+    if let Some(failed) = &gate.failed {
+        job.done = Some(Err(format!("cannot render: {failed}")));
+        return;
+    }
     if job.started.elapsed().as_secs() > GIVE_UP_SECONDS {
-        exit.write(AppExit::error());
+        let pending = gate.last_reason.clone().unwrap_or_else(|| "nothing reported".into());
+        job.done = Some(Err(format!("the render was not ready within {GIVE_UP_SECONDS} s; still pending: {pending}")));
         return;
     }
-    if job.frames < WARMUP_FRAMES || job.waiting {
+    if job.requested || !gate.is_ready() {
         return;
     }
-    job.waiting = true;
+    job.requested = true;
     let out = job.out.clone();
     commands.spawn(Screenshot::image(job.target.clone())).observe(
         move |captured: On<ScreenshotCaptured>, mut job: ResMut<RenderJob>| {
-            job.waiting = false;
-            let data = captured.image.data.clone().unwrap_or_default();
-            if job.previous.as_ref() == Some(&data) {
-                job.done = Some(super::screenshot::save_png(&captured.image, &out));
-            } else {
-                job.previous = Some(data);
-            }
+            job.done = Some(super::screenshot::save_png(&captured.image, &out));
         },
     );
 }

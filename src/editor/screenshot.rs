@@ -7,6 +7,7 @@ use bevy::prelude::*;
 use bevy::render::view::screenshot::{Screenshot, ScreenshotCaptured};
 
 use super::Messages;
+use super::readiness::CaptureGate;
 
 /// A pending screenshot and the options of the next one.
 #[derive(Resource)]
@@ -42,7 +43,8 @@ pub struct ScreenshotPlugin;
 
 impl Plugin for ScreenshotPlugin {
     fn build(&self, app: &mut App) {
-        app.init_resource::<ScreenshotRequest>().add_systems(Last, take_requested_screenshot);
+        app.init_resource::<ScreenshotRequest>()
+            .add_systems(Last, take_requested_screenshot.after(super::readiness::UpdateCaptureGate));
     }
 }
 
@@ -68,11 +70,23 @@ fn take_requested_screenshot(
     mut commands: Commands,
     mut request: ResMut<ScreenshotRequest>,
     mut messages: ResMut<Messages>,
+    gate: Option<Res<CaptureGate>>,
 ) {
     let Some(n) = request.countdown else { return };
     if n > 0 {
         request.countdown = Some(n - 1);
         return;
+    }
+    if let Some(gate) = &gate {
+        if let Some(failed) = &gate.failed {
+            request.countdown = None;
+            messages.push(format!("no screenshot: {failed}"));
+            return;
+        }
+        if !gate.is_ready() {
+            // Pipelines still compiling or meshes not yet on the GPU: wait.
+            return;
+        }
     }
     request.countdown = None;
     let dir = PathBuf::from(request.dir_text.trim());

@@ -163,7 +163,7 @@ fn pose_from_clips(
             _ => &a,
         };
         let upright = if body.upright {
-            let first_up = body.clips[c].1.frame(0)[0] * Vec3::Y;
+            let first_up = body.clips[c].1.frame(0).first().copied().unwrap_or(Quat::IDENTITY) * Vec3::Y;
             Quat::from_rotation_arc(first_up.normalize(), Vec3::Y)
         } else {
             Quat::IDENTITY

@@ -7,7 +7,7 @@ use std::path::Path;
 use glam::Vec3;
 
 use super::error::FormatError;
-use crate::rig::{BoneBox, DofLimits, JointRotation, RawJoint, Skeleton};
+use crate::rig::{BoneBox, DofLimits, JointRotation, MAX_JOINTS, RawJoint, Skeleton};
 
 /// A token and the line it starts on.
 #[derive(Debug, Clone, PartialEq)]
@@ -107,6 +107,7 @@ impl<'a> Tokens<'a> {
                 self.pos += 1;
                 Ok(v)
             }
+            Some(Ok(_)) => Err(self.error(&format!("a finite number ({what})"))),
             _ => Err(self.error(&format!("a number ({what})"))),
         }
     }
@@ -126,64 +127,57 @@ impl<'a> Tokens<'a> {
 
 /// Parses a CSE169 `.skel`. Joints are numbered depth-first in file order (the order
 /// `.skin` files use). Defaults: offset 0, box ±0.1, unlimited rotation, pose 0. The pose
-/// is clamped to the limits.
+/// is clamped to the limits. Nesting is followed with an explicit stack (no recursion), so
+/// any depth parses.
 pub fn parse_skel(reader: impl BufRead, path: &Path) -> Result<Skeleton, FormatError> {
     let mut tokens = Tokens::new(tokenize(reader, path)?, path);
-    let mut raw = Vec::new();
     if tokens.at_end() {
         return Err(tokens.error("`balljoint`"));
     }
-    parse_balljoint(&mut tokens, None, &mut raw)?;
-    if !tokens.at_end() {
-        return Err(tokens.error("the end of the file after the root joint (one root per skeleton)"));
-    }
-    Skeleton::build(raw).map_err(|e| FormatError::rig(path, e))
-}
-
-fn parse_balljoint(tokens: &mut Tokens, parent: Option<usize>, raw: &mut Vec<RawJoint>) -> Result<(), FormatError> {
-    tokens.expect("balljoint")?;
-    let name = tokens.next_token("a joint name")?;
-    if name.text == "{" || name.text == "}" {
-        tokens.pos -= 1;
-        return Err(tokens.error("a joint name"));
-    }
-    tokens.expect("{")?;
-    let index = raw.len();
-    let mut joint = RawJoint::new(name.text, parent, Vec3::ZERO);
-    let mut bone_box = BoneBox { min: Vec3::splat(-0.1), max: Vec3::splat(0.1) };
-    let mut limits = DofLimits::UNLIMITED;
-    let mut pose = Vec3::ZERO;
-    raw.push(joint.clone());
-    loop {
+    let mut raw: Vec<RawJoint> = Vec::new();
+    // The joints whose `{` is open, innermost last.
+    let mut open: Vec<OpenJoint> = vec![open_balljoint(&mut tokens, None, &mut raw)?];
+    while let Some(current) = open.last_mut() {
         let keyword = tokens.peek().map(|t| t.text.clone());
         match keyword.as_deref() {
             Some("}") => {
                 tokens.pos += 1;
-                break;
+                let done = open.pop().expect("the loop holds an open joint");
+                close_balljoint(done, &mut raw);
+                if open.is_empty() && !tokens.at_end() {
+                    return Err(tokens.error("the end of the file after the root joint (one root per skeleton)"));
+                }
             }
             Some("offset") => {
                 tokens.pos += 1;
-                joint.rest_offset = tokens.vec3("offset")?;
+                current.joint.rest_offset = tokens.vec3("offset")?;
             }
             Some("boxmin") => {
                 tokens.pos += 1;
-                bone_box.min = tokens.vec3("boxmin")?;
+                current.bone_box.min = tokens.vec3("boxmin")?;
             }
             Some("boxmax") => {
                 tokens.pos += 1;
-                bone_box.max = tokens.vec3("boxmax")?;
+                current.bone_box.max = tokens.vec3("boxmax")?;
             }
             Some(k @ ("rotxlimit" | "rotylimit" | "rotzlimit")) => {
                 let axis = usize::from(k.as_bytes()[3] - b'x');
                 tokens.pos += 1;
-                limits.min[axis] = tokens.number(&format!("{k} min"))?;
-                limits.max[axis] = tokens.number(&format!("{k} max"))?;
+                current.limits.min[axis] = tokens.number(&format!("{k} min"))?;
+                current.limits.max[axis] = tokens.number(&format!("{k} max"))?;
             }
             Some("pose") => {
                 tokens.pos += 1;
-                pose = tokens.vec3("pose")?;
+                current.pose = tokens.vec3("pose")?;
             }
-            Some("balljoint") => parse_balljoint(tokens, Some(index), raw)?,
+            Some("balljoint") => {
+                let parent = current.index;
+                if raw.len() >= MAX_JOINTS {
+                    return Err(tokens.error(&format!("at most {MAX_JOINTS} joints")));
+                }
+                let child = open_balljoint(&mut tokens, Some(parent), &mut raw)?;
+                open.push(child);
+            }
             _ => {
                 return Err(
                     tokens.error("offset, boxmin, boxmax, rotxlimit, rotylimit, rotzlimit, pose, balljoint or `}`")
@@ -191,9 +185,47 @@ fn parse_balljoint(tokens: &mut Tokens, parent: Option<usize>, raw: &mut Vec<Raw
             }
         }
     }
+    Skeleton::build(raw).map_err(|e| FormatError::rig(path, e))
+}
+
+/// A joint whose block is being read.
+struct OpenJoint {
+    index: usize,
+    joint: RawJoint,
+    bone_box: BoneBox,
+    limits: DofLimits,
+    pose: Vec3,
+}
+
+/// Reads `balljoint NAME {`, reserves the joint's index (depth-first order) and opens it.
+fn open_balljoint(
+    tokens: &mut Tokens,
+    parent: Option<usize>,
+    raw: &mut Vec<RawJoint>,
+) -> Result<OpenJoint, FormatError> {
+    tokens.expect("balljoint")?;
+    let name = tokens.next_token("a joint name")?;
+    if name.text == "{" || name.text == "}" {
+        tokens.pos -= 1;
+        return Err(tokens.error("a joint name"));
+    }
+    tokens.expect("{")?;
+    let joint = RawJoint::new(name.text, parent, Vec3::ZERO);
+    raw.push(joint.clone());
+    Ok(OpenJoint {
+        index: raw.len() - 1,
+        joint,
+        bone_box: BoneBox { min: Vec3::splat(-0.1), max: Vec3::splat(0.1) },
+        limits: DofLimits::UNLIMITED,
+        pose: Vec3::ZERO,
+    })
+}
+
+/// Stores a joint whose `}` was read.
+fn close_balljoint(done: OpenJoint, raw: &mut [RawJoint]) {
+    let OpenJoint { index, mut joint, bone_box, limits, pose } = done;
     joint.limits = limits;
     joint.bone_box = Some(bone_box);
     joint.initial_rotation = JointRotation::euler_xyz(pose.x, pose.y, pose.z);
     raw[index] = joint;
-    Ok(())
 }

@@ -46,15 +46,55 @@ pub fn open(path: &Path) -> Result<std::io::BufReader<std::fs::File>, FormatErro
     std::fs::File::open(path).map(std::io::BufReader::new).map_err(|e| FormatError::io(path, e))
 }
 
+/// Reads the whole input as UTF-8 text; bytes that are not UTF-8 are an error at their line.
+pub fn read_text(mut reader: impl std::io::BufRead, path: &Path) -> Result<String, FormatError> {
+    let mut bytes = Vec::new();
+    reader.read_to_end(&mut bytes).map_err(|e| FormatError::io(path, e))?;
+    String::from_utf8(bytes).map_err(|e| {
+        let bytes = e.as_bytes();
+        let at = e.utf8_error().valid_up_to();
+        let line = 1 + bytes[..at].iter().filter(|&&b| b == b'\n').count();
+        FormatError::syntax(path, line, format!("expected UTF-8 text, found the byte 0x{:02x}", bytes[at]))
+    })
+}
+
 /// Reads lines (LF, CRLF, or bare CR line ends), numbered from 1, with the path in errors.
-pub fn read_lines(mut reader: impl std::io::BufRead, path: &Path) -> Result<Vec<(usize, String)>, FormatError> {
-    let mut text = String::new();
-    reader.read_to_string(&mut text).map_err(|e| FormatError::io(path, e))?;
+pub fn read_lines(reader: impl std::io::BufRead, path: &Path) -> Result<Vec<(usize, String)>, FormatError> {
+    let text = read_text(reader, path)?;
     let text = text.replace("\r\n", "\n").replace('\r', "\n");
     Ok(text.lines().enumerate().map(|(i, l)| (i + 1, l.to_string())).collect())
 }
 
-/// One number, or `path:line: expected a number, found "tok"`.
-pub fn parse_number<T: std::str::FromStr>(token: &str, path: &Path, line_no: usize) -> Result<T, FormatError> {
-    token.parse().map_err(|_| FormatError::syntax(path, line_no, format!("expected a number, found `{token}`")))
+/// A number a file may hold: integers, and floats that must be finite.
+pub trait FileNumber: std::str::FromStr {
+    /// Whether the value can be used (a float is finite; an integer always is).
+    fn is_usable(&self) -> bool {
+        true
+    }
+}
+
+impl FileNumber for f32 {
+    fn is_usable(&self) -> bool {
+        self.is_finite()
+    }
+}
+
+impl FileNumber for f64 {
+    fn is_usable(&self) -> bool {
+        self.is_finite()
+    }
+}
+
+impl FileNumber for usize {}
+impl FileNumber for u32 {}
+impl FileNumber for i64 {}
+
+/// One number, or `path:line: expected a number, found "tok"`; a float must be finite
+/// (`expected a finite number, found nan`: NaN or infinity would poison every matrix).
+pub fn parse_number<T: FileNumber>(token: &str, path: &Path, line_no: usize) -> Result<T, FormatError> {
+    match token.parse::<T>() {
+        Ok(v) if v.is_usable() => Ok(v),
+        Ok(_) => Err(FormatError::syntax(path, line_no, format!("expected a finite number, found `{token}`"))),
+        Err(_) => Err(FormatError::syntax(path, line_no, format!("expected a number, found `{token}`"))),
+    }
 }

@@ -3,7 +3,7 @@
 //! (absolute positions; keys not in hierarchy order; weights optional, sparse, and not
 //! normalised), with an OFF mesh beside it.
 
-use std::collections::BTreeMap;
+use std::collections::{BTreeMap, HashMap};
 use std::io::BufRead;
 use std::path::{Path, PathBuf};
 
@@ -34,24 +34,44 @@ pub struct HomerRig {
     pub weights: Option<Vec<(usize, usize, f32)>>,
 }
 
-/// Parses a Homer rig JSON.
-pub fn parse_rig(mut reader: impl BufRead, path: &Path) -> Result<HomerRig, FormatError> {
-    let mut text = String::new();
-    reader.read_to_string(&mut text).map_err(|e| FormatError::io(path, e))?;
+/// An error at a place in the JSON document (`$["joint"].children[2]`).
+fn json_error(path: &Path, at: &str, message: impl std::fmt::Display) -> FormatError {
+    FormatError::other(path, format!("at {at}: {message}"))
+}
+
+/// Parses a Homer rig JSON. Positions and weights must be finite; errors name the JSON
+/// path (`$["joint"].pos`) or the line.
+pub fn parse_rig(reader: impl BufRead, path: &Path) -> Result<HomerRig, FormatError> {
+    let text = super::error::read_text(reader, path)?;
     let raw: BTreeMap<String, RawHomerJoint> =
-        serde_json::from_str(&text).map_err(|e| FormatError::syntax(path, e.line(), e.to_string()))?;
+        serde_json::from_str(&text).map_err(|e| FormatError::syntax(path, e.line().max(1), e.to_string()))?;
+    if raw.is_empty() {
+        return Err(json_error(path, "$", "expected at least one joint, found an empty object"));
+    }
+    if raw.len() > crate::rig::MAX_JOINTS {
+        return Err(json_error(
+            path,
+            "$",
+            format!("expected at most {} joints, found {}", crate::rig::MAX_JOINTS, raw.len()),
+        ));
+    }
     let names: Vec<&String> = raw.keys().collect();
-    let index = |n: &str| names.iter().position(|k| k.as_str() == n);
+    let index: HashMap<&str, usize> = names.iter().enumerate().map(|(i, n)| (n.as_str(), i)).collect();
     let mut parent: Vec<Option<usize>> = vec![None; names.len()];
-    for (p, joint) in raw.values().enumerate() {
-        for child in &joint.children {
-            let c = index(child).ok_or_else(|| {
-                FormatError::other(path, format!("joint `{}` lists a child `{child}` that is not defined", names[p]))
+    for (p, (name, joint)) in raw.iter().enumerate() {
+        if let Some(bad) = joint.pos.iter().find(|v| !v.is_finite()) {
+            return Err(json_error(path, &format!("$[{name:?}].pos"), format!("expected finite numbers, found {bad}")));
+        }
+        for (k, child) in joint.children.iter().enumerate() {
+            let at = || format!("$[{name:?}].children[{k}]");
+            let c = *index.get(child.as_str()).ok_or_else(|| {
+                json_error(path, &at(), format!("expected a joint name, found `{child}`, which is not defined"))
             })?;
             if let Some(other) = parent[c] {
-                return Err(FormatError::other(
+                return Err(json_error(
                     path,
-                    format!("joint `{child}` is a child of both `{}` and `{}`", names[other], names[p]),
+                    &at(),
+                    format!("joint `{child}` is a child of both `{}` and `{name}`", names[other]),
                 ));
             }
             parent[c] = Some(p);
@@ -66,7 +86,8 @@ pub fn parse_rig(mut reader: impl BufRead, path: &Path) -> Result<HomerRig, Form
             RawJoint::new(name.clone(), parent[i], offset)
         })
         .collect();
-    let (skeleton, new_index) = Skeleton::build_reordered(joints).map_err(|e| FormatError::rig(path, e))?;
+    let (skeleton, new_index) = Skeleton::build_reordered(joints)
+        .map_err(|e| json_error(path, "$", format!("{e} (from the `children` lists)")))?;
     let mut positions = vec![Vec3::ZERO; names.len()];
     let mut weights: Option<Vec<(usize, usize, f32)>> = None;
     for (old, (name, j)) in raw.iter().enumerate() {
@@ -74,12 +95,13 @@ pub fn parse_rig(mut reader: impl BufRead, path: &Path) -> Result<HomerRig, Form
         if let Some(w) = &j.weights {
             let list = weights.get_or_insert_with(Vec::new);
             for (vertex, weight) in w {
+                let at = || format!("$[{name:?}].weights[{vertex:?}]");
                 let v: usize = vertex.parse().map_err(|_| {
-                    FormatError::other(
-                        path,
-                        format!("joint `{name}`: expected a vertex index as weight key, found `{vertex}`"),
-                    )
+                    json_error(path, &at(), format!("expected a vertex index as key, found `{vertex}`"))
                 })?;
+                if !(weight.is_finite() && *weight >= 0.0) {
+                    return Err(json_error(path, &at(), format!("expected a finite weight >= 0, found {weight}")));
+                }
                 list.push((new_index[old], v, *weight));
             }
         }

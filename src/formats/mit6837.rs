@@ -7,7 +7,7 @@ use glam::Vec3;
 
 use super::error::{FormatError, parse_number, read_lines};
 use crate::rig::skinning::NormalisedRow;
-use crate::rig::{RawJoint, Skeleton, SkinWeights};
+use crate::rig::{MAX_JOINTS, RawJoint, Skeleton, SkinWeights};
 
 /// Parses a 6.837 `.skel`: one joint per line, `x y z parent`; the root (parent -1) is
 /// absolute, the others are offsets from their parent. Blank lines are skipped.
@@ -32,7 +32,21 @@ pub fn parse_skel(reader: impl BufRead, path: &Path) -> Result<Skeleton, FormatE
             FormatError::syntax(path, line_no, format!("expected an integer parent index, found `{}`", tokens[3]))
         })?;
         let index = raw.len();
+        if index == MAX_JOINTS {
+            return Err(FormatError::syntax(
+                path,
+                line_no,
+                format!("expected at most {MAX_JOINTS} joints, found more"),
+            ));
+        }
         let parent = match parent {
+            -1 if index > 0 => {
+                return Err(FormatError::syntax(
+                    path,
+                    line_no,
+                    format!("joint {index} is a second root (parent -1); expected a parent index in 0..{index}"),
+                ));
+            }
             -1 => None,
             p if p < 0 || p as usize >= index => {
                 let what = if p >= 0 && (p as usize) == index { "itself" } else { "a joint not defined before it" };

@@ -15,8 +15,10 @@ pub mod smpl;
 pub use character::{CharacterSource, load_character};
 pub use error::FormatError;
 
-/// Writes a whole file or nothing: the content goes to a temporary file beside `path`,
-/// which is flushed, synced and renamed over `path` only when every write succeeded.
+/// Writes a whole file or nothing: the content goes to a new temporary file beside `path`
+/// (an unpredictable name, created exclusively, so no symlink or other file is followed),
+/// which is flushed, synced and renamed over `path` only when every write succeeded; then
+/// the folder is synced so the rename itself survives a crash.
 pub fn write_atomically(
     path: &std::path::Path,
     write: impl FnOnce(&mut std::io::BufWriter<std::fs::File>) -> std::io::Result<()>,
@@ -24,17 +26,46 @@ pub fn write_atomically(
     use std::io::Write;
     let dir = path.parent().filter(|d| !d.as_os_str().is_empty()).unwrap_or(std::path::Path::new("."));
     let name = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
-    let tmp = dir.join(format!(".{name}.{}.tmp", std::process::id()));
+    let (tmp, file) = create_temporary(dir, &name)?;
     let result = (|| {
-        let mut w = std::io::BufWriter::new(std::fs::File::create(&tmp)?);
+        let mut w = std::io::BufWriter::new(file);
         write(&mut w)?;
         w.flush()?;
         w.get_ref().sync_all()?;
         drop(w);
-        std::fs::rename(&tmp, path)
+        std::fs::rename(&tmp, path)?;
+        sync_dir(dir)
     })();
     if result.is_err() {
         let _ = std::fs::remove_file(&tmp);
     }
     result
+}
+
+/// A new file `.NAME.RANDOM.tmp` in `dir`, created with `create_new` (never an existing
+/// file or a symlink's target); a few names are tried.
+fn create_temporary(dir: &std::path::Path, name: &str) -> std::io::Result<(std::path::PathBuf, std::fs::File)> {
+    use std::hash::{BuildHasher, Hasher};
+    let mut last_error = None;
+    for attempt in 0..8u64 {
+        // RandomState is seeded from the OS's randomness: an unguessable name.
+        let mut hasher = std::collections::hash_map::RandomState::new().build_hasher();
+        hasher.write_u64(attempt ^ u64::from(std::process::id()));
+        let tmp = dir.join(format!(".{name}.{:016x}.tmp", hasher.finish()));
+        match std::fs::OpenOptions::new().write(true).create_new(true).open(&tmp) {
+            Ok(file) => return Ok((tmp, file)),
+            Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists => last_error = Some(e),
+            Err(e) => return Err(e),
+        }
+    }
+    Err(last_error.unwrap_or_else(|| std::io::Error::other("no free temporary name")))
+}
+
+/// Flushes a folder's entries to disk (a no-op where folders cannot be opened).
+fn sync_dir(dir: &std::path::Path) -> std::io::Result<()> {
+    #[cfg(unix)]
+    std::fs::File::open(dir)?.sync_all()?;
+    #[cfg(not(unix))]
+    let _ = dir;
+    Ok(())
 }

@@ -70,7 +70,7 @@ pub fn parse_off(reader: impl BufRead, path: &Path) -> Result<ObjMesh, FormatErr
         })?;
         let t: Vec<&str> = l.split_whitespace().collect();
         let k: usize = parse_number(t[0], path, n)?;
-        if k < 3 || t.len() < k + 1 {
+        if k < 3 || t.len() - 1 < k {
             return Err(FormatError::syntax(
                 path,
                 n,

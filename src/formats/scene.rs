@@ -217,44 +217,109 @@ impl Default for SmplDoc {
     }
 }
 
-/// The key a joint's pose is stored under: its name, or `name#index` when another joint
-/// has the same name (CSE169's dragon repeats names).
+/// The key a joint's pose is stored under: its name; `name#index` when another joint has
+/// the same name (CSE169's dragon repeats names) or when the name itself reads as another
+/// joint's `name#index` (a joint literally named `a#1`), so every key finds its own joint.
 pub fn pose_key(skeleton: &Skeleton, joint: usize) -> String {
     let name = &skeleton.joint(joint).name;
-    if skeleton.joints().iter().filter(|j| &j.name == name).count() > 1 {
-        format!("{name}#{joint}")
-    } else {
-        name.clone()
-    }
+    let repeated = skeleton.joints().iter().filter(|j| &j.name == name).count() > 1;
+    let shadowed = joint_of_indexed_key(skeleton, name).is_some_and(|other| other != joint);
+    if repeated || shadowed { format!("{name}#{joint}") } else { name.clone() }
 }
 
-/// Resolves a pose key back to a joint.
+/// Resolves a pose key back to a joint: `name#index` where joint `index` has that name,
+/// otherwise the first joint of that name.
 pub fn joint_of_pose_key(skeleton: &Skeleton, key: &str) -> Option<usize> {
-    if let Some((name, index)) = key.rsplit_once('#')
-        && let Ok(i) = index.parse::<usize>()
-        && i < skeleton.len()
-        && skeleton.joint(i).name == name
-    {
-        return Some(i);
+    joint_of_indexed_key(skeleton, key).or_else(|| skeleton.find(key))
+}
+
+/// The joint a `name#index` key names, when joint `index` has that name.
+fn joint_of_indexed_key(skeleton: &Skeleton, key: &str) -> Option<usize> {
+    let (name, index) = key.rsplit_once('#')?;
+    let i = index.parse::<usize>().ok()?;
+    (i < skeleton.len() && skeleton.joint(i).name == name).then_some(i)
+}
+
+/// Reads a scene; syntax errors carry the line and column, bad numbers the field's path
+/// (`characters[1].placement.scale`).
+pub fn parse_scene(reader: impl BufRead, path: &Path) -> Result<SceneDoc, FormatError> {
+    let text = super::error::read_text(reader, path)?;
+    let doc: SceneDoc = ron::from_str(&text).map_err(|e| {
+        FormatError::syntax(path, e.span.start.line.max(1), format!("column {}: {}", e.span.start.col, e.code))
+    })?;
+    doc.validate().map_err(|e| FormatError::other(path, e))?;
+    Ok(doc)
+}
+
+impl SceneDoc {
+    /// Checks every number: finite, scales and the camera distance positive, quaternions
+    /// not zero, blend weights in 0..=1. The error names the field (`characters[0].placement.scale`).
+    pub fn validate(&self) -> Result<(), String> {
+        for (i, c) in self.characters.iter().enumerate() {
+            let at = |field: &str| format!("characters[{i}].{field}");
+            finite(&at("placement.translation"), &c.placement.translation)?;
+            finite(&at("placement.yaw"), &[c.placement.yaw])?;
+            positive(&at("placement.scale"), c.placement.scale)?;
+            for (key, rotation) in &c.pose {
+                let at = at(&format!("pose[{key:?}]"));
+                match rotation {
+                    JointRotation::Euler(angles, _) => finite(&at, &angles.to_array())?,
+                    JointRotation::Quat(q) => {
+                        finite(&at, &q.to_array())?;
+                        if q.length_squared() < 1e-12 {
+                            return Err(format!("{at}: expected a rotation, found a zero quaternion"));
+                        }
+                    }
+                }
+            }
+            finite(&at("view.tint"), &c.view.tint)?;
+            if let Some(smpl) = &c.smpl {
+                finite(&at("smpl.betas"), &smpl.betas)?;
+                finite(&at("smpl.time"), &[smpl.time])?;
+                finite(&at("smpl.speed"), &[smpl.speed])?;
+                finite(&at("smpl.blend"), &[smpl.blend])?;
+                if !(0.0..=1.0).contains(&smpl.blend) {
+                    return Err(format!(
+                        "{}: expected a blend weight in 0..=1, found {}",
+                        at("smpl.blend"),
+                        smpl.blend
+                    ));
+                }
+            }
+        }
+        if let Some(camera) = &self.camera {
+            finite("camera.focus", &camera.focus)?;
+            finite("camera.yaw", &[camera.yaw, camera.pitch])?;
+            positive("camera.distance", camera.distance)?;
+        }
+        finite("stage.floor_height", &[self.stage.floor_height])
     }
-    skeleton.find(key)
 }
 
-/// Reads a scene; errors carry the line.
-pub fn parse_scene(mut reader: impl BufRead, path: &Path) -> Result<SceneDoc, FormatError> {
-    let mut text = String::new();
-    reader.read_to_string(&mut text).map_err(|e| FormatError::io(path, e))?;
-    ron::from_str(&text).map_err(|e| FormatError::syntax(path, e.span.start.line, e.code.to_string()))
+fn finite(at: &str, values: &[f32]) -> Result<(), String> {
+    match values.iter().find(|v| !v.is_finite()) {
+        Some(v) => Err(format!("{at}: expected a finite number, found {v}")),
+        None => Ok(()),
+    }
 }
 
-/// The scene as pretty RON text.
-pub fn scene_to_string(doc: &SceneDoc) -> String {
-    ron::ser::to_string_pretty(doc, ron::ser::PrettyConfig::default()).expect("scene documents serialise")
+fn positive(at: &str, value: f32) -> Result<(), String> {
+    if value.is_finite() && value > 0.0 {
+        Ok(())
+    } else {
+        Err(format!("{at}: expected a positive finite number, found {value}"))
+    }
+}
+
+/// The scene as pretty RON text; fails when a source path is not valid UTF-8 (RON text
+/// cannot hold it).
+pub fn scene_to_string(doc: &SceneDoc) -> Result<String, ron::Error> {
+    ron::ser::to_string_pretty(doc, ron::ser::PrettyConfig::default())
 }
 
 /// Writes a scene whole or not at all (temporary file, then rename).
 pub fn save_scene(path: &Path, doc: &SceneDoc) -> Result<(), FormatError> {
-    let text = scene_to_string(doc);
+    let text = scene_to_string(doc).map_err(|e| FormatError::other(path, format!("cannot be written: {e}")))?;
     super::write_atomically(path, |w| std::io::Write::write_all(w, text.as_bytes()))
         .map_err(|e| FormatError::io(path, e))
 }

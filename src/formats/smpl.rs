@@ -20,7 +20,7 @@ fn data_lines(reader: impl BufRead, path: &Path) -> Result<Vec<(usize, String)>,
         .collect())
 }
 
-fn numbers<T: std::str::FromStr>(line: &str, path: &Path, line_no: usize) -> Result<Vec<T>, FormatError> {
+fn numbers<T: super::error::FileNumber>(line: &str, path: &Path, line_no: usize) -> Result<Vec<T>, FormatError> {
     line.split_whitespace().map(|t| parse_number(t, path, line_no)).collect()
 }
 
@@ -31,6 +31,13 @@ pub fn parse_hierarchy(reader: impl BufRead, path: &Path) -> Result<Skeleton, Fo
         .first()
         .ok_or_else(|| FormatError::syntax(path, 1, "expected the joint count, found the end of the file"))?;
     let count: usize = parse_number(count.trim(), path, *count_line)?;
+    if count == 0 || count > crate::rig::MAX_JOINTS {
+        return Err(FormatError::syntax(
+            path,
+            *count_line,
+            format!("expected a joint count in 1..={}, found {count}", crate::rig::MAX_JOINTS),
+        ));
+    }
     let rows = &lines[1..];
     if rows.len() != count {
         let at = rows.last().map_or(*count_line, |r| r.0);
@@ -51,8 +58,9 @@ pub fn parse_hierarchy(reader: impl BufRead, path: &Path) -> Result<Skeleton, Fo
             return Err(FormatError::syntax(path, *n, format!("expected joint index {k}, found {index}")));
         }
         let parent: i64 = parse_number(t[1], path, *n)?;
-        if parent >= k as i64 || parent < -1 {
-            return Err(FormatError::syntax(path, *n, format!("expected a parent index in -1..{k}, found {parent}")));
+        if parent >= k as i64 || parent < -1 || (parent == -1 && k > 0) {
+            let allowed = if k == 0 { "-1 (the root)".to_string() } else { format!("0..{k}") };
+            return Err(FormatError::syntax(path, *n, format!("expected a parent index in {allowed}, found {parent}")));
         }
         if t[2] != "EULER_XYZ" {
             return Err(FormatError::syntax(path, *n, format!("expected rotation order EULER_XYZ, found `{}`", t[2])));
@@ -132,13 +140,13 @@ pub fn parse_skin(
     let mut parsed = Vec::with_capacity(vertices);
     for (n, line) in rows {
         let tokens: Vec<&str> = line.split_whitespace().collect();
-        if tokens.len() != 2 * per_vertex {
+        if !tokens.len().is_multiple_of(2) || tokens.len() / 2 != per_vertex {
             return Err(FormatError::syntax(
                 path,
                 *n,
                 format!(
                     "expected {} numbers ({per_vertex} joint weight pairs), found {}",
-                    2 * per_vertex,
+                    2 * u128::from(per_vertex as u64),
                     tokens.len()
                 ),
             ));
@@ -153,7 +161,14 @@ pub fn parse_skin(
                     format!("expected a joint index below {joint_count}, found {j}"),
                 ));
             }
-            row.push((j, parse_number::<f32>(pair[1], path, *n)?));
+            let w: f32 = parse_number(pair[1], path, *n)?;
+            if w < 0.0 {
+                return Err(FormatError::syntax(path, *n, format!("expected weights >= 0, found {w}")));
+            }
+            row.push((j, w));
+        }
+        if row.iter().all(|&(_, w)| w <= 0.0) {
+            return Err(FormatError::syntax(path, *n, "expected at least one positive weight, found none"));
         }
         parsed.push(row);
     }
@@ -176,6 +191,9 @@ pub fn parse_clip(reader: impl BufRead, path: &Path, joint_count: usize) -> Resu
         ));
     }
     let rows = &lines[1..];
+    if h[0] == 0 {
+        return Err(FormatError::syntax(path, *header_line, "expected at least one frame, found a frame count of 0"));
+    }
     if rows.len() != h[0] {
         let at = rows.last().map_or(*header_line, |r| r.0);
         return Err(FormatError::syntax(path, at, format!("expected {} frames, found {}", h[0], rows.len())));

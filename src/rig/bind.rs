@@ -68,12 +68,15 @@ pub fn smooth_bone_weights(
             distances.extend(bones.iter().enumerate().map(|(i, b)| (segment_distance(p, b.start, b.end), i)));
             distances.sort_by(|a, b| a.0.total_cmp(&b.0));
             let nearest = distances.first().map_or(0.0, |d| d.0);
+            // Relative to the nearest bone's (which gets 1), in f64: far vertices neither
+            // underflow to 0 nor overflow; normalised rows are the same as 1 / (d² + ε)².
+            let nearest_term = f64::from(nearest).powi(2) + f64::from(eps);
             let mut row: Vec<(usize, f32)> = Vec::new();
             for &(d, i) in distances.iter().take(max_bones.max(1)) {
                 if d > falloff * nearest + 1e-6 && !row.is_empty() {
                     break;
                 }
-                let w = 1.0 / (d * d + eps).powi(2);
+                let w = (nearest_term / (f64::from(d).powi(2) + f64::from(eps))).powi(2) as f32;
                 match row.iter_mut().find(|(j, _)| *j == bones[i].joint) {
                     Some((_, acc)) => *acc += w,
                     None => row.push((bones[i].joint, w)),
@@ -82,7 +85,11 @@ pub fn smooth_bone_weights(
             row
         })
         .collect();
-    SkinWeights::from_rows(rows, joint_count).expect("distance weights are positive and in range").0
+    match SkinWeights::from_rows(rows, joint_count) {
+        Ok((weights, _)) => weights,
+        // Only a vertex at a non-finite distance gets here (the readers reject such input).
+        Err(_) => nearest_bone_weights(positions, bones),
+    }
 }
 
 /// The frame of a bone from `a` to `b`, as in the FABRIK/skinning exercise: centre
@@ -125,7 +132,12 @@ pub fn bind_to_skeleton(skeleton: &Skeleton, vertices: &[Vec3], binding: Binding
 }
 
 /// Weights for `vertices` from given bones (when the joint positions are known exactly).
+/// A skeleton without bones (one joint, or all joints in one place) binds every vertex to
+/// the root.
 pub fn bind_to_bones(vertices: &[Vec3], bones: &[Bone], joint_count: usize, binding: Binding) -> SkinWeights {
+    if bones.is_empty() {
+        return SkinWeights::rigid(&vec![0; vertices.len()]);
+    }
     match binding {
         Binding::Nearest => nearest_bone_weights(vertices, bones),
         Binding::Smooth => smooth_bone_weights(vertices, bones, joint_count, SMOOTH_MAX_BONES, SMOOTH_FALLOFF),

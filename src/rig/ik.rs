@@ -143,9 +143,12 @@ pub fn solve_ik(
                 report.rounds += 1;
                 let solved = fabrik(&positions, goal.target, tolerance * 0.5, 64);
                 report.iterations += solved.iterations;
+                // The chain is a parent-to-child path: turning chain[k] moves only the
+                // joints after it, so before each bone only its two ends are brought up to
+                // date from its (already updated) parent: O(1) per bone, not a whole FK.
                 for k in 0..chain.len() - 1 {
                     let (j, child) = (chain[k], chain[k + 1]);
-                    forward_kinematics(skeleton, pose, placement, &mut world);
+                    update_path(skeleton, pose, placement, &[j, child], &mut world);
                     let from = world[child].w_axis.truncate() - world[j].w_axis.truncate();
                     let to = solved.positions[k + 1] - solved.positions[k];
                     if from.length_squared() < 1e-12 || to.length_squared() < 1e-12 {
@@ -162,6 +165,7 @@ pub fn solve_ik(
                         report.limited = true;
                     }
                     pose[j] = clamped;
+                    update_path(skeleton, pose, placement, &[j], &mut world);
                 }
             }
             forward_kinematics(skeleton, pose, placement, &mut world);
@@ -170,6 +174,15 @@ pub fn solve_ik(
             report
         })
         .collect()
+}
+
+/// Recomputes the joint-to-world matrices along `path` (each joint the parent of the
+/// next) from the unchanged matrix of the first joint's parent.
+fn update_path(skeleton: &Skeleton, pose: &[JointRotation], placement: Mat4, path: &[usize], world: &mut [Mat4]) {
+    for &j in path {
+        let parent_world = skeleton.parent(j).map_or(placement, |p| world[p]);
+        world[j] = parent_world * pose[j].local_transform(skeleton.joint(j).rest_offset);
+    }
 }
 
 /// The rotation part of a transform (scale removed).

@@ -18,11 +18,16 @@ pub use pose::{DofLimits, EulerOrder, JointRotation};
 pub use skeleton::{BoneBox, JointDef, RawJoint, Skeleton};
 pub use skinning::{Influence, SkinWeights};
 
+/// The most joints a skeleton may have: influences name their joint in 16 bits.
+pub const MAX_JOINTS: usize = 1 << 16;
+
 /// What can be wrong with a rig, independent of the file it came from.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum RigError {
     #[error("the skeleton has no joints")]
     EmptySkeleton,
+    #[error("the skeleton has {count} joints, more than the {MAX_JOINTS} a skin can address")]
+    TooManyJoints { count: usize },
     #[error("joint {joint}: parent index {parent} is out of range (the skeleton has {count} joints)")]
     ParentOutOfRange { joint: usize, parent: usize, count: usize },
     #[error("the skeleton has several roots: {}", roots.join(", "))]
@@ -35,6 +40,8 @@ pub enum RigError {
     InfluenceJointOutOfRange { vertex: usize, joint: usize, count: usize },
     #[error("vertex {vertex}: weight {weight} for joint {joint} is negative or not a number")]
     BadWeight { vertex: usize, joint: usize, weight: f32 },
+    #[error("the skin has more than 2^32 influences")]
+    TooManyInfluences,
     #[error("vertex {vertex} has no positive weight")]
     NoInfluence { vertex: usize },
     #[error("the mesh has {mesh} vertices but the weights cover {weights}")]

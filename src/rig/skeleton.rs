@@ -180,6 +180,9 @@ fn depth_first_order(raw: &[RawJoint]) -> Result<Vec<usize>, RigError> {
     if n == 0 {
         return Err(RigError::EmptySkeleton);
     }
+    if n > super::MAX_JOINTS {
+        return Err(RigError::TooManyJoints { count: n });
+    }
     for (i, j) in raw.iter().enumerate() {
         if let Some(p) = j.parent {
             if p >= n {

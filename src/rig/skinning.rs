@@ -48,7 +48,7 @@ impl SkinWeights {
                 if joint >= joint_count {
                     return Err(RigError::InfluenceJointOutOfRange { vertex, joint, count: joint_count });
                 }
-                if !(weight >= 0.0) || !weight.is_finite() {
+                if !weight.is_finite() || weight < 0.0 {
                     return Err(RigError::BadWeight { vertex, joint, weight });
                 }
                 if weight > 0.0 {
@@ -56,14 +56,18 @@ impl SkinWeights {
                 }
             }
             let row = &mut weights.influences[start..];
-            let sum: f32 = row.iter().map(|i| i.weight).sum();
+            // Summed in f64: finite f32 weights never overflow it (3e38 + 3e38 does in f32).
+            let sum: f64 = row.iter().map(|i| f64::from(i.weight)).sum();
             if sum <= 0.0 {
                 return Err(RigError::NoInfluence { vertex });
             }
-            if (sum - 1.0).abs() > WEIGHT_SUM_TOLERANCE {
-                normalised.push(NormalisedRow { vertex, sum });
+            if (sum - 1.0).abs() > f64::from(WEIGHT_SUM_TOLERANCE) {
+                normalised.push(NormalisedRow { vertex, sum: sum as f32 });
             }
-            row.iter_mut().for_each(|i| i.weight /= sum);
+            row.iter_mut().for_each(|i| i.weight = (f64::from(i.weight) / sum) as f32);
+            if weights.influences.len() > u32::MAX as usize {
+                return Err(RigError::TooManyInfluences);
+            }
             weights.offsets.push(weights.influences.len() as u32);
         }
         Ok((weights, normalised))
@@ -124,7 +128,8 @@ pub fn skin_positions(bind_positions: &[Vec3], weights: &SkinWeights, palette: &
 
 /// Unshares the vertices of every triangle and gives each the triangle's unit normal:
 /// `out_positions[3t + k] = positions[triangles[t][k]]`, `out_normals[3t + k]` = the
-/// normal of t (counter-clockwise front; zero for a degenerate triangle).
+/// normal of t (counter-clockwise front; +y for a degenerate triangle, so no NaN
+/// reaches the GPU).
 ///
 /// # Panics
 /// When the outputs are not 3 entries per triangle or an index is out of range.
@@ -138,7 +143,7 @@ pub fn flat_shade(
     assert_eq!(out_normals.len(), triangles.len() * 3);
     for (t, tri) in triangles.iter().enumerate() {
         let [a, b, c] = tri.map(|i| positions[i as usize]);
-        let n = (b - a).cross(c - a).normalize_or_zero().to_array();
+        let n = (b - a).cross(c - a).normalize_or(Vec3::Y).to_array();
         out_positions[3 * t] = a.to_array();
         out_positions[3 * t + 1] = b.to_array();
         out_positions[3 * t + 2] = c.to_array();

@@ -86,10 +86,11 @@ impl Clip {
         self.root_positions.len()
     }
 
-    /// The rotations of one frame (clamped to the last).
+    /// The rotations of one frame (clamped to the last); empty for a clip without frames
+    /// (the readers never make one).
     pub fn frame(&self, f: usize) -> &[Quat] {
         let f = f.min(self.frame_count().saturating_sub(1));
-        &self.rotations[f * self.joint_count..(f + 1) * self.joint_count]
+        self.rotations.get(f * self.joint_count..(f + 1) * self.joint_count).unwrap_or(&[])
     }
 
     /// Rotations at a fractional frame time, interpolated between neighbouring frames;

@@ -13,7 +13,7 @@ pub mod systems;
 use bevy::prelude::*;
 
 pub use components::*;
-pub use spawn::{spawn_character, spawn_character_posed};
+pub use spawn::{despawn_character, spawn_character, spawn_character_posed};
 
 /// The ordered steps of a frame.
 #[derive(SystemSet, Debug, Clone, Copy, PartialEq, Eq, Hash)]

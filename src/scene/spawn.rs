@@ -80,3 +80,14 @@ pub fn empty_skin_mesh(triangle_count: usize) -> Mesh {
         .with_inserted_attribute(Mesh::ATTRIBUTE_NORMAL, vec![[0.0f32, 1.0, 0.0]; n])
         .with_inserted_attribute(Mesh::ATTRIBUTE_COLOR, vec![[1.0f32; 4]; n])
 }
+
+/// Despawns a character, its joints leaves first and its skin mesh entity. Bevy's
+/// recursive despawn would go as deep as the joint tree (a 50,000-joint chain overflows
+/// the stack); joints are stored parents first, so in reverse each one is a leaf when it
+/// goes.
+pub fn despawn_character(commands: &mut Commands, entity: Entity, character: &Character) {
+    for &joint in character.joints.iter().rev() {
+        commands.entity(joint).try_despawn();
+    }
+    commands.entity(entity).try_despawn();
+}

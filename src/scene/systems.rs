@@ -97,24 +97,31 @@ pub fn compute_joint_to_world(
     }
 }
 
-/// Depth-first walk: push `T(offset) · rotation(entity)`, call `visit` with the top,
-/// recurse into joint children, pop.
+/// Depth-first walk with the matrix stack and an explicit to-do stack (no recursion, so
+/// any depth works): push `T(offset) · rotation(entity)`, call `visit` with the top,
+/// descend into joint children, pop when the subtree is done.
 fn walk_joint_tree(
-    entity: Entity,
+    root: Entity,
     stack: &mut MatrixStack,
     offsets: &Query<(&RestOffset, Option<&Children>), With<Joint>>,
     visit: &mut impl FnMut(Entity, Mat4),
     rotation: &impl Fn(Entity) -> Mat4,
 ) {
-    let Ok((offset, children)) = offsets.get(entity) else {
-        return;
-    };
-    let top = stack.push(Mat4::from_translation(offset.0) * rotation(entity));
-    visit(entity, top);
-    for &child in children.into_iter().flatten() {
-        walk_joint_tree(child, stack, offsets, visit, rotation);
+    // (entity, entering?): each push is matched by one pop when its subtree is done.
+    let mut todo = vec![(root, true)];
+    while let Some((entity, entering)) = todo.pop() {
+        if !entering {
+            stack.pop();
+            continue;
+        }
+        let Ok((offset, children)) = offsets.get(entity) else {
+            continue;
+        };
+        let top = stack.push(Mat4::from_translation(offset.0) * rotation(entity));
+        visit(entity, top);
+        todo.push((entity, false));
+        todo.extend(children.into_iter().flatten().rev().map(|&c| (c, true)));
     }
-    stack.pop();
 }
 
 /// Skins characters marked dirty: palette `CurrentJointToWorld · BindWorldToJoint`, LBS of

@@ -12,13 +12,13 @@ use marionette::scene::*;
 
 use crate::common::data_dir;
 
-fn app() -> App {
+pub fn app() -> App {
     let mut app = App::new();
     app.add_plugins((MinimalPlugins, AssetPlugin::default(), bevy::mesh::MeshPlugin, RigCorePlugin, SkinningPlugin));
     app
 }
 
-fn spawn(app: &mut App, asset: Arc<CharacterAsset>, placement: Placement) -> Entity {
+pub fn spawn(app: &mut App, asset: Arc<CharacterAsset>, placement: Placement) -> Entity {
     let world = app.world_mut();
     let mut meshes = world.remove_resource::<Assets<Mesh>>().unwrap();
     let mut commands_queue = bevy::ecs::world::CommandQueue::default();

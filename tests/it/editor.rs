@@ -98,9 +98,9 @@ fn history_takes_one_step_per_gesture_and_redoes() {
     let mut h = History::default();
     h.begin_edit(&a);
     h.begin_edit(&b); // same gesture: ignored
-    h.end_gesture();
+    h.end_gesture(&b);
     h.begin_edit(&b);
-    h.end_gesture();
+    h.end_gesture(&c);
     assert_eq!(h.undo.len(), 2);
     assert_eq!(h.undo(c.clone()), Some(b.clone()));
     assert_eq!(h.undo(b.clone()), Some(a.clone()));
@@ -109,6 +109,23 @@ fn history_takes_one_step_per_gesture_and_redoes() {
     assert_eq!(h.redo(b.clone()), Some(c.clone()));
     h.begin_edit(&c);
     assert!(h.redo.is_empty(), "a new edit drops the redo steps");
+}
+
+#[test]
+fn a_gesture_that_changes_nothing_is_no_undo_step_and_keeps_redo() {
+    let a = doc_with(SourceDoc::Embedded("puppet".into()), &[]);
+    let mut b = a.clone();
+    b.characters[0].name = "b".into();
+    let mut h = History::default();
+    h.begin_edit(&a);
+    h.end_gesture(&b);
+    assert_eq!(h.undo(b.clone()), Some(a.clone()));
+    assert_eq!(h.redo.len(), 1);
+    // A click that selects a joint: the gesture begins, the scene stays `a`.
+    h.begin_edit(&a);
+    h.end_gesture(&a);
+    assert!(h.undo.is_empty(), "a click is no undo step");
+    assert_eq!(h.redo(a.clone()), Some(b.clone()), "the redo step survives the click");
 }
 
 #[test]
@@ -130,7 +147,7 @@ fn the_shipped_assets_are_what_the_generator_makes() {
         let shipped = std::fs::read_to_string(format!("{}/assets/puppet.{ext}", env!("CARGO_MANIFEST_DIR"))).unwrap();
         assert!(made == shipped, "assets/puppet.{ext} is stale: run `marionette gen-assets assets`");
     }
-    let _ = scene_to_string(&scene);
+    let _ = scene_to_string(&scene).expect("serialises");
 }
 
 /// Renders a small scene headlessly (Vulkan; llvmpipe without a GPU) and checks the picture.

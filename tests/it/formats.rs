@@ -53,7 +53,10 @@ fn mit6837_skel_with_a_joint_that_is_its_own_parent() {
 
 #[test]
 fn mit6837_skel_with_two_roots() {
-    assert_eq!(skel_err("0 0 0 -1\n0 0 0 -1\n"), "m.skel: the skeleton has several roots: joint0, joint1");
+    assert_eq!(
+        skel_err("0 0 0 -1\n0 0 0 -1\n"),
+        "m.skel:2: joint 1 is a second root (parent -1); expected a parent index in 0..1"
+    );
 }
 
 #[test]

@@ -1,10 +1,13 @@
 //! The one integration-test binary (each test binary links bevy, so there is only one).
 
+mod alloc;
 mod common;
 mod data;
 mod ecs;
 mod editor;
 mod formats;
+mod fuzz;
 mod ik;
 mod rig;
+mod robust;
 mod smpl;

@@ -211,8 +211,8 @@ fn flat_shading_unshares_vertices_with_one_unit_normal_per_triangle() {
     flat_shade(&positions, &triangles, &mut out_p, &mut out_n);
     assert_eq!(out_p[3], [1.0, 0.0, 0.0]);
     assert_eq!(out_p[4], [1.0, 1.0, 1.0]);
-    for k in 0..3 {
-        assert_eq!(out_n[k], [0.0, 0.0, 1.0]);
+    for n in &out_n[..3] {
+        assert_eq!(*n, [0.0, 0.0, 1.0]);
     }
     let n = Vec3::from(out_n[3]);
     assert!((n.length() - 1.0).abs() < 1e-6);

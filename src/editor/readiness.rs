@@ -1,0 +1,206 @@
+//! When a frame may be captured: every pipeline the frame needs is compiled (nothing
+//! waiting, nothing failed in the render world's `PipelineCache`), every drawn mesh and
+//! every camera's target image is prepared on the GPU, and every character is skinned for
+//! its current pose, for [`READY_FRAMES`] rendered frames in a row. The CLI render, F12
+//! and the test pictures capture only then. (Fast GPUs used to pass "two frames agree"
+//! while the PBR and shadow pipelines were still compiling in the background.)
+
+use std::sync::{Arc, Mutex};
+
+use bevy::camera::RenderTarget;
+use bevy::prelude::*;
+use bevy::render::mesh::RenderMesh;
+use bevy::render::render_asset::RenderAssets;
+use bevy::render::render_resource::{CachedPipelineState, PipelineCache};
+use bevy::render::texture::GpuImage;
+use bevy::render::{Render, RenderApp, RenderSystems};
+
+use super::document::PendingScene;
+use crate::scene::PoseDirty;
+
+/// Rendered frames in a row that must be ready before a capture.
+pub const READY_FRAMES: u32 = 3;
+
+/// What the render world reported after its last frame.
+#[derive(Debug, Clone, Default, PartialEq, Eq)]
+pub struct GpuStatus {
+    /// Render-world frames seen so far.
+    pub frame: u64,
+    /// Pipelines queued or compiling.
+    pub pipelines_waiting: usize,
+    /// Pipelines whose shaders failed (they will never draw).
+    pub pipelines_failed: Vec<String>,
+    /// Meshes drawn in the main world that the GPU does not hold yet.
+    pub meshes_missing: usize,
+    /// Camera target images the GPU does not hold yet.
+    pub images_missing: usize,
+}
+
+/// The assets the main world draws, for the render world to look for.
+#[derive(Debug, Clone, Default)]
+struct WantedAssets {
+    meshes: Vec<AssetId<Mesh>>,
+    images: Vec<AssetId<Image>>,
+}
+
+/// Shared between the main and the render world.
+#[derive(Resource, Clone, Default)]
+struct GpuStatusChannel {
+    wanted: Arc<Mutex<WantedAssets>>,
+    status: Arc<Mutex<GpuStatus>>,
+}
+
+/// Whether a capture may happen now.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum Readiness {
+    Ready,
+    /// Still waiting; says for what.
+    Waiting(String),
+    /// Can never become ready; says why.
+    Failed(String),
+}
+
+/// Decides from the render world's report and the main world's unfinished work
+/// (characters not yet skinned for their pose, a scene not yet built).
+pub fn readiness(gpu: &GpuStatus, characters_unskinned: usize, scene_pending: bool) -> Readiness {
+    if !gpu.pipelines_failed.is_empty() {
+        return Readiness::Failed(format!("pipelines failed to compile: {}", gpu.pipelines_failed.join("; ")));
+    }
+    let mut waiting = Vec::new();
+    if gpu.frame == 0 {
+        waiting.push("no frame rendered yet".to_string());
+    }
+    if scene_pending {
+        waiting.push("the scene is being built".to_string());
+    }
+    let mut count = |n: usize, what: &str| {
+        if n > 0 {
+            waiting.push(format!("{n} {what}"));
+        }
+    };
+    count(gpu.pipelines_waiting, "pipeline(s) compiling");
+    count(gpu.meshes_missing, "mesh(es) not on the GPU yet");
+    count(gpu.images_missing, "image(s) not on the GPU yet");
+    count(characters_unskinned, "character(s) not skinned for their pose yet");
+    if waiting.is_empty() { Readiness::Ready } else { Readiness::Waiting(waiting.join(", ")) }
+}
+
+/// Counts ready render frames in a row; what was last waited for.
+#[derive(Resource, Debug, Default)]
+pub struct CaptureGate {
+    ready_frames: u32,
+    last_frame: u64,
+    /// The last reason not to capture (for a time-out's message).
+    pub last_reason: Option<String>,
+    /// Set when the frame can never be ready.
+    pub failed: Option<String>,
+}
+
+impl CaptureGate {
+    /// Takes one frame's readiness (`frame` is the render world's frame it is based on:
+    /// a frame reported twice counts once).
+    pub fn observe(&mut self, frame: u64, readiness: Readiness) {
+        match readiness {
+            Readiness::Ready => {
+                if frame != self.last_frame {
+                    self.ready_frames += 1;
+                }
+                self.last_reason = None;
+            }
+            Readiness::Waiting(reason) => {
+                self.ready_frames = 0;
+                self.last_reason = Some(reason);
+            }
+            Readiness::Failed(reason) => {
+                self.ready_frames = 0;
+                self.failed = Some(reason);
+            }
+        }
+        self.last_frame = frame;
+    }
+
+    /// Whether enough ready frames passed in a row.
+    pub fn is_ready(&self) -> bool {
+        self.ready_frames >= READY_FRAMES && self.failed.is_none()
+    }
+
+    /// Starts counting again (after a capture, or when the scene changes).
+    pub fn restart(&mut self) {
+        self.ready_frames = 0;
+    }
+}
+
+/// The step (in `Last`) that updates [`CaptureGate`]; captures run after it.
+#[derive(SystemSet, Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub struct UpdateCaptureGate;
+
+/// Keeps a [`CaptureGate`] up to date from the render world (where there is one).
+pub struct ReadinessPlugin;
+
+impl Plugin for ReadinessPlugin {
+    fn build(&self, app: &mut App) {
+        let channel = GpuStatusChannel::default();
+        app.insert_resource(channel.clone())
+            .init_resource::<CaptureGate>()
+            .add_systems(Last, (publish_wanted_assets, update_capture_gate).chain().in_set(UpdateCaptureGate));
+        if let Some(render_app) = app.get_sub_app_mut(RenderApp) {
+            render_app.insert_resource(channel).add_systems(Render, report_gpu_status.in_set(RenderSystems::Cleanup));
+        }
+    }
+}
+
+/// Lists the meshes drawn and the cameras' target images (reads `Mesh3d`, `RenderTarget`;
+/// writes the channel).
+fn publish_wanted_assets(channel: Res<GpuStatusChannel>, meshes: Query<&Mesh3d>, targets: Query<&RenderTarget>) {
+    let wanted = WantedAssets {
+        meshes: meshes.iter().map(|m| m.id()).collect(),
+        images: targets.iter().filter_map(|t| t.as_image().map(Handle::id)).collect(),
+    };
+    if let Ok(mut w) = channel.wanted.lock() {
+        *w = wanted;
+    }
+}
+
+/// Feeds this frame's readiness to the gate (reads the channel, `PoseDirty`,
+/// `PendingScene`; writes `CaptureGate`).
+fn update_capture_gate(
+    channel: Res<GpuStatusChannel>,
+    dirty: Query<&PoseDirty>,
+    pending: Option<Res<PendingScene>>,
+    mut gate: ResMut<CaptureGate>,
+) {
+    let gpu = channel.status.lock().map(|s| s.clone()).unwrap_or_default();
+    let unskinned = dirty.iter().filter(|d| **d != PoseDirty::default()).count();
+    let scene_pending = pending.is_some_and(|p| p.doc.is_some());
+    gate.observe(gpu.frame, readiness(&gpu, unskinned, scene_pending));
+}
+
+/// After the render world's frame: counts pipelines waiting or failed and the wanted
+/// assets not prepared (reads `PipelineCache`, render assets; writes the channel).
+fn report_gpu_status(
+    channel: Res<GpuStatusChannel>,
+    cache: Res<PipelineCache>,
+    meshes: Res<RenderAssets<RenderMesh>>,
+    images: Res<RenderAssets<GpuImage>>,
+) {
+    let wanted = channel.wanted.lock().map(|w| w.clone()).unwrap_or_default();
+    // A pipeline whose shader is merely not loaded yet is retried (it stays waiting); one
+    // in error and not waiting has failed for good.
+    let waiting: std::collections::HashSet<_> = cache.waiting_pipelines().collect();
+    let pipelines_failed = cache
+        .pipelines()
+        .enumerate()
+        .filter_map(|(id, p)| match &p.state {
+            CachedPipelineState::Err(e) if !waiting.contains(&id) => Some(e.to_string()),
+            _ => None,
+        })
+        .collect::<Vec<_>>();
+    let Ok(mut status) = channel.status.lock() else { return };
+    *status = GpuStatus {
+        frame: status.frame + 1,
+        pipelines_waiting: waiting.len(),
+        pipelines_failed,
+        meshes_missing: wanted.meshes.iter().filter(|&&id| meshes.get(id).is_none()).count(),
+        images_missing: wanted.images.iter().filter(|&&id| images.get(id).is_none()).count(),
+    };
+}
