@@ -100,14 +100,6 @@ pub fn track_egui_pointer(
     }
 }
 
-/// The cursor in the camera's viewport (logical pixels from its top-left corner), as
-/// `Camera::viewport_to_world` and `world_to_viewport` expect; `None` outside the window.
-pub fn cursor_in_viewport(window: &Window, camera: &Camera) -> Option<Vec2> {
-    let cursor = window.cursor_position()?;
-    let origin = camera.logical_viewport_rect().map_or(Vec2::ZERO, |r| r.min);
-    Some(cursor - origin)
-}
-
 /// The part of the window between the side panels (logical pixels), set by the inspector;
 /// `None` leaves the camera on the whole window.
 #[derive(Resource, Clone, Copy, Debug, Default, PartialEq)]

@@ -9,12 +9,12 @@ use bevy::prelude::*;
 use bevy::window::PrimaryWindow;
 
 use super::Selection;
-use super::camera::ViewportHasPointer;
+use super::camera::{OrbitCamera, ViewportHasPointer};
 use super::document::SceneCharacter;
 use super::draw::SkeletonGizmos;
 use super::history::History;
 use super::inspector::SceneSnapshot;
-use super::picking::{PICK_RADIUS_PX, nearest_joint_on_screen};
+use super::picking::{CLICK_SLOP_PX, PICK_RADIUS_PX, nearest_joint_on_screen};
 use crate::posing::{IK_ROUNDS, IK_TOLERANCE};
 use crate::rig::ik::{IkGoal, solve_ik};
 use crate::scene::{Character, CurrentJointToWorld, JointPose, Placement};
@@ -29,6 +29,10 @@ pub struct Drag {
     pub plane_normal: Vec3,
     /// Pinned joints of that character and where they must stay (world).
     pub pins: Vec<(usize, Vec3)>,
+    /// Where the button went down (window pixels): the pose changes only once the cursor
+    /// has moved beyond [`CLICK_SLOP_PX`] from it, so a click is no edit.
+    pub pressed_at: Vec2,
+    pub moved: bool,
 }
 
 #[derive(Resource, Default)]
@@ -87,7 +91,7 @@ fn toggle_pins(
 fn start_drag(
     buttons: Res<ButtonInput<MouseButton>>,
     windows: Query<&Window, With<PrimaryWindow>>,
-    cameras: Query<(&Camera, &GlobalTransform)>,
+    cameras: Query<(&Camera, &GlobalTransform), With<OrbitCamera>>,
     characters: Query<(Entity, &SceneCharacter, &Character, &InheritedVisibility)>,
     joints: Query<&CurrentJointToWorld>,
     pointer: Res<ViewportHasPointer>,
@@ -100,7 +104,7 @@ fn start_drag(
         return;
     }
     let (Ok(window), Ok((camera, camera_transform))) = (windows.single(), cameras.single()) else { return };
-    let Some(cursor) = super::camera::cursor_in_viewport(window, camera) else { return };
+    let Some(cursor) = window.cursor_position() else { return };
     let Some(hit) =
         nearest_joint_on_screen(camera, camera_transform, cursor, PICK_RADIUS_PX * 0.5, &characters, &joints)
     else {
@@ -120,8 +124,15 @@ fn start_drag(
     if let Some(s) = snapshot {
         history.begin_edit(&s.0);
     }
-    drag.active =
-        Some(Drag { character: id, joint, plane_point: at, plane_normal: camera_transform.forward().as_vec3(), pins });
+    drag.active = Some(Drag {
+        character: id,
+        joint,
+        plane_point: at,
+        plane_normal: camera_transform.forward().as_vec3(),
+        pins,
+        pressed_at: cursor,
+        moved: false,
+    });
 }
 
 /// While the button is held, moves the dragged joint to the cursor in its plane by IK;
@@ -130,7 +141,7 @@ fn start_drag(
 fn drag_joint(
     buttons: Res<ButtonInput<MouseButton>>,
     windows: Query<&Window, With<PrimaryWindow>>,
-    cameras: Query<(&Camera, &GlobalTransform)>,
+    cameras: Query<(&Camera, &GlobalTransform), With<OrbitCamera>>,
     characters: Query<(&SceneCharacter, &Character, &Placement)>,
     mut poses: Query<&mut JointPose>,
     mut drag: ResMut<JointDrag>,
@@ -142,7 +153,15 @@ fn drag_joint(
         return;
     }
     let (Ok(window), Ok((camera, camera_transform))) = (windows.single(), cameras.single()) else { return };
-    let Some(cursor) = super::camera::cursor_in_viewport(window, camera) else { return };
+    let Some(cursor) = window.cursor_position() else { return };
+    if !active.moved {
+        if cursor.distance(active.pressed_at) <= CLICK_SLOP_PX {
+            return;
+        }
+        if let Some(d) = drag.active.as_mut() {
+            d.moved = true;
+        }
+    }
     let Ok(ray) = camera.viewport_to_world(camera_transform, cursor) else { return };
     let denom = ray.direction.dot(active.plane_normal);
     if denom.abs() < 1e-6 {

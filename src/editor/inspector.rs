@@ -493,8 +493,10 @@ fn joint_panel(ui: &mut egui::Ui, state: &mut InspectorState, edit: &mut Editabl
 /// Indentation of one tree level, and the deepest level indented further.
 const TREE_INDENT: f32 = 12.0;
 const TREE_MAX_INDENT_LEVELS: usize = 24;
+/// Width of the collapse toggle (and of the space leaves keep in its place).
+const TREE_TOGGLE_WIDTH: f32 = 14.0;
 
-/// The joint tree as indented rows, collapsible per joint (▸/▾); a click selects,
+/// The joint tree as indented rows, collapsible per joint (+/-); a click selects,
 /// Shift/Ctrl-click adds. Walked with an explicit stack, so any depth shows.
 fn joint_tree(ui: &mut egui::Ui, skeleton: &Skeleton, root: usize, id: u64, selection: &mut Selection, additive: bool) {
     let mut todo = vec![(root, 0usize)];
@@ -504,7 +506,13 @@ fn joint_tree(ui: &mut egui::Ui, skeleton: &Skeleton, root: usize, id: u64, sele
         let mut collapsed = ui.data(|d| d.get_temp::<bool>(key)).unwrap_or(false);
         ui.horizontal(|ui| {
             ui.add_space(TREE_INDENT * depth.min(TREE_MAX_INDENT_LEVELS) as f32);
-            if !children.is_empty() && ui.small_button(if collapsed { "▸" } else { "▾" }).clicked() {
+            if children.is_empty() {
+                ui.add_space(TREE_TOGGLE_WIDTH);
+            } else if ui
+                .add_sized([TREE_TOGGLE_WIDTH, 16.0], egui::Button::new(if collapsed { "+" } else { "-" }).small())
+                .on_hover_text(if collapsed { "show the joints below" } else { "hide the joints below" })
+                .clicked()
+            {
                 collapsed = !collapsed;
                 ui.data_mut(|d| d.insert_temp(key, collapsed));
             }

@@ -128,6 +128,8 @@ pub fn run(paths: Vec<PathBuf>) {
             ..default()
         }))
         .add_plugins(bevy_egui::EguiPlugin::default())
+        // egui lives on its own full-window camera (see `spawn_window_camera`).
+        .insert_resource(bevy_egui::EguiGlobalSettings { auto_create_primary_context: false, ..default() })
         .insert_resource(ClearColor(stage::SKY))
         .insert_resource(StartupPaths(paths))
         .add_plugins((
@@ -143,9 +145,16 @@ pub fn run(paths: Vec<PathBuf>) {
         .run();
 }
 
+/// The 3D view (whose viewport is the area between the panels) and, drawn over the whole
+/// window after it, a camera that carries egui's context and renders nothing else.
 fn spawn_window_camera(mut commands: Commands) {
     let orbit = OrbitCamera::default();
     commands.spawn((Camera3d::default(), orbit, orbit.transform()));
+    commands.spawn((
+        Camera2d,
+        Camera { order: 1, clear_color: ClearColorConfig::None, ..default() },
+        bevy_egui::PrimaryEguiContext,
+    ));
 }
 
 fn setup_skin_material(mut commands: Commands, mut materials: ResMut<Assets<StandardMaterial>>) {

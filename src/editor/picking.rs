@@ -4,7 +4,7 @@ use bevy::prelude::*;
 use bevy::window::PrimaryWindow;
 
 use super::Selection;
-use super::camera::{ViewportHasPointer, cursor_in_viewport};
+use super::camera::{OrbitCamera, ViewportHasPointer};
 use super::document::SceneCharacter;
 use crate::scene::{Character, CurrentJointToWorld};
 
@@ -15,6 +15,10 @@ pub struct PointerPress(pub Option<Vec2>);
 /// Screen distance (pixels) within which a click picks a joint.
 pub const PICK_RADIUS_PX: f32 = 40.0;
 
+/// How far (pixels) the cursor may move between press and release for a click; a drag
+/// starts beyond it.
+pub const CLICK_SLOP_PX: f32 = 4.0;
+
 /// On a left click (press and release within a few pixels) in the viewport, selects the
 /// visible joint nearest to the cursor on screen; Shift or Ctrl adds to the selection
 /// (reads input, joint matrices; writes `Selection`).
@@ -23,7 +27,7 @@ pub fn pick_joint_on_click(
     buttons: Res<ButtonInput<MouseButton>>,
     keys: Res<ButtonInput<KeyCode>>,
     windows: Query<&Window, With<PrimaryWindow>>,
-    cameras: Query<(&Camera, &GlobalTransform)>,
+    cameras: Query<(&Camera, &GlobalTransform), With<OrbitCamera>>,
     characters: Query<(Entity, &SceneCharacter, &Character, &InheritedVisibility)>,
     joints: Query<&CurrentJointToWorld>,
     pointer: Res<ViewportHasPointer>,
@@ -31,7 +35,7 @@ pub fn pick_joint_on_click(
     mut selection: ResMut<Selection>,
 ) {
     let (Ok(window), Ok((camera, camera_transform))) = (windows.single(), cameras.single()) else { return };
-    let cursor = cursor_in_viewport(window, camera);
+    let cursor = window.cursor_position();
     if buttons.just_pressed(MouseButton::Left) {
         press.0 = cursor.filter(|_| pointer.0);
     }
@@ -41,7 +45,7 @@ pub fn pick_joint_on_click(
     let (Some(start), Some(cursor)) = (press.0.take(), cursor) else {
         return;
     };
-    if start.distance(cursor) > 4.0 {
+    if start.distance(cursor) > CLICK_SLOP_PX {
         return;
     }
     let best = nearest_joint_on_screen(camera, camera_transform, cursor, PICK_RADIUS_PX, &characters, &joints);

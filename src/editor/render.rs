@@ -100,20 +100,22 @@ pub fn render(
 /// file, an unparsable scene or a character that fails to load is an error (and no picture
 /// is written). Returns the loaded assets for the app to reuse.
 fn preload(paths: &[PathBuf]) -> Result<AssetLibrary, String> {
-    let sources: Vec<(SourceDoc, Option<BindingDoc>)> = match scene_path(paths) {
+    // Each source, with what names it in a scene file (for the message).
+    let sources: Vec<(SourceDoc, Option<BindingDoc>, String)> = match scene_path(paths) {
         Some(scene) => read_scene(scene)
             .map_err(|e| e.to_string())?
             .characters
             .into_iter()
-            .map(|c| (c.source, c.binding))
+            .map(|c| (c.source, c.binding, format!(" (character `{}` of {})", c.name, scene.display())))
             .collect(),
-        None => paths.iter().map(|p| (SourceDoc::File(p.clone()), None)).collect(),
+        None => paths.iter().map(|p| (SourceDoc::File(p.clone()), None, String::new())).collect(),
     };
     let mut library = AssetLibrary::default();
     let errors: Vec<String> = sources
         .iter()
-        .filter_map(|(source, binding)| library.load_bound(source, *binding).err())
-        .map(|e| e.to_string())
+        .filter_map(|(source, binding, named_in)| {
+            library.load_bound(source, *binding).err().map(|e| format!("{e}{named_in}"))
+        })
         .collect();
     if errors.is_empty() { Ok(library) } else { Err(errors.join("\n")) }
 }

@@ -24,7 +24,8 @@ pub struct SkinWeights {
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct NormalisedRow {
     pub vertex: usize,
-    pub sum: f32,
+    /// The row's sum before normalising (f64: f32 weights may sum past f32::MAX).
+    pub sum: f64,
 }
 
 /// Rows whose sum differs from 1 by more than this are reported when normalised.
@@ -62,7 +63,7 @@ impl SkinWeights {
                 return Err(RigError::NoInfluence { vertex });
             }
             if (sum - 1.0).abs() > f64::from(WEIGHT_SUM_TOLERANCE) {
-                normalised.push(NormalisedRow { vertex, sum: sum as f32 });
+                normalised.push(NormalisedRow { vertex, sum });
             }
             row.iter_mut().for_each(|i| i.weight = (f64::from(i.weight) / sum) as f32);
             if weights.influences.len() > u32::MAX as usize {
