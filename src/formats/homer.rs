@@ -128,6 +128,19 @@ pub fn load_homer(path: &Path) -> Result<CharacterAsset, FormatError> {
         FormatError::other(path, "expected an OFF mesh beside it (homer.off or homer3x.off), found none")
     })?;
     let mesh = parse_off(open(&mesh_path)?, &mesh_path)?;
+    let name = path.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_else(|| "homer".into());
+    homer_character(name, rig, mesh, path)
+}
+
+/// A character from a parsed rig and its mesh: the rig's weights (normalised, each vertex
+/// needing one), or, without weights, a smooth binding to the bones. Errors name the rig's
+/// JSON path.
+pub fn homer_character(
+    name: String,
+    rig: HomerRig,
+    mesh: super::obj::ObjMesh,
+    rig_path: &Path,
+) -> Result<CharacterAsset, FormatError> {
     let n = mesh.positions.len();
     let mut warnings = Vec::new();
     let weights = match &rig.weights {
@@ -135,24 +148,28 @@ pub fn load_homer(path: &Path) -> Result<CharacterAsset, FormatError> {
             let mut rows: Vec<Vec<(usize, f32)>> = vec![Vec::new(); n];
             for &(j, v, w) in triples {
                 let row = rows.get_mut(v).ok_or_else(|| {
-                    FormatError::other(path, format!("a weight names vertex {v}, but {} has {n}", mesh_path.display()))
+                    let joint = &rig.skeleton.joint(j).name;
+                    json_error(
+                        rig_path,
+                        &format!("$[{joint:?}].weights[\"{v}\"]"),
+                        format!("expected a vertex index below {n} (the mesh's count), found {v}"),
+                    )
                 })?;
                 row.push((j, w));
             }
             let (weights, normalised) =
-                SkinWeights::from_rows(rows, rig.skeleton.len()).map_err(|e| FormatError::rig(path, e))?;
-            warnings.extend(super::character::normalised_warnings(path, &normalised));
+                SkinWeights::from_rows(rows, rig.skeleton.len()).map_err(|e| json_error(rig_path, "$", e))?;
+            warnings.extend(super::character::normalised_warnings(rig_path, &normalised));
             weights
         }
         None => {
             warnings.push(format!(
                 "{}: no weights in the rig; bound smoothly from the distance to the bones",
-                path.display()
+                rig_path.display()
             ));
             bind_to_bones(&mesh.positions, &bones(&rig.skeleton, &rig.positions), rig.skeleton.len(), Binding::Smooth)
         }
     };
-    let name = path.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_else(|| "homer".into());
     let skin = Skin { bind_positions: mesh.positions, triangles: mesh.triangles, weights };
-    CharacterAsset::new(name, rig.skeleton, skin, warnings).map_err(|e| FormatError::rig(path, e))
+    CharacterAsset::new(name, rig.skeleton, skin, warnings).map_err(|e| json_error(rig_path, "$", e))
 }

@@ -31,7 +31,10 @@ const MEMORY_PER_INPUT_BYTE: usize = 256;
 #[derive(Debug, Clone, Copy, PartialEq)]
 enum Reader {
     Skel6837,
-    Attach { joints: usize, vertices: usize },
+    Attach {
+        joints: usize,
+        vertices: usize,
+    },
     Cse169Skel,
     Obj,
     Off,
@@ -40,6 +43,8 @@ enum Reader {
     SmplSkin,
     SmplClip,
     HomerRig,
+    /// A rig JSON with a small fixed mesh: parsing, then weights or smooth binding.
+    HomerCharacter,
     Scene,
 }
 
@@ -58,9 +63,16 @@ fn read(reader: Reader, bytes: &[u8]) -> Result<(), FormatError> {
         Reader::SmplSkin => smpl::parse_skin(input, path, 24).map(drop),
         Reader::SmplClip => smpl::parse_clip(input, path, 24).map(drop),
         Reader::HomerRig => homer::parse_rig(input, path).map(drop),
+        Reader::HomerCharacter => {
+            let mesh = off::parse_off(Cursor::new(SMALL_OFF), Path::new("small.off")).expect("a valid mesh");
+            homer::homer_character("h".into(), homer::parse_rig(input, path)?, mesh, path).map(drop)
+        }
         Reader::Scene => scene::parse_scene(input, path).map(drop),
     }
 }
+
+/// The mesh given to `HomerCharacter` cases (vertices 0..=3).
+const SMALL_OFF: &str = "OFF\n4 2 0\n0 0 0\n1 0 0\n0 1 0\n1 1 0\n3 0 1 2\n4 0 1 3 2 255 0 0\n";
 
 /// Whether an error says where in the file the problem is.
 fn names_a_place(e: &FormatError) -> bool {
@@ -73,14 +85,18 @@ fn names_a_place(e: &FormatError) -> bool {
     }
 }
 
-/// The first `SEED_BYTES` of a file, cut at a line end (cut seeds are invalid files, which
+/// A file, or for a large one its first and last `SEED_BYTES / 2` cut at line ends (so
+/// headers and later sections such as faces are both mutated; a cut file is invalid, which
 /// is fine for mutation), and whether it is whole.
 fn seed_prefix(bytes: Vec<u8>) -> (Vec<u8>, bool) {
     if bytes.len() <= SEED_BYTES {
         return (bytes, true);
     }
-    let cut = bytes[..SEED_BYTES].iter().rposition(|&b| b == b'\n').map_or(SEED_BYTES, |i| i + 1);
-    (bytes[..cut].to_vec(), false)
+    let half = SEED_BYTES / 2;
+    let head = bytes[..half].iter().rposition(|&b| b == b'\n').map_or(half, |i| i + 1);
+    let from = bytes.len() - half;
+    let tail = bytes[from..].iter().position(|&b| b == b'\n').map_or(from, |i| from + i + 1);
+    ([&bytes[..head], &bytes[tail..]].concat(), false)
 }
 
 fn lines(bytes: &[u8]) -> usize {
@@ -98,7 +114,7 @@ fn inline_seeds() -> Vec<Seed> {
             "balljoint root {\n offset 0 0 0\n boxmin -1 -1 -1 boxmax 1 1 1\n rotxlimit -1 1\n pose 0 0.5 0\n balljoint a{ offset 0 1 0 balljoint b { offset 0 1 0 } }\n}\n",
         ),
         s(Reader::Obj, "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\nf 1 2 3\nf 2/1 4/2 3/3\nf -1 -2 -3\n"),
-        s(Reader::Off, "OFF\n4 2 0\n0 0 0\n1 0 0\n0 1 0\n1 1 0\n3 0 1 2\n4 0 1 3 2 255 0 0\n"),
+        s(Reader::Off, SMALL_OFF),
         s(Reader::SmplHierarchy, &smpl_hierarchy()),
         s(Reader::SmplSkeleton, &format!("1 24\n{}\n", vec!["0 0 0 1 0.1 0.2 0.3"; 24].join(" "))),
         s(Reader::SmplSkin, &format!("2 24 2\n0 0.5 1 0.5\n{}\n", "23 1 0 0")),
@@ -106,6 +122,14 @@ fn inline_seeds() -> Vec<Seed> {
         s(
             Reader::HomerRig,
             r#"{"root":{"pos":[0,0,0],"children":["a"]},"a":{"pos":[0,1,0],"children":["b"],"weights":{"0":0.5,"1":1}},"b":{"pos":[0,2,0]}}"#,
+        ),
+        s(
+            Reader::HomerCharacter,
+            r#"{"root":{"pos":[0,0,0],"children":["a","c"]},"a":{"pos":[0,1,0],"children":["b"]},"b":{"pos":[0,2,0]},"c":{"pos":[1,0,0]}}"#,
+        ),
+        s(
+            Reader::HomerCharacter,
+            r#"{"root":{"pos":[0,0,0],"children":["a"],"weights":{"0":1,"1":0.5,"2":1,"3":1}},"a":{"pos":[0,1,0],"weights":{"1":0.5}}}"#,
         ),
         s(
             Reader::Scene,
@@ -163,6 +187,7 @@ fn file_seeds() -> Vec<Seed> {
     let homer = data.join("homer");
     seeds.push(seed(Reader::Off, homer.join("homer.off")));
     seeds.push(seed(Reader::HomerRig, homer.join("homerskel.json")));
+    seeds.push(seed(Reader::HomerCharacter, homer.join("homerskel.json")));
     seeds.push(seed(Reader::HomerRig, homer.join("homer.json")));
     let smpl = data.join("smpl");
     seeds.push(seed(Reader::SmplHierarchy, smpl.join("smpl_hierarchy.txt")));
@@ -241,7 +266,7 @@ fn mutate(mut bytes: Vec<u8>, u: &mut Unstructured) -> arbitrary::Result<Vec<u8>
         let len = bytes.len();
         let at = if len == 0 { 0 } else { u.choose_index(len)? };
         let span = u.int_in_range(1..=64usize)?.min(len - at.min(len));
-        match u.int_in_range(0..=6)? {
+        match u.int_in_range(0..=8)? {
             0 if len > 0 => bytes[at] ^= 1 << u.int_in_range(0..=7)?,
             1 => {
                 bytes.drain(at..at + span);
@@ -251,8 +276,12 @@ fn mutate(mut bytes: Vec<u8>, u: &mut Unstructured) -> arbitrary::Result<Vec<u8>
                 let to = if bytes.is_empty() { 0 } else { u.choose_index(bytes.len())? };
                 bytes.splice(to..to, copy);
             }
-            3 => {
-                let spans = number_spans(&bytes);
+            3 | 7 | 8 => {
+                // Numbers, half the time the first of a line (counts, parents, polygon sizes).
+                let mut spans = number_spans(&bytes);
+                if u.arbitrary()? {
+                    spans.retain(|&(s, _)| s == 0 || bytes[s - 1] == b'\n');
+                }
                 if !spans.is_empty() {
                     let (s, e) = spans[u.choose_index(spans.len())?];
                     bytes.splice(s..e, u.choose(EXTREMES)?.bytes());
@@ -353,6 +382,7 @@ fn regressions_are_rejected_with_a_place() {
             "skel" => Reader::Skel6837,
             "off" => Reader::Off,
             "obj" => Reader::Obj,
+            "json" if name.contains("character") => Reader::HomerCharacter,
             "json" => Reader::HomerRig,
             "ron" => Reader::Scene,
             "txt" if name.contains("skin") => Reader::SmplSkin,
