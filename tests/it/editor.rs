@@ -215,3 +215,59 @@ fn model1_and_model2_render_side_by_side() {
     assert!(output.status.success(), "{}", String::from_utf8_lossy(&output.stderr));
     assert_eq!(image::open(&out).unwrap().to_rgb8().dimensions(), (160, 120));
 }
+
+#[derive(bevy::prelude::Resource, Default)]
+struct Captured(SceneDoc);
+
+fn capture_scene(reader: marionette::editor::document::SceneReader, mut out: bevy::prelude::ResMut<Captured>) {
+    out.0 = reader.capture();
+}
+
+/// Open replaces the world: the old selection, pins and history refer to nothing in it
+/// and are cleared; a character that fails to load is reported and kept, as it was, in
+/// what Save writes.
+#[test]
+fn opening_a_scene_clears_selection_pins_and_history_and_keeps_unloadable_characters() {
+    use bevy::prelude::*;
+    use marionette::editor::document::{AssetLibrary, NextCharacterId, PendingScene, SceneCharacter};
+    use marionette::editor::ik_drag::Pins;
+    use marionette::editor::stage::StageSettings;
+    use marionette::editor::{Messages, Selection, UnloadedCharacters, apply_pending_scene};
+
+    let mut app = crate::ecs::app();
+    app.init_resource::<AssetLibrary>()
+        .init_resource::<NextCharacterId>()
+        .init_resource::<Messages>()
+        .init_resource::<StageSettings>()
+        .init_resource::<Selection>()
+        .init_resource::<UnloadedCharacters>()
+        .init_resource::<PendingScene>()
+        .init_resource::<Pins>()
+        .init_resource::<History>()
+        .init_resource::<Captured>()
+        .add_systems(Update, (apply_pending_scene, capture_scene).chain());
+    // What the previous scene left behind.
+    *app.world_mut().resource_mut::<Selection>() = Selection { character: Some(7), joints: vec![40] };
+    app.world_mut().resource_mut::<Pins>().0.insert(7, vec![40]);
+    app.world_mut().resource_mut::<History>().undo.push(SceneDoc::default());
+
+    let mut doc = doc_with(SourceDoc::Embedded("puppet".into()), &[]);
+    let mut missing = doc.characters[0].clone();
+    missing.source = SourceDoc::File("/nonexistent/gone.skel".into());
+    missing.name = "gone".into();
+    doc.characters.push(missing.clone());
+    *app.world_mut().resource_mut::<PendingScene>() = PendingScene { doc: Some(doc), with_camera: true, frame: false };
+    app.update();
+    app.update();
+
+    let world = app.world_mut();
+    assert_eq!(*world.resource::<Selection>(), Selection::default());
+    assert!(world.resource::<Pins>().0.is_empty());
+    assert!(world.resource::<History>().undo.is_empty());
+    assert_eq!(world.query::<&SceneCharacter>().iter(world).count(), 1);
+    let messages = &world.resource::<Messages>().0;
+    assert!(messages.iter().any(|m| m.contains("gone.skel") && m.contains("kept in the scene file")), "{messages:?}");
+    let saved = &world.resource::<Captured>().0;
+    assert_eq!(saved.characters.len(), 2);
+    assert_eq!(saved.characters[1], missing, "the unloadable character is saved as it was");
+}
