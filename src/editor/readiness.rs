@@ -123,11 +123,6 @@ impl CaptureGate {
     pub fn is_ready(&self) -> bool {
         self.ready_frames >= READY_FRAMES && self.failed.is_none()
     }
-
-    /// Starts counting again (after a capture, or when the scene changes).
-    pub fn restart(&mut self) {
-        self.ready_frames = 0;
-    }
 }
 
 /// The step (in `Last`) that updates [`CaptureGate`]; captures run after it.

@@ -8,9 +8,9 @@ use crate::rig::RigError;
 /// A reader's failure.
 #[derive(Debug, thiserror::Error)]
 pub enum FormatError {
-    /// `path:line: message` — the input is not what the format expects.
-    #[error("{}:{line}: {message}", path.display())]
-    Syntax { path: PathBuf, line: usize, message: String },
+    /// `path:line[:column]: message` — the input is not what the format expects.
+    #[error("{}:{line}{}: {message}", path.display(), column.map(|c| format!(":{c}")).unwrap_or_default())]
+    Syntax { path: PathBuf, line: usize, column: Option<usize>, message: String },
     /// The file parsed, but the rig it describes is invalid.
     // The cause is part of the message (not an error `source`), so chains print it once.
     #[error("{}: {cause}", path.display())]
@@ -25,7 +25,12 @@ pub enum FormatError {
 
 impl FormatError {
     pub fn syntax(path: &Path, line: usize, message: impl fmt::Display) -> Self {
-        Self::Syntax { path: path.to_path_buf(), line, message: message.to_string() }
+        Self::Syntax { path: path.to_path_buf(), line, column: None, message: message.to_string() }
+    }
+
+    /// As [`syntax`](Self::syntax), at a column of the line (counted from 1).
+    pub fn syntax_at(path: &Path, line: usize, column: usize, message: impl fmt::Display) -> Self {
+        Self::Syntax { path: path.to_path_buf(), line, column: Some(column), message: message.to_string() }
     }
 
     pub fn rig(path: &Path, source: RigError) -> Self {

@@ -43,8 +43,13 @@ fn json_error(path: &Path, at: &str, message: impl std::fmt::Display) -> FormatE
 /// path (`$["joint"].pos`) or the line.
 pub fn parse_rig(reader: impl BufRead, path: &Path) -> Result<HomerRig, FormatError> {
     let text = super::error::read_text(reader, path)?;
-    let raw: BTreeMap<String, RawHomerJoint> =
-        serde_json::from_str(&text).map_err(|e| FormatError::syntax(path, e.line().max(1), e.to_string()))?;
+    let raw: BTreeMap<String, RawHomerJoint> = serde_json::from_str(&text).map_err(|e| {
+        let (line, column) = (e.line().max(1), e.column().max(1));
+        // serde_json's message ends with its own "at line L column C".
+        let message = e.to_string();
+        let message = message.strip_suffix(&format!(" at line {} column {}", e.line(), e.column())).unwrap_or(&message);
+        FormatError::syntax_at(path, line, column, message)
+    })?;
     if raw.is_empty() {
         return Err(json_error(path, "$", "expected at least one joint, found an empty object"));
     }

@@ -244,9 +244,8 @@ fn joint_of_indexed_key(skeleton: &Skeleton, key: &str) -> Option<usize> {
 /// (`characters[1].placement.scale`).
 pub fn parse_scene(reader: impl BufRead, path: &Path) -> Result<SceneDoc, FormatError> {
     let text = super::error::read_text(reader, path)?;
-    let doc: SceneDoc = ron::from_str(&text).map_err(|e| {
-        FormatError::syntax(path, e.span.start.line.max(1), format!("column {}: {}", e.span.start.col, e.code))
-    })?;
+    let doc: SceneDoc = ron::from_str(&text)
+        .map_err(|e| FormatError::syntax_at(path, e.span.start.line.max(1), e.span.start.col.max(1), e.code))?;
     doc.validate().map_err(|e| FormatError::other(path, e))?;
     Ok(doc)
 }

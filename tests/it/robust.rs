@@ -244,7 +244,7 @@ fn render_fails_without_a_picture_for_missing_or_bad_input() {
     let cases: Vec<(Vec<String>, String)> = vec![
         (vec![dir.join("nope.skel").display().to_string()], "nope.skel".into()),
         (vec![missing_scene.display().to_string()], "nope.skel".into()),
-        (vec![regression("scene-truncated.ron")], "scene-truncated.ron:1:".into()),
+        (vec![regression("scene-truncated.ron")], "scene-truncated.ron:1:39: Expected comma".into()),
         (vec![regression("nan-offset.skel")], "nan-offset.skel:2: expected a finite number, found `nan`".into()),
     ];
     for (paths, expected) in cases {
