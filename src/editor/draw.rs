@@ -42,8 +42,10 @@ pub fn draw_skeletons(
             if sc.is_some_and(|s| Some(s.id) == selection.character) { &selection.joints } else { &[] };
         let size = character_size(character) * placement.scale;
         let radius = (size * 0.012).max(0.003);
-        let world =
-            |j: usize| character.joints.get(j).and_then(|&e| joints.get(e).ok()).map_or(Mat4::IDENTITY, |c| c.0);
+        let model_to_world = placement.to_mat4();
+        let world = |j: usize| {
+            model_to_world * character.joints.get(j).and_then(|&e| joints.get(e).ok()).map_or(Mat4::IDENTITY, |c| c.0)
+        };
         for &j in selected {
             gizmos.sphere(Isometry3d::from_translation(world(j).w_axis.truncate()), radius * 2.2, SELECTED_COLOR);
         }

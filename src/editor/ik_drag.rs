@@ -14,7 +14,7 @@ use super::document::SceneCharacter;
 use super::draw::SkeletonGizmos;
 use super::history::History;
 use super::inspector::SceneSnapshot;
-use super::picking::{CLICK_SLOP_PX, PICK_RADIUS_PX, nearest_joint_on_screen};
+use super::picking::{CLICK_SLOP_PX, PICK_RADIUS_PX, PickableCharacters, nearest_joint_on_screen};
 use crate::posing::{IK_ROUNDS, IK_TOLERANCE};
 use crate::rig::ik::{IkGoal, solve_ik};
 use crate::scene::{Character, CurrentJointToWorld, JointPose, Placement};
@@ -92,7 +92,7 @@ fn start_drag(
     buttons: Res<ButtonInput<MouseButton>>,
     windows: Query<&Window, With<PrimaryWindow>>,
     cameras: Query<(&Camera, &GlobalTransform), With<OrbitCamera>>,
-    characters: Query<(Entity, &SceneCharacter, &Character, &InheritedVisibility)>,
+    characters: PickableCharacters,
     joints: Query<&CurrentJointToWorld>,
     pointer: Res<ViewportHasPointer>,
     pins: Res<Pins>,
@@ -111,14 +111,14 @@ fn start_drag(
         return;
     };
     let (id, joint, at) = (hit.id, hit.joint, hit.position);
-    let Ok((_, _, character, _)) = characters.get(hit.entity) else { return };
+    let Ok((_, _, character, placement, _)) = characters.get(hit.entity) else { return };
     if character.asset.skeleton.parent(joint).is_none() {
         return;
     }
     let pins = pins.0.get(&id).map_or(Vec::new(), |list| {
         list.iter()
             .filter(|&&p| p != joint)
-            .filter_map(|&p| Some((p, joints.get(*character.joints.get(p)?).ok()?.position())))
+            .filter_map(|&p| Some((p, joints.get(*character.joints.get(p)?).ok()?.world_position(placement))))
             .collect()
     });
     if let Some(s) = snapshot {
@@ -192,11 +192,11 @@ fn draw_handles(
     selection: Res<Selection>,
     pins: Res<Pins>,
     drag: Res<JointDrag>,
-    characters: Query<(&SceneCharacter, &Character)>,
+    characters: Query<(&SceneCharacter, &Character, &Placement)>,
     joints: Query<&CurrentJointToWorld>,
     mut gizmos: Gizmos<SkeletonGizmos>,
 ) {
-    for (sc, character) in &characters {
+    for (sc, character, placement) in &characters {
         let pinned = pins.0.get(&sc.id);
         let selected = selection.character == Some(sc.id);
         if !selected && pinned.is_none_or(|p| p.is_empty()) {
@@ -219,7 +219,7 @@ fn draw_handles(
             } else {
                 Color::srgb(0.2, 0.9, 1.0)
             };
-            gizmos.cube(Transform::from_translation(m.position()).with_scale(Vec3::splat(size)), color);
+            gizmos.cube(Transform::from_translation(m.world_position(placement)).with_scale(Vec3::splat(size)), color);
         }
     }
 }

@@ -535,7 +535,7 @@ pub fn shortcuts(
     keys: Res<ButtonInput<KeyCode>>,
     wants: Option<Res<bevy_egui::input::EguiWantsInput>>,
     selection: Res<Selection>,
-    mut characters: Query<(&SceneCharacter, &Character, &mut DisplayMode)>,
+    mut characters: Query<(&SceneCharacter, &Character, &mut DisplayMode, &Placement)>,
     joints: Query<&CurrentJointToWorld>,
     mut stage: ResMut<StageSettings>,
     mut history: ResMut<History>,
@@ -573,10 +573,10 @@ pub fn shortcuts(
     }
     let selected = characters.iter_mut().find(|c| Some(c.0.id) == selection.character);
     if keys.just_pressed(KeyCode::KeyS) {
-        if let Some((.., mut display)) = selected {
+        if let Some((_, _, mut display, _)) = selected {
             *display = display.next();
         } else {
-            for (.., mut display) in &mut characters {
+            for (_, _, mut display, _) in &mut characters {
                 *display = display.next();
             }
         }
@@ -584,7 +584,7 @@ pub fn shortcuts(
         let points: Vec<Vec3> = characters
             .iter()
             .filter(|c| selection.character.is_none() || Some(c.0.id) == selection.character)
-            .flat_map(|(_, character, _)| {
+            .flat_map(|(_, character, _, placement)| {
                 let chosen: Vec<usize> = if selection.joints.is_empty() || selection.character.is_none() {
                     (0..character.joints.len()).collect()
                 } else {
@@ -592,7 +592,7 @@ pub fn shortcuts(
                 };
                 chosen
                     .into_iter()
-                    .filter_map(|j| Some(joints.get(*character.joints.get(j)?).ok()?.position()))
+                    .filter_map(|j| Some(joints.get(*character.joints.get(j)?).ok()?.world_position(placement)))
                     .collect::<Vec<_>>()
             })
             .collect();

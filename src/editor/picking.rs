@@ -6,7 +6,7 @@ use bevy::window::PrimaryWindow;
 use super::Selection;
 use super::camera::{OrbitCamera, ViewportHasPointer};
 use super::document::SceneCharacter;
-use crate::scene::{Character, CurrentJointToWorld};
+use crate::scene::{Character, CurrentJointToWorld, Placement};
 
 /// Where the left button went down, to tell a click from a drag.
 #[derive(Resource, Default)]
@@ -28,7 +28,7 @@ pub fn pick_joint_on_click(
     keys: Res<ButtonInput<KeyCode>>,
     windows: Query<&Window, With<PrimaryWindow>>,
     cameras: Query<(&Camera, &GlobalTransform), With<OrbitCamera>>,
-    characters: Query<(Entity, &SceneCharacter, &Character, &InheritedVisibility)>,
+    characters: PickableCharacters,
     joints: Query<&CurrentJointToWorld>,
     pointer: Res<ViewportHasPointer>,
     mut press: ResMut<PointerPress>,
@@ -58,6 +58,14 @@ pub fn pick_joint_on_click(
     }
 }
 
+/// The characters whose joints can be picked: with their placement (joint matrices are
+/// in model space) and whether they are shown.
+pub type PickableCharacters<'w, 's> = Query<
+    'w,
+    's,
+    (Entity, &'static SceneCharacter, &'static Character, &'static Placement, &'static InheritedVisibility),
+>;
+
 /// A joint found under the cursor.
 #[derive(Debug, Clone, Copy)]
 pub struct JointHit {
@@ -75,20 +83,21 @@ pub fn nearest_joint_on_screen(
     camera_transform: &GlobalTransform,
     cursor: Vec2,
     radius: f32,
-    characters: &Query<(Entity, &SceneCharacter, &Character, &InheritedVisibility)>,
+    characters: &PickableCharacters,
     joints: &Query<&CurrentJointToWorld>,
 ) -> Option<JointHit> {
     let mut best: Option<(f32, JointHit)> = None;
-    for (entity, sc, character, visible) in characters {
+    for (entity, sc, character, placement, visible) in characters {
         if !visible.get() {
             continue;
         }
         for (j, &e) in character.joints.iter().enumerate() {
             let Ok(m) = joints.get(e) else { continue };
-            let Ok(screen) = camera.world_to_viewport(camera_transform, m.position()) else { continue };
+            let position = m.world_position(placement);
+            let Ok(screen) = camera.world_to_viewport(camera_transform, position) else { continue };
             let d = screen.distance(cursor);
             if d < radius && best.is_none_or(|b| d < b.0 - 0.5) {
-                best = Some((d, JointHit { entity, id: sc.id, joint: j, position: m.position() }));
+                best = Some((d, JointHit { entity, id: sc.id, joint: j, position }));
             }
         }
     }

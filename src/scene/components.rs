@@ -43,11 +43,16 @@ impl Placement {
 
     /// The model-to-world matrix.
     pub fn to_mat4(&self) -> Mat4 {
-        Mat4::from_scale_rotation_translation(
-            Vec3::splat(self.scale),
-            Quat::from_rotation_y(self.yaw),
-            self.translation,
-        )
+        self.to_transform().to_matrix()
+    }
+
+    /// The character's `Transform`: what places its joints and skin in the world.
+    pub fn to_transform(&self) -> Transform {
+        Transform {
+            translation: self.translation,
+            rotation: Quat::from_rotation_y(self.yaw),
+            scale: Vec3::splat(self.scale),
+        }
     }
 }
 
@@ -136,7 +141,8 @@ impl Default for BindWorldToJoint {
     }
 }
 
-/// The joint's current transform to world space (placement included).
+/// The joint's current transform in the character's model space (the character's
+/// `Transform`, its placement, takes it to the world: see [`Self::world`]).
 #[derive(Component, Clone, Copy, Debug, PartialEq)]
 pub struct CurrentJointToWorld(pub Mat4);
 
@@ -147,8 +153,19 @@ impl Default for CurrentJointToWorld {
 }
 
 impl CurrentJointToWorld {
+    /// The joint's position in model space.
     pub fn position(&self) -> Vec3 {
         self.0.w_axis.truncate()
+    }
+
+    /// The joint's transform in the world, for a character at `placement`.
+    pub fn world(&self, placement: &Placement) -> Mat4 {
+        placement.to_mat4() * self.0
+    }
+
+    /// The joint's position in the world, for a character at `placement`.
+    pub fn world_position(&self, placement: &Placement) -> Vec3 {
+        placement.to_mat4().transform_point3(self.position())
     }
 }
 

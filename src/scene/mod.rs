@@ -50,7 +50,12 @@ impl Plugin for RigCorePlugin {
         .add_systems(PostUpdate, systems::clamp_poses_to_limits.in_set(MarionetteSystems::Solve))
         .add_systems(
             PostUpdate,
-            (systems::mark_changed_characters, systems::bind_rest_pose, systems::compute_joint_to_world)
+            (
+                systems::place_characters,
+                systems::mark_changed_characters,
+                systems::bind_rest_pose,
+                systems::compute_joint_to_world,
+            )
                 .chain()
                 .in_set(MarionetteSystems::MatrixStack),
         );

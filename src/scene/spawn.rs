@@ -4,7 +4,8 @@
 use std::sync::Arc;
 
 use bevy::asset::RenderAssetUsages;
-use bevy::camera::visibility::NoFrustumCulling;
+use bevy::camera::primitives::Aabb;
+use bevy::camera::visibility::NoAutoAabb;
 use bevy::mesh::PrimitiveTopology;
 use bevy::prelude::*;
 
@@ -35,7 +36,7 @@ pub fn spawn_character_posed(
     pose: &[JointRotation],
 ) -> Entity {
     assert_eq!(pose.len(), asset.skeleton.len(), "one pose entry per joint");
-    let character = commands.spawn((Name::new(asset.name.clone()), placement)).id();
+    let character = commands.spawn((Name::new(asset.name.clone()), placement, placement.to_transform())).id();
     let skeleton = &asset.skeleton;
     let mut joints: Vec<Entity> = Vec::with_capacity(skeleton.len());
     for (index, def) in skeleton.joints().iter().enumerate() {
@@ -54,12 +55,13 @@ pub fn spawn_character_posed(
     }
     let mesh = meshes.add(empty_skin_mesh(asset.triangle_count()));
     let skin_entity = commands
-        // Skinned vertices move anywhere: the bounds computed from the empty mesh would cull them.
+        // The skinning system keeps the bounds right as the mesh deforms (model space).
         .spawn((
             SkinMesh { character },
             Mesh3d(mesh.clone()),
             Transform::IDENTITY,
-            NoFrustumCulling,
+            Aabb::default(),
+            NoAutoAabb,
             ChildOf(character),
         ))
         .id();

@@ -1,5 +1,6 @@
 //! The systems of the rig chain: mark what changed, bind, run the matrix stack, skin.
 
+use bevy::camera::primitives::Aabb;
 use bevy::mesh::VertexAttributeValues;
 use bevy::prelude::*;
 
@@ -15,30 +16,36 @@ pub fn clamp_poses_to_limits(mut joints: Query<(&mut JointPose, &JointLimits), C
     }
 }
 
-/// Marks characters whose joints' poses or offsets, placement or view changed
-/// (reads change ticks, writes `PoseDirty`).
+/// Marks characters whose joints' poses or offsets or whose view changed (reads change
+/// ticks, writes `PoseDirty`). A new placement is no reason: joints and skin live in the
+/// character's model space, and its `Transform` places them.
 pub fn mark_changed_characters(
     posed: Query<&Joint, Or<(Changed<JointPose>, Changed<RestOffset>)>>,
     reshaped: Query<&Joint, Changed<RestOffset>>,
-    mut characters: Query<(Ref<Placement>, Ref<SkinView>, &mut PoseDirty)>,
+    mut characters: Query<(Ref<SkinView>, &mut PoseDirty)>,
 ) {
     for joint in &posed {
-        if let Ok((_, _, mut dirty)) = characters.get_mut(joint.character) {
+        if let Ok((_, mut dirty)) = characters.get_mut(joint.character) {
             dirty.matrices = true;
         }
     }
     for joint in &reshaped {
-        if let Ok((_, _, mut dirty)) = characters.get_mut(joint.character) {
+        if let Ok((_, mut dirty)) = characters.get_mut(joint.character) {
             dirty.bind = true;
         }
     }
-    for (placement, view, mut dirty) in &mut characters {
-        if placement.is_changed() {
-            dirty.matrices = true;
-        }
+    for (view, mut dirty) in &mut characters {
         if view.is_changed() {
             dirty.colors = true;
         }
+    }
+}
+
+/// Places each moved character: its `Transform` is its placement (reads `Placement`;
+/// writes `Transform`). Nothing is re-skinned.
+pub fn place_characters(mut characters: Query<(&Placement, &mut Transform), Changed<Placement>>) {
+    for (placement, mut transform) in &mut characters {
+        transform.set_if_neq(placement.to_transform());
     }
 }
 
@@ -68,21 +75,20 @@ pub fn bind_rest_pose(
     }
 }
 
-/// The matrix-stack pass: for characters marked dirty, pushes the placement, then walks
-/// the joint tree depth-first (push `T(offset) · R(pose)`, write the top, recurse, pop)
-/// (reads `Placement`, `RestOffset`, `JointPose`, `Children`; writes `CurrentJointToWorld`).
+/// The matrix-stack pass: for characters marked dirty, walks the joint tree depth-first
+/// from the model-space origin (push `T(offset) · R(pose)`, write the top, descend, pop)
+/// (reads `RestOffset`, `JointPose`, `Children`; writes `CurrentJointToWorld`, model space).
 pub fn compute_joint_to_world(
-    characters: Query<(&Character, &Placement, &PoseDirty)>,
+    characters: Query<(&Character, &PoseDirty)>,
     offsets: Query<(&RestOffset, Option<&Children>), With<Joint>>,
     poses: Query<&JointPose>,
     mut currents: Query<&mut CurrentJointToWorld>,
 ) {
-    for (character, placement, dirty) in &characters {
+    for (character, dirty) in &characters {
         if !dirty.matrices && !dirty.bind {
             continue;
         }
-        let mut stack = MatrixStack::with_capacity(character.joints.len() + 1);
-        stack.push(placement.to_mat4());
+        let mut stack = MatrixStack::with_capacity(character.joints.len());
         walk_joint_tree(
             character.joints[0],
             &mut stack,
@@ -124,13 +130,15 @@ fn walk_joint_tree(
     }
 }
 
-/// Skins characters marked dirty: palette `CurrentJointToWorld · BindWorldToJoint`, LBS of
-/// the bind vertices, then rewrites the render mesh's positions and flat normals, and its
-/// colours when the view changed (reads joint matrices; writes `Mesh` assets, clears
-/// `PoseDirty`).
+/// Skins characters marked dirty, in model space: palette `CurrentJointToWorld ·
+/// BindWorldToJoint`, LBS of the bind vertices, then rewrites the render mesh's positions
+/// and flat normals and the skin's bounds (so culling follows the deformed mesh), and its
+/// colours when the view changed (reads joint matrices; writes `Mesh` assets, `Aabb`,
+/// clears `PoseDirty`).
 pub fn skin_changed_characters(
     mut characters: Query<(&Character, &SkinView, &mut PoseDirty, &mut SkinScratch)>,
     joints: Query<(&CurrentJointToWorld, &BindWorldToJoint)>,
+    mut bounds: Query<&mut Aabb, With<SkinMesh>>,
     mut meshes: ResMut<Assets<Mesh>>,
 ) {
     for (character, view, mut dirty, mut scratch) in &mut characters {
@@ -147,6 +155,9 @@ pub fn skin_changed_characters(
             palette.extend(character.joints.iter().map(|&e| joints.get(e).map_or(Mat4::IDENTITY, |(c, b)| c.0 * b.0)));
             positions.resize(skin.bind_positions.len(), Vec3::ZERO);
             skin_positions(&skin.bind_positions, &skin.weights, palette, positions);
+            if let Ok(mut aabb) = bounds.get_mut(character.skin_entity) {
+                aabb.set_if_neq(bounds_of(positions));
+            }
             let mut normals = match mesh.remove_attribute(Mesh::ATTRIBUTE_NORMAL) {
                 Some(VertexAttributeValues::Float32x3(n)) => n,
                 _ => vec![[0.0; 3]; skin.triangles.len() * 3],
@@ -161,6 +172,14 @@ pub fn skin_changed_characters(
         }
         *dirty = PoseDirty::default();
     }
+}
+
+/// The box around skinned vertices (a point at the origin for none).
+fn bounds_of(positions: &[Vec3]) -> Aabb {
+    let (lo, hi) = positions
+        .iter()
+        .fold((Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)), |(lo, hi), p| (lo.min(*p), hi.max(*p)));
+    if lo.x > hi.x { Aabb::from_min_max(Vec3::ZERO, Vec3::ZERO) } else { Aabb::from_min_max(lo, hi) }
 }
 
 /// Rewrites the per-corner colours: the tint, the weight colours or a joint's heat map.

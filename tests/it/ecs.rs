@@ -2,6 +2,8 @@
 
 use std::sync::Arc;
 
+use bevy::asset::AssetEvent;
+use bevy::ecs::message::Messages;
 use bevy::mesh::VertexAttributeValues;
 use bevy::prelude::*;
 use marionette::posing::posed_positions;
@@ -83,6 +85,8 @@ fn spawning_builds_the_joint_hierarchy_as_entities() {
     }
 }
 
+/// The skin is written in model space; the character's `Transform` (its placement) takes
+/// it to the world, where it matches the kernel skinned at that placement.
 #[test]
 fn posing_a_joint_reskins_the_mesh_like_the_kernel() {
     let asset = Arc::new(embedded_puppet());
@@ -90,9 +94,10 @@ fn posing_a_joint_reskins_the_mesh_like_the_kernel() {
     let mut app = app();
     let character = spawn(&mut app, asset.clone(), placement);
     app.update();
+    let model = Placement::default();
     assert_positions_close(
         &mesh_positions(&app, character),
-        &oracle(&asset, &asset.skeleton.initial_pose(), &placement),
+        &oracle(&asset, &asset.skeleton.initial_pose(), &model),
         1e-5,
     );
     let elbow = asset.skeleton.find("l_elbow").unwrap();
@@ -101,7 +106,81 @@ fn posing_a_joint_reskins_the_mesh_like_the_kernel() {
     app.update();
     let mut pose = asset.skeleton.initial_pose();
     pose[elbow] = rotation;
-    assert_positions_close(&mesh_positions(&app, character), &oracle(&asset, &pose, &placement), 1e-5);
+    assert_positions_close(&mesh_positions(&app, character), &oracle(&asset, &pose, &model), 1e-5);
+    let transform = *app.world().get::<Transform>(character).unwrap();
+    let placed: Vec<[f32; 3]> =
+        mesh_positions(&app, character).iter().map(|p| transform.transform_point(Vec3::from(*p)).to_array()).collect();
+    assert_positions_close(&placed, &oracle(&asset, &pose, &placement), 1e-4);
+}
+
+/// The mesh's normals and colours, like its positions, are what the kernels give.
+#[test]
+fn normals_and_weight_colours_match_the_kernels() {
+    use marionette::rig::skinning::{joint_colors, weight_colors};
+    let asset = Arc::new(embedded_puppet());
+    let mut app = app();
+    let character = spawn(&mut app, asset.clone(), Placement::default());
+    app.world_mut().get_mut::<SkinView>(character).unwrap().weight_colors = true;
+    let knee = asset.skeleton.find("l_knee").unwrap();
+    let rotation = JointRotation::euler_xyz(-1.1, 0.0, 0.2);
+    set_joint(&mut app, character, knee, rotation);
+    app.update();
+    let mut pose = asset.skeleton.initial_pose();
+    pose[knee] = rotation;
+    let skinned = posed_positions(&asset, &pose, Mat4::IDENTITY);
+    let n = asset.triangle_count() * 3;
+    let (mut p, mut normals) = (vec![[0.0; 3]; n], vec![[0.0; 3]; n]);
+    flat_shade(&skinned, &asset.skin.triangles, &mut p, &mut normals);
+    let mut per_vertex = vec![[0.0; 3]; asset.vertex_count()];
+    weight_colors(&asset.skin.weights, &joint_colors(asset.skeleton.len()), &mut per_vertex);
+    let handle = app.world().get::<Character>(character).unwrap().mesh.clone();
+    let mesh = app.world().resource::<Assets<Mesh>>().get(&handle).unwrap();
+    let Some(VertexAttributeValues::Float32x3(mesh_normals)) = mesh.attribute(Mesh::ATTRIBUTE_NORMAL) else {
+        panic!("normals are Float32x3")
+    };
+    assert_positions_close(mesh_normals, &normals, 1e-5);
+    let Some(VertexAttributeValues::Float32x4(colors)) = mesh.attribute(Mesh::ATTRIBUTE_COLOR) else {
+        panic!("colours are Float32x4")
+    };
+    for (corner, &v) in colors.iter().zip(asset.skin.triangles.iter().flatten()) {
+        let [r, g, b] = per_vertex[v as usize];
+        assert_eq!(*corner, [r, g, b, 1.0]);
+    }
+}
+
+/// Which meshes were modified since the last call.
+fn modified_meshes(app: &mut App) -> Vec<AssetId<Mesh>> {
+    let mut messages = app.world_mut().resource_mut::<Messages<AssetEvent<Mesh>>>();
+    messages
+        .drain()
+        .filter_map(|e| match e {
+            AssetEvent::Modified { id } => Some(id),
+            _ => None,
+        })
+        .collect()
+}
+
+#[test]
+fn moving_a_character_rewrites_no_mesh_and_posing_one_rewrites_only_its_own() {
+    let asset = Arc::new(embedded_puppet());
+    let mut app = app();
+    let a = spawn(&mut app, asset.clone(), Placement::default());
+    let b = spawn(&mut app, asset.clone(), Placement::at(Vec3::X));
+    app.update();
+    app.update();
+    modified_meshes(&mut app);
+    let mesh_a = app.world().get::<Character>(a).unwrap().mesh.id();
+    app.world_mut().get_mut::<Placement>(a).unwrap().translation = Vec3::new(3.0, 0.0, 1.0);
+    // Asset events reach `Messages` one frame after the change: two updates.
+    app.update();
+    app.update();
+    assert_eq!(modified_meshes(&mut app), Vec::<AssetId<Mesh>>::new(), "moving re-skins nothing");
+    assert_eq!(app.world().get::<Transform>(a).unwrap().translation, Vec3::new(3.0, 0.0, 1.0));
+    set_joint(&mut app, a, 3, JointRotation::euler_xyz(0.5, 0.0, 0.0));
+    app.update();
+    app.update();
+    assert_eq!(modified_meshes(&mut app), vec![mesh_a], "posing a re-skins a only");
+    let _ = b;
 }
 
 #[test]
