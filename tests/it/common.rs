@@ -4,20 +4,21 @@ use std::path::{Path, PathBuf};
 
 use glam::{Mat4, Vec3};
 
-/// The real data folder from `MARIONETTE_DATA`, or `None` (and a note that the test was
-/// skipped) when it is unset.
-pub fn data_dir(test: &str) -> Option<PathBuf> {
-    match std::env::var_os("MARIONETTE_DATA") {
-        Some(dir) => {
-            let dir = PathBuf::from(dir);
-            assert!(dir.is_dir(), "MARIONETTE_DATA={} is not a folder", dir.display());
-            Some(dir)
-        }
-        None => {
-            eprintln!("skipped {test}: MARIONETTE_DATA is not set");
-            None
-        }
-    }
+/// The real data folder from `MARIONETTE_DATA`. Tests that need it carry
+/// `#[cfg_attr(not(marionette_data), ignore = "…")]` (build.rs sets the cfg when the variable
+/// is set at build time), so without the data they are reported as ignored, not passed.
+///
+/// # Panics
+/// When the variable is unset at run time (the binary was built with it) or not a folder.
+pub fn data_dir() -> PathBuf {
+    optional_data_dir().expect("MARIONETTE_DATA is not set (the tests were built with it; set it again)")
+}
+
+/// The real data folder when `MARIONETTE_DATA` is set (for tests that only do more with it).
+pub fn optional_data_dir() -> Option<PathBuf> {
+    let dir = PathBuf::from(std::env::var_os("MARIONETTE_DATA")?);
+    assert!(dir.is_dir(), "MARIONETTE_DATA={} is not a folder", dir.display());
+    Some(dir)
 }
 
 pub fn path(s: &str) -> &Path {

@@ -10,10 +10,9 @@ use marionette::rig::JointRotation;
 use crate::common::{assert_vec_close, data_dir, scratch};
 
 #[test]
+#[cfg_attr(not(marionette_data), ignore = "needs MARIONETTE_DATA (the course data)")]
 fn all_four_6837_models_load() {
-    let Some(data) = data_dir("all_four_6837_models_load") else {
-        return;
-    };
+    let data = data_dir();
     for m in 1..=4 {
         let asset = load_character(&data.join(format!("mit6837/Model{m}.skel"))).unwrap();
         assert_eq!(asset.skeleton.len(), 18, "Model{m}");
@@ -29,10 +28,9 @@ fn all_four_6837_models_load() {
 }
 
 #[test]
+#[cfg_attr(not(marionette_data), ignore = "needs MARIONETTE_DATA (the course data)")]
 fn exporting_model1_at_rest_returns_the_obj_vertices() {
-    let Some(data) = data_dir("exporting_model1_at_rest_returns_the_obj_vertices") else {
-        return;
-    };
+    let data = data_dir();
     let skel = data.join("mit6837/Model1.skel");
     let out = scratch("export-rest").join("rest.obj");
     let status = Command::new(env!("CARGO_BIN_EXE_marionette"))
@@ -54,10 +52,9 @@ fn exporting_model1_at_rest_returns_the_obj_vertices() {
 }
 
 #[test]
+#[cfg_attr(not(marionette_data), ignore = "needs MARIONETTE_DATA (the course data)")]
 fn export_clamps_and_rejects_unknown_joints() {
-    let Some(data) = data_dir("export_clamps_and_rejects_unknown_joints") else {
-        return;
-    };
+    let data = data_dir();
     let out = scratch("export-bad").join("bad.obj");
     let output = Command::new(env!("CARGO_BIN_EXE_marionette"))
         .args(["export"])
@@ -74,10 +71,9 @@ fn export_clamps_and_rejects_unknown_joints() {
 }
 
 #[test]
+#[cfg_attr(not(marionette_data), ignore = "needs MARIONETTE_DATA (the course data)")]
 fn cse169_skeletons_load_with_their_joint_counts() {
-    let Some(data) = data_dir("cse169_skeletons_load_with_their_joint_counts") else {
-        return;
-    };
+    let data = data_dir();
     for (file, joints) in [("test.skel", 6), ("wasp.skel", 23), ("dragon.skel", 81)] {
         let asset = load_character(&data.join("cse169/project1").join(file)).unwrap();
         assert_eq!(asset.skeleton.len(), joints, "{file}");
@@ -93,10 +89,9 @@ fn cse169_skeletons_load_with_their_joint_counts() {
 }
 
 #[test]
+#[cfg_attr(not(marionette_data), ignore = "needs MARIONETTE_DATA (the course data)")]
 fn rotating_the_root_rigidly_rotates_every_skinned_vertex() {
-    let Some(data) = data_dir("rotating_the_root_rigidly_rotates_every_skinned_vertex") else {
-        return;
-    };
+    let data = data_dir();
     let asset = load_character(&data.join("mit6837/Model1.skel")).unwrap();
     let rest = posed_positions(&asset, &asset.skeleton.rest_pose(), Mat4::IDENTITY);
     let mut pose = asset.skeleton.rest_pose();
@@ -122,10 +117,9 @@ fn rotating_the_root_rigidly_rotates_every_skinned_vertex() {
 }
 
 #[test]
+#[cfg_attr(not(marionette_data), ignore = "needs MARIONETTE_DATA (the course data)")]
 fn info_reports_joints_vertices_and_weight_checks() {
-    let Some(data) = data_dir("info_reports_joints_vertices_and_weight_checks") else {
-        return;
-    };
+    let data = data_dir();
     let output = Command::new(env!("CARGO_BIN_EXE_marionette"))
         .arg("info")
         .arg(data.join("mit6837/Model2.skel"))

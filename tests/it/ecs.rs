@@ -203,10 +203,9 @@ fn only_changed_characters_are_reskinned_and_skins_are_shared() {
 }
 
 #[test]
+#[cfg_attr(not(marionette_data), ignore = "needs MARIONETTE_DATA (the course data)")]
 fn poses_set_outside_the_limits_are_clamped() {
-    let Some(data) = data_dir("poses_set_outside_the_limits_are_clamped") else {
-        return;
-    };
+    let data = data_dir();
     let asset = Arc::new(marionette::formats::load_character(&data.join("cse169/project1/test.skel")).unwrap());
     let knee = asset.skeleton.find("knee_r").unwrap();
     let mut app = app();
@@ -219,10 +218,9 @@ fn poses_set_outside_the_limits_are_clamped() {
 }
 
 #[test]
+#[cfg_attr(not(marionette_data), ignore = "needs MARIONETTE_DATA (the course data)")]
 fn model1_in_the_ecs_matches_the_kernel() {
-    let Some(data) = data_dir("model1_in_the_ecs_matches_the_kernel") else {
-        return;
-    };
+    let data = data_dir();
     let asset = Arc::new(marionette::formats::load_character(&data.join("mit6837/Model1.skel")).unwrap());
     let mut app = app();
     let character = spawn(&mut app, asset.clone(), Placement::default());
@@ -237,11 +235,12 @@ fn model1_in_the_ecs_matches_the_kernel() {
 
 /// SMPL in the ECS (shape change, clip pose) against the pure SMPL poser.
 #[test]
+#[cfg_attr(not(marionette_data), ignore = "needs MARIONETTE_DATA (the course data)")]
 fn smpl_body_in_the_ecs_matches_the_poser() {
     use marionette::editor::smpl::{SmplCharacter, SmplEditorPlugin};
     use marionette::formats::scene::SmplDoc;
     use marionette::smpl_tasks::{FrameSpec, SmplPoser, exercise_beta};
-    let Some(data) = data_dir("smpl_body_in_the_ecs_matches_the_poser") else { return };
+    let data = data_dir();
     let dir = data.join("smpl");
     let (model, _) = marionette::formats::smpl::load_smpl_dir(&dir).unwrap();
     let model = Arc::new(model);

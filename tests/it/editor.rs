@@ -202,10 +202,9 @@ fn render_draws_characters_distinct_from_floor_and_sky_with_weight_hues() {
 }
 
 #[test]
+#[cfg_attr(not(marionette_data), ignore = "needs MARIONETTE_DATA (the course data)")]
 fn model1_and_model2_render_side_by_side() {
-    let Some(data) = data_dir("model1_and_model2_render_side_by_side") else {
-        return;
-    };
+    let data = data_dir();
     let out = scratch("render-models").join("models.png");
     let output = Command::new(env!("CARGO_BIN_EXE_marionette"))
         .args(["render", "--width", "160", "--height", "120", "--out"])

@@ -15,7 +15,7 @@ use std::time::{Duration, Instant};
 use arbitrary::Unstructured;
 use marionette::formats::{FormatError, cse169, homer, mit6837, obj, off, scene, smpl};
 
-use crate::common::data_dir;
+use crate::common::optional_data_dir;
 
 /// Cases per run (a few seconds on two cores in the test profile).
 const CASES: usize = 20_000;
@@ -173,7 +173,7 @@ fn file_seeds() -> Vec<Seed> {
         seed(Reader::Scene, assets.join("default_scene.ron")),
         attach(assets.join("puppet.skel"), assets.join("puppet.attach")),
     ];
-    let Some(data) = data_dir("fuzz seeds from the real data") else { return seeds };
+    let Some(data) = optional_data_dir() else { return seeds };
     let course = data.join("mit6837");
     for m in 1..=4 {
         let skel = course.join(format!("Model{m}.skel"));

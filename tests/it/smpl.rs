@@ -13,10 +13,9 @@ use marionette::smpl_tasks::{
 use crate::common::{assert_vec_close, data_dir, path, scratch};
 
 #[test]
+#[cfg_attr(not(marionette_data), ignore = "needs MARIONETTE_DATA (the course data)")]
 fn smpl_folder_loads_as_one_character() {
-    let Some(data) = data_dir("smpl_folder_loads_as_one_character") else {
-        return;
-    };
+    let data = data_dir();
     let (model, warnings) = load_smpl_dir(&data.join("smpl")).unwrap();
     assert_eq!(model.skeleton.len(), 24);
     assert_eq!(model.base_positions.len(), 6890);
@@ -29,10 +28,9 @@ fn smpl_folder_loads_as_one_character() {
 }
 
 #[test]
+#[cfg_attr(not(marionette_data), ignore = "needs MARIONETTE_DATA (the course data)")]
 fn task4_joint_matrices_match_the_exercise_to_4_decimals() {
-    let Some(data) = data_dir("task4_joint_matrices_match_the_exercise_to_4_decimals") else {
-        return;
-    };
+    let data = data_dir();
     let (model, _) = load_smpl_dir(&data.join("smpl")).unwrap();
     let frames = task_frames(&model, &data.join("smpl"), 4).unwrap();
     let mut poser = SmplPoser::new(&model);
@@ -71,10 +69,9 @@ fn task4_joint_matrices_match_the_exercise_to_4_decimals() {
 }
 
 #[test]
+#[cfg_attr(not(marionette_data), ignore = "needs MARIONETTE_DATA (the course data)")]
 fn task2_moves_only_elbow_weighted_vertices_by_its_weight() {
-    let Some(data) = data_dir("task2_moves_only_elbow_weighted_vertices_by_its_weight") else {
-        return;
-    };
+    let data = data_dir();
     let (model, _) = load_smpl_dir(&data.join("smpl")).unwrap();
     let elbow = model.skeleton.find("L_Elbow").unwrap();
     for (task, follows) in [(2, false), (3, true)] {
@@ -116,10 +113,9 @@ fn is_in_subtree(s: &marionette::rig::Skeleton, mut j: usize, root: usize) -> bo
 }
 
 #[test]
+#[cfg_attr(not(marionette_data), ignore = "needs MARIONETTE_DATA (the course data)")]
 fn shapes_follow_the_blendshape_formula_and_rest_skinning_returns_them() {
-    let Some(data) = data_dir("shapes_follow_the_blendshape_formula_and_rest_skinning_returns_them") else {
-        return;
-    };
+    let data = data_dir();
     let dir = data.join("smpl");
     let (model, _) = load_smpl_dir(&dir).unwrap();
     // β = e_3 gives exactly smpl_03.obj.
@@ -150,10 +146,9 @@ fn shapes_follow_the_blendshape_formula_and_rest_skinning_returns_them() {
 }
 
 #[test]
+#[cfg_attr(not(marionette_data), ignore = "needs MARIONETTE_DATA (the course data)")]
 fn task5_has_480_frames_and_the_cli_writes_numbered_objs() {
-    let Some(data) = data_dir("task5_has_480_frames_and_the_cli_writes_numbered_objs") else {
-        return;
-    };
+    let data = data_dir();
     let dir = data.join("smpl");
     let (model, _) = load_smpl_dir(&dir).unwrap();
     let frames = task_frames(&model, &dir, 5).unwrap();
@@ -188,6 +183,7 @@ fn task5_has_480_frames_and_the_cli_writes_numbered_objs() {
 }
 
 #[test]
+#[cfg_attr(not(marionette_data), ignore = "needs MARIONETTE_DATA (the course data)")]
 fn sequences_parse_and_transitions_go_from_the_outgoing_to_the_incoming_clip() {
     let segs = parse_sequence("7516:0-99:1,8806:20-:2").unwrap();
     assert_eq!(segs.len(), 2);
@@ -195,9 +191,7 @@ fn sequences_parse_and_transitions_go_from_the_outgoing_to_the_incoming_clip() {
     assert_eq!((segs[1].from, segs[1].to), (20, None));
     assert!(parse_sequence("7516:9-3").unwrap_err().contains("TO is before FROM"));
     assert!(parse_sequence("7516:0-3:x").is_err());
-    let Some(data) = data_dir("sequences_parse_and_transitions") else {
-        return;
-    };
+    let data = data_dir();
     let dir = data.join("smpl");
     let (model, _) = load_smpl_dir(&dir).unwrap();
     let a = parse_clip(
