@@ -1,4 +1,4 @@
-//! Tests on the real course data (`MARIONETTE_DATA`); skipped with a note when unset.
+//! Tests on the real course data (`MARIONETTE_DATA`); reported as ignored when it is unset.
 
 use std::process::Command;
 
