@@ -378,13 +378,10 @@ pub fn write_frames_naive(
         let mut shaped = Vec::new();
         model.shaped_positions(&frame.betas, &mut shaped);
         let joints = model.shaped_joints(&frame.betas);
-        let n = joints.len();
-        let mut world = vec![Mat4::IDENTITY; n];
-        for j in 0..n {
-            let local = Mat4::from_translation(model.skeleton.parent(j).map_or(joints[j], |p| joints[j] - joints[p]))
-                * Mat4::from_quat(frame.rotations[j]);
-            world[j] = model.skeleton.parent(j).map_or(local, |p| world[p] * local);
-        }
+        let pose: Vec<JointRotation> = frame.rotations.iter().map(|&q| JointRotation::Quat(q)).collect();
+        let mut world = vec![Mat4::IDENTITY; joints.len()];
+        let offsets = model.rest_offsets(&joints);
+        forward_kinematics_with_offsets(&model.skeleton, &pose, Some(&offsets), Mat4::IDENTITY, &mut world);
         let path = out_dir.join(format!("frame{k:03}.obj"));
         let mut file = std::io::BufWriter::new(std::fs::File::create(&path).map_err(|e| FormatError::io(&path, e))?);
         for (v, x) in shaped.iter().enumerate() {

@@ -9,7 +9,7 @@ use bevy::prelude::*;
 use crate::formats::scene::SmplDoc;
 use crate::rig::JointRotation;
 use crate::rig::smpl::{BlendMode, Clip, SmplModel, blend_rotations};
-use crate::scene::{Character, JointPose, MarionetteSystems, RestOffset};
+use crate::scene::{Character, JointPose, MarionetteSystems, PoseDirty};
 
 /// Frames per second of the SMPL clips.
 pub const CLIP_FPS: f32 = 30.0;
@@ -115,13 +115,10 @@ fn advance_playback(time: Res<Time>, mut bodies: Query<&mut SmplCharacter>) {
     }
 }
 
-/// Rebuilds the shaped mesh and skeleton when β changed (writes `Character`'s asset and
-/// each joint's `RestOffset`; the bind pass and skinning follow).
-fn reshape_bodies(
-    mut bodies: Query<(&mut SmplCharacter, &mut Character), Changed<SmplCharacter>>,
-    mut offsets: Query<&mut RestOffset>,
-) {
-    for (mut body, mut character) in &mut bodies {
+/// Rebuilds the shaped mesh, skeleton and inverse binds when β changed (writes
+/// `Character`'s asset and `PoseDirty`; the bind pass, matrix stack and skinning follow).
+fn reshape_bodies(mut bodies: Query<(&mut SmplCharacter, &mut Character, &mut PoseDirty), Changed<SmplCharacter>>) {
+    for (mut body, mut character, mut dirty) in &mut bodies {
         if body.built_betas == body.betas
             && character.asset.skin.bind_positions.len() == body.model.base_positions.len()
         {
@@ -130,13 +127,10 @@ fn reshape_bodies(
         let Ok(asset) = body.model.asset(&character.asset.name, &body.betas) else {
             continue;
         };
-        for (j, &e) in character.joints.iter().enumerate() {
-            if let Ok(mut o) = offsets.get_mut(e) {
-                o.set_if_neq(RestOffset(asset.skeleton.joint(j).rest_offset));
-            }
-        }
         character.asset = Arc::new(asset);
         body.built_betas = body.betas;
+        dirty.bind = true;
+        dirty.matrices = true;
     }
 }
 

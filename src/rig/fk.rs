@@ -47,6 +47,25 @@ pub fn forward_kinematics_with_offsets(
     }
 }
 
+/// Forward kinematics along `path`, a parent-to-child run of joints: each joint's matrix
+/// is its parent's (already in `joint_to_world`, or `placement` for the root) times its
+/// local transform. What IK uses after turning one joint of a chain: O(path), not O(joints).
+///
+/// # Panics
+/// When a joint of `path` is out of range of `pose` or `joint_to_world`.
+pub fn forward_kinematics_along(
+    skeleton: &Skeleton,
+    pose: &[JointRotation],
+    placement: Mat4,
+    path: &[usize],
+    joint_to_world: &mut [Mat4],
+) {
+    for &j in path {
+        let parent = skeleton.parent(j).map_or(placement, |p| joint_to_world[p]);
+        joint_to_world[j] = parent * pose[j].local_transform(skeleton.joint(j).rest_offset);
+    }
+}
+
 /// The bind pass: world-to-joint matrices at the rest pose (the inverse of the rest
 /// joint-to-world), in model space (identity placement).
 pub fn bind_world_to_joint(skeleton: &Skeleton, offsets: Option<&[Vec3]>) -> Vec<Mat4> {

@@ -2,7 +2,7 @@
 
 use glam::{Mat3, Mat4, Quat, Vec3};
 
-use super::fk::forward_kinematics;
+use super::fk::{forward_kinematics, forward_kinematics_along};
 use super::pose::JointRotation;
 use super::skeleton::Skeleton;
 
@@ -148,7 +148,7 @@ pub fn solve_ik(
                 // date from its (already updated) parent: O(1) per bone, not a whole FK.
                 for k in 0..chain.len() - 1 {
                     let (j, child) = (chain[k], chain[k + 1]);
-                    update_path(skeleton, pose, placement, &[j, child], &mut world);
+                    forward_kinematics_along(skeleton, pose, placement, &[j, child], &mut world);
                     let from = world[child].w_axis.truncate() - world[j].w_axis.truncate();
                     let to = solved.positions[k + 1] - solved.positions[k];
                     if from.length_squared() < 1e-12 || to.length_squared() < 1e-12 {
@@ -165,7 +165,7 @@ pub fn solve_ik(
                         report.limited = true;
                     }
                     pose[j] = clamped;
-                    update_path(skeleton, pose, placement, &[j], &mut world);
+                    forward_kinematics_along(skeleton, pose, placement, &[j], &mut world);
                 }
             }
             forward_kinematics(skeleton, pose, placement, &mut world);
@@ -174,15 +174,6 @@ pub fn solve_ik(
             report
         })
         .collect()
-}
-
-/// Recomputes the joint-to-world matrices along `path` (each joint the parent of the
-/// next) from the unchanged matrix of the first joint's parent.
-fn update_path(skeleton: &Skeleton, pose: &[JointRotation], placement: Mat4, path: &[usize], world: &mut [Mat4]) {
-    for &j in path {
-        let parent_world = skeleton.parent(j).map_or(placement, |p| world[p]);
-        world[j] = parent_world * pose[j].local_transform(skeleton.joint(j).rest_offset);
-    }
 }
 
 /// The rotation part of a transform (scale removed).

@@ -98,7 +98,7 @@ impl DisplayMode {
 pub struct PoseDirty {
     /// Joint matrices must be recomputed (pose or placement changed).
     pub matrices: bool,
-    /// Bind matrices must be recomputed (rest offsets changed, or just spawned).
+    /// Bind matrices must be taken again from the asset (its rest pose was rebuilt).
     pub bind: bool,
     /// Vertex colours must be rewritten.
     pub colors: bool,
@@ -110,7 +110,7 @@ impl PoseDirty {
 
 /// A joint of a character.
 #[derive(Component, Clone, Debug)]
-#[require(RestOffset, JointPose, JointLimits, BindWorldToJoint, CurrentJointToWorld)]
+#[require(JointPose, JointLimits, BindWorldToJoint, CurrentJointToWorld)]
 pub struct Joint {
     /// Index in the character's skeleton (and in its weights).
     pub index: usize,
@@ -118,10 +118,6 @@ pub struct Joint {
     /// The character entity this joint belongs to.
     pub character: Entity,
 }
-
-/// Translation from the parent joint's frame, in the parent's local space (model units).
-#[derive(Component, Clone, Copy, Debug, Default, PartialEq)]
-pub struct RestOffset(pub Vec3);
 
 /// The joint's rotation relative to its parent, kept within its limits.
 #[derive(Component, Clone, Copy, Debug, Default, PartialEq)]
@@ -173,6 +169,13 @@ impl CurrentJointToWorld {
 #[derive(Component, Clone, Copy, Debug)]
 pub struct SkinMesh {
     pub character: Entity,
+}
+
+/// Scratch buffers of the matrix-stack pass, by joint index (no allocation per frame).
+#[derive(Component, Default)]
+pub struct JointScratch {
+    pub pose: Vec<crate::rig::JointRotation>,
+    pub matrices: Vec<Mat4>,
 }
 
 /// Scratch buffers reused by the skinning system (no allocation per frame).

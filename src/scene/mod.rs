@@ -3,8 +3,13 @@
 //! System order, configured once in [`RigCorePlugin`] (all in `PostUpdate`, before Bevy's
 //! transform propagation, which plays no part in joint matrices):
 //!
-//! `Animate` (clips, sliders) → `Solve` (IK, limits) → `MatrixStack` (mark, bind, FK)
-//! → `Skin` (LBS, normals, colours) → `Draw` (skeleton gizmos, overlays).
+//! `Animate` (clips, sliders) → `Solve` (IK, limits) → `MatrixStack` (place, mark, bind,
+//! FK) → `Skin` (LBS, normals, colours, bounds) → `Draw` (skeleton gizmos, overlays).
+//!
+//! Joint matrices and skins are in each character's model space; its `Transform` (set from
+//! `Placement`) places it, so moving a character re-skins nothing. Forward kinematics is
+//! `rig::fk` over the asset's skeleton (the one source of rest offsets); inverse binds are
+//! the asset's, shared by its instances.
 
 pub mod components;
 pub mod spawn;
@@ -22,7 +27,8 @@ pub enum MarionetteSystems {
     Animate,
     /// Inverse kinematics and limit clamping adjust `JointPose`.
     Solve,
-    /// Bind pass and matrix stack write `BindWorldToJoint` and `CurrentJointToWorld`.
+    /// Placement to `Transform`; bind pass and matrix stack write `BindWorldToJoint` and
+    /// `CurrentJointToWorld` (model space).
     MatrixStack,
     /// Skinning rewrites render meshes.
     Skin,

@@ -45,7 +45,9 @@ pub fn spawn_character_posed(
             .spawn((
                 Joint { index, name: def.name.clone(), character },
                 Name::new(def.name.clone()),
-                RestOffset(def.rest_offset),
+                // The asset's inverse binds, shared by every instance (the bind pass runs
+                // only when the rest pose is rebuilt, e.g. SMPL β).
+                BindWorldToJoint(asset.bind_world_to_joint[index]),
                 JointPose(pose[index].clamped(&def.limits)),
                 JointLimits(def.limits),
                 ChildOf(parent),
@@ -68,7 +70,8 @@ pub fn spawn_character_posed(
     commands.entity(character).insert((
         Character { asset, joints, skin_entity, mesh },
         SkinScratch::default(),
-        PoseDirty::ALL,
+        JointScratch::default(),
+        PoseDirty { matrices: true, bind: false, colors: true },
     ));
     character
 }

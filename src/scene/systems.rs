@@ -5,7 +5,8 @@ use bevy::mesh::VertexAttributeValues;
 use bevy::prelude::*;
 
 use super::components::*;
-use crate::rig::MatrixStack;
+use crate::rig::JointRotation;
+use crate::rig::fk::forward_kinematics;
 use crate::rig::skinning::{flat_shade, heat_colors, joint_colors, skin_positions, weight_colors};
 
 /// Clamps changed joint poses to their limits (reads `JointLimits`, writes `JointPose`).
@@ -16,22 +17,17 @@ pub fn clamp_poses_to_limits(mut joints: Query<(&mut JointPose, &JointLimits), C
     }
 }
 
-/// Marks characters whose joints' poses or offsets or whose view changed (reads change
-/// ticks, writes `PoseDirty`). A new placement is no reason: joints and skin live in the
-/// character's model space, and its `Transform` places them.
+/// Marks characters whose joints' poses or whose view changed (reads change ticks, writes
+/// `PoseDirty`). A new placement is no reason: joints and skin live in the character's
+/// model space, and its `Transform` places them. Whoever rebuilds the rest pose (an SMPL
+/// reshape) sets `PoseDirty::bind` itself.
 pub fn mark_changed_characters(
-    posed: Query<&Joint, Or<(Changed<JointPose>, Changed<RestOffset>)>>,
-    reshaped: Query<&Joint, Changed<RestOffset>>,
+    posed: Query<&Joint, Changed<JointPose>>,
     mut characters: Query<(Ref<SkinView>, &mut PoseDirty)>,
 ) {
     for joint in &posed {
         if let Ok((_, mut dirty)) = characters.get_mut(joint.character) {
             dirty.matrices = true;
-        }
-    }
-    for joint in &reshaped {
-        if let Ok((_, mut dirty)) = characters.get_mut(joint.character) {
-            dirty.bind = true;
         }
     }
     for (view, mut dirty) in &mut characters {
@@ -49,84 +45,45 @@ pub fn place_characters(mut characters: Query<(&Placement, &mut Transform), Chan
     }
 }
 
-/// The bind pass: for characters whose rest offsets changed, walks the joint tree at the
-/// rest pose with the matrix stack (model space) and stores each inverse in
-/// `BindWorldToJoint` (reads `RestOffset`, `Children`; writes `BindWorldToJoint`).
-pub fn bind_rest_pose(
-    characters: Query<(&Character, &PoseDirty)>,
-    offsets: Query<(&RestOffset, Option<&Children>), With<Joint>>,
-    mut binds: Query<&mut BindWorldToJoint>,
-) {
+/// The bind pass, for characters whose rest pose was rebuilt (an SMPL reshape swaps in a
+/// new asset): each joint takes the asset's inverse bind, computed once when the asset
+/// was built and shared by its instances (reads `Character`; writes `BindWorldToJoint`).
+pub fn bind_rest_pose(characters: Query<(&Character, &PoseDirty)>, mut binds: Query<&mut BindWorldToJoint>) {
     for (character, dirty) in &characters {
         if !dirty.bind {
             continue;
         }
-        walk_joint_tree(
-            character.joints[0],
-            &mut MatrixStack::new(),
-            &offsets,
-            &mut |entity, top| {
-                if let Ok(mut bind) = binds.get_mut(entity) {
-                    bind.0 = top.inverse();
-                }
-            },
-            &|_| Mat4::IDENTITY,
-        );
+        for (&entity, &inverse) in character.joints.iter().zip(&character.asset.bind_world_to_joint) {
+            if let Ok(mut bind) = binds.get_mut(entity) {
+                bind.0 = inverse;
+            }
+        }
     }
 }
 
-/// The matrix-stack pass: for characters marked dirty, walks the joint tree depth-first
-/// from the model-space origin (push `T(offset) · R(pose)`, write the top, descend, pop)
-/// (reads `RestOffset`, `JointPose`, `Children`; writes `CurrentJointToWorld`, model space).
+/// The matrix-stack pass: for characters marked dirty, gathers the joints' poses by joint
+/// index and runs the one forward kinematics of `rig` over the asset's skeleton (the
+/// matrix stack: push `T(offset) · R(pose)`, write the top, descend, pop) from the
+/// model-space origin (reads `JointPose`, `Character`; writes `CurrentJointToWorld`).
 pub fn compute_joint_to_world(
-    characters: Query<(&Character, &PoseDirty)>,
-    offsets: Query<(&RestOffset, Option<&Children>), With<Joint>>,
+    mut characters: Query<(&Character, &PoseDirty, &mut JointScratch)>,
     poses: Query<&JointPose>,
     mut currents: Query<&mut CurrentJointToWorld>,
 ) {
-    for (character, dirty) in &characters {
+    for (character, dirty, mut scratch) in &mut characters {
         if !dirty.matrices && !dirty.bind {
             continue;
         }
-        let mut stack = MatrixStack::with_capacity(character.joints.len());
-        walk_joint_tree(
-            character.joints[0],
-            &mut stack,
-            &offsets,
-            &mut |entity, top| {
-                if let Ok(mut current) = currents.get_mut(entity) {
-                    current.0 = top;
-                }
-            },
-            &|entity| poses.get(entity).map_or(Mat4::IDENTITY, |p| Mat4::from_mat3(p.0.to_mat3())),
-        );
-    }
-}
-
-/// Depth-first walk with the matrix stack and an explicit to-do stack (no recursion, so
-/// any depth works): push `T(offset) · rotation(entity)`, call `visit` with the top,
-/// descend into joint children, pop when the subtree is done.
-fn walk_joint_tree(
-    root: Entity,
-    stack: &mut MatrixStack,
-    offsets: &Query<(&RestOffset, Option<&Children>), With<Joint>>,
-    visit: &mut impl FnMut(Entity, Mat4),
-    rotation: &impl Fn(Entity) -> Mat4,
-) {
-    // (entity, entering?): each push is matched by one pop when its subtree is done.
-    let mut todo = vec![(root, true)];
-    while let Some((entity, entering)) = todo.pop() {
-        if !entering {
-            stack.pop();
-            continue;
+        let JointScratch { pose, matrices } = &mut *scratch;
+        pose.clear();
+        pose.extend(character.joints.iter().map(|&e| poses.get(e).map_or(JointRotation::IDENTITY, |p| p.0)));
+        matrices.resize(character.joints.len(), Mat4::IDENTITY);
+        forward_kinematics(&character.asset.skeleton, pose, Mat4::IDENTITY, matrices);
+        for (&entity, &m) in character.joints.iter().zip(matrices.iter()) {
+            if let Ok(mut current) = currents.get_mut(entity) {
+                current.0 = m;
+            }
         }
-        let Ok((offset, children)) = offsets.get(entity) else {
-            continue;
-        };
-        let top = stack.push(Mat4::from_translation(offset.0) * rotation(entity));
-        visit(entity, top);
-        todo.push((entity, false));
-        todo.extend(children.into_iter().flatten().rev().map(|&c| (c, true)));
     }
 }
 
