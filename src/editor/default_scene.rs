@@ -21,6 +21,7 @@ fn puppet(
     view: ViewDoc,
 ) -> CharacterDoc {
     CharacterDoc {
+        id: None,
         source: SourceDoc::Embedded("puppet".into()),
         name: name.into(),
         placement: PlacementDoc { translation, yaw, scale: 1.0 },

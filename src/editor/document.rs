@@ -215,6 +215,7 @@ impl SceneReader<'_, '_> {
             })
             .collect();
         CharacterDoc {
+            id: Some(sc.id),
             source: sc.source.clone(),
             name: sc.name.clone(),
             placement: PlacementDoc {
@@ -328,6 +329,7 @@ pub fn doc_side_by_side(library: &mut AssetLibrary, sources: Vec<SourceDoc>, mes
             let (lo, hi) = asset.bounds();
             let center = (lo + hi) / 2.0;
             let doc = CharacterDoc {
+                id: None,
                 name: asset.name.clone(),
                 source,
                 placement: PlacementDoc {

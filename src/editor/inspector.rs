@@ -293,9 +293,7 @@ fn scene_panel(
     }
     if let Some((id, binding)) = rebind_request {
         // Rebuild the scene from this frame's document with the new binding (undoable).
-        let mut ids: Vec<u64> = edit.characters.iter().map(|c| c.1.id).collect();
-        ids.sort();
-        if let Some(k) = ids.iter().position(|&i| i == id) {
+        if let Some(k) = ops.snapshot.0.characters.iter().position(|c| c.id == Some(id)) {
             let mut doc = ops.snapshot.0.clone();
             doc.characters[k].binding = binding;
             *ops.pending = PendingScene { doc: Some(doc), with_camera: false, frame: false };
@@ -309,7 +307,7 @@ fn scene_panel(
         edited = true;
     }
     if let Some(id) = duplicate
-        && let Some(doc) = character_doc(&ops.snapshot.0, edit, id)
+        && let Some(doc) = character_doc(&ops.snapshot.0, id)
     {
         let mut copy = doc;
         copy.name = format!("{} copy", copy.name);
@@ -352,11 +350,8 @@ fn scene_panel(
 }
 
 /// The document of one character from the frame's snapshot.
-fn character_doc(snapshot: &SceneDoc, edit: &Editable, id: u64) -> Option<CharacterDoc> {
-    let mut ids: Vec<u64> = edit.characters.iter().map(|c| c.1.id).collect();
-    ids.sort();
-    let k = ids.iter().position(|&i| i == id)?;
-    snapshot.characters.get(k).cloned()
+fn character_doc(snapshot: &SceneDoc, id: u64) -> Option<CharacterDoc> {
+    snapshot.characters.iter().find(|c| c.id == Some(id)).cloned()
 }
 
 /// Loads and adds a character beside the others; errors go to the messages.
@@ -378,6 +373,7 @@ fn add_character(path: &str, state: &mut InspectorState, edit: &mut Editable, op
     let x = if right.is_finite() { right + 0.3 + (hi.x - lo.x) } else { 0.0 };
     let center = (lo + hi) / 2.0;
     let doc = CharacterDoc {
+        id: None,
         source,
         name: asset.name.clone(),
         placement: PlacementDoc { translation: [x - center.x, -lo.y, -center.z], yaw: 0.0, scale: 1.0 },

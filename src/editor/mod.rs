@@ -245,9 +245,8 @@ pub fn apply_pending_scene(
         crate::scene::despawn_character(&mut commands, e, character);
     }
     let (mut lo, mut hi) = (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY));
-    for (k, c) in doc.characters.iter().enumerate() {
-        // Ids follow document order so undo keeps selections.
-        let id = k as u64 + 1;
+    let ids_of_doc = stable_ids(&doc.characters, &mut ids);
+    for (c, id) in doc.characters.iter().zip(ids_of_doc) {
         match spawn_from_doc(&mut commands, &mut meshes, &mut library, c, id) {
             Ok((_, notes)) => {
                 notes.into_iter().for_each(|m| messages.push(m));
@@ -270,7 +269,6 @@ pub fn apply_pending_scene(
             }
         }
     }
-    ids.0 = ids.0.max(doc.characters.len() as u64);
     if pending.with_camera {
         let s = doc.stage;
         *stage = StageSettings { floor: s.floor, shadows: s.shadows, axes: s.axes, floor_height: s.floor_height };
@@ -282,6 +280,15 @@ pub fn apply_pending_scene(
             }
         }
     }
+}
+
+/// The id each character of a document gets: its own (saved in the scene, kept by undo
+/// and redo, so selections and pins stay valid), or a fresh one where it has none or
+/// repeats one already taken.
+fn stable_ids(characters: &[crate::formats::scene::CharacterDoc], next: &mut NextCharacterId) -> Vec<u64> {
+    next.0 = characters.iter().filter_map(|c| c.id).fold(next.0, u64::max);
+    let mut taken = std::collections::HashSet::new();
+    characters.iter().map(|c| c.id.filter(|&id| taken.insert(id)).unwrap_or_else(|| next.take())).collect()
 }
 
 /// Characters of the current scene that failed to load: kept as their documents were, so

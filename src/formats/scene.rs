@@ -149,6 +149,10 @@ pub struct SmplDoc {
 
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct CharacterDoc {
+    /// The character's stable id in the scene (selections, pins and history refer to it);
+    /// files without one get fresh ids when opened.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub id: Option<u64>,
     pub source: SourceDoc,
     pub name: String,
     #[serde(default)]

@@ -19,6 +19,7 @@ use crate::common::{data_dir, scratch};
 fn doc_with(source: SourceDoc, pose: &[(&str, JointRotation)]) -> SceneDoc {
     SceneDoc {
         characters: vec![CharacterDoc {
+            id: None,
             source,
             name: "c".into(),
             placement: PlacementDoc { translation: [0.5, 0.0, -1.0], yaw: 0.3, scale: 1.2 },
@@ -271,4 +272,47 @@ fn opening_a_scene_clears_selection_pins_and_history_and_keeps_unloadable_charac
     let saved = &world.resource::<Captured>().0;
     assert_eq!(saved.characters.len(), 2);
     assert_eq!(saved.characters[1], missing, "the unloadable character is saved as it was");
+}
+
+/// Ids are saved in the document and kept when it is applied again (undo, redo), so the
+/// selection still names the same character; documents without ids (old files) get fresh
+/// ones that never repeat.
+#[test]
+fn character_ids_survive_rebuilding_from_a_document_and_old_files_get_fresh_ones() {
+    use bevy::prelude::*;
+    use marionette::editor::document::{AssetLibrary, NextCharacterId, PendingScene, SceneCharacter};
+    use marionette::editor::stage::StageSettings;
+    use marionette::editor::{Messages, Selection, UnloadedCharacters, apply_pending_scene};
+
+    let mut app = crate::ecs::app();
+    app.init_resource::<AssetLibrary>()
+        .init_resource::<NextCharacterId>()
+        .init_resource::<Messages>()
+        .init_resource::<StageSettings>()
+        .init_resource::<Selection>()
+        .init_resource::<UnloadedCharacters>()
+        .init_resource::<PendingScene>()
+        .init_resource::<Captured>()
+        .add_systems(Update, (apply_pending_scene, capture_scene).chain());
+    let apply = |app: &mut App, ids: &[Option<u64>], with_camera: bool| {
+        let one = doc_with(SourceDoc::Embedded("puppet".into()), &[]).characters[0].clone();
+        let characters = ids.iter().map(|&id| CharacterDoc { id, ..one.clone() }).collect();
+        let doc = SceneDoc { characters, ..SceneDoc::default() };
+        *app.world_mut().resource_mut::<PendingScene>() = PendingScene { doc: Some(doc), with_camera, frame: false };
+        app.update();
+        app.update();
+        let world = app.world_mut();
+        let mut ids: Vec<u64> = world.query::<&SceneCharacter>().iter(world).map(|c| c.id).collect();
+        ids.sort();
+        ids
+    };
+    assert_eq!(apply(&mut app, &[Some(5), Some(9)], true), vec![5, 9]);
+    *app.world_mut().resource_mut::<Selection>() = Selection { character: Some(9), joints: vec![3] };
+    // Undo of adding character 5: the document without it.
+    assert_eq!(apply(&mut app, &[Some(9)], false), vec![9]);
+    assert_eq!(app.world().resource::<Selection>().character, Some(9), "the selection survives");
+    let saved = &app.world().resource::<Captured>().0;
+    assert_eq!(saved.characters.iter().map(|c| c.id).collect::<Vec<_>>(), vec![Some(9)]);
+    // An old file: no ids, and one repeated id; fresh ids come after every id seen.
+    assert_eq!(apply(&mut app, &[None, Some(9), Some(9)], true), vec![9, 10, 11]);
 }

@@ -157,6 +157,7 @@ fn saving_a_scene_whose_source_path_is_not_utf8_is_an_error_not_a_panic() {
     let bad = std::path::PathBuf::from(std::ffi::OsStr::from_bytes(b"/tmp/caf\xe9.skel"));
     let mut doc = SceneDoc::default();
     doc.characters.push(marionette::formats::scene::CharacterDoc {
+        id: None,
         source: marionette::formats::scene::SourceDoc::File(bad),
         name: "c".into(),
         placement: Default::default(),
