@@ -104,6 +104,59 @@ fn ecs_frame(bencher: Bencher, characters: usize) {
     });
 }
 
+/// 16 characters, one of which is moved (placement) or posed (a joint) each frame: the
+/// frame's cost, and (printed once) the bytes of mesh data handed on to rendering per frame,
+/// i.e. the vertex buffers of the meshes modified that frame.
+#[divan::bench(args = ["moved", "posed"])]
+fn ecs_frame_one_of_16_edited(bencher: Bencher, edit: &str) {
+    let asset = asset();
+    let mut app = App::new();
+    app.add_plugins((MinimalPlugins, AssetPlugin::default(), bevy::mesh::MeshPlugin, RigCorePlugin, SkinningPlugin));
+    let first = {
+        let world = app.world_mut();
+        let mut meshes = world.remove_resource::<Assets<Mesh>>().unwrap();
+        let mut queue = bevy::ecs::world::CommandQueue::default();
+        let ids: Vec<Entity> = {
+            let mut commands = Commands::new(&mut queue, world);
+            (0..16)
+                .map(|i| spawn_character(&mut commands, &mut meshes, asset.clone(), Placement::at(Vec3::X * i as f32)))
+                .collect()
+        };
+        queue.apply(world);
+        world.insert_resource(meshes);
+        ids[0]
+    };
+    let joint = app.world().get::<Character>(first).unwrap().joints[6.min(asset.skeleton.len() - 1)];
+    app.update();
+    app.update();
+    let mut step = 0.0f32;
+    let mut edit_once = |app: &mut App| {
+        step += 0.01;
+        if edit == "moved" {
+            app.world_mut().get_mut::<Placement>(first).unwrap().translation.z = step;
+        } else {
+            app.world_mut().get_mut::<JointPose>(joint).unwrap().0 = JointRotation::euler_xyz(step, 0.0, 0.0);
+        }
+        app.update();
+    };
+    // Bytes handed on per frame: modified meshes' vertex data, over a few frames.
+    app.world_mut().resource_mut::<bevy::ecs::message::Messages<AssetEvent<Mesh>>>().clear();
+    for _ in 0..4 {
+        edit_once(&mut app);
+    }
+    app.update();
+    let modified: Vec<AssetId<Mesh>> = app
+        .world_mut()
+        .resource_mut::<bevy::ecs::message::Messages<AssetEvent<Mesh>>>()
+        .drain()
+        .filter_map(|e| if let AssetEvent::Modified { id } = e { Some(id) } else { None })
+        .collect();
+    let meshes = app.world().resource::<Assets<Mesh>>();
+    let bytes: usize = modified.iter().filter_map(|id| meshes.get(*id)).map(|m| m.get_vertex_buffer_size()).sum();
+    eprintln!("ecs_frame_one_of_16_edited({edit}): {} bytes of mesh data per frame", bytes / 4);
+    bencher.bench_local(|| edit_once(&mut app));
+}
+
 /// A zig-zag chain of `n` joints (unit bones), and a reachable target off its line.
 fn chain(n: usize) -> (Vec<Vec3>, Vec3) {
     let points: Vec<Vec3> = (0..n).map(|i| Vec3::new(i as f32, if i % 2 == 0 { 0.0 } else { 0.3 }, 0.0)).collect();
