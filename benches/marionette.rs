@@ -25,7 +25,7 @@ fn asset() -> Arc<CharacterAsset> {
             let asset = std::env::var_os("MARIONETTE_DATA")
                 .map(|d| std::path::PathBuf::from(d).join("mit6837/Model1.skel"))
                 .and_then(|p| marionette::formats::load_character(&p).ok())
-                .unwrap_or_else(marionette::puppet::embedded_puppet);
+                .unwrap_or_else(marionette::formats::puppet::embedded_puppet);
             eprintln!(
                 "benchmarking `{}`: {} vertices, {} triangles",
                 asset.name,

@@ -3,16 +3,15 @@
 //! - [`rig`]: skeletons, matrix stack, poses, skinning kernels (no Bevy).
 //! - [`formats`]: readers and writers of the course formats (no Bevy).
 //! - [`scene`]: the ECS (joints as entities, matrix-stack and skinning systems).
-//! - [`editor`]: the windowed app.
+//! - [`editor`]: the windowed app and the headless renderer.
+//! - [`cli`]: the command line's specs, summaries and the SMPL exercise's tasks (no Bevy).
 
 // Bevy queries are spelled as types; naming each one would hide more than it shows (Bevy
 // allows this lint across its own workspace for the same reason).
 #![allow(clippy::type_complexity)]
 
+pub mod cli;
 pub mod editor;
 pub mod formats;
-pub mod posing;
-pub mod puppet;
 pub mod rig;
 pub mod scene;
-pub mod smpl_tasks;

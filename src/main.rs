@@ -7,8 +7,10 @@ use anyhow::{Context, Result};
 use clap::{Parser, Subcommand};
 use glam::Mat4;
 
+use marionette::cli::posing::{
+    IkSpec, PoseSpec, apply_ik_specs, apply_pose_specs, describe, describe_ik, posed_positions,
+};
 use marionette::formats::{load_character, obj};
-use marionette::posing::{IkSpec, PoseSpec, apply_ik_specs, apply_pose_specs, describe, describe_ik, posed_positions};
 
 /// The largest picture side `render` accepts (the texture limit of common GPUs).
 const MAX_PICTURE_SIDE: i64 = 8192;
@@ -157,7 +159,7 @@ fn run(cli: Cli) -> Result<()> {
             smpl(&data, task, sequence, transition, slerp, &out, naive)?
         }
         Some(Command::GenAssets { dir }) => {
-            marionette::puppet::write_6837(&marionette::puppet::puppet(), &dir, "puppet")
+            marionette::formats::puppet::write_6837(&marionette::formats::puppet::puppet(), &dir, "puppet")
                 .with_context(|| format!("writing {}", dir.display()))?;
             let scene = dir.join("default_scene.ron");
             marionette::formats::scene::save_scene(&scene, &marionette::editor::default_scene::generate())?;
@@ -201,8 +203,8 @@ fn smpl(
     out: &std::path::Path,
     naive: bool,
 ) -> Result<()> {
+    use marionette::cli::smpl_tasks::{parse_sequence, sequence_frames, task_frames, write_frames, write_frames_naive};
     use marionette::rig::smpl::BlendMode;
-    use marionette::smpl_tasks::{parse_sequence, sequence_frames, task_frames, write_frames, write_frames_naive};
     let started = std::time::Instant::now();
     let (model, warnings) = marionette::formats::smpl::load_smpl_dir(data)?;
     warnings.iter().for_each(|w| eprintln!("warning: {w}"));

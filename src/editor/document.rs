@@ -9,7 +9,6 @@ use bevy::ecs::system::SystemParam;
 use bevy::prelude::*;
 
 use super::camera::OrbitCamera;
-use super::smpl::SmplCharacter;
 use super::stage::StageSettings;
 use crate::formats::scene::{
     BindingDoc, CameraDoc, CharacterDoc, DisplayDoc, PlacementDoc, SceneDoc, SourceDoc, ViewDoc, joint_of_pose_key,
@@ -18,6 +17,7 @@ use crate::formats::scene::{
 use crate::formats::{FormatError, load_character};
 use crate::rig::smpl::{Clip, SmplModel};
 use crate::rig::{CharacterAsset, JointRotation};
+use crate::scene::smpl::SmplCharacter;
 use crate::scene::{Character, DisplayMode, JointPose, Placement, SkinView, spawn_character_posed};
 
 /// A character as the editor knows it: a stable id (kept across undo), its source, name,
@@ -64,7 +64,7 @@ impl AssetLibrary {
             return Ok(asset.clone());
         }
         let asset = Arc::new(match source {
-            SourceDoc::Embedded(name) if name == "puppet" => crate::puppet::embedded_puppet(),
+            SourceDoc::Embedded(name) if name == "puppet" => crate::formats::puppet::embedded_puppet(),
             SourceDoc::Embedded(name) => {
                 return Err(FormatError::other(
                     Path::new(name),

@@ -15,7 +15,7 @@ use super::draw::SkeletonGizmos;
 use super::history::History;
 use super::inspector::SceneSnapshot;
 use super::picking::{CLICK_SLOP_PX, PICK_RADIUS_PX, PickableCharacters, nearest_joint_on_screen};
-use crate::posing::{IK_ROUNDS, IK_TOLERANCE};
+use crate::cli::posing::{IK_ROUNDS, IK_TOLERANCE};
 use crate::rig::ik::{IkGoal, solve_ik};
 use crate::scene::{Character, CurrentJointToWorld, JointPose, Placement};
 
@@ -178,7 +178,7 @@ fn drag_joint(
     let mut goals = vec![IkGoal { end: active.joint, target }];
     goals.extend(active.pins.iter().map(|&(end, target)| IkGoal { end, target }));
     let reports = solve_ik(skeleton, &mut pose, placement.to_mat4(), &goals, IK_TOLERANCE, IK_ROUNDS.min(8));
-    drag.note = reports.first().map(|r| crate::posing::describe_ik(skeleton, r)).unwrap_or_default();
+    drag.note = reports.first().map(|r| crate::cli::posing::describe_ik(skeleton, r)).unwrap_or_default();
     for (&e, p) in character.joints.iter().zip(pose) {
         if let Ok(mut current) = poses.get_mut(e) {
             current.set_if_neq(JointPose(p));

@@ -14,11 +14,11 @@ use super::document::{
 };
 use super::history::{History, HistoryRequest};
 use super::screenshot::ScreenshotRequest;
-use super::smpl::SmplCharacter;
 use super::stage::StageSettings;
 use super::{Messages, Selection};
 use crate::formats::scene::{BindingDoc, CharacterDoc, PlacementDoc, SceneDoc, SourceDoc, ViewDoc};
 use crate::rig::{EulerOrder, JointRotation, Skeleton};
+use crate::scene::smpl::SmplCharacter;
 use crate::scene::{Character, CurrentJointToWorld, DisplayMode, JointLimits, JointPose, Placement, SkinView};
 
 /// Text fields and transient state of the inspector.

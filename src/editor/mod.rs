@@ -17,7 +17,6 @@ pub mod picking;
 pub mod readiness;
 pub mod render;
 pub mod screenshot;
-pub mod smpl;
 pub mod stage;
 
 use std::path::PathBuf;
@@ -38,8 +37,8 @@ pub struct StartupPaths(pub Vec<PathBuf>);
 /// scene that has the named joint (`--pose`, then `--ik`).
 #[derive(Resource, Clone, Debug, Default)]
 pub struct StartupEdits {
-    pub poses: Vec<crate::posing::PoseSpec>,
-    pub ik: Vec<crate::posing::IkSpec>,
+    pub poses: Vec<crate::cli::posing::PoseSpec>,
+    pub ik: Vec<crate::cli::posing::IkSpec>,
 }
 
 /// Messages for the user (load errors, warnings, where files went), newest last.
@@ -81,11 +80,14 @@ impl Plugin for ViewPlugin {
             .init_resource::<AssetLibrary>()
             .init_resource::<PendingScene>()
             .init_resource::<NextCharacterId>()
-            .add_plugins((smpl::SmplEditorPlugin, readiness::ReadinessPlugin))
+            .add_plugins((crate::scene::smpl::SmplPlugin, readiness::ReadinessPlugin))
             .add_systems(Startup, (setup_skin_material, spawn_stage, queue_startup_scene).chain())
             .add_systems(
                 PostUpdate,
-                (apply_pending_scene, sync_character_views).chain().in_set(MarionetteSystems::Animate),
+                (apply_pending_scene, sync_character_views)
+                    .chain()
+                    .in_set(MarionetteSystems::Animate)
+                    .before(crate::scene::smpl::SmplPlayback),
             )
             .add_systems(
                 PostUpdate,
@@ -199,17 +201,17 @@ fn apply_startup_edits(
         let (mut pose, _) = document::pose_from_doc(&asset, c);
         let poses: Vec<_> = edits.poses.iter().filter(|p| skeleton.resolve(&p.joint).is_some()).cloned().collect();
         let ik: Vec<_> = edits.ik.iter().filter(|p| skeleton.resolve(&p.joint).is_some()).cloned().collect();
-        let _ = crate::posing::apply_pose_specs(skeleton, &mut pose, &poses);
+        let _ = crate::cli::posing::apply_pose_specs(skeleton, &mut pose, &poses);
         let p = c.placement;
         let placement = Mat4::from_scale_rotation_translation(
             Vec3::splat(p.scale),
             Quat::from_rotation_y(p.yaw),
             Vec3::from(p.translation),
         );
-        if let Ok(reports) = crate::posing::apply_ik_specs(skeleton, &mut pose, placement, &ik) {
+        if let Ok(reports) = crate::cli::posing::apply_ik_specs(skeleton, &mut pose, placement, &ik) {
             reports
                 .iter()
-                .for_each(|r| messages.push(format!("{}: {}", c.name, crate::posing::describe_ik(skeleton, r))));
+                .for_each(|r| messages.push(format!("{}: {}", c.name, crate::cli::posing::describe_ik(skeleton, r))));
         }
         let initial = skeleton.initial_pose();
         c.pose =

@@ -9,6 +9,7 @@ pub mod homer;
 pub mod mit6837;
 pub mod obj;
 pub mod off;
+pub mod puppet;
 pub mod scene;
 pub mod smpl;
 

@@ -12,6 +12,7 @@
 //! the asset's, shared by its instances.
 
 pub mod components;
+pub mod smpl;
 pub mod spawn;
 pub mod systems;
 

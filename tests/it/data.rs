@@ -3,8 +3,8 @@
 use std::process::Command;
 
 use glam::{Mat4, Quat, Vec3};
+use marionette::cli::posing::posed_positions;
 use marionette::formats::{load_character, obj};
-use marionette::posing::posed_positions;
 use marionette::rig::JointRotation;
 
 use crate::common::{assert_vec_close, data_dir, scratch};

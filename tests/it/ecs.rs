@@ -6,8 +6,8 @@ use bevy::asset::AssetEvent;
 use bevy::ecs::message::Messages;
 use bevy::mesh::VertexAttributeValues;
 use bevy::prelude::*;
-use marionette::posing::posed_positions;
-use marionette::puppet::embedded_puppet;
+use marionette::cli::posing::posed_positions;
+use marionette::formats::puppet::embedded_puppet;
 use marionette::rig::skinning::flat_shade;
 use marionette::rig::{CharacterAsset, JointRotation};
 use marionette::scene::*;
@@ -237,9 +237,9 @@ fn model1_in_the_ecs_matches_the_kernel() {
 #[test]
 #[cfg_attr(not(marionette_data), ignore = "needs MARIONETTE_DATA (the course data)")]
 fn smpl_body_in_the_ecs_matches_the_poser() {
-    use marionette::editor::smpl::{SmplCharacter, SmplEditorPlugin};
+    use marionette::cli::smpl_tasks::{FrameSpec, SmplPoser, exercise_beta};
     use marionette::formats::scene::SmplDoc;
-    use marionette::smpl_tasks::{FrameSpec, SmplPoser, exercise_beta};
+    use marionette::scene::smpl::{SmplCharacter, SmplPlugin};
     let data = data_dir();
     let dir = data.join("smpl");
     let (model, _) = marionette::formats::smpl::load_smpl_dir(&dir).unwrap();
@@ -255,7 +255,7 @@ fn smpl_body_in_the_ecs_matches_the_poser() {
     );
     let asset = Arc::new(model.asset("smpl", &[]).unwrap());
     let mut app = app();
-    app.add_plugins(SmplEditorPlugin);
+    app.add_plugins(SmplPlugin);
     let character = spawn(&mut app, asset.clone(), Placement::default());
     let doc = SmplDoc {
         betas: exercise_beta(2).to_vec(),

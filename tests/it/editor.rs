@@ -80,7 +80,7 @@ fn a_malformed_scene_reports_its_line() {
 
 #[test]
 fn unknown_joints_in_a_scene_pose_are_reported_not_fatal() {
-    let asset = marionette::puppet::embedded_puppet();
+    let asset = marionette::formats::puppet::embedded_puppet();
     let doc = doc_with(
         SourceDoc::Embedded("puppet".into()),
         &[("l_elbow", JointRotation::euler_xyz(0.0, 1.0, 0.0)), ("tail", JointRotation::euler_xyz(1.0, 0.0, 0.0))],
@@ -144,7 +144,7 @@ fn the_shipped_assets_are_what_the_generator_makes() {
     assert_eq!(scene, marionette::editor::default_scene::generate());
     assert!(scene.characters.len() >= 2);
     let dir = scratch("gen-assets");
-    marionette::puppet::write_6837(&marionette::puppet::puppet(), &dir, "puppet").unwrap();
+    marionette::formats::puppet::write_6837(&marionette::formats::puppet::puppet(), &dir, "puppet").unwrap();
     for ext in ["skel", "obj", "attach"] {
         let made = std::fs::read_to_string(dir.join(format!("puppet.{ext}"))).unwrap();
         let shipped = std::fs::read_to_string(format!("{}/assets/puppet.{ext}", env!("CARGO_MANIFEST_DIR"))).unwrap();

@@ -3,8 +3,8 @@
 use std::process::Command;
 
 use glam::{Mat4, Vec3};
+use marionette::cli::posing::posed_positions;
 use marionette::formats::load_character;
-use marionette::posing::posed_positions;
 use marionette::rig::fk::forward_kinematics;
 use marionette::rig::ik::{IkGoal, chain_to_sub_base, fabrik, solve_ik};
 use marionette::rig::{JointRotation, RawJoint, Skeleton};
@@ -222,7 +222,7 @@ fn homer_rig_with_weights_loads_normalised() {
 fn rebinding_in_the_editor_replaces_the_weights_only() {
     use marionette::editor::document::rebind;
     use marionette::formats::scene::BindingDoc;
-    let puppet = marionette::puppet::embedded_puppet();
+    let puppet = marionette::formats::puppet::embedded_puppet();
     let rigid = rebind(&puppet, BindingDoc::Nearest);
     assert_eq!(rigid.skin.weights.max_influences(), 1);
     assert_eq!(rigid.skin.bind_positions, puppet.skin.bind_positions);

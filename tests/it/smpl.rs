@@ -4,11 +4,11 @@ use std::io::Cursor;
 use std::process::Command;
 
 use glam::{Mat3, Quat, Vec3};
-use marionette::formats::smpl::{load_smpl_dir, parse_clip, parse_skin};
-use marionette::rig::smpl::BlendMode;
-use marionette::smpl_tasks::{
+use marionette::cli::smpl_tasks::{
     FrameSpec, SmplPoser, exercise_beta, parse_sequence, sequence_frames, task_frames, task4_rotation,
 };
+use marionette::formats::smpl::{load_smpl_dir, parse_clip, parse_skin};
+use marionette::rig::smpl::BlendMode;
 
 use crate::common::{assert_vec_close, data_dir, path, scratch};
 

@@ -1,5 +1,5 @@
-//! SMPL characters in the editor: live shape (β), clip playback with a timeline, and a
-//! second clip blended in. The scene file keeps β, clips and time.
+//! SMPL characters in the ECS: live shape (β) and clip playback with a second clip blended
+//! in; used by the editor and the headless renderer alike. Scene files keep β, clips, time.
 
 use std::path::PathBuf;
 use std::sync::Arc;
@@ -83,16 +83,22 @@ impl SmplCharacter {
     }
 }
 
-pub struct SmplEditorPlugin;
+/// SMPL playback within `Animate`: advance clips, reshape by β, pose from the clips.
+/// Whatever builds scenes runs before it.
+#[derive(SystemSet, Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub struct SmplPlayback;
 
-impl Plugin for SmplEditorPlugin {
+/// SMPL bodies: β reshaping and clip playback.
+pub struct SmplPlugin;
+
+impl Plugin for SmplPlugin {
     fn build(&self, app: &mut App) {
         app.add_systems(
             PostUpdate,
             (advance_playback, reshape_bodies, pose_from_clips)
                 .chain()
                 .in_set(MarionetteSystems::Animate)
-                .after(super::apply_pending_scene),
+                .in_set(SmplPlayback),
         );
     }
 }

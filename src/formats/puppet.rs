@@ -161,9 +161,9 @@ pub fn write_6837(generated: &Generated, dir: &Path, name: &str) -> std::io::Res
 /// 6.837 readers as any user file.
 pub fn embedded_puppet() -> crate::rig::CharacterAsset {
     use std::io::Cursor;
-    const SKEL: &str = include_str!("../assets/puppet.skel");
-    const OBJ: &str = include_str!("../assets/puppet.obj");
-    const ATTACH: &str = include_str!("../assets/puppet.attach");
+    const SKEL: &str = include_str!("../../assets/puppet.skel");
+    const OBJ: &str = include_str!("../../assets/puppet.obj");
+    const ATTACH: &str = include_str!("../../assets/puppet.attach");
     let read = || -> Result<crate::rig::CharacterAsset, crate::formats::FormatError> {
         let skeleton = mit6837::parse_skel(Cursor::new(SKEL), Path::new("assets/puppet.skel"))?;
         let mesh = obj::parse_obj(Cursor::new(OBJ), Path::new("assets/puppet.obj"))?;
