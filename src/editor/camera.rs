@@ -49,7 +49,7 @@ pub fn orbit_camera_input(
     motion: Res<AccumulatedMouseMotion>,
     scroll: Res<AccumulatedMouseScroll>,
     pointer: Option<Res<ViewportHasPointer>>,
-    drag: Option<Res<super::ik_drag::JointDrag>>,
+    drag: Option<Res<super::state::JointDrag>>,
     mut cameras: Query<&mut OrbitCamera>,
 ) {
     if pointer.is_some_and(|p| !p.0) || drag.is_some_and(|d| d.active.is_some()) {

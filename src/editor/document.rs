@@ -161,7 +161,7 @@ pub struct SceneReader<'w, 's> {
     pub poses: Query<'w, 's, &'static JointPose>,
     pub cameras: Query<'w, 's, &'static OrbitCamera>,
     pub stage: Res<'w, StageSettings>,
-    pub unloaded: Res<'w, super::UnloadedCharacters>,
+    pub unloaded: Res<'w, super::state::UnloadedCharacters>,
 }
 
 impl SceneReader<'_, '_> {

@@ -4,8 +4,8 @@
 
 use bevy::prelude::*;
 
-use super::Selection;
 use super::document::SceneCharacter;
+use super::state::Selection;
 use crate::rig::character::SkinKind;
 use crate::scene::{Character, CurrentJointToWorld, DisplayMode, Placement};
 

@@ -8,39 +8,16 @@ use std::collections::BTreeMap;
 use bevy::prelude::*;
 use bevy::window::PrimaryWindow;
 
-use super::Selection;
 use super::camera::{OrbitCamera, ViewportHasPointer};
 use super::document::SceneCharacter;
 use super::draw::SkeletonGizmos;
 use super::history::History;
 use super::inspector::SceneSnapshot;
 use super::picking::{CLICK_SLOP_PX, PICK_RADIUS_PX, PickableCharacters, nearest_joint_on_screen};
+use super::state::{Drag, JointDrag, Selection};
 use crate::cli::posing::{IK_ROUNDS, IK_TOLERANCE};
 use crate::rig::ik::{IkGoal, solve_ik};
 use crate::scene::{Character, CurrentJointToWorld, JointPose, Placement};
-
-/// A drag under way.
-#[derive(Debug, Clone)]
-pub struct Drag {
-    pub character: u64,
-    pub joint: usize,
-    /// The drag plane: through the joint, facing the camera.
-    pub plane_point: Vec3,
-    pub plane_normal: Vec3,
-    /// Pinned joints of that character and where they must stay (world).
-    pub pins: Vec<(usize, Vec3)>,
-    /// Where the button went down (window pixels): the pose changes only once the cursor
-    /// has moved beyond [`CLICK_SLOP_PX`] from it, so a click is no edit.
-    pub pressed_at: Vec2,
-    pub moved: bool,
-}
-
-#[derive(Resource, Default)]
-pub struct JointDrag {
-    pub active: Option<Drag>,
-    /// The last solve's note (reached or not, limited), shown in the panel.
-    pub note: String,
-}
 
 /// Pinned joints per character id.
 #[derive(Resource, Default)]

@@ -15,7 +15,7 @@ use super::document::{
 use super::history::{History, HistoryRequest};
 use super::screenshot::ScreenshotRequest;
 use super::stage::StageSettings;
-use super::{Messages, Selection};
+use super::state::{Messages, Selection};
 use crate::formats::scene::{BindingDoc, CharacterDoc, PlacementDoc, SceneDoc, SourceDoc, ViewDoc};
 use crate::rig::{EulerOrder, JointRotation, Skeleton};
 use crate::scene::smpl::SmplCharacter;

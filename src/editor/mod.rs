@@ -18,6 +18,7 @@ pub mod readiness;
 pub mod render;
 pub mod screenshot;
 pub mod stage;
+pub mod state;
 
 use std::path::PathBuf;
 
@@ -28,37 +29,7 @@ use crate::scene::{Character, DisplayMode, MarionetteSystems, RigCorePlugin, Ski
 use camera::{OrbitCamera, apply_orbit_camera, orbit_camera_input};
 use document::{AssetLibrary, NextCharacterId, PendingScene, SceneCharacter, spawn_from_doc, startup_doc};
 use stage::{StageSettings, apply_stage_settings, draw_grid_and_axes, spawn_stage};
-
-/// What the app opens with: a scene file, character files, or (empty) the default scene.
-#[derive(Resource, Clone, Debug, Default)]
-pub struct StartupPaths(pub Vec<PathBuf>);
-
-/// Pose and IK edits from the command line, applied to every character of the startup
-/// scene that has the named joint (`--pose`, then `--ik`).
-#[derive(Resource, Clone, Debug, Default)]
-pub struct StartupEdits {
-    pub poses: Vec<crate::cli::posing::PoseSpec>,
-    pub ik: Vec<crate::cli::posing::IkSpec>,
-}
-
-/// Messages for the user (load errors, warnings, where files went), newest last.
-#[derive(Resource, Clone, Debug, Default)]
-pub struct Messages(pub Vec<String>);
-
-impl Messages {
-    pub fn push(&mut self, m: impl Into<String>) {
-        let m = m.into();
-        info!("{m}");
-        self.0.push(m);
-    }
-}
-
-/// The selected character (by scene id) and joints.
-#[derive(Resource, Clone, Debug, Default, PartialEq)]
-pub struct Selection {
-    pub character: Option<u64>,
-    pub joints: Vec<usize>,
-}
+pub use state::{Messages, Selection, StartupEdits, StartupPaths, UnloadedCharacters};
 
 /// One material for every skin: white, so vertex colours (tint or weights) show as they are.
 #[derive(Resource)]
@@ -292,11 +263,6 @@ fn stable_ids(characters: &[crate::formats::scene::CharacterDoc], next: &mut Nex
     let mut taken = std::collections::HashSet::new();
     characters.iter().map(|c| c.id.filter(|&id| taken.insert(id)).unwrap_or_else(|| next.take())).collect()
 }
-
-/// Characters of the current scene that failed to load: kept as their documents were, so
-/// saving writes them back unchanged.
-#[derive(Resource, Clone, Debug, Default)]
-pub struct UnloadedCharacters(pub Vec<crate::formats::scene::CharacterDoc>);
 
 /// What a newly opened scene resets: the selection, the pins, the history, the characters
 /// that did not load.

@@ -3,9 +3,9 @@
 use bevy::prelude::*;
 use bevy::window::PrimaryWindow;
 
-use super::Selection;
 use super::camera::{OrbitCamera, ViewportHasPointer};
 use super::document::SceneCharacter;
+use super::state::Selection;
 use crate::scene::{Character, CurrentJointToWorld, Placement};
 
 /// Where the left button went down, to tell a click from a drag.

@@ -16,7 +16,8 @@ use bevy::winit::WinitPlugin;
 use super::camera::OrbitCamera;
 use super::document::{AssetLibrary, read_scene, scene_path};
 use super::readiness::CaptureGate;
-use super::{Messages, StartupPaths, ViewPlugin, stage};
+use super::state::{Messages, StartupEdits, StartupPaths};
+use super::{ViewPlugin, stage};
 use crate::formats::scene::{BindingDoc, SourceDoc};
 use crate::scene::{RigCorePlugin, SkinningPlugin};
 
@@ -42,7 +43,7 @@ struct RenderJob {
 /// `width`×`height` into `out`. Returns what went wrong, if anything.
 pub fn render(
     paths: Vec<PathBuf>,
-    edits: super::StartupEdits,
+    edits: StartupEdits,
     out: PathBuf,
     width: u32,
     height: u32,

@@ -6,8 +6,8 @@ use std::path::{Path, PathBuf};
 use bevy::prelude::*;
 use bevy::render::view::screenshot::{Screenshot, ScreenshotCaptured};
 
-use super::Messages;
 use super::readiness::CaptureGate;
+use super::state::Messages;
 
 /// A pending screenshot and the options of the next one.
 #[derive(Resource)]

@@ -1,0 +1,66 @@
+//! The editor's shared state, imported by its parts (never through `mod.rs`): what the app
+//! opens with, the messages, the selection, a joint drag under way and the characters that
+//! failed to load.
+
+use std::path::PathBuf;
+
+use bevy::prelude::*;
+
+/// What the app opens with: a scene file, character files, or (empty) the default scene.
+#[derive(Resource, Clone, Debug, Default)]
+pub struct StartupPaths(pub Vec<PathBuf>);
+
+/// Pose and IK edits from the command line, applied to every character of the startup
+/// scene that has the named joint (`--pose`, then `--ik`).
+#[derive(Resource, Clone, Debug, Default)]
+pub struct StartupEdits {
+    pub poses: Vec<crate::cli::posing::PoseSpec>,
+    pub ik: Vec<crate::cli::posing::IkSpec>,
+}
+
+/// Messages for the user (load errors, warnings, where files went), newest last.
+#[derive(Resource, Clone, Debug, Default)]
+pub struct Messages(pub Vec<String>);
+
+impl Messages {
+    pub fn push(&mut self, m: impl Into<String>) {
+        let m = m.into();
+        info!("{m}");
+        self.0.push(m);
+    }
+}
+
+/// The selected character (by scene id) and joints.
+#[derive(Resource, Clone, Debug, Default, PartialEq)]
+pub struct Selection {
+    pub character: Option<u64>,
+    pub joints: Vec<usize>,
+}
+
+/// Characters of the current scene that failed to load: kept as their documents were, so
+/// saving writes them back unchanged.
+#[derive(Resource, Clone, Debug, Default)]
+pub struct UnloadedCharacters(pub Vec<crate::formats::scene::CharacterDoc>);
+
+/// A drag under way.
+#[derive(Debug, Clone)]
+pub struct Drag {
+    pub character: u64,
+    pub joint: usize,
+    /// The drag plane: through the joint, facing the camera.
+    pub plane_point: Vec3,
+    pub plane_normal: Vec3,
+    /// Pinned joints of that character and where they must stay (world).
+    pub pins: Vec<(usize, Vec3)>,
+    /// Where the button went down (window pixels): the pose changes only once the cursor
+    /// has moved beyond [`CLICK_SLOP_PX`](super::picking::CLICK_SLOP_PX) from it, so a click is no edit.
+    pub pressed_at: Vec2,
+    pub moved: bool,
+}
+
+#[derive(Resource, Default)]
+pub struct JointDrag {
+    pub active: Option<Drag>,
+    /// The last solve's note (reached or not, limited), shown in the panel.
+    pub note: String,
+}
