@@ -86,17 +86,26 @@ pub fn apply_orbit_camera(mut cameras: Query<(&OrbitCamera, &mut Transform), Cha
     }
 }
 
-/// Notes whether egui uses the pointer, so drags over panels do not orbit (reads
-/// `EguiWantsInput`; writes `ViewportHasPointer`).
+/// Notes whether the pointer belongs to the 3D view: inside the area between the panels
+/// and not used by egui (a popup, a drag that started on a widget), so clicks and drags
+/// on the panels neither orbit nor pick (reads `EguiWantsInput`, `ViewportArea`, the
+/// cursor; writes `ViewportHasPointer`).
 pub fn track_egui_pointer(
     wants: Option<Res<bevy_egui::input::EguiWantsInput>>,
+    area: Option<Res<ViewportArea>>,
+    windows: Query<&Window, With<bevy::window::PrimaryWindow>>,
     buttons: Res<ButtonInput<MouseButton>>,
     mut pointer: ResMut<ViewportHasPointer>,
 ) {
     let egui_wants = wants.is_some_and(|w| w.wants_any_pointer_input());
+    let cursor = windows.single().ok().and_then(Window::cursor_position);
+    let in_view = match (area.and_then(|a| a.0), cursor) {
+        (Some(rect), Some(cursor)) => rect.contains(cursor),
+        _ => true,
+    };
     // Decide when a drag starts and keep it for the whole drag.
     if buttons.get_just_pressed().next().is_some() || !buttons.get_pressed().any(|_| true) {
-        pointer.0 = !egui_wants;
+        pointer.0 = in_view && !egui_wants;
     }
 }
 

@@ -257,6 +257,84 @@ pub fn pose_from_doc(asset: &CharacterAsset, doc: &CharacterDoc) -> (Vec<JointRo
     (pose, unknown)
 }
 
+fn placement_of(doc: &CharacterDoc) -> Placement {
+    let p = doc.placement;
+    Placement { translation: Vec3::from(p.translation), yaw: p.yaw, scale: p.scale }
+}
+
+fn display_of(doc: &CharacterDoc) -> DisplayMode {
+    match doc.view.display {
+        DisplayDoc::Mesh => DisplayMode::Mesh,
+        DisplayDoc::Skeleton => DisplayMode::Skeleton,
+        DisplayDoc::Both => DisplayMode::Both,
+    }
+}
+
+fn visibility_of(doc: &CharacterDoc) -> Visibility {
+    if doc.view.visible { Visibility::Inherited } else { Visibility::Hidden }
+}
+
+/// The live characters, as far as a document can set them in place.
+#[derive(SystemParam)]
+pub struct LiveCharacters<'w, 's> {
+    pub characters: Query<
+        'w,
+        's,
+        (
+            Entity,
+            &'static Character,
+            &'static mut SceneCharacter,
+            &'static mut Placement,
+            &'static mut SkinView,
+            &'static mut DisplayMode,
+            &'static mut Visibility,
+            Option<&'static mut SmplCharacter>,
+        ),
+    >,
+    pub poses: Query<'w, 's, &'static mut JointPose>,
+}
+
+impl LiveCharacters<'_, '_> {
+    /// Each live character's entity, id, source and binding.
+    pub fn index(&self) -> Vec<(Entity, u64, SourceDoc, Option<BindingDoc>)> {
+        self.characters.iter().map(|(e, _, sc, ..)| (e, sc.id, sc.source.clone(), sc.binding)).collect()
+    }
+
+    /// Sets a live character to its document in place (same entity, same mesh): pose,
+    /// placement, name, view and SMPL state. Changes are written only where values differ,
+    /// so only what changed is re-skinned. Returns messages about unknown pose keys.
+    pub fn update_from_doc(&mut self, entity: Entity, doc: &CharacterDoc) -> Vec<String> {
+        let Ok((_, character, mut sc, mut placement, mut view, mut display, mut visibility, smpl)) =
+            self.characters.get_mut(entity)
+        else {
+            return Vec::new();
+        };
+        let (pose, messages) = pose_from_doc(&character.asset, doc);
+        for (&joint, rotation) in character.joints.iter().zip(pose) {
+            if let Ok(mut current) = self.poses.get_mut(joint) {
+                current.set_if_neq(JointPose(rotation));
+            }
+        }
+        placement.set_if_neq(placement_of(doc));
+        display.set_if_neq(display_of(doc));
+        visibility.set_if_neq(visibility_of(doc));
+        let wanted =
+            SkinView { tint: doc.view.tint, weight_colors: doc.view.weight_colors, heat_joint: view.heat_joint };
+        view.set_if_neq(wanted);
+        if sc.name != doc.name || sc.visible != doc.view.visible || sc.heat_of_selected != doc.view.heat_of_selected {
+            sc.name = doc.name.clone();
+            sc.visible = doc.view.visible;
+            sc.heat_of_selected = doc.view.heat_of_selected;
+        }
+        if let (Some(mut body), Some(state)) = (smpl, doc.smpl.as_ref())
+            && body.doc() != *state
+        {
+            body.apply_doc(state);
+        }
+        messages
+    }
+}
+
 /// Spawns one character of a document with the given id.
 pub fn spawn_from_doc(
     commands: &mut Commands,
@@ -267,14 +345,7 @@ pub fn spawn_from_doc(
 ) -> Result<(Entity, Vec<String>), FormatError> {
     let asset = library.load_bound(&doc.source, doc.binding)?;
     let (pose, messages) = pose_from_doc(&asset, doc);
-    let p = doc.placement;
-    let placement = Placement { translation: Vec3::from(p.translation), yaw: p.yaw, scale: p.scale };
-    let entity = spawn_character_posed(commands, meshes, asset, placement, &pose);
-    let display = match doc.view.display {
-        DisplayDoc::Mesh => DisplayMode::Mesh,
-        DisplayDoc::Skeleton => DisplayMode::Skeleton,
-        DisplayDoc::Both => DisplayMode::Both,
-    };
+    let entity = spawn_character_posed(commands, meshes, asset, placement_of(doc), &pose);
     commands.entity(entity).insert((
         SceneCharacter {
             id,
@@ -285,8 +356,8 @@ pub fn spawn_from_doc(
             binding: doc.binding,
         },
         SkinView { tint: doc.view.tint, weight_colors: doc.view.weight_colors, heat_joint: None },
-        display,
-        if doc.view.visible { Visibility::Inherited } else { Visibility::Hidden },
+        display_of(doc),
+        visibility_of(doc),
     ));
     if let SourceDoc::File(dir) = &doc.source
         && crate::formats::smpl::is_smpl_dir(dir)

@@ -27,7 +27,9 @@ use bevy::window::WindowResolution;
 
 use crate::scene::{Character, DisplayMode, MarionetteSystems, RigCorePlugin, SkinMesh, SkinView, SkinningPlugin};
 use camera::{OrbitCamera, apply_orbit_camera, orbit_camera_input};
-use document::{AssetLibrary, NextCharacterId, PendingScene, SceneCharacter, spawn_from_doc, startup_doc};
+use document::{
+    AssetLibrary, LiveCharacters, NextCharacterId, PendingScene, SceneCharacter, spawn_from_doc, startup_doc,
+};
 use stage::{StageSettings, apply_stage_settings, draw_grid_and_axes, spawn_stage};
 pub use state::{Messages, Selection, StartupEdits, StartupPaths, UnloadedCharacters};
 
@@ -202,7 +204,7 @@ pub fn apply_pending_scene(
     mut ids: ResMut<NextCharacterId>,
     mut messages: ResMut<Messages>,
     mut stage: ResMut<StageSettings>,
-    existing: Query<(Entity, &Character), With<SceneCharacter>>,
+    mut live: LiveCharacters,
     mut cameras: Query<&mut OrbitCamera>,
     mut reset: SceneReset,
 ) {
@@ -214,14 +216,24 @@ pub fn apply_pending_scene(
         reset.clear();
     }
     reset.unloaded.0.clear();
-    for (e, character) in &existing {
-        crate::scene::despawn_character(&mut commands, e, character);
-    }
+    // Undo, redo and rebind keep the characters that stay (same id, source and weights):
+    // they are set in place. A new scene (Open) replaces everything.
+    let live_index = if pending.with_camera { Vec::new() } else { live.index() };
+    let mut kept = std::collections::HashSet::new();
     let (mut lo, mut hi) = (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY));
     let ids_of_doc = stable_ids(&doc.characters, &mut ids);
     for (c, id) in doc.characters.iter().zip(ids_of_doc) {
-        match spawn_from_doc(&mut commands, &mut meshes, &mut library, c, id) {
-            Ok((_, notes)) => {
+        let same =
+            live_index.iter().find(|(_, i, source, binding)| *i == id && *source == c.source && *binding == c.binding);
+        let spawned = match same {
+            Some(&(entity, ..)) => {
+                kept.insert(entity);
+                Ok(live.update_from_doc(entity, c))
+            }
+            None => spawn_from_doc(&mut commands, &mut meshes, &mut library, c, id).map(|(_, notes)| notes),
+        };
+        match spawned {
+            Ok(notes) => {
                 notes.into_iter().for_each(|m| messages.push(m));
                 if let Ok(asset) = library.load(&c.source) {
                     let (a, b) = asset.bounds();
@@ -240,6 +252,11 @@ pub fn apply_pending_scene(
                 messages.push(format!("{e} (`{}` is kept in the scene file as it was)", c.name));
                 reset.unloaded.0.push(c.clone());
             }
+        }
+    }
+    for (entity, character, ..) in &live.characters {
+        if !kept.contains(&entity) {
+            crate::scene::despawn_character(&mut commands, entity, character);
         }
     }
     if pending.with_camera {

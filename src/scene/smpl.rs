@@ -63,6 +63,14 @@ impl SmplCharacter {
         }
     }
 
+    /// Takes the state of a document (β, clips, time, playback), keeping the model, its
+    /// clips and the shape the asset was built for (so a β change reshapes it).
+    pub fn apply_doc(&mut self, doc: &SmplDoc) {
+        let built_betas = self.built_betas;
+        *self = Self::new(self.model.clone(), self.dir.clone(), self.clips.clone(), Some(doc));
+        self.built_betas = built_betas;
+    }
+
     pub fn doc(&self) -> SmplDoc {
         SmplDoc {
             betas: self.betas.to_vec(),

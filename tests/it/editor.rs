@@ -221,21 +221,14 @@ fn model1_and_model2_render_side_by_side() {
 #[derive(bevy::prelude::Resource, Default)]
 struct Captured(SceneDoc);
 
-fn capture_scene(reader: marionette::editor::document::SceneReader, mut out: bevy::prelude::ResMut<Captured>) {
-    out.0 = reader.capture();
-}
-
-/// Open replaces the world: the old selection, pins and history refer to nothing in it
-/// and are cleared; a character that fails to load is reported and kept, as it was, in
-/// what Save writes.
-#[test]
-fn opening_a_scene_clears_selection_pins_and_history_and_keeps_unloadable_characters() {
+/// An app with the ECS core and the editor's scene building (no window, no rendering):
+/// `PendingScene` documents are applied, then the scene is captured into `Captured`.
+fn scene_app() -> bevy::prelude::App {
     use bevy::prelude::*;
-    use marionette::editor::document::{AssetLibrary, NextCharacterId, PendingScene, SceneCharacter};
+    use marionette::editor::document::{AssetLibrary, NextCharacterId, PendingScene};
     use marionette::editor::ik_drag::Pins;
     use marionette::editor::stage::StageSettings;
     use marionette::editor::{Messages, Selection, UnloadedCharacters, apply_pending_scene};
-
     let mut app = crate::ecs::app();
     app.init_resource::<AssetLibrary>()
         .init_resource::<NextCharacterId>()
@@ -248,6 +241,24 @@ fn opening_a_scene_clears_selection_pins_and_history_and_keeps_unloadable_charac
         .init_resource::<History>()
         .init_resource::<Captured>()
         .add_systems(Update, (apply_pending_scene, capture_scene).chain());
+    app
+}
+
+fn capture_scene(reader: marionette::editor::document::SceneReader, mut out: bevy::prelude::ResMut<Captured>) {
+    out.0 = reader.capture();
+}
+
+/// Open replaces the world: the old selection, pins and history refer to nothing in it
+/// and are cleared; a character that fails to load is reported and kept, as it was, in
+/// what Save writes.
+#[test]
+fn opening_a_scene_clears_selection_pins_and_history_and_keeps_unloadable_characters() {
+    use bevy::prelude::*;
+    use marionette::editor::document::{PendingScene, SceneCharacter};
+    use marionette::editor::ik_drag::Pins;
+    use marionette::editor::{Messages, Selection};
+
+    let mut app = scene_app();
     // What the previous scene left behind.
     *app.world_mut().resource_mut::<Selection>() = Selection { character: Some(7), joints: vec![40] };
     app.world_mut().resource_mut::<Pins>().0.insert(7, vec![40]);
@@ -280,20 +291,10 @@ fn opening_a_scene_clears_selection_pins_and_history_and_keeps_unloadable_charac
 #[test]
 fn character_ids_survive_rebuilding_from_a_document_and_old_files_get_fresh_ones() {
     use bevy::prelude::*;
-    use marionette::editor::document::{AssetLibrary, NextCharacterId, PendingScene, SceneCharacter};
-    use marionette::editor::stage::StageSettings;
-    use marionette::editor::{Messages, Selection, UnloadedCharacters, apply_pending_scene};
+    use marionette::editor::Selection;
+    use marionette::editor::document::{PendingScene, SceneCharacter};
 
-    let mut app = crate::ecs::app();
-    app.init_resource::<AssetLibrary>()
-        .init_resource::<NextCharacterId>()
-        .init_resource::<Messages>()
-        .init_resource::<StageSettings>()
-        .init_resource::<Selection>()
-        .init_resource::<UnloadedCharacters>()
-        .init_resource::<PendingScene>()
-        .init_resource::<Captured>()
-        .add_systems(Update, (apply_pending_scene, capture_scene).chain());
+    let mut app = scene_app();
     let apply = |app: &mut App, ids: &[Option<u64>], with_camera: bool| {
         let one = doc_with(SourceDoc::Embedded("puppet".into()), &[]).characters[0].clone();
         let characters = ids.iter().map(|&id| CharacterDoc { id, ..one.clone() }).collect();
@@ -315,4 +316,42 @@ fn character_ids_survive_rebuilding_from_a_document_and_old_files_get_fresh_ones
     assert_eq!(saved.characters.iter().map(|c| c.id).collect::<Vec<_>>(), vec![Some(9)]);
     // An old file: no ids, and one repeated id; fresh ids come after every id seen.
     assert_eq!(apply(&mut app, &[None, Some(9), Some(9)], true), vec![9, 10, 11]);
+}
+
+/// Undo and redo set the characters that stay in place: the same entity and mesh, with
+/// the document's pose and placement (no despawn and respawn).
+#[test]
+fn applying_a_document_again_updates_characters_in_place() {
+    use bevy::prelude::*;
+    use marionette::editor::document::{PendingScene, SceneCharacter};
+    use marionette::scene::{Character, JointPose, Placement};
+
+    let mut app = scene_app();
+    let mut doc = doc_with(SourceDoc::Embedded("puppet".into()), &[]);
+    doc.characters[0].id = Some(3);
+    *app.world_mut().resource_mut::<PendingScene>() =
+        PendingScene { doc: Some(doc.clone()), with_camera: true, frame: false };
+    app.update();
+    app.update();
+    let entity_of = |app: &mut App| {
+        let world = app.world_mut();
+        world.query_filtered::<Entity, With<SceneCharacter>>().iter(world).collect::<Vec<_>>()
+    };
+    let before = entity_of(&mut app);
+    let mesh = app.world().get::<Character>(before[0]).unwrap().mesh.id();
+
+    let elbow_rotation = JointRotation::euler_xyz(0.0, 1.0, 0.0);
+    let mut edited = doc.clone();
+    edited.characters[0].placement.translation = [2.0, 0.0, 1.0];
+    edited.characters[0].pose.insert("l_elbow".into(), elbow_rotation);
+    *app.world_mut().resource_mut::<PendingScene>() =
+        PendingScene { doc: Some(edited), with_camera: false, frame: false };
+    app.update();
+    app.update();
+    assert_eq!(entity_of(&mut app), before, "the same entity");
+    let character = app.world().get::<Character>(before[0]).unwrap().clone();
+    assert_eq!(character.mesh.id(), mesh, "the same mesh");
+    assert_eq!(app.world().get::<Placement>(before[0]).unwrap().translation, Vec3::new(2.0, 0.0, 1.0));
+    let elbow = character.asset.skeleton.find("l_elbow").unwrap();
+    assert_eq!(app.world().get::<JointPose>(character.joints[elbow]).unwrap().0, elbow_rotation);
 }
