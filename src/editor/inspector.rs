@@ -56,7 +56,7 @@ impl Plugin for InspectorPlugin {
             .init_resource::<ViewportArea>()
             .add_systems(PostUpdate, fit_camera_viewport)
             .init_resource::<SceneSnapshot>()
-            .add_systems(Update, capture_snapshot.before(shortcuts))
+            .add_systems(Update, capture_snapshot.run_if(scene_changed).before(shortcuts))
             .add_systems(EguiPrimaryContextPass, inspector_ui);
     }
 }
@@ -64,6 +64,34 @@ impl Plugin for InspectorPlugin {
 /// Captures the scene document (reads the scene; writes `SceneSnapshot`).
 fn capture_snapshot(reader: SceneReader, mut snapshot: ResMut<SceneSnapshot>) {
     snapshot.0 = reader.capture();
+}
+
+/// Whether anything a scene document holds changed since the last frame: only then is the
+/// snapshot captured again (an idle editor builds no document).
+#[allow(clippy::too_many_arguments)]
+fn scene_changed(
+    poses: Query<(), Changed<JointPose>>,
+    characters: Query<
+        (),
+        Or<(
+            Changed<SceneCharacter>,
+            Changed<Placement>,
+            Changed<SkinView>,
+            Changed<DisplayMode>,
+            Changed<SmplCharacter>,
+        )>,
+    >,
+    mut removed: RemovedComponents<SceneCharacter>,
+    cameras: Query<(), Changed<OrbitCamera>>,
+    stage: Res<StageSettings>,
+    unloaded: Res<super::state::UnloadedCharacters>,
+) -> bool {
+    !poses.is_empty()
+        || !characters.is_empty()
+        || removed.read().next().is_some()
+        || !cameras.is_empty()
+        || stage.is_changed()
+        || unloaded.is_changed()
 }
 
 /// What the inspector edits.
