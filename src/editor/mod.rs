@@ -116,6 +116,9 @@ pub fn run(paths: Vec<PathBuf>) {
             screenshot::ScreenshotPlugin,
             history::HistoryPlugin,
         ))
+        // The inspector's edits (bevy_egui's pass) land before the chain that animates,
+        // solves, runs the matrix stack and skins: an edit is skinned the frame it is made.
+        .configure_sets(PostUpdate, MarionetteSystems::Animate.after(bevy_egui::EguiPostUpdateSet::EndPass))
         .add_systems(Startup, spawn_window_camera)
         .run();
 }
