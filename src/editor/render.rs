@@ -16,8 +16,9 @@ use bevy::winit::WinitPlugin;
 use super::camera::OrbitCamera;
 use super::document::{AssetLibrary, read_scene, scene_path};
 use super::readiness::CaptureGate;
+use super::stage;
 use super::state::{Messages, StartupEdits, StartupPaths};
-use super::{ViewPlugin, stage};
+use super::view::ViewPlugin;
 use crate::formats::scene::{BindingDoc, SourceDoc};
 use crate::scene::{RigCorePlugin, SkinningPlugin};
 
