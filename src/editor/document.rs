@@ -186,12 +186,7 @@ impl SceneReader<'_, '_> {
                 pitch: o.pitch,
                 distance: o.distance,
             }),
-            stage: crate::formats::scene::StageDoc {
-                floor: self.stage.floor,
-                shadows: self.stage.shadows,
-                axes: self.stage.axes,
-                floor_height: self.stage.floor_height,
-            },
+            stage: self.stage.0,
         }
     }
 

@@ -3,21 +3,10 @@
 use bevy::light::{DirectionalLightShadowMap, light_consts};
 use bevy::prelude::*;
 
-/// Scene-wide view settings.
-#[derive(Resource, Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
-pub struct StageSettings {
-    pub floor: bool,
-    pub shadows: bool,
-    pub axes: bool,
-    /// Height of the floor plane (world y).
-    pub floor_height: f32,
-}
-
-impl Default for StageSettings {
-    fn default() -> Self {
-        Self { floor: true, shadows: true, axes: false, floor_height: 0.0 }
-    }
-}
+/// Scene-wide view settings: the scene file's own type (floor, shadows, axes, floor
+/// height), held as a resource.
+#[derive(Resource, Clone, Copy, Debug, Default, PartialEq, Deref, DerefMut)]
+pub struct StageSettings(pub crate::formats::scene::StageDoc);
 
 /// The sky (clear) colour.
 pub const SKY: Color = Color::srgb(0.62, 0.7, 0.78);

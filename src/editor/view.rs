@@ -186,8 +186,7 @@ pub fn apply_pending_scene(
         }
     }
     if pending.with_camera {
-        let s = doc.stage;
-        *stage = StageSettings { floor: s.floor, shadows: s.shadows, axes: s.axes, floor_height: s.floor_height };
+        stage.0 = doc.stage;
         for mut orbit in &mut cameras {
             if let Some(c) = doc.camera {
                 *orbit = OrbitCamera { focus: Vec3::from(c.focus), yaw: c.yaw, pitch: c.pitch, distance: c.distance };

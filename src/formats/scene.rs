@@ -181,12 +181,17 @@ pub struct CameraDoc {
     pub distance: f32,
 }
 
+/// Scene-wide view settings (the editor holds this very type as its stage resource).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(default)]
 pub struct StageDoc {
+    /// Draw the floor (and its grid).
     pub floor: bool,
+    /// The sun casts shadows.
     pub shadows: bool,
+    /// Draw the world axes.
     pub axes: bool,
+    /// Height of the floor plane (world y).
     pub floor_height: f32,
 }
 
