@@ -3,27 +3,19 @@
 use bevy::input::mouse::{AccumulatedMouseMotion, AccumulatedMouseScroll, MouseScrollUnit};
 use bevy::prelude::*;
 
-/// An orbit around `focus` (world space), at `distance`, with `yaw`/`pitch` in radians.
-#[derive(Component, Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
-pub struct OrbitCamera {
-    pub focus: Vec3,
-    pub yaw: f32,
-    pub pitch: f32,
-    pub distance: f32,
-}
+use crate::formats::scene::CameraDoc;
 
-impl Default for OrbitCamera {
-    fn default() -> Self {
-        Self { focus: Vec3::new(0.0, 0.5, 0.0), yaw: 0.0, pitch: -0.25, distance: 3.0 }
-    }
-}
+/// The camera's orbit: the scene file's own type (focus, yaw, pitch, distance) on the
+/// camera entity.
+#[derive(Component, Clone, Copy, Debug, Default, PartialEq, Deref, DerefMut)]
+pub struct OrbitCamera(pub CameraDoc);
 
 impl OrbitCamera {
     /// A camera looking at a box so that it fills most of the view.
     pub fn framing(lo: Vec3, hi: Vec3) -> Self {
         let center = (lo + hi) / 2.0;
         let radius = ((hi - lo).length() / 2.0).max(0.05);
-        Self { focus: center, yaw: 0.35, pitch: -0.25, distance: radius * 2.6 }
+        Self(CameraDoc { focus: center, yaw: 0.35, pitch: -0.25, distance: radius * 2.6 })
     }
 
     pub fn transform(&self) -> Transform {

@@ -11,8 +11,7 @@ use bevy::prelude::*;
 use super::camera::OrbitCamera;
 use super::stage::StageSettings;
 use crate::formats::scene::{
-    BindingDoc, CameraDoc, CharacterDoc, DisplayDoc, PlacementDoc, SceneDoc, SourceDoc, ViewDoc, joint_of_pose_key,
-    pose_key,
+    BindingDoc, CharacterDoc, DisplayDoc, PlacementDoc, SceneDoc, SourceDoc, ViewDoc, joint_of_pose_key, pose_key,
 };
 use crate::formats::{FormatError, load_character};
 use crate::rig::smpl::{Clip, SmplModel};
@@ -180,12 +179,7 @@ impl SceneReader<'_, '_> {
         SceneDoc {
             // Characters that failed to load stay in the document as they were.
             characters: characters.into_iter().map(|(_, d)| d).chain(self.unloaded.0.iter().cloned()).collect(),
-            camera: self.cameras.iter().next().map(|o| CameraDoc {
-                focus: o.focus.to_array(),
-                yaw: o.yaw,
-                pitch: o.pitch,
-                distance: o.distance,
-            }),
+            camera: self.cameras.iter().next().map(|o| o.0),
             stage: self.stage.0,
         }
     }

@@ -189,7 +189,7 @@ pub fn apply_pending_scene(
         stage.0 = doc.stage;
         for mut orbit in &mut cameras {
             if let Some(c) = doc.camera {
-                *orbit = OrbitCamera { focus: Vec3::from(c.focus), yaw: c.yaw, pitch: c.pitch, distance: c.distance };
+                *orbit = OrbitCamera(c);
             } else if pending.frame && lo.x <= hi.x {
                 *orbit = OrbitCamera::framing(lo, hi);
             }

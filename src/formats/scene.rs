@@ -173,12 +173,20 @@ pub struct CharacterDoc {
 /// How to bind a skin from its skeleton's bones (stored as `Nearest` or `Smooth`).
 pub use crate::rig::bind::Binding as BindingDoc;
 
+/// The orbit camera: an orbit around `focus` (world space) at `distance`, with `yaw` and
+/// `pitch` in radians (the editor holds this very type on its camera).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct CameraDoc {
-    pub focus: [f32; 3],
+    pub focus: glam::Vec3,
     pub yaw: f32,
     pub pitch: f32,
     pub distance: f32,
+}
+
+impl Default for CameraDoc {
+    fn default() -> Self {
+        Self { focus: glam::Vec3::new(0.0, 0.5, 0.0), yaw: 0.0, pitch: -0.25, distance: 3.0 }
+    }
 }
 
 /// Scene-wide view settings (the editor holds this very type as its stage resource).
@@ -296,7 +304,7 @@ impl SceneDoc {
             }
         }
         if let Some(camera) = &self.camera {
-            finite("camera.focus", &camera.focus)?;
+            finite("camera.focus", &camera.focus.to_array())?;
             finite("camera.yaw", &[camera.yaw, camera.pitch])?;
             positive("camera.distance", camera.distance)?;
         }

@@ -160,8 +160,12 @@ fn render_draws_characters_distinct_from_floor_and_sky_with_weight_hues() {
     let mut doc =
         doc_with(SourceDoc::Embedded("puppet".into()), &[("l_shoulder", JointRotation::euler_xyz(0.0, 0.0, -1.0))]);
     doc.characters[0].placement = PlacementDoc { translation: [0.0, 0.0, 0.0], yaw: 0.0, scale: 1.0 };
-    doc.camera =
-        Some(marionette::formats::scene::CameraDoc { focus: [0.0, 0.5, 0.0], yaw: 0.0, pitch: -0.2, distance: 1.6 });
+    doc.camera = Some(marionette::formats::scene::CameraDoc {
+        focus: glam::Vec3::new(0.0, 0.5, 0.0),
+        yaw: 0.0,
+        pitch: -0.2,
+        distance: 1.6,
+    });
     let scene = dir.join("scene.ron");
     write_scene(&scene, &doc).unwrap();
     let out = dir.join("shot.png");
