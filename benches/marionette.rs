@@ -74,25 +74,32 @@ fn kernel_skin_and_flat_shade(bencher: Bencher) {
 }
 
 /// One `App::update` where every character has one joint changed: mark, FK, skin.
+/// An app with the ECS core and `n` characters of `asset` in a row.
+fn crowd_app(asset: &Arc<CharacterAsset>, n: usize) -> (App, Vec<Entity>) {
+    let mut app = App::new();
+    app.add_plugins((MinimalPlugins, AssetPlugin::default(), bevy::mesh::MeshPlugin, RigCorePlugin, SkinningPlugin));
+    let world = app.world_mut();
+    let mut meshes = world.remove_resource::<Assets<Mesh>>().unwrap();
+    let mut queue = bevy::ecs::world::CommandQueue::default();
+    let ids: Vec<Entity> = {
+        let mut commands = Commands::new(&mut queue, world);
+        (0..n)
+            .map(|i| spawn_character(&mut commands, &mut meshes, asset.clone(), Placement::at(Vec3::X * i as f32)))
+            .collect()
+    };
+    queue.apply(world);
+    world.insert_resource(meshes);
+    (app, ids)
+}
+
 #[divan::bench(args = [1, 16])]
 fn ecs_frame(bencher: Bencher, characters: usize) {
     let asset = asset();
-    let mut app = App::new();
-    app.add_plugins((MinimalPlugins, AssetPlugin::default(), bevy::mesh::MeshPlugin, RigCorePlugin, SkinningPlugin));
-    let joints: Vec<Entity> = {
-        let world = app.world_mut();
-        let mut meshes = world.remove_resource::<Assets<Mesh>>().unwrap();
-        let mut queue = bevy::ecs::world::CommandQueue::default();
-        let ids: Vec<Entity> = {
-            let mut commands = Commands::new(&mut queue, world);
-            (0..characters)
-                .map(|i| spawn_character(&mut commands, &mut meshes, asset.clone(), Placement::at(Vec3::X * i as f32)))
-                .collect()
-        };
-        queue.apply(world);
-        world.insert_resource(meshes);
-        ids.iter().map(|&c| world.get::<Character>(c).unwrap().joints[6.min(asset.skeleton.len() - 1)]).collect()
-    };
+    let (mut app, crowd) = crowd_app(&asset, characters);
+    let joints: Vec<Entity> = crowd
+        .iter()
+        .map(|&c| app.world().get::<Character>(c).unwrap().joints[6.min(asset.skeleton.len() - 1)])
+        .collect();
     app.update();
     let mut angle = 0.0f32;
     bencher.bench_local(|| {
@@ -110,22 +117,8 @@ fn ecs_frame(bencher: Bencher, characters: usize) {
 #[divan::bench(args = ["moved", "posed"])]
 fn ecs_frame_one_of_16_edited(bencher: Bencher, edit: &str) {
     let asset = asset();
-    let mut app = App::new();
-    app.add_plugins((MinimalPlugins, AssetPlugin::default(), bevy::mesh::MeshPlugin, RigCorePlugin, SkinningPlugin));
-    let first = {
-        let world = app.world_mut();
-        let mut meshes = world.remove_resource::<Assets<Mesh>>().unwrap();
-        let mut queue = bevy::ecs::world::CommandQueue::default();
-        let ids: Vec<Entity> = {
-            let mut commands = Commands::new(&mut queue, world);
-            (0..16)
-                .map(|i| spawn_character(&mut commands, &mut meshes, asset.clone(), Placement::at(Vec3::X * i as f32)))
-                .collect()
-        };
-        queue.apply(world);
-        world.insert_resource(meshes);
-        ids[0]
-    };
+    let (mut app, crowd) = crowd_app(&asset, 16);
+    let first = crowd[0];
     let joint = app.world().get::<Character>(first).unwrap().joints[6.min(asset.skeleton.len() - 1)];
     app.update();
     app.update();

@@ -165,7 +165,7 @@ fn moving_a_character_rewrites_no_mesh_and_posing_one_rewrites_only_its_own() {
     let asset = Arc::new(embedded_puppet());
     let mut app = app();
     let a = spawn(&mut app, asset.clone(), Placement::default());
-    let b = spawn(&mut app, asset.clone(), Placement::at(Vec3::X));
+    let _other = spawn(&mut app, asset.clone(), Placement::at(Vec3::X));
     app.update();
     app.update();
     modified_meshes(&mut app);
@@ -180,7 +180,6 @@ fn moving_a_character_rewrites_no_mesh_and_posing_one_rewrites_only_its_own() {
     app.update();
     app.update();
     assert_eq!(modified_meshes(&mut app), vec![mesh_a], "posing a re-skins a only");
-    let _ = b;
 }
 
 #[test]
