@@ -11,7 +11,7 @@ use bevy::prelude::*;
 use super::camera::OrbitCamera;
 use super::stage::StageSettings;
 use crate::formats::scene::{
-    BindingDoc, CharacterDoc, DisplayDoc, PlacementDoc, SceneDoc, SourceDoc, ViewDoc, joint_of_pose_key, pose_key,
+    BindingDoc, CharacterDoc, PlacementDoc, SceneDoc, SourceDoc, ViewDoc, joint_of_pose_key, pose_key,
 };
 use crate::formats::{FormatError, load_character};
 use crate::rig::smpl::{Clip, SmplModel};
@@ -214,11 +214,7 @@ impl SceneReader<'_, '_> {
             },
             pose,
             view: ViewDoc {
-                display: match display {
-                    DisplayMode::Mesh => DisplayDoc::Mesh,
-                    DisplayMode::Skeleton => DisplayDoc::Skeleton,
-                    DisplayMode::Both => DisplayDoc::Both,
-                },
+                display: display.0,
                 visible: sc.visible,
                 weight_colors: view.weight_colors,
                 heat_of_selected: sc.heat_of_selected,
@@ -252,11 +248,7 @@ fn placement_of(doc: &CharacterDoc) -> Placement {
 }
 
 fn display_of(doc: &CharacterDoc) -> DisplayMode {
-    match doc.view.display {
-        DisplayDoc::Mesh => DisplayMode::Mesh,
-        DisplayDoc::Skeleton => DisplayMode::Skeleton,
-        DisplayDoc::Both => DisplayMode::Both,
-    }
+    DisplayMode(doc.view.display)
 }
 
 fn visibility_of(doc: &CharacterDoc) -> Visibility {

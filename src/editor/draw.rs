@@ -49,7 +49,7 @@ pub fn draw_skeletons(
         for &j in selected {
             gizmos.sphere(Isometry3d::from_translation(world(j).w_axis.truncate()), radius * 2.2, SELECTED_COLOR);
         }
-        if *mode == DisplayMode::Mesh {
+        if **mode == crate::formats::scene::DisplayDoc::Mesh {
             continue;
         }
         let skeleton = &character.asset.skeleton;

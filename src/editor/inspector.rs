@@ -16,7 +16,7 @@ use super::history::{History, HistoryRequest};
 use super::screenshot::ScreenshotRequest;
 use super::stage::StageSettings;
 use super::state::{Messages, Selection};
-use crate::formats::scene::{BindingDoc, CharacterDoc, PlacementDoc, SceneDoc, SourceDoc, ViewDoc};
+use crate::formats::scene::{BindingDoc, CharacterDoc, DisplayDoc, PlacementDoc, SceneDoc, SourceDoc, ViewDoc};
 use crate::rig::{EulerOrder, JointRotation, Skeleton};
 use crate::scene::smpl::SmplCharacter;
 use crate::scene::{Character, CurrentJointToWorld, DisplayMode, JointLimits, JointPose, Placement, SkinView};
@@ -286,12 +286,12 @@ fn scene_panel(
                 edited = true;
             }
             ui.horizontal(|ui| {
-                let mut d = *display;
-                ui.radio_value(&mut d, DisplayMode::Mesh, "mesh");
-                ui.radio_value(&mut d, DisplayMode::Skeleton, "skeleton");
-                ui.radio_value(&mut d, DisplayMode::Both, "both");
-                if d != *display {
-                    *display = d;
+                let mut d = **display;
+                ui.radio_value(&mut d, DisplayDoc::Mesh, "mesh");
+                ui.radio_value(&mut d, DisplayDoc::Skeleton, "skeleton");
+                ui.radio_value(&mut d, DisplayDoc::Both, "both");
+                if d != **display {
+                    **display = d;
                     edited = true;
                 }
             });
@@ -598,10 +598,10 @@ pub fn shortcuts(
     let selected = characters.iter_mut().find(|c| Some(c.0.id) == selection.character);
     if keys.just_pressed(KeyCode::KeyS) {
         if let Some((_, _, mut display, _)) = selected {
-            *display = display.next();
+            **display = display.next();
         } else {
             for (_, _, mut display, _) in &mut characters {
-                *display = display.next();
+                **display = display.next();
             }
         }
     } else if keys.just_pressed(KeyCode::KeyF) {

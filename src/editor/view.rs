@@ -264,7 +264,11 @@ fn apply_display_mode(
 ) {
     for (character, mode) in &characters {
         if let Ok(mut v) = visibility.get_mut(character.skin_entity) {
-            *v = if *mode == DisplayMode::Skeleton { Visibility::Hidden } else { Visibility::Inherited };
+            *v = if **mode == crate::formats::scene::DisplayDoc::Skeleton {
+                Visibility::Hidden
+            } else {
+                Visibility::Inherited
+            };
         }
     }
 }

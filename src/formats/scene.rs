@@ -95,13 +95,24 @@ impl Default for PlacementDoc {
     }
 }
 
-/// Display of one character.
+/// Whether a character shows its skin, its skeleton, or both.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
 pub enum DisplayDoc {
     #[default]
     Mesh,
     Skeleton,
     Both,
+}
+
+impl DisplayDoc {
+    /// The next mode in the cycle mesh → skeleton → both.
+    pub fn next(self) -> Self {
+        match self {
+            DisplayDoc::Mesh => DisplayDoc::Skeleton,
+            DisplayDoc::Skeleton => DisplayDoc::Both,
+            DisplayDoc::Both => DisplayDoc::Mesh,
+        }
+    }
 }
 
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]

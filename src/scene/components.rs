@@ -73,25 +73,10 @@ impl Default for SkinView {
     }
 }
 
-/// Whether a character shows its skin, its skeleton, or both.
-#[derive(Component, Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
-pub enum DisplayMode {
-    #[default]
-    Mesh,
-    Skeleton,
-    Both,
-}
-
-impl DisplayMode {
-    /// The next mode in the cycle mesh → skeleton → both.
-    pub fn next(self) -> Self {
-        match self {
-            DisplayMode::Mesh => DisplayMode::Skeleton,
-            DisplayMode::Skeleton => DisplayMode::Both,
-            DisplayMode::Both => DisplayMode::Mesh,
-        }
-    }
-}
+/// Whether a character shows its skin, its skeleton, or both: the scene file's own type,
+/// on the character entity.
+#[derive(Component, Clone, Copy, Debug, Default, PartialEq, Eq, Deref, DerefMut)]
+pub struct DisplayMode(pub crate::formats::scene::DisplayDoc);
 
 /// Set when a character's pose, placement or view changed and its skin must be redone.
 #[derive(Component, Clone, Copy, Debug, Default, PartialEq, Eq)]
