@@ -6,6 +6,7 @@ use bevy::prelude::*;
 
 use super::document::SceneCharacter;
 use super::state::Selection;
+use crate::formats::scene::DisplayDoc;
 use crate::rig::character::SkinKind;
 use crate::scene::{Character, CurrentJointToWorld, DisplayMode, Placement};
 
@@ -49,7 +50,7 @@ pub fn draw_skeletons(
         for &j in selected {
             gizmos.sphere(Isometry3d::from_translation(world(j).w_axis.truncate()), radius * 2.2, SELECTED_COLOR);
         }
-        if **mode == crate::formats::scene::DisplayDoc::Mesh {
+        if **mode == DisplayDoc::Mesh {
             continue;
         }
         let skeleton = &character.asset.skeleton;

@@ -11,6 +11,7 @@ use super::document::{
 use super::stage::{StageSettings, apply_stage_settings, draw_grid_and_axes, spawn_stage};
 use super::state::{Messages, Selection, StartupEdits, StartupPaths, UnloadedCharacters};
 use super::{draw, history, ik_drag};
+use crate::formats::scene::DisplayDoc;
 use crate::scene::{Character, DisplayMode, MarionetteSystems, SkinMesh, SkinView};
 
 /// One material for every skin: white, so vertex colours (tint or weights) show as they are.
@@ -264,11 +265,7 @@ fn apply_display_mode(
 ) {
     for (character, mode) in &characters {
         if let Ok(mut v) = visibility.get_mut(character.skin_entity) {
-            *v = if **mode == crate::formats::scene::DisplayDoc::Skeleton {
-                Visibility::Hidden
-            } else {
-                Visibility::Inherited
-            };
+            *v = if **mode == DisplayDoc::Skeleton { Visibility::Hidden } else { Visibility::Inherited };
         }
     }
 }
