@@ -15,7 +15,7 @@ fn pose(specs: &[(&str, [f32; 3])]) -> BTreeMap<String, JointRotation> {
 
 fn puppet(
     name: &str,
-    translation: [f32; 3],
+    translation: glam::Vec3,
     yaw: f32,
     pose: BTreeMap<String, JointRotation>,
     view: ViewDoc,
@@ -74,9 +74,9 @@ pub fn generate() -> SceneDoc {
     let blue = ViewDoc { tint: [0.45, 0.6, 0.8], ..ViewDoc::default() };
     SceneDoc {
         characters: vec![
-            puppet("Ada", [-0.4, 0.0, 0.0], 0.9, waving, ViewDoc::default()),
-            puppet("Bo", [0.4, 0.0, 0.05], -0.9, reaching, blue),
-            puppet("Cy", [0.0, -0.29, -0.95], 0.0, sitting, weights),
+            puppet("Ada", glam::Vec3::new(-0.4, 0.0, 0.0), 0.9, waving, ViewDoc::default()),
+            puppet("Bo", glam::Vec3::new(0.4, 0.0, 0.05), -0.9, reaching, blue),
+            puppet("Cy", glam::Vec3::new(0.0, -0.29, -0.95), 0.0, sitting, weights),
         ],
         camera: Some(CameraDoc { focus: glam::Vec3::new(0.0, 0.42, -0.3), yaw: 0.0, pitch: -0.32, distance: 2.9 }),
         stage: StageDoc::default(),

@@ -207,11 +207,7 @@ impl SceneReader<'_, '_> {
             id: Some(sc.id),
             source: sc.source.clone(),
             name: sc.name.clone(),
-            placement: PlacementDoc {
-                translation: placement.translation.to_array(),
-                yaw: placement.yaw,
-                scale: placement.scale,
-            },
+            placement: placement.0,
             pose,
             view: ViewDoc {
                 display: display.0,
@@ -243,8 +239,7 @@ pub fn pose_from_doc(asset: &CharacterAsset, doc: &CharacterDoc) -> (Vec<JointRo
 }
 
 fn placement_of(doc: &CharacterDoc) -> Placement {
-    let p = doc.placement;
-    Placement { translation: Vec3::from(p.translation), yaw: p.yaw, scale: p.scale }
+    Placement(doc.placement)
 }
 
 fn display_of(doc: &CharacterDoc) -> DisplayMode {
@@ -385,7 +380,7 @@ pub fn doc_side_by_side(library: &mut AssetLibrary, sources: Vec<SourceDoc>, mes
                 name: asset.name.clone(),
                 source,
                 placement: PlacementDoc {
-                    translation: [x + w / 2.0 - center.x, -lo.y, -center.z],
+                    translation: Vec3::new(x + w / 2.0 - center.x, -lo.y, -center.z),
                     yaw: 0.0,
                     scale: 1.0,
                 },

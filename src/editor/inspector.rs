@@ -404,7 +404,7 @@ fn add_character(path: &str, state: &mut InspectorState, edit: &mut Editable, op
         id: None,
         source,
         name: asset.name.clone(),
-        placement: PlacementDoc { translation: [x - center.x, -lo.y, -center.z], yaw: 0.0, scale: 1.0 },
+        placement: PlacementDoc { translation: Vec3::new(x - center.x, -lo.y, -center.z), yaw: 0.0, scale: 1.0 },
         pose: Default::default(),
         view: ViewDoc::default(),
         smpl: None,

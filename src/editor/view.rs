@@ -101,13 +101,7 @@ fn apply_startup_edits(
         let poses: Vec<_> = edits.poses.iter().filter(|p| skeleton.resolve(&p.joint).is_some()).cloned().collect();
         let ik: Vec<_> = edits.ik.iter().filter(|p| skeleton.resolve(&p.joint).is_some()).cloned().collect();
         let _ = crate::cli::posing::apply_pose_specs(skeleton, &mut pose, &poses);
-        let p = c.placement;
-        let placement = Mat4::from_scale_rotation_translation(
-            Vec3::splat(p.scale),
-            Quat::from_rotation_y(p.yaw),
-            Vec3::from(p.translation),
-        );
-        if let Ok(reports) = crate::cli::posing::apply_ik_specs(skeleton, &mut pose, placement, &ik) {
+        if let Ok(reports) = crate::cli::posing::apply_ik_specs(skeleton, &mut pose, c.placement.to_mat4(), &ik) {
             reports
                 .iter()
                 .for_each(|r| messages.push(format!("{}: {}", c.name, crate::cli::posing::describe_ik(skeleton, r))));
@@ -164,11 +158,7 @@ pub fn apply_pending_scene(
                 notes.into_iter().for_each(|m| messages.push(m));
                 if let Ok(asset) = library.load(&c.source) {
                     let (a, b) = asset.bounds();
-                    let m = Mat4::from_scale_rotation_translation(
-                        Vec3::splat(c.placement.scale),
-                        Quat::from_rotation_y(c.placement.yaw),
-                        Vec3::from(c.placement.translation),
-                    );
+                    let m = c.placement.to_mat4();
                     for corner in [a, b, Vec3::new(a.x, b.y, a.z), Vec3::new(b.x, a.y, b.z)] {
                         lo = lo.min(m.transform_point3(corner));
                         hi = hi.max(m.transform_point3(corner));

@@ -81,17 +81,31 @@ pub fn relative_path(path: &Path, dir: &Path) -> PathBuf {
     out
 }
 
+/// Where a character stands: model space → world is `T(translation) · Ry(yaw) · S(scale)`
+/// (the editor holds this very type on the character entity).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct PlacementDoc {
-    pub translation: [f32; 3],
+    pub translation: glam::Vec3,
     /// Radians about the vertical axis.
     pub yaw: f32,
+    /// Uniform scale.
     pub scale: f32,
 }
 
 impl Default for PlacementDoc {
     fn default() -> Self {
-        Self { translation: [0.0; 3], yaw: 0.0, scale: 1.0 }
+        Self { translation: glam::Vec3::ZERO, yaw: 0.0, scale: 1.0 }
+    }
+}
+
+impl PlacementDoc {
+    /// The model-to-world matrix.
+    pub fn to_mat4(&self) -> glam::Mat4 {
+        glam::Mat4::from_scale_rotation_translation(
+            glam::Vec3::splat(self.scale),
+            glam::Quat::from_rotation_y(self.yaw),
+            self.translation,
+        )
     }
 }
 
@@ -284,7 +298,7 @@ impl SceneDoc {
     pub fn validate(&self) -> Result<(), String> {
         for (i, c) in self.characters.iter().enumerate() {
             let at = |field: &str| format!("characters[{i}].{field}");
-            finite(&at("placement.translation"), &c.placement.translation)?;
+            finite(&at("placement.translation"), &c.placement.translation.to_array())?;
             finite(&at("placement.yaw"), &[c.placement.yaw])?;
             positive(&at("placement.scale"), c.placement.scale)?;
             for (key, rotation) in &c.pose {

@@ -4,6 +4,7 @@ use std::sync::Arc;
 
 use bevy::prelude::*;
 
+use crate::formats::scene::PlacementDoc;
 use crate::rig::{CharacterAsset, DofLimits, JointRotation};
 
 /// A character: the loaded asset it was made from (shared by every character made from
@@ -19,31 +20,18 @@ pub struct Character {
     pub mesh: Handle<Mesh>,
 }
 
-/// Where a character stands in the world: model space → world is
-/// `T(translation) · Ry(yaw) · S(scale)`.
-#[derive(Component, Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
-pub struct Placement {
-    pub translation: Vec3,
-    /// Rotation about the vertical (y) axis, radians.
-    pub yaw: f32,
-    /// Uniform scale.
-    pub scale: f32,
-}
-
-impl Default for Placement {
-    fn default() -> Self {
-        Self { translation: Vec3::ZERO, yaw: 0.0, scale: 1.0 }
-    }
-}
+/// Where a character stands in the world (the scene file's own `PlacementDoc`: model
+/// space → world is `T(translation) · Ry(yaw) · S(scale)`), on the character entity.
+#[derive(Component, Clone, Copy, Debug, Default, PartialEq, Deref, DerefMut)]
+pub struct Placement(pub PlacementDoc);
 
 impl Placement {
-    pub fn at(translation: Vec3) -> Self {
-        Self { translation, ..default() }
+    pub fn new(translation: Vec3, yaw: f32, scale: f32) -> Self {
+        Self(PlacementDoc { translation, yaw, scale })
     }
 
-    /// The model-to-world matrix.
-    pub fn to_mat4(&self) -> Mat4 {
-        self.to_transform().to_matrix()
+    pub fn at(translation: Vec3) -> Self {
+        Self::new(translation, 0.0, 1.0)
     }
 
     /// The character's `Transform`: what places its joints and skin in the world.

@@ -90,7 +90,7 @@ fn spawning_builds_the_joint_hierarchy_as_entities() {
 #[test]
 fn posing_a_joint_reskins_the_mesh_like_the_kernel() {
     let asset = Arc::new(embedded_puppet());
-    let placement = Placement { translation: Vec3::new(1.0, 0.0, -2.0), yaw: 0.4, scale: 1.5 };
+    let placement = Placement::new(Vec3::new(1.0, 0.0, -2.0), 0.4, 1.5);
     let mut app = app();
     let character = spawn(&mut app, asset.clone(), placement);
     app.update();

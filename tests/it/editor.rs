@@ -22,7 +22,7 @@ fn doc_with(source: SourceDoc, pose: &[(&str, JointRotation)]) -> SceneDoc {
             id: None,
             source,
             name: "c".into(),
-            placement: PlacementDoc { translation: [0.5, 0.0, -1.0], yaw: 0.3, scale: 1.2 },
+            placement: PlacementDoc { translation: glam::Vec3::new(0.5, 0.0, -1.0), yaw: 0.3, scale: 1.2 },
             pose: pose.iter().map(|(k, r)| (k.to_string(), *r)).collect::<BTreeMap<_, _>>(),
             view: ViewDoc { weight_colors: true, ..ViewDoc::default() },
             smpl: None,
@@ -159,7 +159,7 @@ fn render_draws_characters_distinct_from_floor_and_sky_with_weight_hues() {
     let dir = scratch("render");
     let mut doc =
         doc_with(SourceDoc::Embedded("puppet".into()), &[("l_shoulder", JointRotation::euler_xyz(0.0, 0.0, -1.0))]);
-    doc.characters[0].placement = PlacementDoc { translation: [0.0, 0.0, 0.0], yaw: 0.0, scale: 1.0 };
+    doc.characters[0].placement = PlacementDoc::default();
     doc.camera = Some(marionette::formats::scene::CameraDoc {
         focus: glam::Vec3::new(0.0, 0.5, 0.0),
         yaw: 0.0,
@@ -346,7 +346,7 @@ fn applying_a_document_again_updates_characters_in_place() {
 
     let elbow_rotation = JointRotation::euler_xyz(0.0, 1.0, 0.0);
     let mut edited = doc.clone();
-    edited.characters[0].placement.translation = [2.0, 0.0, 1.0];
+    edited.characters[0].placement.translation = Vec3::new(2.0, 0.0, 1.0);
     edited.characters[0].pose.insert("l_elbow".into(), elbow_rotation);
     *app.world_mut().resource_mut::<PendingScene>() =
         PendingScene { doc: Some(edited), with_camera: false, frame: false };
