@@ -1,6 +1,8 @@
 //! Benchmarks: the skinning kernel; one frame of the ECS systems for 1 and 16 characters
-//! (one joint changed per character per frame, so every character re-skins); FABRIK on
-//! 3-, 6- and 20-joint chains; the rotation-space IK solve of the CSE169 dragon's tail.
+//! (one joint changed per character per frame, so every character re-skins); one of 16
+//! moved or posed (with the bytes of mesh data handed on); an editing frame (three SMPL
+//! bodies playing, a puppet dragged by IK); FABRIK on 3-, 6- and 20-joint chains; the
+//! rotation-space IK solve of the CSE169 dragon's tail.
 //!
 //! Run: `cargo bench --profile dev --bench marionette` (with `MARIONETTE_DATA` set, the
 //! 6.837 Model1 is used; otherwise the project's puppet).
@@ -78,6 +80,12 @@ fn kernel_skin_and_flat_shade(bencher: Bencher) {
 fn crowd_app(asset: &Arc<CharacterAsset>, n: usize) -> (App, Vec<Entity>) {
     let mut app = App::new();
     app.add_plugins((MinimalPlugins, AssetPlugin::default(), bevy::mesh::MeshPlugin, RigCorePlugin, SkinningPlugin));
+    let ids = spawn_row(&mut app, asset, n);
+    (app, ids)
+}
+
+/// Spawns `n` characters of `asset` one unit apart along x.
+fn spawn_row(app: &mut App, asset: &Arc<CharacterAsset>, n: usize) -> Vec<Entity> {
     let world = app.world_mut();
     let mut meshes = world.remove_resource::<Assets<Mesh>>().unwrap();
     let mut queue = bevy::ecs::world::CommandQueue::default();
@@ -89,7 +97,7 @@ fn crowd_app(asset: &Arc<CharacterAsset>, n: usize) -> (App, Vec<Entity>) {
     };
     queue.apply(world);
     world.insert_resource(meshes);
-    (app, ids)
+    ids
 }
 
 #[divan::bench(args = [1, 16])]
@@ -148,6 +156,66 @@ fn ecs_frame_one_of_16_edited(bencher: Bencher, edit: &str) {
     let bytes: usize = modified.iter().filter_map(|id| meshes.get(*id)).map(|m| m.get_vertex_buffer_size()).sum();
     eprintln!("ecs_frame_one_of_16_edited({edit}): {} bytes of mesh data per frame", bytes / 4);
     bencher.bench_local(|| edit_once(&mut app));
+}
+
+/// An editing frame: three SMPL bodies each playing its own clip (sampled, reshaped once,
+/// posed every frame) while the puppet's hand is dragged by IK each frame; main-world
+/// systems only (no render world). Needs `MARIONETTE_DATA` (the SMPL folder); without it
+/// only the dragged puppet runs.
+#[divan::bench]
+fn editing_frame_3_smpl_playing_1_puppet_dragged(bencher: Bencher) {
+    use marionette::formats::scene::SmplDoc;
+    use marionette::rig::ik::{IkGoal, solve_ik};
+    use marionette::scene::smpl::{SmplCharacter, SmplPlugin};
+    let puppet = Arc::new(marionette::formats::puppet::embedded_puppet());
+    let (mut app, crowd) = crowd_app(&puppet, 1);
+    app.add_plugins(SmplPlugin);
+    if let Some(dir) = std::env::var_os("MARIONETTE_DATA").map(|d| std::path::PathBuf::from(d).join("smpl")) {
+        let (model, _) = marionette::formats::smpl::load_smpl_dir(&dir).expect("the SMPL folder loads");
+        let model = Arc::new(model);
+        let clips: Vec<(String, Arc<_>)> = marionette::formats::smpl::clip_paths(&dir)
+            .iter()
+            .map(|p| {
+                let reader = marionette::formats::error::open(p).expect("clip opens");
+                let clip = marionette::formats::smpl::parse_clip(reader, p, model.skeleton.len()).expect("clip parses");
+                (p.file_name().unwrap().to_string_lossy().into_owned(), Arc::new(clip))
+            })
+            .collect();
+        let asset = Arc::new(model.asset("smpl", &[]).expect("the body builds"));
+        let bodies = spawn_row(&mut app, &asset, 3);
+        for (i, &body) in bodies.iter().enumerate() {
+            let doc = SmplDoc {
+                betas: vec![0.5 * i as f32; 10],
+                clip: Some(clips[i % clips.len()].0.clone()),
+                playing: true,
+                time: 10.0 * i as f32,
+                ..SmplDoc::default()
+            };
+            let state = SmplCharacter::new(model.clone(), dir.clone(), clips.clone(), Some(&doc));
+            app.world_mut().entity_mut(body).insert(state);
+        }
+    }
+    app.update();
+    app.update();
+    let character = app.world().get::<Character>(crowd[0]).unwrap().clone();
+    let hand = puppet.skeleton.find("l_hand").expect("the puppet has a left hand");
+    let mut step = 0.0f32;
+    bencher.bench_local(|| {
+        step += 0.02;
+        // What a drag does each frame: solve on the live pose, write the joints.
+        let world = app.world_mut();
+        let mut pose: Vec<JointRotation> = character
+            .joints
+            .iter()
+            .map(|&e| world.get::<JointPose>(e).map_or(JointRotation::IDENTITY, |p| p.0))
+            .collect();
+        let target = Vec3::new(0.3 + 0.1 * step.sin(), 1.2, 0.2 * step.cos());
+        solve_ik(&puppet.skeleton, &mut pose, Mat4::IDENTITY, &[IkGoal { end: hand, target }], 1e-4, 8);
+        for (&e, p) in character.joints.iter().zip(pose) {
+            world.get_mut::<JointPose>(e).unwrap().0 = p;
+        }
+        app.update();
+    });
 }
 
 /// A zig-zag chain of `n` joints (unit bones), and a reachable target off its line.
