@@ -147,13 +147,12 @@ impl Plugin for ReadinessPlugin {
 /// Lists the meshes drawn and the cameras' target images (reads `Mesh3d`, `RenderTarget`;
 /// writes the channel).
 fn publish_wanted_assets(channel: Res<GpuStatusChannel>, meshes: Query<&Mesh3d>, targets: Query<&RenderTarget>) {
-    let wanted = WantedAssets {
-        meshes: meshes.iter().map(|m| m.id()).collect(),
-        images: targets.iter().filter_map(|t| t.as_image().map(Handle::id)).collect(),
-    };
-    if let Ok(mut w) = channel.wanted.lock() {
-        *w = wanted;
-    }
+    let Ok(mut wanted) = channel.wanted.lock() else { return };
+    // The same buffers every frame: no allocation once they are large enough.
+    wanted.meshes.clear();
+    wanted.meshes.extend(meshes.iter().map(|m| m.id()));
+    wanted.images.clear();
+    wanted.images.extend(targets.iter().filter_map(|t| t.as_image().map(Handle::id)));
 }
 
 /// Feeds this frame's readiness to the gate (reads the channel, `PoseDirty`,
@@ -178,7 +177,6 @@ fn report_gpu_status(
     meshes: Res<RenderAssets<RenderMesh>>,
     images: Res<RenderAssets<GpuImage>>,
 ) {
-    let wanted = channel.wanted.lock().map(|w| w.clone()).unwrap_or_default();
     // A pipeline whose shader is merely not loaded yet is retried (it stays waiting); one
     // in error and not waiting has failed for good.
     let waiting: std::collections::HashSet<_> = cache.waiting_pipelines().collect();
@@ -190,12 +188,19 @@ fn report_gpu_status(
             _ => None,
         })
         .collect::<Vec<_>>();
+    let (meshes_missing, images_missing) = match channel.wanted.lock() {
+        Ok(wanted) => (
+            wanted.meshes.iter().filter(|&&id| meshes.get(id).is_none()).count(),
+            wanted.images.iter().filter(|&&id| images.get(id).is_none()).count(),
+        ),
+        Err(_) => (0, 0),
+    };
     let Ok(mut status) = channel.status.lock() else { return };
     *status = GpuStatus {
         frame: status.frame + 1,
         pipelines_waiting: waiting.len(),
         pipelines_failed,
-        meshes_missing: wanted.meshes.iter().filter(|&&id| meshes.get(id).is_none()).count(),
-        images_missing: wanted.images.iter().filter(|&&id| images.get(id).is_none()).count(),
+        meshes_missing,
+        images_missing,
     };
 }

@@ -88,13 +88,7 @@ impl CharacterAsset {
 
     /// Axis-aligned bounds of the bind-pose mesh (model space).
     pub fn bounds(&self) -> (Vec3, Vec3) {
-        let mut lo = Vec3::splat(f32::INFINITY);
-        let mut hi = Vec3::splat(f32::NEG_INFINITY);
-        for p in &self.skin.bind_positions {
-            lo = lo.min(*p);
-            hi = hi.max(*p);
-        }
-        if lo.x > hi.x { (Vec3::ZERO, Vec3::ZERO) } else { (lo, hi) }
+        super::skinning::bounds(&self.skin.bind_positions)
     }
 }
 

@@ -127,6 +127,14 @@ pub fn skin_positions(bind_positions: &[Vec3], weights: &SkinWeights, palette: &
     }
 }
 
+/// The axis-aligned box `(min, max)` around `points` (both zero for none).
+pub fn bounds(points: &[Vec3]) -> (Vec3, Vec3) {
+    let (lo, hi) = points
+        .iter()
+        .fold((Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)), |(lo, hi), p| (lo.min(*p), hi.max(*p)));
+    if lo.x > hi.x { (Vec3::ZERO, Vec3::ZERO) } else { (lo, hi) }
+}
+
 /// Unshares the vertices of every triangle and gives each the triangle's unit normal:
 /// `out_positions[3t + k] = positions[triangles[t][k]]`, `out_normals[3t + k]` = the
 /// normal of t (counter-clockwise front; +y for a degenerate triangle, so no NaN

@@ -7,7 +7,7 @@ use bevy::prelude::*;
 use super::components::*;
 use crate::rig::JointRotation;
 use crate::rig::fk::forward_kinematics;
-use crate::rig::skinning::{flat_shade, heat_colors, joint_colors, skin_positions, weight_colors};
+use crate::rig::skinning::{bounds, flat_shade, heat_colors, joint_colors, skin_positions, weight_colors};
 
 /// Clamps changed joint poses to their limits (reads `JointLimits`, writes `JointPose`).
 pub fn clamp_poses_to_limits(mut joints: Query<(&mut JointPose, &JointLimits), Changed<JointPose>>) {
@@ -95,7 +95,7 @@ pub fn compute_joint_to_world(
 pub fn skin_changed_characters(
     mut characters: Query<(&Character, &SkinView, &mut PoseDirty, &mut SkinScratch)>,
     joints: Query<(&CurrentJointToWorld, &BindWorldToJoint)>,
-    mut bounds: Query<&mut Aabb, With<SkinMesh>>,
+    mut skin_bounds: Query<&mut Aabb, With<SkinMesh>>,
     mut meshes: ResMut<Assets<Mesh>>,
 ) {
     for (character, view, mut dirty, mut scratch) in &mut characters {
@@ -112,8 +112,9 @@ pub fn skin_changed_characters(
             palette.extend(character.joints.iter().map(|&e| joints.get(e).map_or(Mat4::IDENTITY, |(c, b)| c.0 * b.0)));
             positions.resize(skin.bind_positions.len(), Vec3::ZERO);
             skin_positions(&skin.bind_positions, &skin.weights, palette, positions);
-            if let Ok(mut aabb) = bounds.get_mut(character.skin_entity) {
-                aabb.set_if_neq(bounds_of(positions));
+            if let Ok(mut aabb) = skin_bounds.get_mut(character.skin_entity) {
+                let (lo, hi) = bounds(positions);
+                aabb.set_if_neq(Aabb::from_min_max(lo, hi));
             }
             let mut normals = match mesh.remove_attribute(Mesh::ATTRIBUTE_NORMAL) {
                 Some(VertexAttributeValues::Float32x3(n)) => n,
@@ -129,14 +130,6 @@ pub fn skin_changed_characters(
         }
         *dirty = PoseDirty::default();
     }
-}
-
-/// The box around skinned vertices (a point at the origin for none).
-fn bounds_of(positions: &[Vec3]) -> Aabb {
-    let (lo, hi) = positions
-        .iter()
-        .fold((Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)), |(lo, hi), p| (lo.min(*p), hi.max(*p)));
-    if lo.x > hi.x { Aabb::from_min_max(Vec3::ZERO, Vec3::ZERO) } else { Aabb::from_min_max(lo, hi) }
 }
 
 /// Rewrites the per-corner colours: the tint, the weight colours or a joint's heat map.
