@@ -191,7 +191,7 @@ fn editing_frame_3_smpl_playing_1_puppet_dragged(bencher: Bencher) {
                 time: 10.0 * i as f32,
                 ..SmplDoc::default()
             };
-            let state = SmplCharacter::new(model.clone(), dir.clone(), clips.clone(), Some(&doc));
+            let state = SmplCharacter::new(model.clone(), dir.clone(), clips.clone(), doc);
             app.world_mut().entity_mut(body).insert(state);
         }
     }

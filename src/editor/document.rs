@@ -1,34 +1,71 @@
-//! The scene as a document: capture the ECS state into a `SceneDoc`, and rebuild the ECS
-//! from one (used by scene files, undo/redo and the startup scene).
+//! The scene as a document: the scene character's identity and its id index, capturing
+//! the live ECS into a `SceneDoc` (saving, duplicating, removing), spawning characters from
+//! documents, and scene files.
 
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
+use bevy::ecs::lifecycle::HookContext;
 use bevy::ecs::system::SystemParam;
+use bevy::ecs::world::DeferredWorld;
 use bevy::prelude::*;
 
 use super::camera::OrbitCamera;
 use super::stage::StageSettings;
 use crate::formats::scene::{
-    BindingDoc, CharacterDoc, PlacementDoc, SceneDoc, SourceDoc, ViewDoc, joint_of_pose_key, pose_key,
+    BindingDoc, CharacterDoc, CharacterId, PlacementDoc, SceneDoc, SourceDoc, ViewDoc, joint_of_pose_key, pose_key,
 };
 use crate::formats::{FormatError, load_character};
 use crate::rig::smpl::{Clip, SmplModel};
 use crate::rig::{CharacterAsset, JointRotation};
 use crate::scene::smpl::SmplCharacter;
-use crate::scene::{Character, DisplayMode, JointPose, Placement, SkinView, spawn_character_posed};
+use crate::scene::{Character, CharacterView, JointPose, Placement, spawn_character_posed};
 
-/// A character as the editor knows it: a stable id (kept across undo), its source, name,
-/// visibility and whether the selected joint's weights are shown.
+/// A character as the scene knows it: its stable id, where it comes from, its name and
+/// whether its weights were computed from the bones. The rest of its document lives in
+/// `Placement`, `CharacterView`, the joints' `JointPose` and `SmplCharacter`.
 #[derive(Component, Clone, Debug)]
+#[component(on_insert = index_character, on_discard = unindex_character)]
 pub struct SceneCharacter {
-    pub id: u64,
+    pub id: CharacterId,
     pub source: SourceDoc,
     pub name: String,
-    pub visible: bool,
-    pub heat_of_selected: bool,
     pub binding: Option<BindingDoc>,
+}
+
+/// Each scene character's entity by id (kept by `SceneCharacter`'s hooks).
+#[derive(Resource, Default, Debug)]
+pub struct CharacterIndex(HashMap<CharacterId, Entity>);
+
+impl CharacterIndex {
+    pub fn get(&self, id: CharacterId) -> Option<Entity> {
+        self.0.get(&id).copied()
+    }
+
+    pub fn len(&self) -> usize {
+        self.0.len()
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.0.is_empty()
+    }
+}
+
+fn index_character(mut world: DeferredWorld, context: HookContext) {
+    let Some(id) = world.get::<SceneCharacter>(context.entity).map(|c| c.id) else { return };
+    if let Some(mut index) = world.get_resource_mut::<CharacterIndex>() {
+        index.0.insert(id, context.entity);
+    }
+}
+
+fn unindex_character(mut world: DeferredWorld, context: HookContext) {
+    let Some(id) = world.get::<SceneCharacter>(context.entity).map(|c| c.id) else { return };
+    if let Some(mut index) = world.get_resource_mut::<CharacterIndex>()
+        && index.0.get(&id) == Some(&context.entity)
+    {
+        index.0.remove(&id);
+    }
 }
 
 /// Loaded characters by source, shared by every scene character made from them.
@@ -120,12 +157,11 @@ impl AssetLibrary {
     }
 }
 
-/// A scene to build in place of the current one (all characters are replaced).
+/// A scene to open in place of the current one (startup, Open): every character, the
+/// camera and the stage are replaced; selection, pins and history cleared.
 #[derive(Resource, Default)]
 pub struct PendingScene {
     pub doc: Option<SceneDoc>,
-    /// Also set camera and stage from the document (not for undo).
-    pub with_camera: bool,
     /// Frame all characters afterwards (when the document has no camera).
     pub frame: bool,
 }
@@ -135,13 +171,13 @@ pub struct PendingScene {
 pub struct NextCharacterId(pub u64);
 
 impl NextCharacterId {
-    pub fn take(&mut self) -> u64 {
+    pub fn take(&mut self) -> CharacterId {
         self.0 += 1;
-        self.0
+        CharacterId(self.0)
     }
 }
 
-/// Everything needed to capture the scene as a document.
+/// Everything needed to capture the scene as a document (read only).
 #[derive(SystemParam)]
 pub struct SceneReader<'w, 's> {
     pub characters: Query<
@@ -152,8 +188,7 @@ pub struct SceneReader<'w, 's> {
             &'static SceneCharacter,
             &'static Character,
             &'static Placement,
-            &'static SkinView,
-            &'static DisplayMode,
+            &'static CharacterView,
             Option<&'static SmplCharacter>,
         ),
     >,
@@ -164,34 +199,24 @@ pub struct SceneReader<'w, 's> {
 }
 
 impl SceneReader<'_, '_> {
-    /// The current scene, characters in id order.
+    /// The current scene, characters in id order (built when saving or when a character is
+    /// duplicated or removed, never every frame).
     pub fn capture(&self) -> SceneDoc {
-        let mut characters: Vec<(u64, CharacterDoc)> = self
-            .characters
-            .iter()
-            .map(|(_, sc, character, placement, view, display, smpl)| {
-                let mut doc = self.character_doc(sc, character, placement, view, display);
-                doc.smpl = smpl.map(SmplCharacter::doc);
-                (sc.id, doc)
-            })
-            .collect();
-        characters.sort_by_key(|(id, _)| *id);
+        let mut characters: Vec<CharacterDoc> =
+            self.characters.iter().filter_map(|c| self.character_doc(c.0)).collect();
+        characters.sort_by_key(|c| c.id);
         SceneDoc {
             // Characters that failed to load stay in the document as they were.
-            characters: characters.into_iter().map(|(_, d)| d).chain(self.unloaded.0.iter().cloned()).collect(),
+            characters: characters.into_iter().chain(self.unloaded.0.iter().cloned()).collect(),
             camera: self.cameras.iter().next().map(|o| o.0),
             stage: self.stage.0,
         }
     }
 
-    fn character_doc(
-        &self,
-        sc: &SceneCharacter,
-        character: &Character,
-        placement: &Placement,
-        view: &SkinView,
-        display: &DisplayMode,
-    ) -> CharacterDoc {
+    /// The document of one live character: joints listed where they differ from the
+    /// source's pose.
+    pub fn character_doc(&self, entity: Entity) -> Option<CharacterDoc> {
+        let (_, sc, character, placement, view, smpl) = self.characters.get(entity).ok()?;
         let skeleton = &character.asset.skeleton;
         let initial = skeleton.initial_pose();
         let pose = character
@@ -203,22 +228,16 @@ impl SceneReader<'_, '_> {
                 (p != initial[j]).then(|| (pose_key(skeleton, j), p))
             })
             .collect();
-        CharacterDoc {
+        Some(CharacterDoc {
             id: Some(sc.id),
             source: sc.source.clone(),
             name: sc.name.clone(),
             placement: placement.0,
             pose,
-            view: ViewDoc {
-                display: display.0,
-                visible: sc.visible,
-                weight_colors: view.weight_colors,
-                heat_of_selected: sc.heat_of_selected,
-                tint: view.tint,
-            },
-            smpl: None,
+            view: view.0.clone(),
+            smpl: smpl.map(|body| body.state.clone()),
             binding: sc.binding,
-        }
+        })
     }
 }
 
@@ -238,77 +257,9 @@ pub fn pose_from_doc(asset: &CharacterAsset, doc: &CharacterDoc) -> (Vec<JointRo
     (pose, unknown)
 }
 
-fn placement_of(doc: &CharacterDoc) -> Placement {
-    Placement(doc.placement)
-}
-
-fn display_of(doc: &CharacterDoc) -> DisplayMode {
-    DisplayMode(doc.view.display)
-}
-
-fn visibility_of(doc: &CharacterDoc) -> Visibility {
-    if doc.view.visible { Visibility::Inherited } else { Visibility::Hidden }
-}
-
-/// The live characters, as far as a document can set them in place.
-#[derive(SystemParam)]
-pub struct LiveCharacters<'w, 's> {
-    pub characters: Query<
-        'w,
-        's,
-        (
-            Entity,
-            &'static Character,
-            &'static mut SceneCharacter,
-            &'static mut Placement,
-            &'static mut SkinView,
-            &'static mut DisplayMode,
-            &'static mut Visibility,
-            Option<&'static mut SmplCharacter>,
-        ),
-    >,
-    pub poses: Query<'w, 's, &'static mut JointPose>,
-}
-
-impl LiveCharacters<'_, '_> {
-    /// Each live character's entity, id, source and binding.
-    pub fn index(&self) -> Vec<(Entity, u64, SourceDoc, Option<BindingDoc>)> {
-        self.characters.iter().map(|(e, _, sc, ..)| (e, sc.id, sc.source.clone(), sc.binding)).collect()
-    }
-
-    /// Sets a live character to its document in place (same entity, same mesh): pose,
-    /// placement, name, view and SMPL state. Changes are written only where values differ,
-    /// so only what changed is re-skinned. Returns messages about unknown pose keys.
-    pub fn update_from_doc(&mut self, entity: Entity, doc: &CharacterDoc) -> Vec<String> {
-        let Ok((_, character, mut sc, mut placement, mut view, mut display, mut visibility, smpl)) =
-            self.characters.get_mut(entity)
-        else {
-            return Vec::new();
-        };
-        let (pose, messages) = pose_from_doc(&character.asset, doc);
-        for (&joint, rotation) in character.joints.iter().zip(pose) {
-            if let Ok(mut current) = self.poses.get_mut(joint) {
-                current.set_if_neq(JointPose(rotation));
-            }
-        }
-        placement.set_if_neq(placement_of(doc));
-        display.set_if_neq(display_of(doc));
-        visibility.set_if_neq(visibility_of(doc));
-        let wanted =
-            SkinView { tint: doc.view.tint, weight_colors: doc.view.weight_colors, heat_joint: view.heat_joint };
-        view.set_if_neq(wanted);
-        if sc.name != doc.name || sc.visible != doc.view.visible || sc.heat_of_selected != doc.view.heat_of_selected {
-            sc.name = doc.name.clone();
-            sc.visible = doc.view.visible;
-            sc.heat_of_selected = doc.view.heat_of_selected;
-        }
-        if let (Some(mut body), Some(state)) = (smpl, doc.smpl.as_ref())
-            && body.doc() != *state
-        {
-            body.apply_doc(state);
-        }
-        messages
-    }
+/// Bevy's visibility for a character's view.
+pub fn visibility_of(view: &ViewDoc) -> Visibility {
+    if view.visible { Visibility::Inherited } else { Visibility::Hidden }
 }
 
 /// Spawns one character of a document with the given id.
@@ -317,29 +268,23 @@ pub fn spawn_from_doc(
     meshes: &mut Assets<Mesh>,
     library: &mut AssetLibrary,
     doc: &CharacterDoc,
-    id: u64,
+    id: CharacterId,
 ) -> Result<(Entity, Vec<String>), FormatError> {
     let asset = library.load_bound(&doc.source, doc.binding)?;
+    let smpl = match &doc.source {
+        SourceDoc::File(dir) if crate::formats::smpl::is_smpl_dir(dir) => Some((dir, library.smpl(dir)?)),
+        _ => None,
+    };
     let (pose, messages) = pose_from_doc(&asset, doc);
-    let entity = spawn_character_posed(commands, meshes, asset, placement_of(doc), &pose);
+    let entity = spawn_character_posed(commands, meshes, asset, Placement(doc.placement), &pose);
     commands.entity(entity).insert((
-        SceneCharacter {
-            id,
-            source: doc.source.clone(),
-            name: doc.name.clone(),
-            visible: doc.view.visible,
-            heat_of_selected: doc.view.heat_of_selected,
-            binding: doc.binding,
-        },
-        SkinView { tint: doc.view.tint, weight_colors: doc.view.weight_colors, heat_joint: None },
-        display_of(doc),
-        visibility_of(doc),
+        SceneCharacter { id, source: doc.source.clone(), name: doc.name.clone(), binding: doc.binding },
+        CharacterView(doc.view.clone()),
+        visibility_of(&doc.view),
     ));
-    if let SourceDoc::File(dir) = &doc.source
-        && crate::formats::smpl::is_smpl_dir(dir)
-    {
-        let set = library.smpl(dir)?;
-        commands.entity(entity).insert(SmplCharacter::new(set.model, dir.clone(), set.clips, doc.smpl.as_ref()));
+    if let Some((dir, set)) = smpl {
+        let state = doc.smpl.clone().unwrap_or_default();
+        commands.entity(entity).insert(SmplCharacter::new(set.model, dir.clone(), set.clips, state));
     }
     Ok((entity, messages))
 }
@@ -449,4 +394,20 @@ pub fn write_scene(path: &Path, doc: &SceneDoc) -> Result<(), FormatError> {
         c.source = c.source.relative_to(dir);
     }
     crate::formats::scene::save_scene(path, &doc)
+}
+
+/// Saves the scene to `path`, saying so (or why not) in the messages.
+pub fn save_scene_to(path: &str, doc: &SceneDoc, messages: &mut super::state::Messages) {
+    match write_scene(Path::new(path), doc) {
+        Ok(()) => messages.push(format!("saved the scene to {path}")),
+        Err(e) => messages.push(format!("the scene was not saved: {e}")),
+    }
+}
+
+/// Queues the scene file at `path` to replace the current scene, or says why it cannot.
+pub fn open_scene_from(path: &str, pending: &mut PendingScene, messages: &mut super::state::Messages) {
+    match read_scene(Path::new(path)) {
+        Ok(doc) => *pending = PendingScene { frame: doc.camera.is_none(), doc: Some(doc) },
+        Err(e) => messages.push(e.to_string()),
+    }
 }

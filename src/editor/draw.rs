@@ -8,7 +8,7 @@ use super::document::SceneCharacter;
 use super::state::Selection;
 use crate::formats::scene::DisplayDoc;
 use crate::rig::character::SkinKind;
-use crate::scene::{Character, CurrentJointToWorld, DisplayMode, Placement};
+use crate::scene::{Character, CharacterView, CurrentJointToWorld, Placement};
 
 /// Skeleton gizmos draw over the meshes (they would be hidden inside them).
 #[derive(Default, Reflect, GizmoConfigGroup)]
@@ -30,12 +30,12 @@ const SELECTED_COLOR: Color = Color::srgb(1.0, 0.15, 0.3);
 /// Draws skeletons of characters in skeleton or both view, and the selected joints of
 /// any character (reads joint matrices, `Selection`; draws gizmos).
 pub fn draw_skeletons(
-    characters: Query<(&Character, &DisplayMode, &Placement, Option<&SceneCharacter>, &InheritedVisibility)>,
+    characters: Query<(&Character, &CharacterView, &Placement, Option<&SceneCharacter>, &InheritedVisibility)>,
     joints: Query<&CurrentJointToWorld>,
     selection: Res<Selection>,
     mut gizmos: Gizmos<SkeletonGizmos>,
 ) {
-    for (character, mode, placement, sc, visible) in &characters {
+    for (character, view, placement, sc, visible) in &characters {
         if !visible.get() {
             continue;
         }
@@ -50,7 +50,7 @@ pub fn draw_skeletons(
         for &j in selected {
             gizmos.sphere(Isometry3d::from_translation(world(j).w_axis.truncate()), radius * 2.2, SELECTED_COLOR);
         }
-        if **mode == DisplayDoc::Mesh {
+        if view.display == DisplayDoc::Mesh {
             continue;
         }
         let skeleton = &character.asset.skeleton;

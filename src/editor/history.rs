@@ -1,24 +1,23 @@
-//! Undo and redo of pose, placement and add/remove edits: snapshots of the scene
-//! document, one per edit gesture (a whole slider drag is one step).
+//! Undo and redo as commands: each step is the list of edits that undoes one gesture (a
+//! whole slider or IK drag, one key press, one button), in the order they were recorded.
+//! [`apply_edits`](super::commands::apply_edits) fills and replays it.
 
 use bevy::prelude::*;
 
-use super::document::{PendingScene, SceneReader};
-use crate::formats::scene::SceneDoc;
+use super::commands::Edit;
 
-/// Snapshots before each edit, and those undone.
-#[derive(Resource, Default)]
+/// The undo and redo steps, and what undoes the gesture under way.
+#[derive(Resource, Default, Debug)]
 pub struct History {
-    pub undo: Vec<SceneDoc>,
-    pub redo: Vec<SceneDoc>,
-    /// An edit gesture is under way (its snapshot is already taken).
-    pub editing: bool,
-    /// Requests from keys or buttons, served by `apply_history_requests`.
+    undo: Vec<Vec<Edit>>,
+    redo: Vec<Vec<Edit>>,
+    /// What undoes the gesture under way, in the order its edits were applied.
+    gesture: Vec<Edit>,
+    /// Where the gesture's last add or remove was recorded: edits before it are not merged
+    /// with those after (they may name another incarnation of the character).
+    barrier: usize,
+    /// Requests from keys or buttons, served by `apply_edits`.
     pub request: Option<HistoryRequest>,
-    /// The redo steps a gesture cleared, given back if it turns out to change nothing.
-    redo_before_gesture: Vec<SceneDoc>,
-    /// Whether this gesture pushed an undo step.
-    pushed: bool,
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -31,77 +30,93 @@ pub enum HistoryRequest {
 pub const HISTORY_DEPTH: usize = 200;
 
 impl History {
-    /// Records `before` as the state to return to, once per gesture.
-    pub fn begin_edit(&mut self, before: &SceneDoc) {
-        if self.editing {
-            return;
-        }
-        self.editing = true;
-        self.pushed = self.undo.last() != Some(before);
-        if self.pushed {
-            self.undo.push(before.clone());
-            if self.undo.len() > HISTORY_DEPTH {
-                self.undo.remove(0);
+    pub fn can_undo(&self) -> bool {
+        !self.undo.is_empty() || !self.gesture.is_empty()
+    }
+
+    pub fn can_redo(&self) -> bool {
+        !self.redo.is_empty()
+    }
+
+    /// The number of undo steps.
+    pub fn undo_steps(&self) -> usize {
+        self.undo.len()
+    }
+
+    pub fn redo_steps(&self) -> usize {
+        self.redo.len()
+    }
+
+    pub fn gesture_open(&self) -> bool {
+        !self.gesture.is_empty()
+    }
+
+    /// Adds what undoes one applied edit to the gesture under way. Within a gesture only
+    /// the first value of each thing edited is kept: a slider dragged over a hundred frames
+    /// is one value to return to.
+    pub fn record(&mut self, inverse: Edit) {
+        let recent = &self.gesture[self.barrier..];
+        match inverse {
+            Edit::Add(_) | Edit::Remove(_) => {
+                self.gesture.push(inverse);
+                self.barrier = self.gesture.len();
+            }
+            Edit::Pose { character, mut joints } => {
+                joints.retain(|&(j, _)| {
+                    !recent.iter().any(|e| match e {
+                        Edit::Pose { character: c, joints: earlier } => {
+                            *c == character && earlier.iter().any(|&(k, _)| k == j)
+                        }
+                        _ => false,
+                    })
+                });
+                if !joints.is_empty() {
+                    self.gesture.push(Edit::Pose { character, joints });
+                }
+            }
+            other => {
+                let same_slot = |e: &Edit| {
+                    std::mem::discriminant(e) == std::mem::discriminant(&other) && e.character() == other.character()
+                };
+                if !recent.iter().any(same_slot) {
+                    self.gesture.push(other);
+                }
             }
         }
-        self.redo_before_gesture = std::mem::take(&mut self.redo);
     }
 
-    /// Ends the gesture (no button held any more). A gesture that left the scene as it
-    /// was (a click that only selected) is no undo step: its entry is dropped and the redo
-    /// steps come back.
-    pub fn end_gesture(&mut self, now: &SceneDoc) {
-        self.editing = false;
-        if self.pushed && self.undo.last() == Some(now) {
-            self.undo.pop();
-            self.redo = std::mem::take(&mut self.redo_before_gesture);
+    /// Takes what undoes the gesture under way, ending it.
+    pub fn take_gesture(&mut self) -> Vec<Edit> {
+        self.barrier = 0;
+        std::mem::take(&mut self.gesture)
+    }
+
+    /// Records a finished gesture as an undo step; a new step clears the redo steps.
+    pub fn commit(&mut self, step: Vec<Edit>) {
+        self.redo.clear();
+        push_bounded(&mut self.undo, step);
+    }
+
+    /// The step to replay for `request`.
+    pub fn pop(&mut self, request: HistoryRequest) -> Option<Vec<Edit>> {
+        match request {
+            HistoryRequest::Undo => self.undo.pop(),
+            HistoryRequest::Redo => self.redo.pop(),
         }
-        self.pushed = false;
-        self.redo_before_gesture.clear();
     }
 
-    /// The state to restore for undo, given the current one.
-    pub fn undo(&mut self, current: SceneDoc) -> Option<SceneDoc> {
-        let previous = self.undo.pop()?;
-        self.redo.push(current);
-        Some(previous)
-    }
-
-    pub fn redo(&mut self, current: SceneDoc) -> Option<SceneDoc> {
-        let next = self.redo.pop()?;
-        self.undo.push(current);
-        Some(next)
+    /// Records what undoes a replayed step on the other stack.
+    pub fn push_opposite(&mut self, request: HistoryRequest, step: Vec<Edit>) {
+        match request {
+            HistoryRequest::Undo => push_bounded(&mut self.redo, step),
+            HistoryRequest::Redo => push_bounded(&mut self.undo, step),
+        }
     }
 }
 
-pub struct HistoryPlugin;
-
-impl Plugin for HistoryPlugin {
-    fn build(&self, app: &mut App) {
-        app.init_resource::<History>().add_systems(Update, (end_gestures, apply_history_requests));
-    }
-}
-
-/// Ends an edit gesture when no mouse button is held (reads input and the scene; writes
-/// `History`).
-fn end_gestures(buttons: Res<ButtonInput<MouseButton>>, reader: SceneReader, mut history: ResMut<History>) {
-    if history.editing && !buttons.get_pressed().any(|_| true) {
-        history.end_gesture(&reader.capture());
-    }
-}
-
-/// Serves undo/redo requests by rebuilding the scene from a snapshot, keeping the camera
-/// (reads the scene; writes `History`, `PendingScene`).
-fn apply_history_requests(mut history: ResMut<History>, reader: SceneReader, mut pending: ResMut<PendingScene>) {
-    let Some(request) = history.request.take() else {
-        return;
-    };
-    let current = reader.capture();
-    let target = match request {
-        HistoryRequest::Undo => history.undo(current),
-        HistoryRequest::Redo => history.redo(current),
-    };
-    if let Some(doc) = target {
-        *pending = PendingScene { doc: Some(doc), with_camera: false, frame: false };
+fn push_bounded(stack: &mut Vec<Vec<Edit>>, step: Vec<Edit>) {
+    stack.push(step);
+    if stack.len() > HISTORY_DEPTH {
+        stack.remove(0);
     }
 }

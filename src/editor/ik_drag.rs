@@ -1,7 +1,7 @@
 //! Posing by dragging: grab a joint in the viewport and move it in the plane facing the
 //! camera; FABRIK moves its chain every frame (for a non-leaf joint this turns its parent
-//! towards the cursor). Pinned joints (P) hold their place meanwhile. The edits are
-//! ordinary pose edits (undo, scene files).
+//! towards the cursor). Pinned joints (P) hold their place meanwhile. Each frame's solve is
+//! an ordinary pose `Edit`, applied in `Animate`; the whole drag is one undo step.
 
 use std::collections::BTreeMap;
 
@@ -9,19 +9,19 @@ use bevy::prelude::*;
 use bevy::window::PrimaryWindow;
 
 use super::camera::{OrbitCamera, ViewportHasPointer};
+use super::commands::{Edit, EditQueue};
 use super::document::SceneCharacter;
 use super::draw::SkeletonGizmos;
-use super::history::History;
-use super::inspector::SceneSnapshot;
 use super::picking::{CLICK_SLOP_PX, PICK_RADIUS_PX, PickableCharacters, nearest_joint_on_screen};
 use super::state::{Drag, JointDrag, Selection};
 use crate::cli::posing::{IK_ROUNDS, IK_TOLERANCE};
+use crate::formats::scene::CharacterId;
 use crate::rig::ik::{IkGoal, solve_ik};
 use crate::scene::{Character, CurrentJointToWorld, JointPose, Placement};
 
 /// Pinned joints per character id.
 #[derive(Resource, Default)]
-pub struct Pins(pub BTreeMap<u64, Vec<usize>>);
+pub struct Pins(pub BTreeMap<CharacterId, Vec<usize>>);
 
 pub struct IkDragPlugin;
 
@@ -63,7 +63,7 @@ fn toggle_pins(
 }
 
 /// On a left press near a joint, starts dragging it (reads input, joints; writes
-/// `JointDrag`, `Selection`, `History`).
+/// `JointDrag`).
 #[allow(clippy::too_many_arguments)]
 fn start_drag(
     buttons: Res<ButtonInput<MouseButton>>,
@@ -73,8 +73,6 @@ fn start_drag(
     joints: Query<&CurrentJointToWorld>,
     pointer: Res<ViewportHasPointer>,
     pins: Res<Pins>,
-    snapshot: Option<Res<SceneSnapshot>>,
-    mut history: ResMut<History>,
     mut drag: ResMut<JointDrag>,
 ) {
     if !buttons.just_pressed(MouseButton::Left) || !pointer.0 {
@@ -98,9 +96,6 @@ fn start_drag(
             .filter_map(|&p| Some((p, joints.get(*character.joints.get(p)?).ok()?.world_position(placement))))
             .collect()
     });
-    if let Some(s) = snapshot {
-        history.begin_edit(&s.0);
-    }
     drag.active = Some(Drag {
         character: id,
         joint,
@@ -113,14 +108,15 @@ fn start_drag(
 }
 
 /// While the button is held, moves the dragged joint to the cursor in its plane by IK;
-/// ends the drag on release (reads input, poses; writes `JointPose`, `JointDrag`).
+/// ends the drag on release (reads input, poses; writes `EditQueue`, `JointDrag`).
 #[allow(clippy::too_many_arguments)]
 fn drag_joint(
     buttons: Res<ButtonInput<MouseButton>>,
     windows: Query<&Window, With<PrimaryWindow>>,
     cameras: Query<(&Camera, &GlobalTransform), With<OrbitCamera>>,
     characters: Query<(&SceneCharacter, &Character, &Placement)>,
-    mut poses: Query<&mut JointPose>,
+    poses: Query<&JointPose>,
+    mut edits: ResMut<EditQueue>,
     mut drag: ResMut<JointDrag>,
     mut selection: ResMut<Selection>,
 ) {
@@ -151,15 +147,15 @@ fn drag_joint(
         *selection = Selection { character: Some(active.character), joints: vec![active.joint] };
     }
     let skeleton = &character.asset.skeleton;
-    let mut pose: Vec<_> = character.joints.iter().map(|&e| poses.get(e).map_or(Default::default(), |p| p.0)).collect();
+    let before: Vec<_> = character.joints.iter().map(|&e| poses.get(e).map_or(Default::default(), |p| p.0)).collect();
+    let mut pose = before.clone();
     let mut goals = vec![IkGoal { end: active.joint, target }];
     goals.extend(active.pins.iter().map(|&(end, target)| IkGoal { end, target }));
     let reports = solve_ik(skeleton, &mut pose, placement.to_mat4(), &goals, IK_TOLERANCE, IK_ROUNDS.min(8));
     drag.note = reports.first().map(|r| crate::cli::posing::describe_ik(skeleton, r)).unwrap_or_default();
-    for (&e, p) in character.joints.iter().zip(pose) {
-        if let Ok(mut current) = poses.get_mut(e) {
-            current.set_if_neq(JointPose(p));
-        }
+    let joints: Vec<_> = pose.into_iter().enumerate().filter(|&(j, p)| p != before[j]).collect();
+    if !joints.is_empty() {
+        edits.push(Edit::Pose { character: active.character, joints });
     }
 }
 

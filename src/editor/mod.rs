@@ -1,24 +1,31 @@
-//! The app around the ECS core: the stage, the scene document (load, save, undo), the
-//! orbit camera, skeleton drawing, picking, the egui inspector, screenshots, and the
-//! headless renderer.
+//! The app around the ECS core: the stage, the scene (opened from and saved to documents),
+//! edits as commands with undo and redo, the orbit camera, skeleton drawing, picking, the
+//! egui panels, screenshots, and the headless renderer.
 //!
-//! Plugins (one per capability): [`ViewPlugin`] (stage, document, drawing; also used
-//! headless), [`InteractionPlugin`] (camera input, picking, shortcuts),
-//! [`inspector::InspectorPlugin`], [`screenshot::ScreenshotPlugin`].
+//! The ECS is the only live model. The panels, the shortcuts and drags in the viewport read
+//! it and push [`commands::Edit`]s, applied in `Animate`; a `SceneDoc` is built only to save,
+//! duplicate or remove (what a history entry needs).
+//!
+//! Plugins (one per capability): [`ViewPlugin`] (stage, scene, edits and history, drawing;
+//! also used headless), [`InteractionPlugin`] (camera input, picking, IK drag, shortcuts),
+//! [`ui::InspectorPlugin`], [`screenshot::ScreenshotPlugin`]. Children import shared state
+//! ([`state`], [`document`], [`commands`]), never this module.
 
 pub mod camera;
+pub mod commands;
 pub mod default_scene;
 pub mod document;
 pub mod draw;
 pub mod history;
 pub mod ik_drag;
-pub mod inspector;
 pub mod picking;
 pub mod readiness;
 pub mod render;
 pub mod screenshot;
+pub mod shortcuts;
 pub mod stage;
 pub mod state;
+pub mod ui;
 pub mod view;
 
 use std::path::PathBuf;
@@ -29,7 +36,7 @@ use bevy::window::WindowResolution;
 use crate::scene::{MarionetteSystems, RigCorePlugin, SkinningPlugin};
 use camera::{OrbitCamera, orbit_camera_input};
 pub use state::{Messages, Selection, StartupEdits, StartupPaths, UnloadedCharacters};
-pub use view::{ViewPlugin, apply_pending_scene};
+pub use view::{ScenePlugin, ViewPlugin, apply_pending_scene};
 
 /// Mouse and keyboard in the viewport: orbit camera, picking, shortcuts.
 pub struct InteractionPlugin;
@@ -39,7 +46,13 @@ impl Plugin for InteractionPlugin {
         app.add_plugins(ik_drag::IkDragPlugin);
         app.init_resource::<camera::ViewportHasPointer>().init_resource::<picking::PointerPress>().add_systems(
             Update,
-            (camera::track_egui_pointer, orbit_camera_input, picking::pick_joint_on_click, inspector::shortcuts)
+            (
+                camera::track_egui_pointer,
+                orbit_camera_input,
+                picking::pick_joint_on_click,
+                shortcuts::scene_shortcuts,
+                shortcuts::frame_selection,
+            )
                 .chain(),
         );
     }
@@ -66,9 +79,8 @@ pub fn run(paths: Vec<PathBuf>) {
             SkinningPlugin,
             ViewPlugin,
             InteractionPlugin,
-            inspector::InspectorPlugin,
+            ui::InspectorPlugin,
             screenshot::ScreenshotPlugin,
-            history::HistoryPlugin,
         ))
         // The inspector's edits (bevy_egui's pass) land before the chain that animates,
         // solves, runs the matrix stack and skins: an edit is skinned the frame it is made.

@@ -6,6 +6,7 @@ use bevy::window::PrimaryWindow;
 use super::camera::{OrbitCamera, ViewportHasPointer};
 use super::document::SceneCharacter;
 use super::state::Selection;
+use crate::formats::scene::CharacterId;
 use crate::scene::{Character, CurrentJointToWorld, Placement};
 
 /// Where the left button went down, to tell a click from a drag.
@@ -70,7 +71,7 @@ pub type PickableCharacters<'w, 's> = Query<
 #[derive(Debug, Clone, Copy)]
 pub struct JointHit {
     pub entity: Entity,
-    pub id: u64,
+    pub id: CharacterId,
     pub joint: usize,
     /// World position.
     pub position: Vec3,
@@ -105,7 +106,7 @@ pub fn nearest_joint_on_screen(
 }
 
 /// Selects joint `j` of character `id`; `additive` toggles it within the selection.
-pub fn select_joint(selection: &mut Selection, id: u64, j: usize, additive: bool) {
+pub fn select_joint(selection: &mut Selection, id: CharacterId, j: usize, additive: bool) {
     if selection.character != Some(id) || !additive {
         selection.character = Some(id);
         selection.joints = vec![j];

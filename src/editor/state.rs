@@ -6,6 +6,8 @@ use std::path::PathBuf;
 
 use bevy::prelude::*;
 
+use crate::formats::scene::CharacterId;
+
 /// What the app opens with: a scene file, character files, or (empty) the default scene.
 #[derive(Resource, Clone, Debug, Default)]
 pub struct StartupPaths(pub Vec<PathBuf>);
@@ -33,7 +35,7 @@ impl Messages {
 /// The selected character (by scene id) and joints.
 #[derive(Resource, Clone, Debug, Default, PartialEq)]
 pub struct Selection {
-    pub character: Option<u64>,
+    pub character: Option<CharacterId>,
     pub joints: Vec<usize>,
 }
 
@@ -45,7 +47,7 @@ pub struct UnloadedCharacters(pub Vec<crate::formats::scene::CharacterDoc>);
 /// A drag under way.
 #[derive(Debug, Clone)]
 pub struct Drag {
-    pub character: u64,
+    pub character: CharacterId,
     pub joint: usize,
     /// The drag plane: through the joint, facing the camera.
     pub plane_point: Vec3,

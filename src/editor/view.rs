@@ -1,48 +1,56 @@
 //! The view both the window and the headless renderer need besides the core: the stage,
-//! the scene built from documents (startup, Open, undo/redo applied in place), the skin
-//! material and the drawing of skeletons.
+//! the scene opened from a document (startup, Open), each character's view kept in step
+//! with its options, the skin material and the drawing of skeletons.
 
 use bevy::prelude::*;
 
 use super::camera::{OrbitCamera, apply_orbit_camera};
-use super::document::{
-    AssetLibrary, LiveCharacters, NextCharacterId, PendingScene, SceneCharacter, spawn_from_doc, startup_doc,
-};
+use super::document::{AssetLibrary, NextCharacterId, PendingScene, SceneCharacter, spawn_from_doc, startup_doc};
 use super::stage::{StageSettings, apply_stage_settings, draw_grid_and_axes, spawn_stage};
 use super::state::{Messages, Selection, StartupEdits, StartupPaths, UnloadedCharacters};
 use super::{draw, history, ik_drag};
-use crate::formats::scene::DisplayDoc;
-use crate::scene::{Character, DisplayMode, MarionetteSystems, SkinMesh, SkinView};
+use crate::formats::scene::{CharacterId, DisplayDoc};
+use crate::scene::{Character, CharacterView, HeatJoint, MarionetteSystems, SkinMesh};
 
 /// One material for every skin: white, so vertex colours (tint or weights) show as they are.
 #[derive(Resource)]
 pub struct SkinMaterial(pub Handle<StandardMaterial>);
 
-/// Stage, scene document and drawing: everything both the window and the headless
-/// renderer need besides the core.
-pub struct ViewPlugin;
+/// The live scene without drawing: opening documents, edits and their history, SMPL
+/// playback, each character's view in step with its options (used by the window, the
+/// headless renderer and the tests).
+pub struct ScenePlugin;
 
-impl Plugin for ViewPlugin {
+impl Plugin for ScenePlugin {
     fn build(&self, app: &mut App) {
-        draw::setup_skeleton_gizmos(app);
         app.init_resource::<StageSettings>()
             .init_resource::<Messages>()
-            .init_resource::<StartupPaths>()
-            .init_resource::<StartupEdits>()
             .init_resource::<Selection>()
             .init_resource::<UnloadedCharacters>()
-            .init_resource::<AssetLibrary>()
             .init_resource::<PendingScene>()
-            .init_resource::<NextCharacterId>()
-            .add_plugins((crate::scene::smpl::SmplPlugin, super::readiness::ReadinessPlugin))
-            .add_systems(Startup, (setup_skin_material, spawn_stage, queue_startup_scene).chain())
+            .init_resource::<ik_drag::Pins>()
+            .add_plugins((crate::scene::smpl::SmplPlugin, super::commands::CommandsPlugin))
             .add_systems(
                 PostUpdate,
                 (apply_pending_scene, sync_character_views)
                     .chain()
                     .in_set(MarionetteSystems::Animate)
                     .before(crate::scene::smpl::SmplPlayback),
-            )
+            );
+    }
+}
+
+/// The scene with its stage and drawing: everything both the window and the headless
+/// renderer need besides the core; opens what the command line named at startup.
+pub struct ViewPlugin;
+
+impl Plugin for ViewPlugin {
+    fn build(&self, app: &mut App) {
+        draw::setup_skeleton_gizmos(app);
+        app.init_resource::<StartupPaths>()
+            .init_resource::<StartupEdits>()
+            .add_plugins((ScenePlugin, super::readiness::ReadinessPlugin))
+            .add_systems(Startup, (setup_skin_material, spawn_stage, queue_startup_scene).chain())
             .add_systems(
                 PostUpdate,
                 (
@@ -77,9 +85,7 @@ fn queue_startup_scene(
     notes.into_iter().for_each(|m| messages.push(m));
     if let Some(mut doc) = doc {
         apply_startup_edits(&mut doc, &edits, &mut library, &mut messages);
-        pending.frame = doc.camera.is_none();
-        pending.with_camera = true;
-        pending.doc = Some(doc);
+        *pending = PendingScene { frame: doc.camera.is_none(), doc: Some(doc) };
     }
 }
 
@@ -112,10 +118,10 @@ fn apply_startup_edits(
     }
 }
 
-/// Builds the pending document: characters that stay (same id, source and weights; not on
-/// Open) are set in place, the others spawned, those no longer listed despawned; sets camera
-/// and stage when asked; frames the characters when the document has no camera (reads
-/// `PendingScene`; writes entities, `OrbitCamera`, `StageSettings`, `Messages`).
+/// Opens the pending document in place of the current scene: every character is
+/// replaced, camera and stage set, selection, pins and history cleared; frames the
+/// characters when the document has no camera (reads `PendingScene`; writes entities,
+/// `OrbitCamera`, `StageSettings`, `Messages`).
 #[allow(clippy::too_many_arguments)]
 pub fn apply_pending_scene(
     mut commands: Commands,
@@ -125,36 +131,22 @@ pub fn apply_pending_scene(
     mut ids: ResMut<NextCharacterId>,
     mut messages: ResMut<Messages>,
     mut stage: ResMut<StageSettings>,
-    mut live: LiveCharacters,
+    live: Query<(Entity, &Character)>,
     mut cameras: Query<&mut OrbitCamera>,
     mut reset: SceneReset,
 ) {
     let Some(doc) = pending.doc.take() else {
         return;
     };
-    if pending.with_camera {
-        // A new scene (Open, startup): nothing selected, pinned or undoable refers to it.
-        reset.clear();
+    reset.clear();
+    for (entity, character) in &live {
+        crate::scene::despawn_character(&mut commands, entity, character);
     }
-    reset.unloaded.0.clear();
-    // Undo, redo and rebind keep the characters that stay (same id, source and weights):
-    // they are set in place. A new scene (Open) replaces everything.
-    let live_index = if pending.with_camera { Vec::new() } else { live.index() };
-    let mut kept = std::collections::HashSet::new();
     let (mut lo, mut hi) = (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY));
     let ids_of_doc = stable_ids(&doc.characters, &mut ids);
     for (c, id) in doc.characters.iter().zip(ids_of_doc) {
-        let same =
-            live_index.iter().find(|(_, i, source, binding)| *i == id && *source == c.source && *binding == c.binding);
-        let spawned = match same {
-            Some(&(entity, ..)) => {
-                kept.insert(entity);
-                Ok(live.update_from_doc(entity, c))
-            }
-            None => spawn_from_doc(&mut commands, &mut meshes, &mut library, c, id).map(|(_, notes)| notes),
-        };
-        match spawned {
-            Ok(notes) => {
+        match spawn_from_doc(&mut commands, &mut meshes, &mut library, c, id) {
+            Ok((_, notes)) => {
                 notes.into_iter().for_each(|m| messages.push(m));
                 if let Ok(asset) = library.load(&c.source) {
                     let (a, b) = asset.bounds();
@@ -171,19 +163,12 @@ pub fn apply_pending_scene(
             }
         }
     }
-    for (entity, character, ..) in &live.characters {
-        if !kept.contains(&entity) {
-            crate::scene::despawn_character(&mut commands, entity, character);
-        }
-    }
-    if pending.with_camera {
-        stage.0 = doc.stage;
-        for mut orbit in &mut cameras {
-            if let Some(c) = doc.camera {
-                *orbit = OrbitCamera(c);
-            } else if pending.frame && lo.x <= hi.x {
-                *orbit = OrbitCamera::framing(lo, hi);
-            }
+    stage.0 = doc.stage;
+    for mut orbit in &mut cameras {
+        if let Some(c) = doc.camera {
+            *orbit = OrbitCamera(c);
+        } else if pending.frame && lo.x <= hi.x {
+            *orbit = OrbitCamera::framing(lo, hi);
         }
     }
 }
@@ -191,8 +176,8 @@ pub fn apply_pending_scene(
 /// The id each character of a document gets: its own (saved in the scene, kept by undo
 /// and redo, so selections and pins stay valid), or a fresh one where it has none or
 /// repeats one already taken.
-fn stable_ids(characters: &[crate::formats::scene::CharacterDoc], next: &mut NextCharacterId) -> Vec<u64> {
-    next.0 = characters.iter().filter_map(|c| c.id).fold(next.0, u64::max);
+fn stable_ids(characters: &[crate::formats::scene::CharacterDoc], next: &mut NextCharacterId) -> Vec<CharacterId> {
+    next.0 = characters.iter().filter_map(|c| c.id).map(|id| id.0).fold(next.0, u64::max);
     let mut taken = std::collections::HashSet::new();
     characters.iter().map(|c| c.id.filter(|&id| taken.insert(id)).unwrap_or_else(|| next.take())).collect()
 }
@@ -202,38 +187,32 @@ fn stable_ids(characters: &[crate::formats::scene::CharacterDoc], next: &mut Nex
 #[derive(bevy::ecs::system::SystemParam)]
 pub struct SceneReset<'w> {
     selection: ResMut<'w, Selection>,
-    pins: Option<ResMut<'w, ik_drag::Pins>>,
-    history: Option<ResMut<'w, history::History>>,
+    pins: ResMut<'w, ik_drag::Pins>,
+    history: ResMut<'w, history::History>,
     unloaded: ResMut<'w, UnloadedCharacters>,
 }
 
 impl SceneReset<'_> {
     fn clear(&mut self) {
         *self.selection = Selection::default();
-        if let Some(pins) = &mut self.pins {
-            pins.0.clear();
-        }
-        if let Some(history) = &mut self.history {
-            **history = history::History::default();
-        }
+        self.unloaded.0.clear();
+        self.pins.0.clear();
+        *self.history = history::History::default();
     }
 }
 
-/// Keeps each character's colouring in step with its options and the selection (reads
-/// `SceneCharacter`, `Selection`; writes `SkinView`, `Visibility`).
-fn sync_character_views(
+/// Keeps each character's heat joint and visibility in step with its view options and
+/// the selection (reads `CharacterView`, `Selection`; writes `HeatJoint`, `Visibility`).
+pub fn sync_character_views(
     selection: Res<Selection>,
-    mut characters: Query<(&SceneCharacter, &mut SkinView, &mut Visibility)>,
+    mut characters: Query<(&SceneCharacter, &CharacterView, &mut HeatJoint, &mut Visibility)>,
 ) {
-    for (sc, mut view, mut visibility) in &mut characters {
-        let heat = (sc.heat_of_selected && selection.character == Some(sc.id))
+    for (sc, view, mut heat, mut visibility) in &mut characters {
+        let joint = (view.heat_of_selected && selection.character == Some(sc.id))
             .then(|| selection.joints.first().copied())
             .flatten();
-        if view.heat_joint != heat {
-            view.heat_joint = heat;
-        }
-        let wanted = if sc.visible { Visibility::Inherited } else { Visibility::Hidden };
-        visibility.set_if_neq(wanted);
+        heat.set_if_neq(HeatJoint(joint));
+        visibility.set_if_neq(super::document::visibility_of(view));
     }
 }
 
@@ -248,14 +227,14 @@ fn attach_skin_material(
     }
 }
 
-/// Shows or hides skins by display mode (reads `DisplayMode`; writes skin `Visibility`).
+/// Shows or hides skins by display mode (reads `CharacterView`; writes skin `Visibility`).
 fn apply_display_mode(
-    characters: Query<(&Character, &DisplayMode), Changed<DisplayMode>>,
+    characters: Query<(&Character, &CharacterView), Changed<CharacterView>>,
     mut visibility: Query<&mut Visibility, With<SkinMesh>>,
 ) {
-    for (character, mode) in &characters {
+    for (character, view) in &characters {
         if let Ok(mut v) = visibility.get_mut(character.skin_entity) {
-            *v = if **mode == DisplayDoc::Skeleton { Visibility::Hidden } else { Visibility::Inherited };
+            v.set_if_neq(if view.display == DisplayDoc::Skeleton { Visibility::Hidden } else { Visibility::Inherited });
         }
     }
 }

@@ -172,12 +172,23 @@ pub struct SmplDoc {
     pub upright: bool,
 }
 
+/// A character's stable id within a scene: saved in scene files, kept by undo and redo;
+/// selections, pins and the history name characters by it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize)]
+#[serde(transparent)]
+pub struct CharacterId(pub u64);
+
+impl std::fmt::Display for CharacterId {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "#{}", self.0)
+    }
+}
+
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct CharacterDoc {
-    /// The character's stable id in the scene (selections, pins and history refer to it);
-    /// files without one get fresh ids when opened.
+    /// The character's stable id in the scene; files without one get fresh ids when opened.
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub id: Option<u64>,
+    pub id: Option<CharacterId>,
     pub source: SourceDoc,
     pub name: String,
     #[serde(default)]

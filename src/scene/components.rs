@@ -4,13 +4,13 @@ use std::sync::Arc;
 
 use bevy::prelude::*;
 
-use crate::formats::scene::PlacementDoc;
+use crate::formats::scene::{PlacementDoc, ViewDoc};
 use crate::rig::{CharacterAsset, DofLimits, JointRotation};
 
 /// A character: the loaded asset it was made from (shared by every character made from
 /// the same files), its joint entities by joint index and the entity that draws its skin.
 #[derive(Component, Clone)]
-#[require(Placement, SkinView, DisplayMode, PoseDirty, Transform, Visibility)]
+#[require(Placement, CharacterView, HeatJoint, PoseDirty, Transform, Visibility)]
 pub struct Character {
     pub asset: Arc<CharacterAsset>,
     /// `joints[i]` is the entity of joint `i` of `asset.skeleton`.
@@ -44,27 +44,15 @@ impl Placement {
     }
 }
 
-/// How a character's skin is coloured.
-#[derive(Component, Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
-pub struct SkinView {
-    /// Base colour when weight colours are off (linear RGB).
-    pub tint: [f32; 3],
-    /// A distinct hue per joint, blended by the weights.
-    pub weight_colors: bool,
-    /// A heat map of this joint's weights (overrides `weight_colors`).
-    pub heat_joint: Option<usize>,
-}
+/// How a character is shown: skin, skeleton or both, visible, tint, weight colours, heat
+/// map of the selected joint (the scene file's own `ViewDoc`, on the character entity).
+#[derive(Component, Clone, Debug, Default, PartialEq, Deref, DerefMut)]
+pub struct CharacterView(pub ViewDoc);
 
-impl Default for SkinView {
-    fn default() -> Self {
-        Self { tint: [0.8, 0.62, 0.45], weight_colors: false, heat_joint: None }
-    }
-}
-
-/// Whether a character shows its skin, its skeleton, or both: the scene file's own type,
-/// on the character entity.
-#[derive(Component, Clone, Copy, Debug, Default, PartialEq, Eq, Deref, DerefMut)]
-pub struct DisplayMode(pub crate::formats::scene::DisplayDoc);
+/// The joint whose weights the skin shows as a heat map (overrides weight colours); set
+/// from the selection where the view asks for it.
+#[derive(Component, Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct HeatJoint(pub Option<usize>);
 
 /// Set when a character's pose, placement or view changed and its skin must be redone.
 #[derive(Component, Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -156,4 +144,21 @@ pub struct JointScratch {
 pub struct SkinScratch {
     pub palette: Vec<Mat4>,
     pub positions: Vec<Vec3>,
+    /// What the mesh's colours were last written from.
+    pub colored_with: Option<Coloring>,
+}
+
+/// What a skin's colours depend on: a view change that leaves this alone (display mode,
+/// visibility) rewrites no colours.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Coloring {
+    tint: [f32; 3],
+    weight_colors: bool,
+    heat_joint: Option<usize>,
+}
+
+impl Coloring {
+    pub fn of(view: &CharacterView, heat: &HeatJoint) -> Self {
+        Self { tint: view.tint, weight_colors: view.weight_colors, heat_joint: heat.0 }
+    }
 }

@@ -14,80 +14,42 @@ use crate::scene::{Character, JointPose, MarionetteSystems, PoseDirty};
 /// Frames per second of the SMPL clips.
 pub const CLIP_FPS: f32 = 30.0;
 
-/// The SMPL state of a character.
+/// An SMPL body: the model and the clips of its folder, and its live state, the scene
+/// file's own `SmplDoc` (β, clips by file name, time, playback, blend).
 #[derive(Component, Clone)]
 pub struct SmplCharacter {
     pub model: Arc<SmplModel>,
     pub dir: PathBuf,
     pub clips: Vec<(String, Arc<Clip>)>,
-    pub betas: [f32; 10],
-    pub clip: Option<usize>,
-    /// Playback time in frames.
-    pub time: f32,
-    pub playing: bool,
-    pub speed: f32,
-    pub looping: bool,
-    pub blend_clip: Option<usize>,
-    /// 0: the first clip only; 1: the second only.
-    pub blend: f32,
-    /// Turn the root so the clip's first frame stands upright.
-    pub upright: bool,
-    /// The shape the character's asset was built for.
-    built_betas: [f32; 10],
+    pub state: SmplDoc,
+    /// The shape the character's asset was built for (none: the mean shape).
+    built_betas: Vec<f32>,
 }
 
 impl SmplCharacter {
-    pub fn new(model: Arc<SmplModel>, dir: PathBuf, clips: Vec<(String, Arc<Clip>)>, doc: Option<&SmplDoc>) -> Self {
-        let index = |name: &Option<String>| name.as_ref().and_then(|n| clips.iter().position(|c| &c.0 == n));
-        let mut betas = [0.0; 10];
-        if let Some(d) = doc {
-            for (b, v) in betas.iter_mut().zip(&d.betas) {
-                *b = *v;
-            }
-        }
-        let d = doc.cloned().unwrap_or_default();
-        Self {
-            clip: index(&d.clip),
-            blend_clip: index(&d.blend_clip),
-            time: d.time,
-            playing: d.playing,
-            speed: if d.speed == 0.0 { 1.0 } else { d.speed },
-            looping: d.looping,
-            blend: d.blend,
-            upright: d.upright,
-            model,
-            dir,
-            clips,
-            betas,
-            built_betas: [0.0; 10],
-        }
+    pub fn new(model: Arc<SmplModel>, dir: PathBuf, clips: Vec<(String, Arc<Clip>)>, state: SmplDoc) -> Self {
+        Self { model, dir, clips, state, built_betas: Vec::new() }
     }
 
-    /// Takes the state of a document (β, clips, time, playback), keeping the model, its
-    /// clips and the shape the asset was built for (so a β change reshapes it).
-    pub fn apply_doc(&mut self, doc: &SmplDoc) {
-        let built_betas = self.built_betas;
-        *self = Self::new(self.model.clone(), self.dir.clone(), self.clips.clone(), Some(doc));
-        self.built_betas = built_betas;
+    /// The index of the clip file `name` in the folder.
+    pub fn clip_index(&self, name: Option<&str>) -> Option<usize> {
+        let name = name?;
+        self.clips.iter().position(|c| c.0 == name)
     }
 
-    pub fn doc(&self) -> SmplDoc {
-        SmplDoc {
-            betas: self.betas.to_vec(),
-            clip: self.clip.map(|c| self.clips[c].0.clone()),
-            time: self.time,
-            playing: self.playing,
-            speed: self.speed,
-            looping: self.looping,
-            blend_clip: self.blend_clip.map(|c| self.clips[c].0.clone()),
-            blend: self.blend,
-            upright: self.upright,
-        }
+    /// The clip that plays, if its file is in the folder.
+    pub fn clip(&self) -> Option<&Clip> {
+        self.clip_index(self.state.clip.as_deref()).map(|c| &*self.clips[c].1)
+    }
+
+    /// The clip blended in, if its file is in the folder.
+    pub fn blend_clip(&self) -> Option<&Clip> {
+        self.clip_index(self.state.blend_clip.as_deref()).map(|c| &*self.clips[c].1)
     }
 
     /// Length of the current clip in frames (0 without one).
     pub fn clip_frames(&self) -> usize {
-        self.clip.map_or(0, |c| self.clips[c].1.frame_count())
+        self.clip().map_or(0, Clip::frame_count)
     }
 }
 
@@ -114,18 +76,19 @@ impl Plugin for SmplPlugin {
 /// Advances playing clips by the frame time (reads `Time`; writes `SmplCharacter`).
 fn advance_playback(time: Res<Time>, mut bodies: Query<&mut SmplCharacter>) {
     for mut body in &mut bodies {
-        if !body.playing || body.clip.is_none() {
+        let n = body.clip_frames() as f32;
+        if !body.state.playing || n == 0.0 {
             continue;
         }
-        let n = body.clip_frames() as f32;
-        let mut t = body.time + time.delta_secs() * CLIP_FPS * body.speed;
-        if body.looping {
-            t = t.rem_euclid(n.max(1.0));
+        let state = &mut body.state;
+        let mut t = state.time + time.delta_secs() * CLIP_FPS * state.speed;
+        if state.looping {
+            t = t.rem_euclid(n);
         } else if t >= n - 1.0 {
             t = n - 1.0;
-            body.playing = false;
+            state.playing = false;
         }
-        body.time = t;
+        state.time = t;
     }
 }
 
@@ -133,19 +96,25 @@ fn advance_playback(time: Res<Time>, mut bodies: Query<&mut SmplCharacter>) {
 /// `Character`'s asset and `PoseDirty`; the bind pass, matrix stack and skinning follow).
 fn reshape_bodies(mut bodies: Query<(&mut SmplCharacter, &mut Character, &mut PoseDirty), Changed<SmplCharacter>>) {
     for (mut body, mut character, mut dirty) in &mut bodies {
-        if body.built_betas == body.betas
+        if same_shape(&body.built_betas, &body.state.betas)
             && character.asset.skin.bind_positions.len() == body.model.base_positions.len()
         {
             continue;
         }
-        let Ok(asset) = body.model.asset(&character.asset.name, &body.betas) else {
+        let Ok(asset) = body.model.asset(&character.asset.name, &body.state.betas) else {
             continue;
         };
         character.asset = Arc::new(asset);
-        body.built_betas = body.betas;
+        let body = &mut *body;
+        body.built_betas.clone_from(&body.state.betas);
         dirty.bind = true;
         dirty.matrices = true;
     }
+}
+
+/// Whether two β lists give the same shape (missing coefficients are zero).
+fn same_shape(a: &[f32], b: &[f32]) -> bool {
+    (0..a.len().max(b.len())).all(|i| a.get(i).unwrap_or(&0.0) == b.get(i).unwrap_or(&0.0))
 }
 
 /// Writes the clip pose (blended with the second clip) into the joints when the clip,
@@ -158,20 +127,20 @@ fn pose_from_clips(
     let mut b = Vec::new();
     let mut mixed = Vec::new();
     for (body, character) in &bodies {
-        let Some(c) = body.clip else { continue };
-        body.clips[c].1.sample(body.time, body.looping, BlendMode::Nlerp, &mut a);
-        let rotations = match body.blend_clip {
-            Some(k) if body.blend > 0.0 => {
-                let other = &body.clips[k].1;
+        let Some(clip) = body.clip() else { continue };
+        let state = &body.state;
+        clip.sample(state.time, state.looping, BlendMode::Nlerp, &mut a);
+        let rotations = match body.blend_clip() {
+            Some(other) if state.blend > 0.0 => {
                 // The second clip runs on the same clock, wrapped to its own length.
-                other.sample(body.time, true, BlendMode::Nlerp, &mut b);
-                blend_rotations(&a, &b, body.blend, BlendMode::Nlerp, &mut mixed);
+                other.sample(state.time, true, BlendMode::Nlerp, &mut b);
+                blend_rotations(&a, &b, state.blend, BlendMode::Nlerp, &mut mixed);
                 &mixed
             }
             _ => &a,
         };
-        let upright = if body.upright {
-            let first_up = body.clips[c].1.frame(0).first().copied().unwrap_or(Quat::IDENTITY) * Vec3::Y;
+        let upright = if state.upright {
+            let first_up = clip.frame(0).first().copied().unwrap_or(Quat::IDENTITY) * Vec3::Y;
             Quat::from_rotation_arc(first_up.normalize(), Vec3::Y)
         } else {
             Quat::IDENTITY

@@ -17,21 +17,22 @@ pub fn clamp_poses_to_limits(mut joints: Query<(&mut JointPose, &JointLimits), C
     }
 }
 
-/// Marks characters whose joints' poses or whose view changed (reads change ticks, writes
+/// Marks characters whose joints' poses or whose colouring (tint, weight colours, heat
+/// joint; not the display mode or visibility) changed (reads change ticks, writes
 /// `PoseDirty`). A new placement is no reason: joints and skin live in the character's
 /// model space, and its `Transform` places them. Whoever rebuilds the rest pose (an SMPL
 /// reshape) sets `PoseDirty::bind` itself.
 pub fn mark_changed_characters(
     posed: Query<&Joint, Changed<JointPose>>,
-    mut characters: Query<(Ref<SkinView>, &mut PoseDirty)>,
+    mut characters: Query<(&CharacterView, &HeatJoint, &SkinScratch, &mut PoseDirty)>,
 ) {
     for joint in &posed {
-        if let Ok((_, mut dirty)) = characters.get_mut(joint.character) {
+        if let Ok((.., mut dirty)) = characters.get_mut(joint.character) {
             dirty.matrices = true;
         }
     }
-    for (view, mut dirty) in &mut characters {
-        if view.is_changed() {
+    for (view, heat, scratch, mut dirty) in &mut characters {
+        if scratch.colored_with != Some(Coloring::of(view, heat)) {
             dirty.colors = true;
         }
     }
@@ -93,12 +94,12 @@ pub fn compute_joint_to_world(
 /// colours when the view changed (reads joint matrices; writes `Mesh` assets, `Aabb`,
 /// clears `PoseDirty`).
 pub fn skin_changed_characters(
-    mut characters: Query<(&Character, &SkinView, &mut PoseDirty, &mut SkinScratch)>,
+    mut characters: Query<(&Character, &CharacterView, &HeatJoint, &mut PoseDirty, &mut SkinScratch)>,
     joints: Query<(&CurrentJointToWorld, &BindWorldToJoint)>,
     mut skin_bounds: Query<&mut Aabb, With<SkinMesh>>,
     mut meshes: ResMut<Assets<Mesh>>,
 ) {
-    for (character, view, mut dirty, mut scratch) in &mut characters {
+    for (character, view, heat, mut dirty, mut scratch) in &mut characters {
         if *dirty == PoseDirty::default() {
             continue;
         }
@@ -106,7 +107,7 @@ pub fn skin_changed_characters(
         let Some(mut mesh) = meshes.get_mut(&character.mesh) else {
             continue;
         };
-        let SkinScratch { palette, positions } = &mut *scratch;
+        let SkinScratch { palette, positions, .. } = &mut *scratch;
         if dirty.matrices || dirty.bind {
             palette.clear();
             palette.extend(character.joints.iter().map(|&e| joints.get(e).map_or(Mat4::IDENTITY, |(c, b)| c.0 * b.0)));
@@ -126,18 +127,19 @@ pub fn skin_changed_characters(
             mesh.insert_attribute(Mesh::ATTRIBUTE_NORMAL, normals);
         }
         if dirty.colors {
-            write_colors(&mut mesh, character, view);
+            write_colors(&mut mesh, character, view, heat.0);
+            scratch.colored_with = Some(Coloring::of(view, heat));
         }
         *dirty = PoseDirty::default();
     }
 }
 
 /// Rewrites the per-corner colours: the tint, the weight colours or a joint's heat map.
-fn write_colors(mesh: &mut Mesh, character: &Character, view: &SkinView) {
+fn write_colors(mesh: &mut Mesh, character: &Character, view: &CharacterView, heat_joint: Option<usize>) {
     let skin = &character.asset.skin;
     let n = skin.bind_positions.len();
     let mut per_vertex = vec![view.tint; n];
-    if let Some(j) = view.heat_joint.filter(|&j| j < character.joints.len()) {
+    if let Some(j) = heat_joint.filter(|&j| j < character.joints.len()) {
         heat_colors(&skin.weights, j, &mut per_vertex);
     } else if view.weight_colors {
         weight_colors(&skin.weights, &joint_colors(character.joints.len()), &mut per_vertex);

@@ -120,7 +120,7 @@ fn normals_and_weight_colours_match_the_kernels() {
     let asset = Arc::new(embedded_puppet());
     let mut app = app();
     let character = spawn(&mut app, asset.clone(), Placement::default());
-    app.world_mut().get_mut::<SkinView>(character).unwrap().weight_colors = true;
+    app.world_mut().get_mut::<CharacterView>(character).unwrap().weight_colors = true;
     let knee = asset.skeleton.find("l_knee").unwrap();
     let rotation = JointRotation::euler_xyz(-1.1, 0.0, 0.2);
     set_joint(&mut app, character, knee, rotation);
@@ -267,7 +267,7 @@ fn smpl_body_in_the_ecs_matches_the_poser() {
         model.clone(),
         dir.clone(),
         vec![("c".into(), clip.clone())],
-        Some(&doc),
+        doc,
     ));
     app.update();
     app.update();

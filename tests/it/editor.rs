@@ -1,5 +1,4 @@
-//! The editor's document layer: scene files, undo history, screenshots and the headless
-//! render.
+//! The editor's document layer: scene files, screenshots and the headless render.
 
 use std::collections::BTreeMap;
 use std::io::Cursor;
@@ -7,7 +6,6 @@ use std::path::PathBuf;
 use std::process::Command;
 
 use marionette::editor::document::{pose_from_doc, read_scene, write_scene};
-use marionette::editor::history::History;
 use marionette::editor::screenshot::timestamp;
 use marionette::formats::scene::{
     CharacterDoc, PlacementDoc, SceneDoc, SourceDoc, ViewDoc, parse_scene, scene_to_string,
@@ -16,7 +14,7 @@ use marionette::rig::JointRotation;
 
 use crate::common::{data_dir, scratch};
 
-fn doc_with(source: SourceDoc, pose: &[(&str, JointRotation)]) -> SceneDoc {
+pub fn doc_with(source: SourceDoc, pose: &[(&str, JointRotation)]) -> SceneDoc {
     SceneDoc {
         characters: vec![CharacterDoc {
             id: None,
@@ -89,46 +87,6 @@ fn unknown_joints_in_a_scene_pose_are_reported_not_fatal() {
     assert_eq!(pose[asset.skeleton.find("l_elbow").unwrap()], JointRotation::euler_xyz(0.0, 1.0, 0.0));
     assert_eq!(messages.len(), 1);
     assert!(messages[0].contains("no joint `tail`"), "{}", messages[0]);
-}
-
-#[test]
-fn history_takes_one_step_per_gesture_and_redoes() {
-    let a = doc_with(SourceDoc::Embedded("puppet".into()), &[]);
-    let mut b = a.clone();
-    b.characters[0].name = "b".into();
-    let mut c = a.clone();
-    c.characters[0].name = "c2".into();
-    let mut h = History::default();
-    h.begin_edit(&a);
-    h.begin_edit(&b); // same gesture: ignored
-    h.end_gesture(&b);
-    h.begin_edit(&b);
-    h.end_gesture(&c);
-    assert_eq!(h.undo.len(), 2);
-    assert_eq!(h.undo(c.clone()), Some(b.clone()));
-    assert_eq!(h.undo(b.clone()), Some(a.clone()));
-    assert_eq!(h.undo(a.clone()), None);
-    assert_eq!(h.redo(a.clone()), Some(b.clone()));
-    assert_eq!(h.redo(b.clone()), Some(c.clone()));
-    h.begin_edit(&c);
-    assert!(h.redo.is_empty(), "a new edit drops the redo steps");
-}
-
-#[test]
-fn a_gesture_that_changes_nothing_is_no_undo_step_and_keeps_redo() {
-    let a = doc_with(SourceDoc::Embedded("puppet".into()), &[]);
-    let mut b = a.clone();
-    b.characters[0].name = "b".into();
-    let mut h = History::default();
-    h.begin_edit(&a);
-    h.end_gesture(&b);
-    assert_eq!(h.undo(b.clone()), Some(a.clone()));
-    assert_eq!(h.redo.len(), 1);
-    // A click that selects a joint: the gesture begins, the scene stays `a`.
-    h.begin_edit(&a);
-    h.end_gesture(&a);
-    assert!(h.undo.is_empty(), "a click is no undo step");
-    assert_eq!(h.redo(a.clone()), Some(b.clone()), "the redo step survives the click");
 }
 
 #[test]
@@ -220,142 +178,4 @@ fn model1_and_model2_render_side_by_side() {
         .unwrap();
     assert!(output.status.success(), "{}", String::from_utf8_lossy(&output.stderr));
     assert_eq!(image::open(&out).unwrap().to_rgb8().dimensions(), (160, 120));
-}
-
-#[derive(bevy::prelude::Resource, Default)]
-struct Captured(SceneDoc);
-
-/// An app with the ECS core and the editor's scene building (no window, no rendering):
-/// `PendingScene` documents are applied, then the scene is captured into `Captured`.
-fn scene_app() -> bevy::prelude::App {
-    use bevy::prelude::*;
-    use marionette::editor::document::{AssetLibrary, NextCharacterId, PendingScene};
-    use marionette::editor::ik_drag::Pins;
-    use marionette::editor::stage::StageSettings;
-    use marionette::editor::{Messages, Selection, UnloadedCharacters, apply_pending_scene};
-    let mut app = crate::ecs::app();
-    app.init_resource::<AssetLibrary>()
-        .init_resource::<NextCharacterId>()
-        .init_resource::<Messages>()
-        .init_resource::<StageSettings>()
-        .init_resource::<Selection>()
-        .init_resource::<UnloadedCharacters>()
-        .init_resource::<PendingScene>()
-        .init_resource::<Pins>()
-        .init_resource::<History>()
-        .init_resource::<Captured>()
-        .add_systems(Update, (apply_pending_scene, capture_scene).chain());
-    app
-}
-
-fn capture_scene(reader: marionette::editor::document::SceneReader, mut out: bevy::prelude::ResMut<Captured>) {
-    out.0 = reader.capture();
-}
-
-/// Open replaces the world: the old selection, pins and history refer to nothing in it
-/// and are cleared; a character that fails to load is reported and kept, as it was, in
-/// what Save writes.
-#[test]
-fn opening_a_scene_clears_selection_pins_and_history_and_keeps_unloadable_characters() {
-    use bevy::prelude::*;
-    use marionette::editor::document::{PendingScene, SceneCharacter};
-    use marionette::editor::ik_drag::Pins;
-    use marionette::editor::{Messages, Selection};
-
-    let mut app = scene_app();
-    // What the previous scene left behind.
-    *app.world_mut().resource_mut::<Selection>() = Selection { character: Some(7), joints: vec![40] };
-    app.world_mut().resource_mut::<Pins>().0.insert(7, vec![40]);
-    app.world_mut().resource_mut::<History>().undo.push(SceneDoc::default());
-
-    let mut doc = doc_with(SourceDoc::Embedded("puppet".into()), &[]);
-    let mut missing = doc.characters[0].clone();
-    missing.source = SourceDoc::File("/nonexistent/gone.skel".into());
-    missing.name = "gone".into();
-    doc.characters.push(missing.clone());
-    *app.world_mut().resource_mut::<PendingScene>() = PendingScene { doc: Some(doc), with_camera: true, frame: false };
-    app.update();
-    app.update();
-
-    let world = app.world_mut();
-    assert_eq!(*world.resource::<Selection>(), Selection::default());
-    assert!(world.resource::<Pins>().0.is_empty());
-    assert!(world.resource::<History>().undo.is_empty());
-    assert_eq!(world.query::<&SceneCharacter>().iter(world).count(), 1);
-    let messages = &world.resource::<Messages>().0;
-    assert!(messages.iter().any(|m| m.contains("gone.skel") && m.contains("kept in the scene file")), "{messages:?}");
-    let saved = &world.resource::<Captured>().0;
-    assert_eq!(saved.characters.len(), 2);
-    assert_eq!(saved.characters[1], missing, "the unloadable character is saved as it was");
-}
-
-/// Ids are saved in the document and kept when it is applied again (undo, redo), so the
-/// selection still names the same character; documents without ids (old files) get fresh
-/// ones that never repeat.
-#[test]
-fn character_ids_survive_rebuilding_from_a_document_and_old_files_get_fresh_ones() {
-    use bevy::prelude::*;
-    use marionette::editor::Selection;
-    use marionette::editor::document::{PendingScene, SceneCharacter};
-
-    let mut app = scene_app();
-    let apply = |app: &mut App, ids: &[Option<u64>], with_camera: bool| {
-        let one = doc_with(SourceDoc::Embedded("puppet".into()), &[]).characters[0].clone();
-        let characters = ids.iter().map(|&id| CharacterDoc { id, ..one.clone() }).collect();
-        let doc = SceneDoc { characters, ..SceneDoc::default() };
-        *app.world_mut().resource_mut::<PendingScene>() = PendingScene { doc: Some(doc), with_camera, frame: false };
-        app.update();
-        app.update();
-        let world = app.world_mut();
-        let mut ids: Vec<u64> = world.query::<&SceneCharacter>().iter(world).map(|c| c.id).collect();
-        ids.sort();
-        ids
-    };
-    assert_eq!(apply(&mut app, &[Some(5), Some(9)], true), vec![5, 9]);
-    *app.world_mut().resource_mut::<Selection>() = Selection { character: Some(9), joints: vec![3] };
-    // Undo of adding character 5: the document without it.
-    assert_eq!(apply(&mut app, &[Some(9)], false), vec![9]);
-    assert_eq!(app.world().resource::<Selection>().character, Some(9), "the selection survives");
-    let saved = &app.world().resource::<Captured>().0;
-    assert_eq!(saved.characters.iter().map(|c| c.id).collect::<Vec<_>>(), vec![Some(9)]);
-    // An old file: no ids, and one repeated id; fresh ids come after every id seen.
-    assert_eq!(apply(&mut app, &[None, Some(9), Some(9)], true), vec![9, 10, 11]);
-}
-
-/// Undo and redo set the characters that stay in place: the same entity and mesh, with
-/// the document's pose and placement (no despawn and respawn).
-#[test]
-fn applying_a_document_again_updates_characters_in_place() {
-    use bevy::prelude::*;
-    use marionette::editor::document::{PendingScene, SceneCharacter};
-    use marionette::scene::{Character, JointPose, Placement};
-
-    let mut app = scene_app();
-    let mut doc = doc_with(SourceDoc::Embedded("puppet".into()), &[]);
-    doc.characters[0].id = Some(3);
-    *app.world_mut().resource_mut::<PendingScene>() =
-        PendingScene { doc: Some(doc.clone()), with_camera: true, frame: false };
-    app.update();
-    app.update();
-    let entity_of = |app: &mut App| {
-        let world = app.world_mut();
-        world.query_filtered::<Entity, With<SceneCharacter>>().iter(world).collect::<Vec<_>>()
-    };
-    let before = entity_of(&mut app);
-    let mesh = app.world().get::<Character>(before[0]).unwrap().mesh.id();
-
-    let elbow_rotation = JointRotation::euler_xyz(0.0, 1.0, 0.0);
-    let mut edited = doc.clone();
-    edited.characters[0].placement.translation = Vec3::new(2.0, 0.0, 1.0);
-    edited.characters[0].pose.insert("l_elbow".into(), elbow_rotation);
-    *app.world_mut().resource_mut::<PendingScene>() =
-        PendingScene { doc: Some(edited), with_camera: false, frame: false };
-    app.update();
-    app.update();
-    assert_eq!(entity_of(&mut app), before, "the same entity");
-    let character = app.world().get::<Character>(before[0]).unwrap().clone();
-    assert_eq!(character.mesh.id(), mesh, "the same mesh");
-    assert_eq!(app.world().get::<Placement>(before[0]).unwrap().translation, Vec3::new(2.0, 0.0, 1.0));
-    let elbow = character.asset.skeleton.find("l_elbow").unwrap();
-    assert_eq!(app.world().get::<JointPose>(character.joints[elbow]).unwrap().0, elbow_rotation);
 }

@@ -5,6 +5,7 @@ mod common;
 mod data;
 mod ecs;
 mod editor;
+mod edits;
 mod formats;
 mod fuzz;
 mod ik;

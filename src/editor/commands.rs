@@ -1,0 +1,330 @@
+//! Edits as commands. Every user action — from the panels, the shortcuts, a drag in the
+//! viewport — is an [`Edit`] pushed to the [`EditQueue`]; [`apply_edits`] applies them to
+//! the live ECS in `Animate` (so an edit is skinned the frame it is made) and records what
+//! undoes each: its inverse, an `Edit` too. Undo and redo apply those inverses, so entities
+//! and ids stay; only adding and removing spawn or despawn.
+
+use bevy::ecs::system::SystemState;
+use bevy::prelude::*;
+
+use super::document::{AssetLibrary, CharacterIndex, NextCharacterId, SceneCharacter, SceneReader, spawn_from_doc};
+use super::history::History;
+use super::stage::StageSettings;
+use super::state::Messages;
+use crate::formats::scene::{BindingDoc, CharacterDoc, CharacterId, PlacementDoc, SmplDoc, StageDoc, ViewDoc};
+use crate::rig::JointRotation;
+use crate::scene::smpl::SmplCharacter;
+use crate::scene::{Character, CharacterView, JointLimits, JointPose, MarionetteSystems, Placement, PoseDirty};
+
+/// One user action on the scene.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Edit {
+    /// Turn joints (by index) to these rotations, clamped to their limits.
+    Pose {
+        character: CharacterId,
+        joints: Vec<(usize, JointRotation)>,
+    },
+    /// Move, turn or scale a character.
+    Place {
+        character: CharacterId,
+        placement: PlacementDoc,
+    },
+    /// Display mode, visibility, weight colours, heat map, tint.
+    View {
+        character: CharacterId,
+        view: ViewDoc,
+    },
+    Rename {
+        character: CharacterId,
+        name: String,
+    },
+    /// β, clips, time, playback and blend of an SMPL body.
+    Smpl {
+        character: CharacterId,
+        state: SmplDoc,
+    },
+    /// Weights from the file (`None`) or computed from the bones.
+    Rebind {
+        character: CharacterId,
+        binding: Option<BindingDoc>,
+    },
+    /// Floor, shadows, axes.
+    Stage(StageDoc),
+    /// A character from its document (a fresh id is given when it has none).
+    Add(Box<CharacterDoc>),
+    Remove(CharacterId),
+}
+
+impl Edit {
+    /// The character it edits (none for the stage).
+    pub fn character(&self) -> Option<CharacterId> {
+        match self {
+            Edit::Pose { character, .. }
+            | Edit::Place { character, .. }
+            | Edit::View { character, .. }
+            | Edit::Rename { character, .. }
+            | Edit::Smpl { character, .. }
+            | Edit::Rebind { character, .. }
+            | Edit::Remove(character) => Some(*character),
+            Edit::Add(doc) => doc.id,
+            Edit::Stage(_) => None,
+        }
+    }
+}
+
+/// Edits waiting for this frame's `Animate`.
+#[derive(Resource, Default, Debug)]
+pub struct EditQueue(pub Vec<Edit>);
+
+impl EditQueue {
+    pub fn push(&mut self, edit: Edit) {
+        self.0.push(edit);
+    }
+}
+
+/// Set by the panels while a widget is held or typed into: the gesture (a slider drag, a
+/// name being typed) goes on, and stays one undo step, even between mouse presses.
+#[derive(Resource, Default, Debug, PartialEq, Eq)]
+pub struct GestureHold(pub bool);
+
+/// Edits as commands, and their history.
+pub struct CommandsPlugin;
+
+impl Plugin for CommandsPlugin {
+    fn build(&self, app: &mut App) {
+        app.init_resource::<EditQueue>()
+            .init_resource::<History>()
+            .init_resource::<GestureHold>()
+            .init_resource::<CharacterIndex>()
+            .init_resource::<NextCharacterId>()
+            .init_resource::<Messages>()
+            .init_resource::<AssetLibrary>()
+            .add_systems(
+                PostUpdate,
+                apply_edits
+                    .in_set(MarionetteSystems::Animate)
+                    .after(super::view::apply_pending_scene)
+                    .before(super::view::sync_character_views)
+                    .before(crate::scene::smpl::SmplPlayback),
+            );
+    }
+}
+
+/// Applies the queued edits and serves undo/redo, recording what undoes each edit into the
+/// gesture under way; the gesture ends when no mouse button or widget is held (exclusive:
+/// edits may spawn and despawn).
+pub fn apply_edits(world: &mut World) {
+    let queue = std::mem::take(&mut world.resource_mut::<EditQueue>().0);
+    let request = world.resource_mut::<History>().request.take();
+    if queue.is_empty() && request.is_none() && !world.resource::<History>().gesture_open() {
+        return;
+    }
+    for edit in queue {
+        if let Some(inverse) = apply_reporting(world, edit) {
+            world.resource_mut::<History>().record(inverse);
+        }
+    }
+    let held = world.get_resource::<ButtonInput<MouseButton>>().is_some_and(|b| b.get_pressed().next().is_some())
+        || world.resource::<GestureHold>().0;
+    if !held || request.is_some() {
+        close_gesture(world);
+    }
+    if let Some(request) = request
+        && let Some(step) = world.resource_mut::<History>().pop(request)
+    {
+        let back = replay(world, step);
+        world.resource_mut::<History>().push_opposite(request, back);
+    }
+}
+
+/// Ends the gesture under way: what undoes it becomes one undo step, less what would
+/// change nothing now (a drag that came back, a click that only selected).
+fn close_gesture(world: &mut World) {
+    let mut step = world.resource_mut::<History>().take_gesture();
+    step.retain(|inverse| matches!(inverse_of(world, inverse), Ok(Some(_))));
+    if !step.is_empty() {
+        world.resource_mut::<History>().commit(step);
+    }
+}
+
+/// Applies a step's edits last first; returns what undoes the replay.
+fn replay(world: &mut World, step: Vec<Edit>) -> Vec<Edit> {
+    step.into_iter().rev().filter_map(|edit| apply_reporting(world, edit)).collect()
+}
+
+fn apply_reporting(world: &mut World, edit: Edit) -> Option<Edit> {
+    apply(world, edit).unwrap_or_else(|message| {
+        world.resource_mut::<Messages>().push(message);
+        None
+    })
+}
+
+/// Applies `edit` to the live scene. Returns what undoes it (`None` when it changed
+/// nothing), or why it could not be applied.
+pub fn apply(world: &mut World, mut edit: Edit) -> Result<Option<Edit>, String> {
+    if let Edit::Add(doc) = &mut edit
+        && doc.id.is_none()
+    {
+        doc.id = Some(world.resource_mut::<NextCharacterId>().take());
+    }
+    let Some(inverse) = inverse_of(world, &edit)? else { return Ok(None) };
+    write(world, edit)?;
+    Ok(Some(inverse))
+}
+
+/// What would undo `edit` in the scene as it is: `None` when `edit` would change nothing.
+pub fn inverse_of(world: &mut World, edit: &Edit) -> Result<Option<Edit>, String> {
+    let unless = |same: bool, undo: Edit| (!same).then_some(undo);
+    Ok(match edit {
+        Edit::Pose { character, joints } => {
+            let found = character_of(world, *character)?;
+            let mut undo: Vec<(usize, JointRotation)> = Vec::new();
+            for &(j, rotation) in joints {
+                let (pose, limits) = joint_state(world, &found, j)?;
+                if pose != rotation.clamped(&limits) && !undo.iter().any(|&(k, _)| k == j) {
+                    undo.push((j, pose));
+                }
+            }
+            (!undo.is_empty()).then(|| Edit::Pose { character: *character, joints: undo })
+        }
+        Edit::Place { character, placement } => {
+            let old = component::<Placement>(world, *character)?.0;
+            unless(old == *placement, Edit::Place { character: *character, placement: old })
+        }
+        Edit::View { character, view } => {
+            let old = component::<CharacterView>(world, *character)?.0.clone();
+            unless(old == *view, Edit::View { character: *character, view: old })
+        }
+        Edit::Rename { character, name } => {
+            let old = component::<SceneCharacter>(world, *character)?.name.clone();
+            unless(old == *name, Edit::Rename { character: *character, name: old })
+        }
+        Edit::Smpl { character, state } => {
+            let old = component::<SmplCharacter>(world, *character)?.state.clone();
+            unless(old == *state, Edit::Smpl { character: *character, state: old })
+        }
+        Edit::Rebind { character, binding } => {
+            let old = component::<SceneCharacter>(world, *character)?.binding;
+            unless(old == *binding, Edit::Rebind { character: *character, binding: old })
+        }
+        Edit::Stage(stage) => {
+            let old = world.resource::<StageSettings>().0;
+            unless(old == *stage, Edit::Stage(old))
+        }
+        Edit::Add(doc) => {
+            let id = doc.id.ok_or("a character to add has an id")?;
+            if world.resource::<CharacterIndex>().get(id).is_some() {
+                return Err(format!("character {id} is already in the scene"));
+            }
+            Some(Edit::Remove(id))
+        }
+        Edit::Remove(id) => {
+            let entity = entity_of(world, *id)?;
+            let mut reader = SystemState::<SceneReader>::new(world);
+            let doc =
+                reader.get(world).map_err(|e| e.to_string())?.character_doc(entity).ok_or_else(|| missing(*id))?;
+            Some(Edit::Add(Box::new(doc)))
+        }
+    })
+}
+
+/// Writes `edit` into the live scene.
+fn write(world: &mut World, edit: Edit) -> Result<(), String> {
+    match edit {
+        Edit::Pose { character, joints } => {
+            let found = character_of(world, character)?;
+            for (j, rotation) in joints {
+                let (_, limits) = joint_state(world, &found, j)?;
+                if let Some(mut pose) = world.get_mut::<JointPose>(found.joints[j]) {
+                    pose.set_if_neq(JointPose(rotation.clamped(&limits)));
+                }
+            }
+        }
+        Edit::Place { character, placement } => component_mut::<Placement>(world, character)?.0 = placement,
+        Edit::View { character, view } => component_mut::<CharacterView>(world, character)?.0 = view,
+        Edit::Rename { character, name } => component_mut::<SceneCharacter>(world, character)?.name = name,
+        Edit::Smpl { character, state } => component_mut::<SmplCharacter>(world, character)?.state = state,
+        Edit::Rebind { character, binding } => rebind_character(world, character, binding)?,
+        Edit::Stage(stage) => world.resource_mut::<StageSettings>().0 = stage,
+        Edit::Add(doc) => add_character(world, &doc)?,
+        Edit::Remove(id) => {
+            let entity = entity_of(world, id)?;
+            let found = character_of(world, id)?;
+            crate::scene::despawn_character(&mut world.commands(), entity, &found);
+            world.flush();
+        }
+    }
+    Ok(())
+}
+
+/// Spawns a character from its document (same entity layout as any scene character).
+fn add_character(world: &mut World, doc: &CharacterDoc) -> Result<(), String> {
+    let id = doc.id.ok_or("a character to add has an id")?;
+    let spawned = world.resource_scope(|world, mut library: Mut<AssetLibrary>| {
+        world.resource_scope(|world, mut meshes: Mut<Assets<Mesh>>| {
+            spawn_from_doc(&mut world.commands(), &mut meshes, &mut library, doc, id)
+        })
+    });
+    world.flush();
+    let (_, notes) = spawned.map_err(|e| e.to_string())?;
+    let mut messages = world.resource_mut::<Messages>();
+    notes.into_iter().for_each(|m| messages.push(m));
+    Ok(())
+}
+
+/// Swaps in the asset with the wanted weights (same skeleton, same mesh): re-skinned and
+/// recoloured this frame.
+fn rebind_character(world: &mut World, id: CharacterId, binding: Option<BindingDoc>) -> Result<(), String> {
+    let entity = entity_of(world, id)?;
+    let source = component::<SceneCharacter>(world, id)?.source.clone();
+    let asset = world.resource_mut::<AssetLibrary>().load_bound(&source, binding).map_err(|e| e.to_string())?;
+    let mut character = world.entity_mut(entity);
+    if let Some(mut c) = character.get_mut::<Character>() {
+        c.asset = asset;
+    }
+    if let Some(mut dirty) = character.get_mut::<PoseDirty>() {
+        dirty.matrices = true;
+        dirty.colors = true;
+    }
+    if let Some(mut sc) = character.get_mut::<SceneCharacter>() {
+        sc.binding = binding;
+    }
+    Ok(())
+}
+
+fn missing(id: CharacterId) -> String {
+    format!("character {id} is not in the scene")
+}
+
+fn entity_of(world: &World, id: CharacterId) -> Result<Entity, String> {
+    world.resource::<CharacterIndex>().get(id).ok_or_else(|| missing(id))
+}
+
+fn character_of(world: &World, id: CharacterId) -> Result<Character, String> {
+    component::<Character>(world, id).cloned()
+}
+
+fn component<C: Component>(world: &World, id: CharacterId) -> Result<&C, String> {
+    world.get::<C>(entity_of(world, id)?).ok_or_else(|| missing(id))
+}
+
+fn component_mut<C: Component<Mutability = bevy::ecs::component::Mutable>>(
+    world: &mut World,
+    id: CharacterId,
+) -> Result<Mut<'_, C>, String> {
+    let entity = entity_of(world, id)?;
+    world.get_mut::<C>(entity).ok_or_else(|| missing(id))
+}
+
+/// A joint's pose and limits.
+fn joint_state(
+    world: &World,
+    character: &Character,
+    j: usize,
+) -> Result<(JointRotation, crate::rig::DofLimits), String> {
+    let no_joint = || format!("{} has no joint {j}", character.asset.name);
+    let &entity = character.joints.get(j).ok_or_else(no_joint)?;
+    let pose = world.get::<JointPose>(entity).ok_or_else(no_joint)?.0;
+    let limits = world.get::<JointLimits>(entity).ok_or_else(no_joint)?.0;
+    Ok((pose, limits))
+}

@@ -1,0 +1,114 @@
+//! Keyboard shortcuts in the viewport: S display mode, A axes, Ctrl+Z / Ctrl+Shift+Z undo
+//! and redo, Ctrl+S / Ctrl+O save and open, F12 screenshot (scene edits go out as `Edit`s);
+//! F frames the selection.
+
+use bevy::prelude::*;
+
+use super::camera::OrbitCamera;
+use super::commands::{Edit, EditQueue};
+use super::document::{PendingScene, SceneReader, open_scene_from, save_scene_to};
+use super::history::{History, HistoryRequest};
+use super::screenshot::ScreenshotRequest;
+use super::state::{Messages, Selection};
+use super::ui::InspectorState;
+use crate::formats::scene::ViewDoc;
+use crate::scene::{Character, CurrentJointToWorld, Placement};
+
+/// Whether the keys are the viewport's (egui has no text field focused).
+fn viewport_has_keys(wants: &Option<Res<bevy_egui::input::EguiWantsInput>>) -> bool {
+    !wants.as_ref().is_some_and(|w| w.wants_any_keyboard_input())
+}
+
+fn ctrl_held(keys: &ButtonInput<KeyCode>) -> bool {
+    keys.any_pressed([KeyCode::ControlLeft, KeyCode::ControlRight, KeyCode::SuperLeft, KeyCode::SuperRight])
+}
+
+/// The shortcuts that edit, undo, save or open the scene, or take a screenshot (reads keys
+/// and the scene; writes `EditQueue`, `History`'s request, `PendingScene`, `Messages`).
+#[allow(clippy::too_many_arguments)]
+pub fn scene_shortcuts(
+    keys: Res<ButtonInput<KeyCode>>,
+    wants: Option<Res<bevy_egui::input::EguiWantsInput>>,
+    selection: Res<Selection>,
+    scene: SceneReader,
+    mut edits: ResMut<EditQueue>,
+    mut history: ResMut<History>,
+    mut shot: ResMut<ScreenshotRequest>,
+    state: Option<Res<InspectorState>>,
+    mut pending: ResMut<PendingScene>,
+    mut messages: ResMut<Messages>,
+) {
+    if !viewport_has_keys(&wants) {
+        return;
+    }
+    if keys.just_pressed(KeyCode::F12) {
+        shot.request();
+    }
+    if ctrl_held(&keys) {
+        let shift = keys.any_pressed([KeyCode::ShiftLeft, KeyCode::ShiftRight]);
+        if keys.just_pressed(KeyCode::KeyZ) {
+            history.request = Some(if shift { HistoryRequest::Redo } else { HistoryRequest::Undo });
+        }
+        if let Some(state) = &state {
+            if keys.just_pressed(KeyCode::KeyS) {
+                save_scene_to(&state.scene_path, &scene.capture(), &mut messages);
+            }
+            if keys.just_pressed(KeyCode::KeyO) {
+                open_scene_from(&state.scene_path, &mut pending, &mut messages);
+            }
+        }
+        return;
+    }
+    if keys.just_pressed(KeyCode::KeyA) {
+        edits.push(Edit::Stage(crate::formats::scene::StageDoc { axes: !scene.stage.axes, ..scene.stage.0 }));
+    }
+    if keys.just_pressed(KeyCode::KeyS) {
+        // The selected character, or every character when none is selected.
+        for (_, sc, _, _, view, _) in &scene.characters {
+            if selection.character.is_none_or(|id| id == sc.id) {
+                let view = ViewDoc { display: view.display.next(), ..view.0.clone() };
+                edits.push(Edit::View { character: sc.id, view });
+            }
+        }
+    }
+}
+
+/// F frames the selected joints, the selected character, or everything (reads joints;
+/// writes `OrbitCamera`).
+pub fn frame_selection(
+    keys: Res<ButtonInput<KeyCode>>,
+    wants: Option<Res<bevy_egui::input::EguiWantsInput>>,
+    selection: Res<Selection>,
+    characters: Query<(&super::document::SceneCharacter, &Character, &Placement)>,
+    joints: Query<&CurrentJointToWorld>,
+    mut cameras: Query<&mut OrbitCamera>,
+) {
+    if !keys.just_pressed(KeyCode::KeyF) || ctrl_held(&keys) || !viewport_has_keys(&wants) {
+        return;
+    }
+    let points: Vec<Vec3> = characters
+        .iter()
+        .filter(|c| selection.character.is_none_or(|id| id == c.0.id))
+        .flat_map(|(_, character, placement)| {
+            let chosen: Vec<usize> = if selection.joints.is_empty() || selection.character.is_none() {
+                (0..character.joints.len()).collect()
+            } else {
+                selection.joints.clone()
+            };
+            chosen
+                .into_iter()
+                .filter_map(|j| Some(joints.get(*character.joints.get(j)?).ok()?.world_position(placement)))
+                .collect::<Vec<_>>()
+        })
+        .collect();
+    if points.is_empty() {
+        return;
+    }
+    let lo = points.iter().fold(Vec3::splat(f32::INFINITY), |a, p| a.min(*p));
+    let hi = points.iter().fold(Vec3::splat(f32::NEG_INFINITY), |a, p| a.max(*p));
+    for mut orbit in &mut cameras {
+        let framed = OrbitCamera::framing(lo, hi + Vec3::splat(0.15));
+        orbit.focus = (lo + hi) / 2.0;
+        orbit.distance = framed.distance.max(0.4);
+    }
+}

@@ -1,0 +1,110 @@
+//! The egui panels: the scene panel (left), the joint panel (right) and an SMPL body's
+//! panel inside the scene panel. They read the live scene and push [`Edit`]s; nothing here
+//! writes the scene itself.
+
+pub mod joint_panel;
+pub mod scene_panel;
+pub mod smpl_panel;
+
+use bevy::ecs::system::SystemParam;
+use bevy::prelude::*;
+use bevy_egui::{EguiContexts, EguiPrimaryContextPass, egui};
+
+use super::camera::{ViewportArea, fit_camera_viewport};
+use super::commands::{Edit, EditQueue, GestureHold};
+use super::document::{AssetLibrary, NextCharacterId, PendingScene, SceneReader};
+use super::history::History;
+use super::screenshot::ScreenshotRequest;
+use super::state::{Messages, Selection};
+
+/// Text fields and transient state of the panels.
+#[derive(Resource)]
+pub struct InspectorState {
+    pub add_path: String,
+    pub recent: Vec<String>,
+    pub scene_path: String,
+    /// The DOF being dragged and its value, shown in the viewport.
+    pub active_dof: Option<String>,
+}
+
+impl Default for InspectorState {
+    fn default() -> Self {
+        let cwd = std::env::current_dir().map(|d| d.display().to_string()).unwrap_or_default();
+        Self {
+            add_path: format!("{cwd}/"),
+            recent: Vec::new(),
+            scene_path: format!("{cwd}/scene.ron"),
+            active_dof: None,
+        }
+    }
+}
+
+/// What the panels read, and where they send edits and requests.
+#[derive(SystemParam)]
+pub struct Panels<'w, 's> {
+    pub scene: SceneReader<'w, 's>,
+    pub edits: ResMut<'w, EditQueue>,
+    pub selection: ResMut<'w, Selection>,
+    pub history: ResMut<'w, History>,
+    pub messages: ResMut<'w, Messages>,
+    pub library: ResMut<'w, AssetLibrary>,
+    pub ids: ResMut<'w, NextCharacterId>,
+    pub pending: ResMut<'w, PendingScene>,
+}
+
+impl Panels<'_, '_> {
+    pub fn push(&mut self, edit: Edit) {
+        self.edits.push(edit);
+    }
+}
+
+pub struct InspectorPlugin;
+
+impl Plugin for InspectorPlugin {
+    fn build(&self, app: &mut App) {
+        app.init_resource::<InspectorState>()
+            .init_resource::<ViewportArea>()
+            .add_systems(PostUpdate, fit_camera_viewport)
+            .add_systems(EguiPrimaryContextPass, inspector_ui);
+    }
+}
+
+/// Draws the panels (their edits land in this frame's `Animate`); the viewport is what
+/// they leave free. While a widget is held or typed into, the gesture stays open.
+fn inspector_ui(
+    mut contexts: EguiContexts,
+    mut state: ResMut<InspectorState>,
+    mut panels: Panels,
+    mut shot: ResMut<ScreenshotRequest>,
+    mut viewport_area: ResMut<ViewportArea>,
+    mut hold: ResMut<GestureHold>,
+) -> Result {
+    if shot.hide_ui() {
+        // A screenshot without panels shows the whole window.
+        viewport_area.set_if_neq(ViewportArea(None));
+        return Ok(());
+    }
+    let ctx = contexts.ctx_mut()?.clone();
+    let mut ui = egui::Ui::new(
+        ctx.clone(),
+        "viewport".into(),
+        egui::UiBuilder::new().layer_id(egui::LayerId::background()).max_rect(ctx.viewport_rect()),
+    );
+    state.active_dof = None;
+    egui::Panel::left("scene_panel").resizable(true).default_size(250.0).show(&mut ui, |ui| {
+        egui::ScrollArea::vertical().show(ui, |ui| scene_panel::scene_panel(ui, &mut state, &mut panels, &mut shot));
+    });
+    egui::Panel::right("joint_panel").resizable(true).default_size(250.0).show(&mut ui, |ui| {
+        egui::ScrollArea::vertical().show(ui, |ui| joint_panel::joint_panel(ui, &mut state, &mut panels));
+    });
+    let central = ui.available_rect_before_wrap();
+    let area = ViewportArea(Some(Rect::new(central.min.x, central.min.y, central.max.x, central.max.y)));
+    viewport_area.set_if_neq(area);
+    if let Some(text) = &state.active_dof {
+        egui::Area::new("active_dof".into()).anchor(egui::Align2::CENTER_TOP, [0.0, 12.0]).show(&ctx, |ui| {
+            egui::Frame::popup(ui.style()).show(ui, |ui| ui.label(egui::RichText::new(text).size(20.0).strong()));
+        });
+    }
+    hold.set_if_neq(GestureHold(ctx.egui_is_using_pointer() || ctx.egui_wants_keyboard_input()));
+    Ok(())
+}

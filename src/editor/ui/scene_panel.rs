@@ -1,0 +1,266 @@
+//! The scene panel: scene files and history, adding characters, the character list and
+//! the selected character's name, placement, view, weights and SMPL state, the stage's view
+//! options, screenshots and messages.
+
+use std::path::{Path, PathBuf};
+
+use bevy::prelude::*;
+use bevy_egui::egui;
+
+use super::{InspectorState, Panels};
+use crate::editor::commands::Edit;
+use crate::editor::document::{open_scene_from, save_scene_to};
+use crate::editor::history::HistoryRequest;
+use crate::editor::screenshot::ScreenshotRequest;
+use crate::editor::state::Selection;
+use crate::formats::scene::{BindingDoc, CharacterDoc, CharacterId, DisplayDoc, PlacementDoc, SourceDoc, ViewDoc};
+
+/// Space left between a character added and the rightmost one.
+const ADD_GAP: f32 = 0.3;
+
+pub fn scene_panel(ui: &mut egui::Ui, state: &mut InspectorState, panels: &mut Panels, shot: &mut ScreenshotRequest) {
+    ui.heading("Scene");
+    scene_file_row(ui, state, panels);
+    history_row(ui, panels);
+    ui.separator();
+    add_row(ui, state, panels);
+    ui.separator();
+    let mut list: Vec<(Entity, CharacterId)> = panels.scene.characters.iter().map(|c| (c.0, c.1.id)).collect();
+    list.sort_by_key(|c| c.1);
+    for (entity, id) in list {
+        character_row(ui, panels, entity, id);
+        if panels.selection.character == Some(id) {
+            selected_character(ui, panels, entity, id);
+        }
+    }
+    ui.separator();
+    stage_rows(ui, panels);
+    ui.separator();
+    screenshot_rows(ui, shot);
+    ui.separator();
+    messages(ui, panels);
+}
+
+fn scene_file_row(ui: &mut egui::Ui, state: &mut InspectorState, panels: &mut Panels) {
+    ui.horizontal(|ui| {
+        ui.add(egui::TextEdit::singleline(&mut state.scene_path).desired_width(170.0));
+        if ui.button("Save").on_hover_text("Ctrl+S").clicked() {
+            save_scene_to(&state.scene_path, &panels.scene.capture(), &mut panels.messages);
+        }
+        if ui.button("Open").on_hover_text("Ctrl+O").clicked() {
+            open_scene_from(&state.scene_path, &mut panels.pending, &mut panels.messages);
+        }
+    });
+}
+
+fn history_row(ui: &mut egui::Ui, panels: &mut Panels) {
+    ui.horizontal(|ui| {
+        let undo = egui::Button::new("Undo");
+        if ui.add_enabled(panels.history.can_undo(), undo).on_hover_text("Ctrl+Z").clicked() {
+            panels.history.request = Some(HistoryRequest::Undo);
+        }
+        let redo = egui::Button::new("Redo");
+        if ui.add_enabled(panels.history.can_redo(), redo).on_hover_text("Ctrl+Shift+Z").clicked() {
+            panels.history.request = Some(HistoryRequest::Redo);
+        }
+    });
+}
+
+fn add_row(ui: &mut egui::Ui, state: &mut InspectorState, panels: &mut Panels) {
+    ui.label("Add a character (.skel, SMPL folder, rig .json):");
+    ui.horizontal(|ui| {
+        ui.add(egui::TextEdit::singleline(&mut state.add_path).desired_width(220.0));
+        if ui.button("Add").clicked() {
+            let path = state.add_path.trim().to_string();
+            add_character(&path, state, panels);
+        }
+    });
+    if state.recent.is_empty() {
+        return;
+    }
+    ui.horizontal_wrapped(|ui| {
+        ui.label("Recent:");
+        for r in state.recent.clone() {
+            let label = Path::new(&r).file_name().map_or(r.clone(), |n| n.to_string_lossy().into_owned());
+            if ui.small_button(label).on_hover_text(&r).clicked() {
+                add_character(&r, state, panels);
+            }
+        }
+    });
+}
+
+/// Loads a character file and adds it right of the others, standing on the floor, and
+/// selects it; errors go to the messages.
+fn add_character(path: &str, state: &mut InspectorState, panels: &mut Panels) {
+    if path.is_empty() {
+        return;
+    }
+    let source = SourceDoc::File(PathBuf::from(path));
+    let asset = match panels.library.load(&source) {
+        Ok(a) => a,
+        Err(e) => return panels.messages.push(e.to_string()),
+    };
+    panels.messages.0.extend(asset.warnings.iter().cloned());
+    let right = panels.scene.characters.iter().map(|c| c.3.translation.x).fold(f32::NEG_INFINITY, f32::max);
+    let (lo, hi) = asset.bounds();
+    let x = if right.is_finite() { right + ADD_GAP + (hi.x - lo.x) } else { 0.0 };
+    let center = (lo + hi) / 2.0;
+    let id = panels.ids.take();
+    panels.push(Edit::Add(Box::new(CharacterDoc {
+        id: Some(id),
+        source,
+        name: asset.name.clone(),
+        placement: PlacementDoc { translation: Vec3::new(x - center.x, -lo.y, -center.z), yaw: 0.0, scale: 1.0 },
+        pose: Default::default(),
+        view: ViewDoc::default(),
+        smpl: None,
+        binding: None,
+    })));
+    *panels.selection = Selection { character: Some(id), joints: Vec::new() };
+    state.recent.retain(|r| r != path);
+    state.recent.insert(0, path.to_string());
+    state.recent.truncate(8);
+    if let Some(dir) = Path::new(path).parent() {
+        state.add_path = format!("{}/", dir.display());
+    }
+}
+
+/// The character's name (a click selects it) and its visibility.
+fn character_row(ui: &mut egui::Ui, panels: &mut Panels, entity: Entity, id: CharacterId) {
+    let Ok((_, sc, _, _, view, _)) = panels.scene.characters.get(entity) else { return };
+    let selected = panels.selection.character == Some(id);
+    let mut shown = view.visible;
+    let (name, view) = (sc.name.clone(), view.0.clone());
+    ui.horizontal(|ui| {
+        if ui.selectable_label(selected, &name).clicked() && !selected {
+            *panels.selection = Selection { character: Some(id), joints: Vec::new() };
+        }
+        if ui.checkbox(&mut shown, "").on_hover_text("show").changed() {
+            panels.push(Edit::View { character: id, view: ViewDoc { visible: shown, ..view } });
+        }
+    });
+}
+
+/// Name, source, duplicate/remove, placement, display and colours, weights, SMPL state of
+/// the selected character.
+fn selected_character(ui: &mut egui::Ui, panels: &mut Panels, entity: Entity, id: CharacterId) {
+    let Ok((_, sc, character, placement, view, smpl)) = panels.scene.characters.get(entity) else { return };
+    let (mut name, source, binding) = (sc.name.clone(), sc.source.label(), sc.binding);
+    let (mut p, mut v) = (placement.0, view.0.clone());
+    let counts = format!("{} joints, {} vertices", character.asset.skeleton.len(), character.asset.vertex_count());
+    let mut edits = Vec::new();
+    let (mut duplicate, mut remove) = (false, false);
+    egui::Frame::group(ui.style()).show(ui, |ui| {
+        ui.horizontal(|ui| {
+            ui.label("Name");
+            if ui.text_edit_singleline(&mut name).changed() {
+                edits.push(Edit::Rename { character: id, name: name.clone() });
+            }
+        });
+        ui.label(egui::RichText::new(source).small());
+        ui.label(counts);
+        ui.horizontal(|ui| {
+            duplicate = ui.button("Duplicate").clicked();
+            remove = ui.button("Remove").clicked();
+        });
+        placement_rows(ui, &mut p);
+        ui.horizontal(|ui| {
+            ui.radio_value(&mut v.display, DisplayDoc::Mesh, "mesh");
+            ui.radio_value(&mut v.display, DisplayDoc::Skeleton, "skeleton");
+            ui.radio_value(&mut v.display, DisplayDoc::Both, "both");
+        });
+        ui.checkbox(&mut v.weight_colors, "weight colours");
+        ui.checkbox(&mut v.heat_of_selected, "weights of the selected joint");
+    });
+    if p != placement.0 {
+        edits.push(Edit::Place { character: id, placement: p });
+    }
+    if v != view.0 {
+        edits.push(Edit::View { character: id, view: v });
+    }
+    ui.horizontal(|ui| {
+        ui.label("Weights:");
+        for (label, b) in
+            [("from the file", None), ("nearest bone", Some(BindingDoc::Nearest)), ("smooth", Some(BindingDoc::Smooth))]
+        {
+            if ui.selectable_label(binding == b, label).clicked() && binding != b {
+                edits.push(Edit::Rebind { character: id, binding: b });
+            }
+        }
+    });
+    if let Some(body) = smpl
+        && let Some(state) = super::smpl_panel::smpl_panel(ui, body)
+    {
+        edits.push(Edit::Smpl { character: id, state });
+    }
+    if duplicate && let Some(mut copy) = panels.scene.character_doc(entity) {
+        let copy_id = panels.ids.take();
+        copy.id = Some(copy_id);
+        copy.name = format!("{} copy", copy.name);
+        copy.placement.translation.x += 0.5;
+        edits.push(Edit::Add(Box::new(copy)));
+        *panels.selection = Selection { character: Some(copy_id), joints: Vec::new() };
+    }
+    if remove {
+        edits.push(Edit::Remove(id));
+        *panels.selection = Selection::default();
+    }
+    edits.into_iter().for_each(|e| panels.push(e));
+}
+
+/// Position, turn (degrees) and scale.
+fn placement_rows(ui: &mut egui::Ui, p: &mut PlacementDoc) {
+    ui.horizontal(|ui| {
+        ui.label("Position");
+        for k in 0..3 {
+            ui.add(egui::DragValue::new(&mut p.translation[k]).speed(0.01).max_decimals(3));
+        }
+    });
+    let mut yaw_deg = p.yaw.to_degrees();
+    ui.horizontal(|ui| {
+        ui.label("Turn");
+        if ui.add(egui::DragValue::new(&mut yaw_deg).speed(1.0).suffix("°")).changed() {
+            p.yaw = yaw_deg.to_radians();
+        }
+        ui.label("Scale");
+        ui.add(egui::DragValue::new(&mut p.scale).speed(0.01).range(0.01..=100.0));
+    });
+}
+
+fn stage_rows(ui: &mut egui::Ui, panels: &mut Panels) {
+    ui.heading("View");
+    let mut stage = panels.scene.stage.0;
+    ui.horizontal(|ui| {
+        ui.checkbox(&mut stage.floor, "floor");
+        ui.checkbox(&mut stage.shadows, "shadows");
+        ui.checkbox(&mut stage.axes, "axes (A)");
+    });
+    if stage != panels.scene.stage.0 {
+        panels.push(Edit::Stage(stage));
+    }
+    ui.label("S cycles mesh / skeleton / both; F frames the selection; click a joint to select it.");
+}
+
+fn screenshot_rows(ui: &mut egui::Ui, shot: &mut ScreenshotRequest) {
+    ui.heading("Screenshot");
+    ui.horizontal(|ui| {
+        ui.label("Folder");
+        ui.text_edit_singleline(&mut shot.dir_text);
+    });
+    ui.checkbox(&mut shot.with_panels, "include the panels");
+    if ui.button("Save screenshot (F12)").clicked() {
+        shot.request();
+    }
+}
+
+fn messages(ui: &mut egui::Ui, panels: &Panels) {
+    ui.heading("Messages");
+    for m in panels.messages.0.iter().rev().take(8) {
+        let color = if m.contains("saved") || m.contains("wrote") {
+            egui::Color32::DARK_GREEN
+        } else {
+            egui::Color32::from_rgb(190, 40, 40)
+        };
+        ui.colored_label(color, m);
+    }
+}

@@ -1,0 +1,229 @@
+//! Edits as commands on the live ECS: undo and redo replay inverses in place, a gesture is
+//! one step, a click none; opening a scene replaces the world; ids are stable.
+
+use bevy::prelude::*;
+use marionette::editor::commands::{Edit, EditQueue, GestureHold};
+use marionette::editor::document::{CharacterIndex, PendingScene, SceneCharacter, SceneReader};
+use marionette::editor::history::{History, HistoryRequest};
+use marionette::editor::ik_drag::Pins;
+use marionette::editor::{Messages, ScenePlugin, Selection};
+use marionette::formats::scene::{
+    BindingDoc, CharacterDoc, CharacterId, DisplayDoc, SceneDoc, SourceDoc, StageDoc, ViewDoc,
+};
+use marionette::rig::JointRotation;
+use marionette::scene::{Character, JointPose, Placement};
+
+use crate::editor::doc_with;
+
+#[derive(Resource, Default)]
+struct Captured(SceneDoc);
+
+/// The ECS core and the live scene (no window, no rendering); after each update the scene
+/// is captured into `Captured`.
+fn scene_app() -> App {
+    let mut app = crate::ecs::app();
+    app.add_plugins(ScenePlugin).init_resource::<Captured>().add_systems(Last, capture_scene);
+    app
+}
+
+fn capture_scene(reader: SceneReader, mut out: ResMut<Captured>) {
+    out.0 = reader.capture();
+}
+
+/// Opens a scene of puppets with these ids.
+fn open_puppets(app: &mut App, ids: &[Option<u64>]) {
+    let one = doc_with(SourceDoc::Embedded("puppet".into()), &[]).characters[0].clone();
+    let characters = ids.iter().map(|&id| CharacterDoc { id: id.map(CharacterId), ..one.clone() }).collect();
+    let doc = SceneDoc { characters, ..SceneDoc::default() };
+    *app.world_mut().resource_mut::<PendingScene>() = PendingScene { doc: Some(doc), frame: false };
+    app.update();
+    app.update();
+}
+
+fn edit(app: &mut App, edit: Edit) {
+    app.world_mut().resource_mut::<EditQueue>().push(edit);
+    app.update();
+}
+
+fn request(app: &mut App, request: HistoryRequest) {
+    app.world_mut().resource_mut::<History>().request = Some(request);
+    app.update();
+}
+
+fn entity(app: &App, id: u64) -> Entity {
+    app.world().resource::<CharacterIndex>().get(CharacterId(id)).expect("the character is in the scene")
+}
+
+fn joint(app: &App, id: u64, name: &str) -> usize {
+    app.world().get::<Character>(entity(app, id)).unwrap().asset.skeleton.find(name).unwrap()
+}
+
+/// Everything an edit can change: the scene document (poses, placements, views, names,
+/// weights, stage, ids) and the number of entities.
+fn state(app: &mut App) -> (SceneDoc, usize) {
+    let doc = app.world().resource::<Captured>().0.clone();
+    let count = app.world_mut().query::<Entity>().iter(app.world()).count();
+    (doc, count)
+}
+
+#[test]
+fn commands_then_undo_all_return_the_ecs_to_its_start_and_redo_to_its_end() {
+    let mut app = scene_app();
+    open_puppets(&mut app, &[Some(1), Some(2)]);
+    let (first, first_mesh) = (entity(&app, 1), app.world().get::<Character>(entity(&app, 1)).unwrap().mesh.id());
+    let elbow = joint(&app, 1, "l_elbow");
+    let selection = Selection { character: Some(CharacterId(1)), joints: vec![elbow] };
+    *app.world_mut().resource_mut::<Selection>() = selection.clone();
+    let start = state(&mut app);
+
+    let mut added = doc_with(SourceDoc::Embedded("puppet".into()), &[]).characters[0].clone();
+    added.id = Some(CharacterId(10));
+    added.placement.translation.x = 3.0;
+    let edits = vec![
+        Edit::Pose { character: CharacterId(1), joints: vec![(elbow, JointRotation::euler_xyz(0.0, 0.7, 0.0))] },
+        Edit::Place { character: CharacterId(2), placement: Placement::new(Vec3::new(1.0, 0.0, 2.0), 0.5, 1.5).0 },
+        Edit::View {
+            character: CharacterId(1),
+            view: ViewDoc { display: DisplayDoc::Both, tint: [0.1, 0.2, 0.3], ..ViewDoc::default() },
+        },
+        Edit::Rename { character: CharacterId(2), name: "Bea".into() },
+        Edit::Stage(StageDoc { axes: true, floor: false, ..StageDoc::default() }),
+        Edit::Rebind { character: CharacterId(1), binding: Some(BindingDoc::Nearest) },
+        Edit::Add(Box::new(added)),
+        Edit::Pose { character: CharacterId(10), joints: vec![(elbow, JointRotation::euler_xyz(0.3, 0.0, 0.0))] },
+        Edit::Remove(CharacterId(2)),
+    ];
+    let n = edits.len();
+    for e in edits {
+        edit(&mut app, e);
+    }
+    let end = state(&mut app);
+    assert_ne!(end, start);
+    assert_eq!(app.world().resource::<History>().undo_steps(), n, "one step per edit");
+    assert_eq!(end.0.characters.iter().map(|c| c.id.unwrap().0).collect::<Vec<_>>(), vec![1, 10]);
+
+    for _ in 0..n {
+        request(&mut app, HistoryRequest::Undo);
+    }
+    assert_eq!(state(&mut app), start, "undo all returns to the exact start");
+    assert_eq!(entity(&app, 1), first, "the character that stayed keeps its entity");
+    assert_eq!(app.world().get::<Character>(first).unwrap().mesh.id(), first_mesh, "and its mesh");
+    assert_eq!(*app.world().resource::<Selection>(), selection, "the selection survives");
+    assert!(!app.world().resource::<History>().can_undo());
+
+    for _ in 0..n {
+        request(&mut app, HistoryRequest::Redo);
+    }
+    assert_eq!(state(&mut app), end, "redo all returns to the end");
+    assert!(app.world().resource::<Messages>().0.iter().all(|m| !m.contains("not in the scene")));
+}
+
+/// A slider dragged over many frames is one undo step back to where it started; a click
+/// that changes nothing (or a drag that comes back) is none and keeps the redo steps.
+#[test]
+fn a_gesture_is_one_undo_step_and_a_click_is_none() {
+    let mut app = scene_app();
+    open_puppets(&mut app, &[Some(1)]);
+    let elbow = joint(&app, 1, "l_elbow");
+    let pose_of = |app: &App| {
+        app.world().get::<JointPose>(app.world().get::<Character>(entity(app, 1)).unwrap().joints[elbow]).unwrap().0
+    };
+    let before = pose_of(&app);
+    let turn =
+        |a: f32| Edit::Pose { character: CharacterId(1), joints: vec![(elbow, JointRotation::euler_xyz(0.0, a, 0.0))] };
+
+    app.world_mut().resource_mut::<GestureHold>().0 = true;
+    for k in 1..=5 {
+        edit(&mut app, turn(0.1 * k as f32));
+    }
+    assert_eq!(app.world().resource::<History>().undo_steps(), 0, "the gesture is still under way");
+    app.world_mut().resource_mut::<GestureHold>().0 = false;
+    app.update();
+    assert_eq!(app.world().resource::<History>().undo_steps(), 1, "a drag is one step");
+    request(&mut app, HistoryRequest::Undo);
+    assert_eq!(pose_of(&app), before, "undo returns to where the drag started");
+    assert_eq!(app.world().resource::<History>().redo_steps(), 1);
+
+    // A click on the slider: the same value again.
+    app.world_mut().resource_mut::<GestureHold>().0 = true;
+    edit(&mut app, Edit::Pose { character: CharacterId(1), joints: vec![(elbow, before)] });
+    app.world_mut().resource_mut::<GestureHold>().0 = false;
+    app.update();
+    // A drag that comes back to where it began.
+    app.world_mut().resource_mut::<GestureHold>().0 = true;
+    edit(&mut app, turn(0.4));
+    edit(&mut app, Edit::Pose { character: CharacterId(1), joints: vec![(elbow, before)] });
+    app.world_mut().resource_mut::<GestureHold>().0 = false;
+    app.update();
+    let history = app.world().resource::<History>();
+    assert_eq!((history.undo_steps(), history.redo_steps()), (0, 1), "no step; the redo step survives");
+}
+
+/// Selecting changes nothing the history holds; an edit naming a character that is not
+/// there is a message, not a panic and not a step.
+#[test]
+fn selecting_is_no_edit_and_edits_of_missing_characters_are_reported() {
+    let mut app = scene_app();
+    open_puppets(&mut app, &[Some(1)]);
+    *app.world_mut().resource_mut::<Selection>() = Selection { character: Some(CharacterId(1)), joints: vec![3] };
+    app.update();
+    assert!(!app.world().resource::<History>().can_undo(), "selecting is no undo step");
+    edit(&mut app, Edit::Rename { character: CharacterId(99), name: "x".into() });
+    assert!(!app.world().resource::<History>().can_undo());
+    let messages = &app.world().resource::<Messages>().0;
+    assert!(messages.iter().any(|m| m.contains("character #99 is not in the scene")), "{messages:?}");
+}
+
+/// Open replaces the world: the old selection, pins and history refer to nothing in it
+/// and are cleared; a character that fails to load is reported and kept, as it was, in
+/// what Save writes.
+#[test]
+fn opening_a_scene_clears_selection_pins_and_history_and_keeps_unloadable_characters() {
+    let mut app = scene_app();
+    open_puppets(&mut app, &[Some(7)]);
+    // What the previous scene left behind.
+    *app.world_mut().resource_mut::<Selection>() = Selection { character: Some(CharacterId(7)), joints: vec![4] };
+    app.world_mut().resource_mut::<Pins>().0.insert(CharacterId(7), vec![4]);
+    edit(&mut app, Edit::Rename { character: CharacterId(7), name: "renamed".into() });
+    assert!(app.world().resource::<History>().can_undo());
+
+    let mut doc = doc_with(SourceDoc::Embedded("puppet".into()), &[]);
+    let mut missing = doc.characters[0].clone();
+    missing.source = SourceDoc::File("/nonexistent/gone.skel".into());
+    missing.name = "gone".into();
+    doc.characters.push(missing.clone());
+    *app.world_mut().resource_mut::<PendingScene>() = PendingScene { doc: Some(doc), frame: false };
+    app.update();
+    app.update();
+
+    let world = app.world_mut();
+    assert_eq!(*world.resource::<Selection>(), Selection::default());
+    assert!(world.resource::<Pins>().0.is_empty());
+    assert!(!world.resource::<History>().can_undo());
+    assert_eq!(world.query::<&SceneCharacter>().iter(world).count(), 1);
+    let messages = &world.resource::<Messages>().0;
+    assert!(messages.iter().any(|m| m.contains("gone.skel") && m.contains("kept in the scene file")), "{messages:?}");
+    let saved = &world.resource::<Captured>().0;
+    assert_eq!(saved.characters.len(), 2);
+    assert_eq!(saved.characters[1], missing, "the unloadable character is saved as it was");
+}
+
+/// Ids are saved in the document and kept when it is opened; documents without ids (old
+/// files) or with a repeated one get fresh ids that never repeat.
+#[test]
+fn character_ids_are_kept_from_files_and_old_files_get_fresh_ones() {
+    let mut app = scene_app();
+    let ids = |app: &mut App| {
+        let world = app.world_mut();
+        let mut ids: Vec<u64> = world.query::<&SceneCharacter>().iter(world).map(|c| c.id.0).collect();
+        ids.sort();
+        ids
+    };
+    open_puppets(&mut app, &[Some(5), Some(9)]);
+    assert_eq!(ids(&mut app), vec![5, 9]);
+    let saved: Vec<_> = app.world().resource::<Captured>().0.characters.iter().map(|c| c.id).collect();
+    assert_eq!(saved, vec![Some(CharacterId(5)), Some(CharacterId(9))], "ids are saved");
+    open_puppets(&mut app, &[None, Some(9), Some(9)]);
+    assert_eq!(ids(&mut app), vec![9, 10, 11]);
+    assert_eq!(app.world().resource::<CharacterIndex>().len(), 3, "the index follows despawns and spawns");
+}
