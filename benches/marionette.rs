@@ -1,7 +1,8 @@
 //! Benchmarks: the skinning kernel; one frame of the ECS systems for 1 and 16 characters
 //! (one joint changed per character per frame, so every character re-skins); one of 16
-//! moved or posed (with the bytes of mesh data handed on); an editing frame (three SMPL
-//! bodies playing, a puppet dragged by IK); FABRIK on 3-, 6- and 20-joint chains; the
+//! moved or posed (with the bytes of mesh data handed on); an editing frame through the
+//! editor's commands (three SMPL bodies playing, a puppet dragged by IK, extraction's mesh
+//! clones), with and without the old per-frame document capture; FABRIK on 3-, 6- and 20-joint chains; the
 //! rotation-space IK solve of the CSE169 dragon's tail.
 //!
 //! Run: `cargo bench --profile dev --bench marionette` (with `MARIONETTE_DATA` set, the
@@ -158,64 +159,111 @@ fn ecs_frame_one_of_16_edited(bencher: Bencher, edit: &str) {
     bencher.bench_local(|| edit_once(&mut app));
 }
 
-/// An editing frame: three SMPL bodies each playing its own clip (sampled, reshaped once,
-/// posed every frame) while the puppet's hand is dragged by IK each frame; main-world
-/// systems only (no render world). Needs `MARIONETTE_DATA` (the SMPL folder); without it
-/// only the dragged puppet runs.
-#[divan::bench]
-fn editing_frame_3_smpl_playing_1_puppet_dragged(bencher: Bencher) {
-    use marionette::formats::scene::SmplDoc;
+/// Mesh data handed to the render world: Bevy's extraction clones every main-world mesh
+/// that changed (`RenderAssetUsages::MAIN_WORLD`); this stand-in does the same clone.
+#[derive(Resource, Default)]
+struct Extracted {
+    frames: usize,
+    bytes: usize,
+}
+
+fn extract_modified_meshes(
+    mut events: MessageReader<AssetEvent<Mesh>>,
+    meshes: Res<Assets<Mesh>>,
+    mut out: ResMut<Extracted>,
+) {
+    out.frames += 1;
+    for event in events.read() {
+        if let AssetEvent::Modified { id } = event
+            && let Some(mesh) = meshes.get(*id)
+        {
+            let copy = divan::black_box(mesh.clone());
+            out.bytes += copy.get_vertex_buffer_size();
+        }
+    }
+}
+
+/// The document capture the editor ran every frame before edits became commands.
+fn capture_scene_document(reader: marionette::editor::document::SceneReader) {
+    divan::black_box(reader.capture());
+}
+
+/// An editing frame through the editor's own path: a scene of the puppet and three SMPL
+/// bodies each playing its own clip with its own β (from `MARIONETTE_DATA`; without it only
+/// the puppet), opened from a document; each frame the puppet's hand is dragged by IK (the
+/// solve, then an `Edit::Pose` applied in `Animate`), the chain runs, and every modified
+/// mesh is cloned as extraction does. `before`: the same frame plus the scene document the
+/// editor captured every frame before edits became commands.
+#[divan::bench(args = ["after", "before"])]
+fn editing_frame_3_smpl_playing_1_puppet_dragged(bencher: Bencher, variant: &str) {
+    use marionette::editor::commands::{Edit, EditQueue};
+    use marionette::editor::document::{CharacterIndex, PendingScene};
+    use marionette::formats::scene::{CharacterDoc, CharacterId, SceneDoc, SmplDoc, SourceDoc};
     use marionette::rig::ik::{IkGoal, solve_ik};
-    use marionette::scene::smpl::{SmplCharacter, SmplPlugin};
-    let puppet = Arc::new(marionette::formats::puppet::embedded_puppet());
-    let (mut app, crowd) = crowd_app(&puppet, 1);
-    app.add_plugins(SmplPlugin);
+    let mut app = App::new();
+    app.add_plugins((MinimalPlugins, AssetPlugin::default(), bevy::mesh::MeshPlugin, RigCorePlugin, SkinningPlugin))
+        .add_plugins(marionette::editor::ScenePlugin)
+        .init_resource::<Extracted>()
+        .add_systems(Last, extract_modified_meshes);
+    if variant == "before" {
+        app.add_systems(Update, capture_scene_document);
+    }
+    let character = |id: u64, source: SourceDoc, x: f32, smpl: Option<SmplDoc>| CharacterDoc {
+        id: Some(CharacterId(id)),
+        name: format!("c{id}"),
+        source,
+        placement: marionette::formats::scene::PlacementDoc { translation: Vec3::X * x, ..Default::default() },
+        pose: Default::default(),
+        view: Default::default(),
+        smpl,
+        binding: None,
+    };
+    let mut characters = vec![character(1, SourceDoc::Embedded("puppet".into()), 0.0, None)];
     if let Some(dir) = std::env::var_os("MARIONETTE_DATA").map(|d| std::path::PathBuf::from(d).join("smpl")) {
-        let (model, _) = marionette::formats::smpl::load_smpl_dir(&dir).expect("the SMPL folder loads");
-        let model = Arc::new(model);
-        let clips: Vec<(String, Arc<_>)> = marionette::formats::smpl::clip_paths(&dir)
-            .iter()
-            .map(|p| {
-                let reader = marionette::formats::error::open(p).expect("clip opens");
-                let clip = marionette::formats::smpl::parse_clip(reader, p, model.skeleton.len()).expect("clip parses");
-                (p.file_name().unwrap().to_string_lossy().into_owned(), Arc::new(clip))
-            })
-            .collect();
-        let asset = Arc::new(model.asset("smpl", &[]).expect("the body builds"));
-        let bodies = spawn_row(&mut app, &asset, 3);
-        for (i, &body) in bodies.iter().enumerate() {
-            let doc = SmplDoc {
+        let clips = marionette::formats::smpl::clip_paths(&dir);
+        for i in 0..3 {
+            let state = SmplDoc {
                 betas: vec![0.5 * i as f32; 10],
-                clip: Some(clips[i % clips.len()].0.clone()),
+                clip: Some(clips[i % clips.len()].file_name().unwrap().to_string_lossy().into_owned()),
                 playing: true,
                 time: 10.0 * i as f32,
                 ..SmplDoc::default()
             };
-            let state = SmplCharacter::new(model.clone(), dir.clone(), clips.clone(), doc);
-            app.world_mut().entity_mut(body).insert(state);
+            characters.push(character(2 + i as u64, SourceDoc::File(dir.clone()), 1.0 + i as f32, Some(state)));
         }
     }
+    let doc = SceneDoc { characters, ..SceneDoc::default() };
+    *app.world_mut().resource_mut::<PendingScene>() = PendingScene { doc: Some(doc), frame: false };
     app.update();
     app.update();
-    let character = app.world().get::<Character>(crowd[0]).unwrap().clone();
-    let hand = puppet.skeleton.find("l_hand").expect("the puppet has a left hand");
+    let puppet = app.world().resource::<CharacterIndex>().get(CharacterId(1)).expect("the puppet opened");
+    let puppet = app.world().get::<Character>(puppet).unwrap().clone();
+    let hand = puppet.asset.skeleton.find("l_hand").expect("the puppet has a left hand");
     let mut step = 0.0f32;
-    bencher.bench_local(|| {
+    let mut drag_once = |app: &mut App| {
         step += 0.02;
-        // What a drag does each frame: solve on the live pose, write the joints.
+        // What the drag does each frame: solve on the live pose, push the changed joints.
         let world = app.world_mut();
-        let mut pose: Vec<JointRotation> = character
-            .joints
-            .iter()
-            .map(|&e| world.get::<JointPose>(e).map_or(JointRotation::IDENTITY, |p| p.0))
-            .collect();
+        let before: Vec<JointRotation> =
+            puppet.joints.iter().map(|&e| world.get::<JointPose>(e).map_or(JointRotation::IDENTITY, |p| p.0)).collect();
+        let mut pose = before.clone();
         let target = Vec3::new(0.3 + 0.1 * step.sin(), 1.2, 0.2 * step.cos());
-        solve_ik(&puppet.skeleton, &mut pose, Mat4::IDENTITY, &[IkGoal { end: hand, target }], 1e-4, 8);
-        for (&e, p) in character.joints.iter().zip(pose) {
-            world.get_mut::<JointPose>(e).unwrap().0 = p;
-        }
+        solve_ik(&puppet.asset.skeleton, &mut pose, Mat4::IDENTITY, &[IkGoal { end: hand, target }], 1e-4, 8);
+        let joints = pose.into_iter().enumerate().filter(|&(j, p)| p != before[j]).collect();
+        world.resource_mut::<EditQueue>().push(Edit::Pose { character: CharacterId(1), joints });
         app.update();
-    });
+    };
+    *app.world_mut().resource_mut::<Extracted>() = Extracted::default();
+    for _ in 0..8 {
+        drag_once(&mut app);
+    }
+    let extracted = app.world().resource::<Extracted>();
+    eprintln!(
+        "editing frame ({variant}): {} characters, {} bytes of mesh data extracted per frame",
+        app.world().resource::<CharacterIndex>().len(),
+        extracted.bytes / extracted.frames
+    );
+    bencher.bench_local(|| drag_once(&mut app));
 }
 
 /// A zig-zag chain of `n` joints (unit bones), and a reachable target off its line.

@@ -111,22 +111,28 @@ impl Plugin for CommandsPlugin {
 }
 
 /// Applies the queued edits and serves undo/redo, recording what undoes each edit into the
-/// gesture under way; the gesture ends when no mouse button or widget is held (exclusive:
-/// edits may spawn and despawn).
+/// gesture under way. A gesture ends in the first frame no mouse button or widget is held,
+/// and is judged (what changed) in the next, once that frame's chain has run: a clip's
+/// pose is only written by playback. Exclusive: edits may spawn and despawn.
 pub fn apply_edits(world: &mut World) {
+    if world.resource::<History>().gesture_ended {
+        close_gesture(world);
+    }
     let queue = std::mem::take(&mut world.resource_mut::<EditQueue>().0);
     let request = world.resource_mut::<History>().request.take();
     if queue.is_empty() && request.is_none() && !world.resource::<History>().gesture_open() {
         return;
     }
     for edit in queue {
-        if let Some(inverse) = apply_reporting(world, edit) {
+        for inverse in apply_reporting(world, edit) {
             world.resource_mut::<History>().record(inverse);
         }
     }
     let held = world.get_resource::<ButtonInput<MouseButton>>().is_some_and(|b| b.get_pressed().next().is_some())
         || world.resource::<GestureHold>().0;
-    if !held || request.is_some() {
+    world.resource_mut::<History>().gesture_ended = !held;
+    if request.is_some() {
+        // What is undone must be a step first.
         close_gesture(world);
     }
     if let Some(request) = request
@@ -149,27 +155,42 @@ fn close_gesture(world: &mut World) {
 
 /// Applies a step's edits last first; returns what undoes the replay.
 fn replay(world: &mut World, step: Vec<Edit>) -> Vec<Edit> {
-    step.into_iter().rev().filter_map(|edit| apply_reporting(world, edit)).collect()
+    step.into_iter().rev().flat_map(|edit| apply_reporting(world, edit)).collect()
 }
 
-fn apply_reporting(world: &mut World, edit: Edit) -> Option<Edit> {
+fn apply_reporting(world: &mut World, edit: Edit) -> Vec<Edit> {
     apply(world, edit).unwrap_or_else(|message| {
         world.resource_mut::<Messages>().push(message);
-        None
+        Vec::new()
     })
 }
 
-/// Applies `edit` to the live scene. Returns what undoes it (`None` when it changed
-/// nothing), or why it could not be applied.
-pub fn apply(world: &mut World, mut edit: Edit) -> Result<Option<Edit>, String> {
+/// Applies `edit` to the live scene. Returns what undoes it, to be applied last first
+/// (empty when it changed nothing), or why it could not be applied.
+pub fn apply(world: &mut World, mut edit: Edit) -> Result<Vec<Edit>, String> {
     if let Edit::Add(doc) = &mut edit
         && doc.id.is_none()
     {
         doc.id = Some(world.resource_mut::<NextCharacterId>().take());
     }
-    let Some(inverse) = inverse_of(world, &edit)? else { return Ok(None) };
+    let Some(inverse) = inverse_of(world, &edit)? else { return Ok(Vec::new()) };
+    let mut undo = Vec::with_capacity(2);
+    if let Edit::Smpl { character, .. } = &edit {
+        // Playback poses the joints from the clip; without a clip to return to, undo must
+        // give the joints back their rotations.
+        undo.push(current_pose(world, *character)?);
+    }
+    undo.push(inverse);
     write(world, edit)?;
-    Ok(Some(inverse))
+    Ok(undo)
+}
+
+/// A pose edit that sets every joint of a character to its rotation now.
+fn current_pose(world: &World, id: CharacterId) -> Result<Edit, String> {
+    let found = character_of(world, id)?;
+    let joints =
+        (0..found.joints.len()).map(|j| Ok((j, joint_state(world, &found, j)?.0))).collect::<Result<_, String>>()?;
+    Ok(Edit::Pose { character: id, joints })
 }
 
 /// What would undo `edit` in the scene as it is: `None` when `edit` would change nothing.
@@ -185,7 +206,7 @@ pub fn inverse_of(world: &mut World, edit: &Edit) -> Result<Option<Edit>, String
                     undo.push((j, pose));
                 }
             }
-            (!undo.is_empty()).then(|| Edit::Pose { character: *character, joints: undo })
+            (!undo.is_empty()).then_some(Edit::Pose { character: *character, joints: undo })
         }
         Edit::Place { character, placement } => {
             let old = component::<Placement>(world, *character)?.0;

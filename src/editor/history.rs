@@ -16,6 +16,8 @@ pub struct History {
     /// Where the gesture's last add or remove was recorded: edits before it are not merged
     /// with those after (they may name another incarnation of the character).
     barrier: usize,
+    /// The gesture ended (nothing held) and becomes a step in the next frame.
+    pub gesture_ended: bool,
     /// Requests from keys or buttons, served by `apply_edits`.
     pub request: Option<HistoryRequest>,
 }
@@ -88,6 +90,7 @@ impl History {
     /// Takes what undoes the gesture under way, ending it.
     pub fn take_gesture(&mut self) -> Vec<Edit> {
         self.barrier = 0;
+        self.gesture_ended = false;
         std::mem::take(&mut self.gesture)
     }
 

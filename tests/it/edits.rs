@@ -97,6 +97,7 @@ fn commands_then_undo_all_return_the_ecs_to_its_start_and_redo_to_its_end() {
     for e in edits {
         edit(&mut app, e);
     }
+    app.update();
     let end = state(&mut app);
     assert_ne!(end, start);
     assert_eq!(app.world().resource::<History>().undo_steps(), n, "one step per edit");
@@ -139,6 +140,7 @@ fn a_gesture_is_one_undo_step_and_a_click_is_none() {
     assert_eq!(app.world().resource::<History>().undo_steps(), 0, "the gesture is still under way");
     app.world_mut().resource_mut::<GestureHold>().0 = false;
     app.update();
+    app.update();
     assert_eq!(app.world().resource::<History>().undo_steps(), 1, "a drag is one step");
     request(&mut app, HistoryRequest::Undo);
     assert_eq!(pose_of(&app), before, "undo returns to where the drag started");
@@ -154,6 +156,7 @@ fn a_gesture_is_one_undo_step_and_a_click_is_none() {
     edit(&mut app, turn(0.4));
     edit(&mut app, Edit::Pose { character: CharacterId(1), joints: vec![(elbow, before)] });
     app.world_mut().resource_mut::<GestureHold>().0 = false;
+    app.update();
     app.update();
     let history = app.world().resource::<History>();
     assert_eq!((history.undo_steps(), history.redo_steps()), (0, 1), "no step; the redo step survives");
@@ -185,6 +188,7 @@ fn opening_a_scene_clears_selection_pins_and_history_and_keeps_unloadable_charac
     *app.world_mut().resource_mut::<Selection>() = Selection { character: Some(CharacterId(7)), joints: vec![4] };
     app.world_mut().resource_mut::<Pins>().0.insert(CharacterId(7), vec![4]);
     edit(&mut app, Edit::Rename { character: CharacterId(7), name: "renamed".into() });
+    app.update();
     assert!(app.world().resource::<History>().can_undo());
 
     let mut doc = doc_with(SourceDoc::Embedded("puppet".into()), &[]);
@@ -226,4 +230,44 @@ fn character_ids_are_kept_from_files_and_old_files_get_fresh_ones() {
     open_puppets(&mut app, &[None, Some(9), Some(9)]);
     assert_eq!(ids(&mut app), vec![9, 10, 11]);
     assert_eq!(app.world().resource::<CharacterIndex>().len(), 3, "the index follows despawns and spawns");
+}
+
+/// An SMPL body's shape and clip are edits like any other: undo reshapes it back (same
+/// entity) and redo again.
+#[test]
+#[cfg_attr(not(marionette_data), ignore = "needs MARIONETTE_DATA (the SMPL folder)")]
+fn smpl_shape_and_clip_edits_undo_and_redo() {
+    use marionette::formats::scene::SmplDoc;
+    use marionette::scene::smpl::SmplCharacter;
+    let dir = crate::common::data_dir().join("smpl");
+    let mut app = scene_app();
+    let body = CharacterDoc {
+        id: Some(CharacterId(1)),
+        source: SourceDoc::File(dir.clone()),
+        name: "body".into(),
+        placement: Default::default(),
+        pose: Default::default(),
+        view: ViewDoc::default(),
+        smpl: Some(SmplDoc::default()),
+        binding: None,
+    };
+    *app.world_mut().resource_mut::<PendingScene>() =
+        PendingScene { doc: Some(SceneDoc { characters: vec![body], ..SceneDoc::default() }), frame: false };
+    app.update();
+    app.update();
+    let e = entity(&app, 1);
+    let shape = |app: &App| app.world().get::<Character>(e).unwrap().asset.skin.bind_positions.clone();
+    let start = (state(&mut app), shape(&app));
+    let clip = marionette::formats::smpl::clip_paths(&dir)[0].file_name().unwrap().to_string_lossy().into_owned();
+    let wanted = SmplDoc { betas: vec![2.0, -1.0], clip: Some(clip), time: 12.0, ..SmplDoc::default() };
+    edit(&mut app, Edit::Smpl { character: CharacterId(1), state: wanted.clone() });
+    assert_eq!(app.world().get::<SmplCharacter>(e).unwrap().state, wanted);
+    let end = (state(&mut app), shape(&app));
+    assert_ne!(end.1, start.1, "β reshaped the body");
+    assert_ne!(end.0, start.0, "the clip posed it");
+    request(&mut app, HistoryRequest::Undo);
+    assert_eq!((state(&mut app), shape(&app)), start);
+    assert_eq!(entity(&app, 1), e);
+    request(&mut app, HistoryRequest::Redo);
+    assert_eq!((state(&mut app), shape(&app)), end);
 }
