@@ -97,8 +97,6 @@ impl Plugin for CommandsPlugin {
             .init_resource::<GestureHold>()
             .init_resource::<CharacterIndex>()
             .init_resource::<NextCharacterId>()
-            .init_resource::<Messages>()
-            .init_resource::<AssetLibrary>()
             .add_systems(
                 PostUpdate,
                 apply_edits

@@ -29,6 +29,7 @@ impl Plugin for ScenePlugin {
             .init_resource::<UnloadedCharacters>()
             .init_resource::<PendingScene>()
             .init_resource::<ik_drag::Pins>()
+            .init_resource::<AssetLibrary>()
             .add_plugins((crate::scene::smpl::SmplPlugin, super::commands::CommandsPlugin))
             .add_systems(
                 PostUpdate,
