@@ -261,7 +261,11 @@ fn write(world: &mut World, edit: Edit) -> Result<(), String> {
         }
         Edit::Place { character, placement } => component_mut::<Placement>(world, character)?.0 = placement,
         Edit::View { character, view } => component_mut::<CharacterView>(world, character)?.0 = view,
-        Edit::Rename { character, name } => component_mut::<SceneCharacter>(world, character)?.name = name,
+        Edit::Rename { character, name } => {
+            let entity = entity_of(world, character)?;
+            world.entity_mut(entity).insert(Name::new(name.clone()));
+            component_mut::<SceneCharacter>(world, character)?.name = name;
+        }
         Edit::Smpl { character, state } => component_mut::<SmplCharacter>(world, character)?.state = state,
         Edit::Rebind { character, binding } => rebind_character(world, character, binding)?,
         Edit::Stage(stage) => world.resource_mut::<StageSettings>().0 = stage,
