@@ -51,29 +51,68 @@ fn posed_palette(asset: &CharacterAsset) -> Vec<Mat4> {
     palette
 }
 
-/// LBS of every vertex (positions only).
-#[divan::bench]
-fn kernel_skin_positions(bencher: Bencher) {
-    let asset = asset();
-    let palette = posed_palette(&asset);
-    let mut out = vec![Vec3::ZERO; asset.vertex_count()];
-    bencher.bench_local(|| {
-        skin_positions(&asset.skin.bind_positions, &asset.skin.weights, &palette, divan::black_box(&mut out))
+/// The SMPL body (6,890 vertices, up to 4 influences) with a shape, when `MARIONETTE_DATA`
+/// is set; otherwise the benchmarked asset.
+fn smpl_body() -> Arc<CharacterAsset> {
+    static BODY: OnceLock<Arc<CharacterAsset>> = OnceLock::new();
+    BODY.get_or_init(|| {
+        std::env::var_os("MARIONETTE_DATA")
+            .map(|d| std::path::PathBuf::from(d).join("smpl"))
+            .and_then(|dir| marionette::formats::smpl::load_smpl_dir(&dir).ok())
+            .and_then(|(model, _)| model.asset("smpl", &[1.0, -0.5]).ok())
+            .map_or_else(asset, Arc::new)
+    })
+    .clone()
+}
+
+type Kernel = fn(&[Vec3], &marionette::rig::SkinWeights, &[Mat4], &mut [Vec3]);
+
+/// The skinning kernels on the SMPL body, positions only, in vertices per second:
+/// `oracle` (the plain loop, today's kernel before this one), `fast` (AVX2 + FMA where the CPU
+/// has them), `portable` (glam `Vec4`).
+#[divan::bench(args = ["oracle", "fast", "portable"])]
+fn kernel_skin_positions(bencher: Bencher, kernel: &str) {
+    let body = smpl_body();
+    let palette = posed_palette(&body);
+    let mut out = vec![Vec3::ZERO; body.vertex_count()];
+    let run: Kernel = match kernel {
+        "oracle" => skin_positions,
+        "fast" => marionette::rig::lbs::skin,
+        _ => marionette::rig::lbs::skin_portable,
+    };
+    bencher
+        .counter(divan::counter::ItemsCount::new(body.vertex_count()))
+        .bench_local(|| run(&body.skin.bind_positions, &body.skin.weights, &palette, divan::black_box(&mut out)));
+}
+
+/// LBS plus flat normals into unshared render buffers (what one SMPL body costs), per
+/// vertex of the body.
+#[divan::bench(args = ["oracle", "fast"])]
+fn kernel_skin_and_flat_shade(bencher: Bencher, kernel: &str) {
+    let body = smpl_body();
+    let palette = posed_palette(&body);
+    let mut skinned = vec![Vec3::ZERO; body.vertex_count()];
+    let n = body.triangle_count() * 3;
+    let (mut p, mut nrm) = (vec![[0.0; 3]; n], vec![[0.0; 3]; n]);
+    let run: Kernel = if kernel == "oracle" { skin_positions } else { marionette::rig::lbs::skin };
+    bencher.counter(divan::counter::ItemsCount::new(body.vertex_count())).bench_local(|| {
+        run(&body.skin.bind_positions, &body.skin.weights, &palette, &mut skinned);
+        flat_shade(&skinned, &body.skin.triangles, &mut p, divan::black_box(&mut nrm));
     });
 }
 
-/// LBS plus flat normals into unshared render buffers (what one character costs).
+/// Flat normals alone on the SMPL body, per triangle.
 #[divan::bench]
-fn kernel_skin_and_flat_shade(bencher: Bencher) {
-    let asset = asset();
-    let palette = posed_palette(&asset);
-    let mut skinned = vec![Vec3::ZERO; asset.vertex_count()];
-    let n = asset.triangle_count() * 3;
+fn kernel_flat_shade(bencher: Bencher) {
+    let body = smpl_body();
+    let palette = posed_palette(&body);
+    let mut skinned = vec![Vec3::ZERO; body.vertex_count()];
+    marionette::rig::lbs::skin(&body.skin.bind_positions, &body.skin.weights, &palette, &mut skinned);
+    let n = body.triangle_count() * 3;
     let (mut p, mut nrm) = (vec![[0.0; 3]; n], vec![[0.0; 3]; n]);
-    bencher.bench_local(|| {
-        skin_positions(&asset.skin.bind_positions, &asset.skin.weights, &palette, &mut skinned);
-        flat_shade(&skinned, &asset.skin.triangles, &mut p, divan::black_box(&mut nrm));
-    });
+    bencher
+        .counter(divan::counter::ItemsCount::new(body.triangle_count()))
+        .bench_local(|| flat_shade(&skinned, &body.skin.triangles, &mut p, divan::black_box(&mut nrm)));
 }
 
 /// One `App::update` where every character has one joint changed: mark, FK, skin.

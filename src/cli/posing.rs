@@ -4,7 +4,7 @@
 use glam::{Mat4, Vec3};
 
 use crate::rig::fk::{forward_kinematics, skinning_palette};
-use crate::rig::skinning::skin_positions;
+use crate::rig::lbs::skin;
 use crate::rig::{CharacterAsset, JointRotation, Skeleton};
 
 /// What is wrong with a `JOINT=rx,ry,rz` spec.
@@ -76,7 +76,7 @@ pub fn posed_positions(asset: &CharacterAsset, pose: &[JointRotation], placement
     let mut palette = vec![Mat4::IDENTITY; n];
     skinning_palette(&current, &asset.bind_world_to_joint, &mut palette);
     let mut out = vec![Vec3::ZERO; asset.vertex_count()];
-    skin_positions(&asset.skin.bind_positions, &asset.skin.weights, &palette, &mut out);
+    skin(&asset.skin.bind_positions, &asset.skin.weights, &palette, &mut out);
     out
 }
 

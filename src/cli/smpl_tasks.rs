@@ -14,7 +14,7 @@ use crate::formats::error::open;
 use crate::formats::smpl::{clip_paths, parse_clip};
 use crate::formats::{FormatError, write_atomically};
 use crate::rig::fk::forward_kinematics_with_offsets;
-use crate::rig::skinning::skin_positions;
+use crate::rig::lbs::skin;
 use crate::rig::smpl::{BlendMode, Clip, SmplModel, blend_rotation};
 use crate::rig::{JointRotation, Skeleton};
 
@@ -116,7 +116,7 @@ impl<'a> SmplPoser<'a> {
         for ((p, w), j) in self.palette.iter_mut().zip(&self.world).zip(&self.joints) {
             *p = *w * Mat4::from_translation(-*j);
         }
-        skin_positions(&self.shaped, &self.model.weights, &self.palette, out);
+        skin(&self.shaped, &self.model.weights, &self.palette, out);
     }
 }
 

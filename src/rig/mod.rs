@@ -5,6 +5,7 @@ pub mod bind;
 pub mod character;
 pub mod fk;
 pub mod ik;
+pub mod lbs;
 pub mod matrix_stack;
 pub mod pose;
 pub mod skeleton;

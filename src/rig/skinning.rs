@@ -4,6 +4,7 @@
 use glam::{Mat4, Vec3};
 
 use super::RigError;
+use super::lbs::InfluenceGroups;
 
 /// One joint's influence on a vertex.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -18,6 +19,8 @@ pub struct Influence {
 pub struct SkinWeights {
     offsets: Vec<u32>,
     influences: Vec<Influence>,
+    /// The same rows partitioned by influence count, for the fast kernel.
+    groups: InfluenceGroups,
 }
 
 /// A vertex whose weights did not sum to 1 and were normalised.
@@ -41,7 +44,7 @@ impl SkinWeights {
         I: IntoIterator<Item = R>,
         R: IntoIterator<Item = (usize, f32)>,
     {
-        let mut weights = SkinWeights { offsets: vec![0], influences: Vec::new() };
+        let mut weights = SkinWeights { offsets: vec![0], ..Self::default() };
         let mut normalised = Vec::new();
         for (vertex, row) in rows.into_iter().enumerate() {
             let start = weights.influences.len();
@@ -71,15 +74,22 @@ impl SkinWeights {
             }
             weights.offsets.push(weights.influences.len() as u32);
         }
+        weights.groups = InfluenceGroups::build(&weights.offsets, &weights.influences);
         Ok((weights, normalised))
     }
 
     /// Every vertex bound rigidly to one joint.
     pub fn rigid(joint_of_vertex: &[u16]) -> Self {
-        Self {
-            offsets: (0..=joint_of_vertex.len() as u32).collect(),
-            influences: joint_of_vertex.iter().map(|&joint| Influence { joint, weight: 1.0 }).collect(),
-        }
+        let offsets: Vec<u32> = (0..=joint_of_vertex.len() as u32).collect();
+        let influences: Vec<Influence> =
+            joint_of_vertex.iter().map(|&joint| Influence { joint, weight: 1.0 }).collect();
+        let groups = InfluenceGroups::build(&offsets, &influences);
+        Self { offsets, influences, groups }
+    }
+
+    /// The rows partitioned by influence count (see [`super::lbs`]).
+    pub fn groups(&self) -> &InfluenceGroups {
+        &self.groups
     }
 
     pub fn vertex_count(&self) -> usize {
@@ -106,6 +116,7 @@ impl SkinWeights {
 }
 
 /// Skins bind-pose vertices: `out[v] = Σ w · palette[j] · bind[v]` over v's influences.
+/// The plain loop, kept as the oracle of the fast kernel [`super::lbs::skin`].
 ///
 /// `bind_positions` are in the bind (model) space, `palette[j]` is
 /// `current_joint_to_world · bind_world_to_joint`, `out` is in world space.

@@ -7,7 +7,8 @@ use bevy::prelude::*;
 use super::components::*;
 use crate::rig::JointRotation;
 use crate::rig::fk::forward_kinematics;
-use crate::rig::skinning::{bounds, flat_shade, heat_colors, joint_colors, skin_positions, weight_colors};
+use crate::rig::lbs;
+use crate::rig::skinning::{bounds, flat_shade, heat_colors, joint_colors, weight_colors};
 
 /// Clamps changed joint poses to their limits (reads `JointLimits`, writes `JointPose`).
 pub fn clamp_poses_to_limits(mut joints: Query<(&mut JointPose, &JointLimits), Changed<JointPose>>) {
@@ -112,7 +113,7 @@ pub fn skin_changed_characters(
             palette.clear();
             palette.extend(character.joints.iter().map(|&e| joints.get(e).map_or(Mat4::IDENTITY, |(c, b)| c.0 * b.0)));
             positions.resize(skin.bind_positions.len(), Vec3::ZERO);
-            skin_positions(&skin.bind_positions, &skin.weights, palette, positions);
+            lbs::skin(&skin.bind_positions, &skin.weights, palette, positions);
             if let Ok(mut aabb) = skin_bounds.get_mut(character.skin_entity) {
                 let (lo, hi) = bounds(positions);
                 aabb.set_if_neq(Aabb::from_min_max(lo, hi));

@@ -9,6 +9,7 @@ mod edits;
 mod formats;
 mod fuzz;
 mod ik;
+mod kernel;
 mod rig;
 mod robust;
 mod smpl;

@@ -1,0 +1,164 @@
+//! The fast linear-blend-skinning kernel. Vertices are grouped by influence count when the
+//! weights are built (1, 2, 3 or 4 influences in fixed-size rows; more in a general
+//! group); each vertex blends its palette matrices once (`M = Σ wᵢ Pᵢ`) and transforms its
+//! bind position by `M`. On x86-64 with AVX2 and FMA (detected at run time) the blend is
+//! fused multiply-adds on the matrices' 128-bit columns; elsewhere glam's `Vec4` does it.
+//! [`skin_positions`](super::skinning::skin_positions) stays as the plain oracle.
+
+use glam::{Mat4, Vec3, Vec4};
+
+use super::skinning::{Influence, SkinWeights};
+
+/// Vertices with the same number of influences, in rows of `k` joints and weights.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct FixedGroup {
+    /// The vertices of the group, ascending.
+    pub vertices: Vec<u32>,
+    /// `k` joints per vertex.
+    pub joints: Vec<u16>,
+    /// `k` weights per vertex (summing to 1).
+    pub weights: Vec<f32>,
+}
+
+/// A skin's vertices partitioned by influence count: `fixed[k - 1]` holds the vertices with
+/// `k` influences (k = 1..=4), `wide` those with more (read from the compressed rows).
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct InfluenceGroups {
+    pub fixed: [FixedGroup; 4],
+    pub wide: Vec<u32>,
+    /// One past the largest joint any influence names (0 for no influence).
+    pub joint_bound: usize,
+}
+
+impl InfluenceGroups {
+    /// Partitions the rows `influences[offsets[v]..offsets[v + 1]]`.
+    pub fn build(offsets: &[u32], influences: &[Influence]) -> Self {
+        let mut groups = Self::default();
+        for (v, w) in offsets.windows(2).enumerate() {
+            let row = &influences[w[0] as usize..w[1] as usize];
+            groups.joint_bound = row.iter().map(|i| i.joint as usize + 1).fold(groups.joint_bound, usize::max);
+            match row.len() {
+                k @ 1..=4 => {
+                    let group = &mut groups.fixed[k - 1];
+                    group.vertices.push(v as u32);
+                    group.joints.extend(row.iter().map(|i| i.joint));
+                    group.weights.extend(row.iter().map(|i| i.weight));
+                }
+                _ => groups.wide.push(v as u32),
+            }
+        }
+        groups
+    }
+}
+
+/// Skins bind-pose vertices: `out[v] = (Σ wᵢ · palette[jᵢ]) · bind[v]` (the same result as
+/// the oracle up to rounding). No allocation.
+///
+/// # Panics
+/// When the lengths of `bind_positions`, `weights` and `out` differ, or an influence names
+/// a joint beyond the palette.
+pub fn skin(bind_positions: &[Vec3], weights: &SkinWeights, palette: &[Mat4], out: &mut [Vec3]) {
+    assert_eq!(bind_positions.len(), weights.vertex_count(), "one weight row per vertex");
+    assert_eq!(out.len(), bind_positions.len(), "one output per vertex");
+    let groups = weights.groups();
+    assert!(groups.joint_bound <= palette.len(), "an influence names a joint beyond the palette");
+    #[cfg(target_arch = "x86_64")]
+    if std::arch::is_x86_feature_detected!("avx2") && std::arch::is_x86_feature_detected!("fma") {
+        // SAFETY: the CPU has AVX2 and FMA (checked above).
+        unsafe {
+            avx2::skin_fixed::<1>(bind_positions, &groups.fixed[0], palette, out);
+            avx2::skin_fixed::<2>(bind_positions, &groups.fixed[1], palette, out);
+            avx2::skin_fixed::<3>(bind_positions, &groups.fixed[2], palette, out);
+            avx2::skin_fixed::<4>(bind_positions, &groups.fixed[3], palette, out);
+        }
+        skin_wide(bind_positions, weights, &groups.wide, palette, out);
+        return;
+    }
+    skin_portable(bind_positions, weights, palette, out);
+}
+
+/// [`skin`] without the AVX2 path: glam's `Vec4` on any target (what other CPUs run).
+///
+/// # Panics
+/// As [`skin`].
+pub fn skin_portable(bind_positions: &[Vec3], weights: &SkinWeights, palette: &[Mat4], out: &mut [Vec3]) {
+    assert_eq!(bind_positions.len(), weights.vertex_count(), "one weight row per vertex");
+    assert_eq!(out.len(), bind_positions.len(), "one output per vertex");
+    let groups = weights.groups();
+    skin_fixed_portable::<1>(bind_positions, &groups.fixed[0], palette, out);
+    skin_fixed_portable::<2>(bind_positions, &groups.fixed[1], palette, out);
+    skin_fixed_portable::<3>(bind_positions, &groups.fixed[2], palette, out);
+    skin_fixed_portable::<4>(bind_positions, &groups.fixed[3], palette, out);
+    skin_wide(bind_positions, weights, &groups.wide, palette, out);
+}
+
+/// The portable path of one fixed group: blend `K` matrices with glam's `Vec4`.
+fn skin_fixed_portable<const K: usize>(bind: &[Vec3], group: &FixedGroup, palette: &[Mat4], out: &mut [Vec3]) {
+    let rows = group.joints.chunks_exact(K).zip(group.weights.chunks_exact(K));
+    for (&v, (joints, weights)) in group.vertices.iter().zip(rows) {
+        let mut m = [Vec4::ZERO; 4];
+        for (&j, &w) in joints.iter().zip(weights) {
+            let p = &palette[j as usize];
+            m[0] += p.x_axis * w;
+            m[1] += p.y_axis * w;
+            m[2] += p.z_axis * w;
+            m[3] += p.w_axis * w;
+        }
+        let b = bind[v as usize];
+        out[v as usize] = (m[0] * b.x + m[1] * b.y + m[2] * b.z + m[3]).truncate();
+    }
+}
+
+/// Vertices with more than four influences, blended the same way from the compressed rows.
+fn skin_wide(bind: &[Vec3], weights: &SkinWeights, wide: &[u32], palette: &[Mat4], out: &mut [Vec3]) {
+    for &v in wide {
+        let mut m = Mat4::ZERO;
+        for inf in weights.of_vertex(v as usize) {
+            let p = &palette[inf.joint as usize];
+            m.x_axis += p.x_axis * inf.weight;
+            m.y_axis += p.y_axis * inf.weight;
+            m.z_axis += p.z_axis * inf.weight;
+            m.w_axis += p.w_axis * inf.weight;
+        }
+        out[v as usize] = m.transform_point3(bind[v as usize]);
+    }
+}
+
+#[cfg(target_arch = "x86_64")]
+mod avx2 {
+    use std::arch::x86_64::*;
+
+    use glam::{Mat4, Vec3, Vec4};
+
+    use super::FixedGroup;
+
+    /// One fixed group with FMA on 128-bit columns (glam's `Vec4` is an `__m128`, so the
+    /// palette's columns load as they are, with no copy).
+    ///
+    /// # Safety
+    /// The CPU must have AVX2 and FMA. (Indices are checked: a joint beyond the palette or a
+    /// vertex beyond the buffers panics.)
+    #[target_feature(enable = "avx2,fma")]
+    pub unsafe fn skin_fixed<const K: usize>(bind: &[Vec3], group: &FixedGroup, palette: &[Mat4], out: &mut [Vec3]) {
+        let rows = group.joints.chunks_exact(K).zip(group.weights.chunks_exact(K));
+        for (&v, (joints, weights)) in group.vertices.iter().zip(rows) {
+            let (joints, weights): (&[u16; K], &[f32; K]) = (joints.try_into().unwrap(), weights.try_into().unwrap());
+            let mut c = [_mm_setzero_ps(); 4];
+            for k in 0..K {
+                let m = &palette[joints[k] as usize];
+                let w = _mm_set1_ps(weights[k]);
+                c[0] = _mm_fmadd_ps(w, m.x_axis.into(), c[0]);
+                c[1] = _mm_fmadd_ps(w, m.y_axis.into(), c[1]);
+                c[2] = _mm_fmadd_ps(w, m.z_axis.into(), c[2]);
+                c[3] = _mm_fmadd_ps(w, m.w_axis.into(), c[3]);
+            }
+            let b = bind[v as usize];
+            let p = _mm_fmadd_ps(
+                c[0],
+                _mm_set1_ps(b.x),
+                _mm_fmadd_ps(c[1], _mm_set1_ps(b.y), _mm_fmadd_ps(c[2], _mm_set1_ps(b.z), c[3])),
+            );
+            out[v as usize] = Vec4::from(p).truncate();
+        }
+    }
+}
