@@ -23,6 +23,7 @@ pub mod readiness;
 pub mod render;
 pub mod screenshot;
 pub mod shortcuts;
+pub mod skin_material;
 pub mod stage;
 pub mod state;
 pub mod ui;

@@ -6,15 +6,12 @@ use bevy::prelude::*;
 
 use super::camera::{OrbitCamera, apply_orbit_camera};
 use super::document::{AssetLibrary, NextCharacterId, PendingScene, SceneCharacter, spawn_from_doc, startup_doc};
+use super::skin_material::SkinMaterial;
 use super::stage::{StageSettings, apply_stage_settings, draw_grid_and_axes, spawn_stage};
 use super::state::{Messages, Selection, StartupEdits, StartupPaths, UnloadedCharacters};
 use super::{draw, history, ik_drag};
 use crate::formats::scene::{CharacterId, DisplayDoc};
 use crate::scene::{Character, CharacterView, HeatJoint, MarionetteSystems, SkinMesh};
-
-/// One material for every skin: white, so vertex colours (tint or weights) show as they are.
-#[derive(Resource)]
-pub struct SkinMaterial(pub Handle<StandardMaterial>);
 
 /// The live scene without drawing: opening documents, edits and their history, SMPL
 /// playback, each character's view in step with its options (used by the window, the
@@ -51,7 +48,8 @@ impl Plugin for ViewPlugin {
         app.init_resource::<StartupPaths>()
             .init_resource::<StartupEdits>()
             .add_plugins((ScenePlugin, super::readiness::ReadinessPlugin))
-            .add_systems(Startup, (setup_skin_material, spawn_stage, queue_startup_scene).chain())
+            .add_plugins(super::skin_material::SkinMaterialPlugin)
+            .add_systems(Startup, (spawn_stage, queue_startup_scene).chain())
             .add_systems(
                 PostUpdate,
                 (
@@ -65,12 +63,6 @@ impl Plugin for ViewPlugin {
                     .in_set(MarionetteSystems::Draw),
             );
     }
-}
-
-fn setup_skin_material(mut commands: Commands, mut materials: ResMut<Assets<StandardMaterial>>) {
-    let material =
-        materials.add(StandardMaterial { base_color: Color::WHITE, perceptual_roughness: 0.75, ..default() });
-    commands.insert_resource(SkinMaterial(material));
 }
 
 /// Turns the startup paths into the first scene (writes `PendingScene`, `Messages`).

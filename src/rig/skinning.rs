@@ -1,7 +1,7 @@
 //! Linear blend skinning (skeletal subspace deformation) over plain slices, flat normals
 //! and weight colours. No allocation per call: callers own every buffer.
 
-use glam::{Mat4, Vec3};
+use glam::{Mat4, Vec3, Vec3A};
 
 use super::RigError;
 use super::lbs::InfluenceGroups;
@@ -161,13 +161,12 @@ pub fn flat_shade(
 ) {
     assert_eq!(out_positions.len(), triangles.len() * 3);
     assert_eq!(out_normals.len(), triangles.len() * 3);
-    for (t, tri) in triangles.iter().enumerate() {
-        let [a, b, c] = tri.map(|i| positions[i as usize]);
-        let n = (b - a).cross(c - a).normalize_or(Vec3::Y).to_array();
-        out_positions[3 * t] = a.to_array();
-        out_positions[3 * t + 1] = b.to_array();
-        out_positions[3 * t + 2] = c.to_array();
-        out_normals[3 * t..3 * t + 3].fill(n);
+    let corners = out_positions.chunks_exact_mut(3).zip(out_normals.chunks_exact_mut(3));
+    for (tri, (p, n)) in triangles.iter().zip(corners) {
+        let [a, b, c] = tri.map(|i| Vec3A::from(positions[i as usize]));
+        let normal = (b - a).cross(c - a).normalize_or(Vec3A::Y).to_array();
+        p.copy_from_slice(&[a.to_array(), b.to_array(), c.to_array()]);
+        n.fill(normal);
     }
 }
 

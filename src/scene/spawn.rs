@@ -6,7 +6,7 @@ use std::sync::Arc;
 use bevy::asset::RenderAssetUsages;
 use bevy::camera::primitives::Aabb;
 use bevy::camera::visibility::NoAutoAabb;
-use bevy::mesh::PrimitiveTopology;
+use bevy::mesh::{Indices, PrimitiveTopology};
 use bevy::prelude::*;
 
 use super::components::*;
@@ -55,7 +55,7 @@ pub fn spawn_character_posed(
             .id();
         joints.push(joint);
     }
-    let mesh = meshes.add(empty_skin_mesh(asset.triangle_count()));
+    let mesh = meshes.add(empty_skin_mesh(&asset.skin.triangles, asset.vertex_count()));
     let skin_entity = commands
         // The skinning system keeps the bounds right as the mesh deforms (model space).
         .spawn((
@@ -76,14 +76,15 @@ pub fn spawn_character_posed(
     character
 }
 
-/// A render mesh with room for 3 unshared vertices per triangle: positions, flat normals,
-/// vertex colours. Kept in the main world so the skinning system can rewrite it.
-pub fn empty_skin_mesh(triangle_count: usize) -> Mesh {
-    let n = triangle_count * 3;
+/// A render mesh of the skin's own vertices and triangles: positions and colours, no
+/// normals (the skin material lights each triangle with its own normal, from the
+/// derivatives of the position). Kept in the main world so the skinning system can rewrite
+/// its positions.
+pub fn empty_skin_mesh(triangles: &[[u32; 3]], vertex_count: usize) -> Mesh {
     Mesh::new(PrimitiveTopology::TriangleList, RenderAssetUsages::default())
-        .with_inserted_attribute(Mesh::ATTRIBUTE_POSITION, vec![[0.0f32; 3]; n])
-        .with_inserted_attribute(Mesh::ATTRIBUTE_NORMAL, vec![[0.0f32, 1.0, 0.0]; n])
-        .with_inserted_attribute(Mesh::ATTRIBUTE_COLOR, vec![[1.0f32; 4]; n])
+        .with_inserted_attribute(Mesh::ATTRIBUTE_POSITION, vec![[0.0f32; 3]; vertex_count])
+        .with_inserted_attribute(Mesh::ATTRIBUTE_COLOR, vec![[1.0f32; 4]; vertex_count])
+        .with_inserted_indices(Indices::U32(triangles.iter().flatten().copied().collect()))
 }
 
 /// Despawns a character, its joints leaves first and its skin mesh entity. Bevy's

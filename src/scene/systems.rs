@@ -8,7 +8,7 @@ use super::components::*;
 use crate::rig::JointRotation;
 use crate::rig::fk::forward_kinematics;
 use crate::rig::lbs;
-use crate::rig::skinning::{bounds, flat_shade, heat_colors, joint_colors, weight_colors};
+use crate::rig::skinning::{bounds, heat_colors, joint_colors, weight_colors};
 
 /// Clamps changed joint poses to their limits (reads `JointLimits`, writes `JointPose`).
 pub fn clamp_poses_to_limits(mut joints: Query<(&mut JointPose, &JointLimits), Changed<JointPose>>) {
@@ -90,9 +90,9 @@ pub fn compute_joint_to_world(
 }
 
 /// Skins characters marked dirty, in model space: palette `CurrentJointToWorld ·
-/// BindWorldToJoint`, LBS of the bind vertices, then rewrites the render mesh's positions
-/// and flat normals and the skin's bounds (so culling follows the deformed mesh), and its
-/// colours when the view changed (reads joint matrices; writes `Mesh` assets, `Aabb`,
+/// BindWorldToJoint`, LBS of the bind vertices, then rewrites the render mesh's vertex
+/// positions (the material lights each triangle with its own normal) and the skin's bounds
+/// (so culling follows the deformed mesh), and its colours when they changed (reads joint matrices; writes `Mesh` assets, `Aabb`,
 /// clears `PoseDirty`).
 pub fn skin_changed_characters(
     mut characters: Query<(&Character, &CharacterView, &HeatJoint, &mut PoseDirty, &mut SkinScratch)>,
@@ -118,14 +118,9 @@ pub fn skin_changed_characters(
                 let (lo, hi) = bounds(positions);
                 aabb.set_if_neq(Aabb::from_min_max(lo, hi));
             }
-            let mut normals = match mesh.remove_attribute(Mesh::ATTRIBUTE_NORMAL) {
-                Some(VertexAttributeValues::Float32x3(n)) => n,
-                _ => vec![[0.0; 3]; skin.triangles.len() * 3],
-            };
             if let Some(VertexAttributeValues::Float32x3(out)) = mesh.attribute_mut(Mesh::ATTRIBUTE_POSITION) {
-                flat_shade(positions, &skin.triangles, out, &mut normals);
+                out.iter_mut().zip(positions.iter()).for_each(|(o, p)| *o = p.to_array());
             }
-            mesh.insert_attribute(Mesh::ATTRIBUTE_NORMAL, normals);
         }
         if dirty.colors {
             write_colors(&mut mesh, character, view, heat.0);
@@ -135,7 +130,7 @@ pub fn skin_changed_characters(
     }
 }
 
-/// Rewrites the per-corner colours: the tint, the weight colours or a joint's heat map.
+/// Rewrites the vertex colours: the tint, the weight colours or a joint's heat map.
 fn write_colors(mesh: &mut Mesh, character: &Character, view: &CharacterView, heat_joint: Option<usize>) {
     let skin = &character.asset.skin;
     let n = skin.bind_positions.len();
@@ -146,9 +141,8 @@ fn write_colors(mesh: &mut Mesh, character: &Character, view: &CharacterView, he
         weight_colors(&skin.weights, &joint_colors(character.joints.len()), &mut per_vertex);
     }
     if let Some(VertexAttributeValues::Float32x4(out)) = mesh.attribute_mut(Mesh::ATTRIBUTE_COLOR) {
-        for (corner, &v) in out.iter_mut().zip(skin.triangles.iter().flatten()) {
-            let [r, g, b] = per_vertex[v as usize];
-            *corner = [r, g, b, 1.0];
+        for (o, [r, g, b]) in out.iter_mut().zip(per_vertex) {
+            *o = [r, g, b, 1.0];
         }
     }
 }

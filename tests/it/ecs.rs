@@ -8,7 +8,6 @@ use bevy::mesh::VertexAttributeValues;
 use bevy::prelude::*;
 use marionette::cli::posing::posed_positions;
 use marionette::formats::puppet::embedded_puppet;
-use marionette::rig::skinning::flat_shade;
 use marionette::rig::{CharacterAsset, JointRotation};
 use marionette::scene::*;
 
@@ -42,13 +41,10 @@ fn mesh_positions(app: &App, character: Entity) -> Vec<[f32; 3]> {
     }
 }
 
-/// The kernel's expected render positions: skinned, then unshared per triangle.
+/// The kernel's expected render positions: the skinned vertices (the mesh shares them
+/// between triangles).
 fn oracle(asset: &CharacterAsset, pose: &[JointRotation], placement: &Placement) -> Vec<[f32; 3]> {
-    let skinned = posed_positions(asset, pose, placement.to_mat4());
-    let n = asset.triangle_count() * 3;
-    let (mut p, mut nrm) = (vec![[0.0; 3]; n], vec![[0.0; 3]; n]);
-    flat_shade(&skinned, &asset.skin.triangles, &mut p, &mut nrm);
-    p
+    posed_positions(asset, pose, placement.to_mat4()).iter().map(|p| p.to_array()).collect()
 }
 
 fn assert_positions_close(a: &[[f32; 3]], b: &[[f32; 3]], tol: f32) {
@@ -113,9 +109,11 @@ fn posing_a_joint_reskins_the_mesh_like_the_kernel() {
     assert_positions_close(&placed, &oracle(&asset, &pose, &placement), 1e-4);
 }
 
-/// The mesh's normals and colours, like its positions, are what the kernels give.
+/// The mesh is the skin's own vertices and triangles: its positions and colours are what
+/// the kernels give, its indices the triangles; it carries no normals (the skin material
+/// lights each triangle with its own, from the position's derivatives).
 #[test]
-fn normals_and_weight_colours_match_the_kernels() {
+fn mesh_triangles_and_weight_colours_match_the_kernels() {
     use marionette::rig::skinning::{joint_colors, weight_colors};
     let asset = Arc::new(embedded_puppet());
     let mut app = app();
@@ -127,24 +125,20 @@ fn normals_and_weight_colours_match_the_kernels() {
     app.update();
     let mut pose = asset.skeleton.initial_pose();
     pose[knee] = rotation;
-    let skinned = posed_positions(&asset, &pose, Mat4::IDENTITY);
-    let n = asset.triangle_count() * 3;
-    let (mut p, mut normals) = (vec![[0.0; 3]; n], vec![[0.0; 3]; n]);
-    flat_shade(&skinned, &asset.skin.triangles, &mut p, &mut normals);
+    let skinned: Vec<[f32; 3]> = posed_positions(&asset, &pose, Mat4::IDENTITY).iter().map(|p| p.to_array()).collect();
     let mut per_vertex = vec![[0.0; 3]; asset.vertex_count()];
     weight_colors(&asset.skin.weights, &joint_colors(asset.skeleton.len()), &mut per_vertex);
     let handle = app.world().get::<Character>(character).unwrap().mesh.clone();
     let mesh = app.world().resource::<Assets<Mesh>>().get(&handle).unwrap();
-    let Some(VertexAttributeValues::Float32x3(mesh_normals)) = mesh.attribute(Mesh::ATTRIBUTE_NORMAL) else {
-        panic!("normals are Float32x3")
-    };
-    assert_positions_close(mesh_normals, &normals, 1e-5);
+    assert_positions_close(&mesh_positions(&app, character), &skinned, 1e-5);
+    assert!(mesh.attribute(Mesh::ATTRIBUTE_NORMAL).is_none(), "no normals are written");
+    let Some(bevy::mesh::Indices::U32(indices)) = mesh.indices() else { panic!("indices are u32") };
+    assert_eq!(indices.as_slice(), asset.skin.triangles.as_flattened());
     let Some(VertexAttributeValues::Float32x4(colors)) = mesh.attribute(Mesh::ATTRIBUTE_COLOR) else {
         panic!("colours are Float32x4")
     };
-    for (corner, &v) in colors.iter().zip(asset.skin.triangles.iter().flatten()) {
-        let [r, g, b] = per_vertex[v as usize];
-        assert_eq!(*corner, [r, g, b, 1.0]);
+    for (color, [r, g, b]) in colors.iter().zip(per_vertex) {
+        assert_eq!(*color, [r, g, b, 1.0]);
     }
 }
 
@@ -275,9 +269,6 @@ fn smpl_body_in_the_ecs_matches_the_poser() {
         FrameSpec { betas: exercise_beta(2), rotations: clip.frame(42).to_vec(), translation: None, skinned: true };
     let mut expected = Vec::new();
     SmplPoser::new(&model).frame(&frame, &mut expected);
-    let current = app.world().get::<Character>(character).unwrap().asset.clone();
-    let n = current.triangle_count() * 3;
-    let (mut p, mut nrm) = (vec![[0.0; 3]; n], vec![[0.0; 3]; n]);
-    flat_shade(&expected, &current.skin.triangles, &mut p, &mut nrm);
-    assert_positions_close(&mesh_positions(&app, character), &p, 1e-5);
+    let expected: Vec<[f32; 3]> = expected.iter().map(|p| p.to_array()).collect();
+    assert_positions_close(&mesh_positions(&app, character), &expected, 1e-5);
 }

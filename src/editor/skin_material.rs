@@ -1,0 +1,42 @@
+//! The material every skin is drawn with: `StandardMaterial` (white, so vertex colours show
+//! as they are) extended with a fragment shader that lights each triangle with its own
+//! normal, from the derivatives of the world position. The skinning system then writes
+//! only shared vertex positions (and colours when they change): no unshared corners and
+//! no normals on the CPU or in the upload.
+
+use bevy::asset::embedded_asset;
+use bevy::pbr::{ExtendedMaterial, MaterialExtension, MaterialPlugin};
+use bevy::prelude::*;
+use bevy::render::render_resource::AsBindGroup;
+use bevy::shader::ShaderRef;
+
+/// The extension: no data of its own, only the flat-normal fragment shader.
+#[derive(Asset, AsBindGroup, Reflect, Debug, Clone, Default)]
+pub struct FlatNormals {}
+
+impl MaterialExtension for FlatNormals {
+    fn fragment_shader() -> ShaderRef {
+        "embedded://marionette/editor/flat_normals.wgsl".into()
+    }
+}
+
+/// The skin material type.
+pub type SkinMaterialAsset = ExtendedMaterial<StandardMaterial, FlatNormals>;
+
+/// One material for every skin.
+#[derive(Resource)]
+pub struct SkinMaterial(pub Handle<SkinMaterialAsset>);
+
+pub struct SkinMaterialPlugin;
+
+impl Plugin for SkinMaterialPlugin {
+    fn build(&self, app: &mut App) {
+        embedded_asset!(app, "flat_normals.wgsl");
+        app.add_plugins(MaterialPlugin::<SkinMaterialAsset>::default()).add_systems(Startup, setup_skin_material);
+    }
+}
+
+fn setup_skin_material(mut commands: Commands, mut materials: ResMut<Assets<SkinMaterialAsset>>) {
+    let base = StandardMaterial { base_color: Color::WHITE, perceptual_roughness: 0.75, ..default() };
+    commands.insert_resource(SkinMaterial(materials.add(ExtendedMaterial { base, extension: FlatNormals {} })));
+}
