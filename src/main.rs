@@ -108,6 +108,22 @@ enum Command {
         #[arg(long)]
         naive: bool,
     },
+    /// A crowd of animated characters headless through the app and the render world:
+    /// frame time (p50/p95) by phase, mesh data handed on, and the skinning kernel's speed.
+    Bench {
+        /// How many characters (SMPL bodies from the data folder, else puppets).
+        #[arg(long, default_value_t = 64, value_parser = clap::value_parser!(u32).range(1..=4096))]
+        characters: u32,
+        /// Frames measured (after warming up).
+        #[arg(long, default_value_t = 300, value_parser = clap::value_parser!(u32).range(1..=100_000))]
+        frames: u32,
+        /// The course data folder (its `smpl`); defaults to MARIONETTE_DATA.
+        #[arg(long)]
+        data: Option<PathBuf>,
+        /// Print one JSON object instead of the table.
+        #[arg(long)]
+        json: bool,
+    },
     /// Rebuild the project's own characters into a folder (normally `assets`).
     GenAssets {
         #[arg(default_value = "assets")]
@@ -157,6 +173,17 @@ fn run(cli: Cli) -> Result<()> {
         Some(Command::Bind { mesh, skeleton, out, smooth }) => bind(&mesh, &skeleton, &out, smooth)?,
         Some(Command::Smpl { data, task, sequence, transition, slerp, out, naive }) => {
             smpl(&data, task, sequence, transition, slerp, &out, naive)?
+        }
+        Some(Command::Bench { characters, frames, data, json }) => {
+            use marionette::editor::bench;
+            let data = bench::data_folder(data);
+            let report =
+                bench::run(characters as usize, frames as usize, data.as_deref()).map_err(anyhow::Error::msg)?;
+            if json {
+                println!("{}", serde_json::to_string(&report)?);
+            } else {
+                println!("{}", bench::table(&report));
+            }
         }
         Some(Command::GenAssets { dir }) => {
             marionette::formats::puppet::write_6837(&marionette::formats::puppet::puppet(), &dir, "puppet")

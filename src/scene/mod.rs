@@ -69,11 +69,14 @@ impl Plugin for RigCorePlugin {
     }
 }
 
-/// CPU skinning of changed characters into their render meshes.
+/// CPU skinning of changed characters (in parallel) into their render meshes.
 pub struct SkinningPlugin;
 
 impl Plugin for SkinningPlugin {
     fn build(&self, app: &mut App) {
-        app.add_systems(PostUpdate, systems::skin_changed_characters.in_set(MarionetteSystems::Skin));
+        app.add_systems(
+            PostUpdate,
+            (systems::skin_changed_characters, systems::write_skinned_meshes).chain().in_set(MarionetteSystems::Skin),
+        );
     }
 }

@@ -89,14 +89,32 @@ pub fn compute_joint_to_world(
     }
 }
 
-/// Skins characters marked dirty, in model space: palette `CurrentJointToWorld ·
-/// BindWorldToJoint`, LBS of the bind vertices, then rewrites the render mesh's vertex
-/// positions (the material lights each triangle with its own normal) and the skin's bounds
-/// (so culling follows the deformed mesh), and its colours when they changed (reads joint matrices; writes `Mesh` assets, `Aabb`,
-/// clears `PoseDirty`).
+/// Skins characters marked dirty, in model space and in parallel on Bevy's compute task
+/// pool: palette `CurrentJointToWorld · BindWorldToJoint`, then the LBS kernel of the bind
+/// vertices into the character's scratch (reads joint matrices; writes `SkinScratch`).
 pub fn skin_changed_characters(
-    mut characters: Query<(&Character, &CharacterView, &HeatJoint, &mut PoseDirty, &mut SkinScratch)>,
+    mut characters: Query<(&Character, &PoseDirty, &mut SkinScratch)>,
     joints: Query<(&CurrentJointToWorld, &BindWorldToJoint)>,
+) {
+    characters.par_iter_mut().for_each(|(character, dirty, mut scratch)| {
+        if !(dirty.matrices || dirty.bind) {
+            return;
+        }
+        let skin = &character.asset.skin;
+        let SkinScratch { palette, positions, .. } = &mut *scratch;
+        palette.clear();
+        palette.extend(character.joints.iter().map(|&e| joints.get(e).map_or(Mat4::IDENTITY, |(c, b)| c.0 * b.0)));
+        positions.resize(skin.bind_positions.len(), Vec3::ZERO);
+        lbs::skin(&skin.bind_positions, &skin.weights, palette, positions);
+    });
+}
+
+/// Hands each re-skinned character's vertices to its render mesh (the material lights each
+/// triangle with its own normal), keeps the skin's bounds right (so culling follows the
+/// deformed mesh), rewrites colours when they changed, and clears `PoseDirty` (reads
+/// `SkinScratch`; writes `Mesh` assets, `Aabb`).
+pub fn write_skinned_meshes(
+    mut characters: Query<(&Character, &CharacterView, &HeatJoint, &mut PoseDirty, &mut SkinScratch)>,
     mut skin_bounds: Query<&mut Aabb, With<SkinMesh>>,
     mut meshes: ResMut<Assets<Mesh>>,
 ) {
@@ -104,22 +122,16 @@ pub fn skin_changed_characters(
         if *dirty == PoseDirty::default() {
             continue;
         }
-        let skin = &character.asset.skin;
         let Some(mut mesh) = meshes.get_mut(&character.mesh) else {
             continue;
         };
-        let SkinScratch { palette, positions, .. } = &mut *scratch;
         if dirty.matrices || dirty.bind {
-            palette.clear();
-            palette.extend(character.joints.iter().map(|&e| joints.get(e).map_or(Mat4::IDENTITY, |(c, b)| c.0 * b.0)));
-            positions.resize(skin.bind_positions.len(), Vec3::ZERO);
-            lbs::skin(&skin.bind_positions, &skin.weights, palette, positions);
             if let Ok(mut aabb) = skin_bounds.get_mut(character.skin_entity) {
-                let (lo, hi) = bounds(positions);
+                let (lo, hi) = bounds(&scratch.positions);
                 aabb.set_if_neq(Aabb::from_min_max(lo, hi));
             }
             if let Some(VertexAttributeValues::Float32x3(out)) = mesh.attribute_mut(Mesh::ATTRIBUTE_POSITION) {
-                out.iter_mut().zip(positions.iter()).for_each(|(o, p)| *o = p.to_array());
+                out.iter_mut().zip(&scratch.positions).for_each(|(o, p)| *o = p.to_array());
             }
         }
         if dirty.colors {

@@ -1,0 +1,380 @@
+//! `marionette bench`: a crowd of animated characters, headless, through the real app
+//! schedule and the render world (extraction and upload; the picture is drawn into a small
+//! offscreen target), timed per phase over many frames; and the skinning kernel against the
+//! plain loop it replaced.
+
+use std::path::{Path, PathBuf};
+use std::time::{Duration, Instant};
+
+use bevy::app::AppExit;
+use bevy::asset::AssetEvent;
+use bevy::camera::RenderTarget;
+use bevy::prelude::*;
+use bevy::render::pipelined_rendering::PipelinedRenderingPlugin;
+use bevy::render::render_resource::{TextureFormat, TextureUsages};
+use bevy::render::{Render, RenderApp, RenderSystems};
+use bevy::window::ExitCondition;
+use bevy::winit::WinitPlugin;
+
+use crate::editor::camera::OrbitCamera;
+use crate::editor::document::PendingScene;
+use crate::editor::readiness::CaptureGate;
+use crate::formats::scene::{CharacterDoc, PlacementDoc, SceneDoc, SmplDoc, SourceDoc, ViewDoc};
+use crate::rig::{CharacterAsset, JointRotation};
+use crate::scene::smpl::SmplCharacter;
+use crate::scene::{Character, JointPose, MarionetteSystems, RigCorePlugin, SkinningPlugin};
+
+/// What one run measured.
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct BenchReport {
+    pub characters: usize,
+    pub kind: String,
+    pub vertices_per_character: usize,
+    pub frames: usize,
+    /// CPU work of a frame: main-world schedule, extraction, and the render world's asset
+    /// preparation (the upload).
+    pub frame_ms_p50: f64,
+    pub frame_ms_p95: f64,
+    /// Medians of the phases.
+    pub sampling_ms_p50: f64,
+    pub fk_ms_p50: f64,
+    pub skin_ms_p50: f64,
+    pub extract_ms_p50: f64,
+    pub upload_ms_p50: f64,
+    /// The rest of the render world (drawing; on llvmpipe that is CPU work too).
+    pub render_world_ms_p50: f64,
+    pub upload_bytes_per_frame: usize,
+    /// The kernel on one character of the crowd, positions only, on one core.
+    pub kernel_mvps: f64,
+    /// The plain loop it replaced (kept as the oracle), same character, same run.
+    pub baseline_kernel_mvps: f64,
+}
+
+/// Instants at the phase boundaries of the main world's frame.
+#[derive(Resource, Default)]
+struct MainClock([Option<Instant>; 4]);
+
+/// Instants around the render world's asset preparation.
+#[derive(Resource, Default)]
+struct RenderClock([Option<Instant>; 2]);
+
+/// Mesh data handed on this frame (vertex buffer sizes of modified meshes).
+#[derive(Resource, Default)]
+struct HandedOn(usize);
+
+/// Runs the crowd bench: `characters` SMPL bodies from `data` (clips and β varied, all
+/// playing), or puppets swaying when there is no SMPL folder.
+pub fn run(characters: usize, frames: usize, data: Option<&Path>) -> Result<BenchReport, String> {
+    let smpl_dir = data.map(|d| d.join("smpl")).filter(|d| crate::formats::smpl::is_smpl_dir(d));
+    let (doc, kind) = match &smpl_dir {
+        Some(dir) => (smpl_crowd(dir, characters)?, "SMPL body"),
+        None => (puppet_crowd(characters), "puppet"),
+    };
+    let mut app = crowd_app(smpl_dir.is_none());
+    app.finish();
+    app.cleanup();
+    app.update();
+    *app.world_mut().resource_mut::<PendingScene>() = PendingScene { doc: Some(doc), frame: true };
+    warm_up(&mut app)?;
+    let asset = first_character_asset(&mut app).ok_or("the crowd has no character")?;
+    let mut samples = Vec::with_capacity(frames);
+    let mut bytes = 0;
+    for _ in 0..frames {
+        samples.push(timed_frame(&mut app));
+        bytes += app.world().resource::<HandedOn>().0;
+    }
+    let (kernel_mvps, baseline_kernel_mvps) = kernel_speeds(&asset);
+    let phase = |k: usize| median(samples.iter().map(|s| s[k]).collect());
+    let frame: Vec<f64> = samples.iter().map(|s| s[1] + s[2] + s[3] + s[4] + s[5]).collect();
+    Ok(BenchReport {
+        characters,
+        kind: kind.to_string(),
+        vertices_per_character: asset.vertex_count(),
+        frames,
+        frame_ms_p50: percentile(frame.clone(), 0.5),
+        frame_ms_p95: percentile(frame, 0.95),
+        sampling_ms_p50: phase(1),
+        fk_ms_p50: phase(2),
+        skin_ms_p50: phase(3),
+        extract_ms_p50: phase(4),
+        upload_ms_p50: phase(5),
+        render_world_ms_p50: phase(6),
+        upload_bytes_per_frame: bytes / frames.max(1),
+        kernel_mvps,
+        baseline_kernel_mvps,
+    })
+}
+
+/// The report as a table.
+pub fn table(r: &BenchReport) -> String {
+    format!(
+        "{} × {} ({} vertices each), {} frames\n\
+         frame (CPU: main world + extraction + upload)  p50 {:.2} ms  p95 {:.2} ms\n\
+         \x20 sampling {:.2} ms | FK {:.2} ms | skin {:.2} ms | extract {:.2} ms | upload {:.2} ms   (medians)\n\
+         \x20 render world besides the upload (drawing; CPU on llvmpipe) {:.2} ms\n\
+         mesh data handed on per frame: {} bytes\n\
+         kernel: {:.1} M vertices/s per core (the plain loop it replaced: {:.1}, ×{:.2})",
+        r.characters,
+        r.kind,
+        r.vertices_per_character,
+        r.frames,
+        r.frame_ms_p50,
+        r.frame_ms_p95,
+        r.sampling_ms_p50,
+        r.fk_ms_p50,
+        r.skin_ms_p50,
+        r.extract_ms_p50,
+        r.upload_ms_p50,
+        r.render_world_ms_p50,
+        r.upload_bytes_per_frame,
+        r.kernel_mvps,
+        r.baseline_kernel_mvps,
+        r.kernel_mvps / r.baseline_kernel_mvps,
+    )
+}
+
+/// The headless app: the editor's scene, stage and drawing, rendered into a small image
+/// without pipelining (so each phase can be timed in order), with clocks at the phase
+/// boundaries.
+fn crowd_app(sway: bool) -> App {
+    let mut app = App::new();
+    app.add_plugins(
+        DefaultPlugins
+            .set(WindowPlugin {
+                primary_window: None,
+                exit_condition: ExitCondition::DontExit,
+                close_when_requested: false,
+                ..default()
+            })
+            .disable::<WinitPlugin>()
+            .disable::<PipelinedRenderingPlugin>(),
+    )
+    .add_plugins((RigCorePlugin, SkinningPlugin, crate::editor::ViewPlugin))
+    .init_resource::<MainClock>()
+    .init_resource::<HandedOn>()
+    .add_systems(Startup, spawn_offscreen_camera)
+    .add_systems(PostUpdate, stamp::<0>.before(MarionetteSystems::Animate))
+    .add_systems(PostUpdate, stamp::<1>.after(MarionetteSystems::Animate).before(MarionetteSystems::Solve))
+    .add_systems(PostUpdate, stamp::<2>.after(MarionetteSystems::MatrixStack).before(MarionetteSystems::Skin))
+    .add_systems(PostUpdate, stamp::<3>.after(MarionetteSystems::Skin))
+    .add_systems(Last, count_handed_on);
+    if sway {
+        app.add_systems(PostUpdate, sway_puppets.in_set(MarionetteSystems::Animate));
+    }
+    let render = app.sub_app_mut(RenderApp);
+    render.init_resource::<RenderClock>();
+    render.add_systems(Render, render_stamp::<0>.before(RenderSystems::PrepareAssets));
+    render.add_systems(Render, render_stamp::<1>.after(RenderSystems::PrepareAssets));
+    app
+}
+
+fn stamp<const K: usize>(mut clock: ResMut<MainClock>) {
+    clock.0[K] = Some(Instant::now());
+}
+
+fn render_stamp<const K: usize>(mut clock: ResMut<RenderClock>) {
+    clock.0[K] = Some(Instant::now());
+}
+
+fn spawn_offscreen_camera(mut commands: Commands, mut images: ResMut<Assets<Image>>) {
+    let mut image = Image::new_target_texture(320, 240, TextureFormat::Rgba8UnormSrgb, None);
+    image.texture_descriptor.usage |= TextureUsages::COPY_SRC;
+    let target = images.add(image);
+    let orbit = OrbitCamera::default();
+    commands.spawn((Camera3d::default(), RenderTarget::Image(target.into()), orbit, orbit.transform()));
+}
+
+/// The vertex data of the meshes modified this frame (what extraction clones).
+fn count_handed_on(
+    mut events: MessageReader<AssetEvent<Mesh>>,
+    meshes: Res<Assets<Mesh>>,
+    mut handed: ResMut<HandedOn>,
+) {
+    handed.0 = events
+        .read()
+        .filter_map(|e| if let AssetEvent::Modified { id } = e { meshes.get(*id) } else { None })
+        .map(Mesh::get_vertex_buffer_size)
+        .sum();
+}
+
+/// Puppets have no clips: every joint sways with time, so every puppet re-skins each frame.
+fn sway_puppets(
+    time: Res<Time>,
+    characters: Query<&Character, Without<SmplCharacter>>,
+    mut poses: Query<&mut JointPose>,
+) {
+    let t = time.elapsed_secs();
+    for (i, character) in characters.iter().enumerate() {
+        for (j, &joint) in character.joints.iter().enumerate().skip(1) {
+            if let Ok(mut pose) = poses.get_mut(joint) {
+                let a = 0.2 * (t * 2.0 + i as f32 * 0.7 + j as f32 * 0.3).sin();
+                pose.0 = JointRotation::euler_xyz(a, 0.0, a * 0.5);
+            }
+        }
+    }
+}
+
+/// Runs frames until every pipeline is compiled and every mesh is on the GPU (at most a
+/// few minutes on llvmpipe), then a few more.
+fn warm_up(app: &mut App) -> Result<(), String> {
+    let started = Instant::now();
+    while !app.world().get_resource::<CaptureGate>().is_some_and(CaptureGate::is_ready) {
+        if started.elapsed() > Duration::from_secs(300) {
+            return Err("the renderer was not ready within 300 s".to_string());
+        }
+        if let Some(exit) = app.should_exit()
+            && exit != AppExit::Success
+        {
+            return Err("the app stopped while warming up".to_string());
+        }
+        app.update();
+    }
+    for _ in 0..10 {
+        app.update();
+    }
+    Ok(())
+}
+
+fn first_character_asset(app: &mut App) -> Option<std::sync::Arc<CharacterAsset>> {
+    let world = app.world_mut();
+    world.query::<&Character>().iter(world).next().map(|c| c.asset.clone())
+}
+
+/// One frame, as `App::update` runs it, timed: [whole, sampling, FK, skin, extract, upload,
+/// rest of the render world] in milliseconds.
+fn timed_frame(app: &mut App) -> [f64; 7] {
+    let start = Instant::now();
+    let apps = app.sub_apps_mut();
+    apps.main.run_default_schedule();
+    let mut extract = Duration::ZERO;
+    let mut render = Duration::ZERO;
+    for sub_app in apps.sub_apps.values_mut() {
+        let t = Instant::now();
+        sub_app.extract(apps.main.world_mut());
+        extract += t.elapsed();
+        let t = Instant::now();
+        sub_app.update();
+        render += t.elapsed();
+    }
+    apps.main.world_mut().clear_trackers();
+    let ms = |d: Duration| d.as_secs_f64() * 1e3;
+    let clock = app.world().resource::<MainClock>().0;
+    let between = |a: usize, b: usize| match (clock[a], clock[b]) {
+        (Some(a), Some(b)) => ms(b.saturating_duration_since(a)),
+        _ => 0.0,
+    };
+    let upload = app.sub_app(RenderApp).world().get_resource::<RenderClock>().map_or(0.0, |c| match c.0 {
+        [Some(a), Some(b)] => ms(b.saturating_duration_since(a)),
+        _ => 0.0,
+    });
+    [
+        ms(start.elapsed()),
+        between(0, 1),
+        between(1, 2),
+        between(2, 3),
+        ms(extract),
+        upload,
+        (ms(render) - upload).max(0.0),
+    ]
+}
+
+/// Vertices per second of the kernel and of the plain loop on `asset` in a posed pose.
+fn kernel_speeds(asset: &CharacterAsset) -> (f64, f64) {
+    let n = asset.skeleton.len();
+    let pose: Vec<JointRotation> = (0..n).map(|i| JointRotation::euler_xyz(0.1 * i as f32, 0.05, -0.02)).collect();
+    let mut current = vec![Mat4::IDENTITY; n];
+    crate::rig::fk::forward_kinematics(&asset.skeleton, &pose, Mat4::IDENTITY, &mut current);
+    let mut palette = vec![Mat4::IDENTITY; n];
+    crate::rig::fk::skinning_palette(&current, &asset.bind_world_to_joint, &mut palette);
+    let mut out = vec![Vec3::ZERO; asset.vertex_count()];
+    let skin = &asset.skin;
+    let mut speed = |run: &mut dyn FnMut(&mut [Vec3])| {
+        let (mut runs, started) = (0usize, Instant::now());
+        while started.elapsed() < Duration::from_millis(300) {
+            run(&mut out);
+            runs += 1;
+        }
+        (runs * skin.bind_positions.len()) as f64 / started.elapsed().as_secs_f64() / 1e6
+    };
+    let fast = speed(&mut |o| crate::rig::lbs::skin(&skin.bind_positions, &skin.weights, &palette, o));
+    let plain = speed(&mut |o| crate::rig::skinning::skin_positions(&skin.bind_positions, &skin.weights, &palette, o));
+    (fast, plain)
+}
+
+fn median(v: Vec<f64>) -> f64 {
+    percentile(v, 0.5)
+}
+
+/// The `q` quantile (nearest rank) of `v`.
+fn percentile(mut v: Vec<f64>, q: f64) -> f64 {
+    if v.is_empty() {
+        return 0.0;
+    }
+    v.sort_by(f64::total_cmp);
+    let rank = ((q * v.len() as f64).ceil() as usize).clamp(1, v.len());
+    v[rank - 1]
+}
+
+/// Where the `i`-th of `n` characters stands: a square grid `spacing` apart, centred.
+fn grid(i: usize, n: usize, spacing: f32) -> Vec3 {
+    let side = (n as f32).sqrt().ceil().max(1.0) as usize;
+    let (row, col) = (i / side, i % side);
+    let half = (side - 1) as f32 / 2.0;
+    Vec3::new((col as f32 - half) * spacing, 0.0, (row as f32 - half) * spacing)
+}
+
+fn crowd_member(i: usize, n: usize, source: SourceDoc, spacing: f32, lift: f32, smpl: Option<SmplDoc>) -> CharacterDoc {
+    CharacterDoc {
+        id: None,
+        source,
+        name: format!("crowd {i}"),
+        placement: PlacementDoc { translation: grid(i, n, spacing) + Vec3::Y * lift, yaw: 0.0, scale: 1.0 },
+        pose: Default::default(),
+        view: ViewDoc::default(),
+        smpl,
+        binding: None,
+    }
+}
+
+/// `n` SMPL bodies, each with its own β and clip (every third blends a second clip), all
+/// playing from different times.
+pub fn smpl_crowd(dir: &Path, n: usize) -> Result<SceneDoc, String> {
+    let clips: Vec<String> = crate::formats::smpl::clip_paths(dir)
+        .iter()
+        .filter_map(|p| Some(p.file_name()?.to_string_lossy().into_owned()))
+        .collect();
+    if clips.is_empty() {
+        return Err(format!("{}: expected SMPL clips (smpl_quaternions_*.txt), found none", dir.display()));
+    }
+    let characters = (0..n)
+        .map(|i| {
+            let state = SmplDoc {
+                betas: (0..10).map(|k| (((i * 7 + k * 3) % 11) as f32 - 5.0) * 0.3).collect(),
+                clip: Some(clips[i % clips.len()].clone()),
+                time: (i * 13 % 60) as f32,
+                playing: true,
+                blend_clip: (i % 3 == 0).then(|| clips[(i + 1) % clips.len()].clone()),
+                blend: if i % 3 == 0 { 0.5 } else { 0.0 },
+                ..SmplDoc::default()
+            };
+            crowd_member(i, n, SourceDoc::File(dir.to_path_buf()), 1.2, 1.2, Some(state))
+        })
+        .collect();
+    Ok(SceneDoc { characters, camera: None, stage: unshadowed_stage() })
+}
+
+/// `n` puppets on a grid.
+pub fn puppet_crowd(n: usize) -> SceneDoc {
+    let characters = (0..n).map(|i| crowd_member(i, n, SourceDoc::Embedded("puppet".into()), 0.8, 0.0, None)).collect();
+    SceneDoc { characters, camera: None, stage: unshadowed_stage() }
+}
+
+/// No shadows: the drawing (not what is measured) stays affordable on llvmpipe.
+fn unshadowed_stage() -> crate::formats::scene::StageDoc {
+    crate::formats::scene::StageDoc { shadows: false, ..Default::default() }
+}
+
+/// The data folder: `--data`, else `MARIONETTE_DATA`.
+pub fn data_folder(data: Option<PathBuf>) -> Option<PathBuf> {
+    data.or_else(|| std::env::var_os("MARIONETTE_DATA").map(PathBuf::from))
+}
