@@ -190,7 +190,9 @@ fn run(cli: Cli) -> Result<()> {
                 .with_context(|| format!("writing {}", dir.display()))?;
             let scene = dir.join("default_scene.ron");
             marionette::formats::scene::save_scene(&scene, &marionette::editor::default_scene::generate())?;
-            println!("wrote {}/puppet.{{skel,obj,attach}} and {}", dir.display(), scene.display());
+            let crowd = dir.join("crowd_scene.ron");
+            marionette::formats::scene::save_scene(&crowd, &marionette::editor::crowd::shipped_crowd())?;
+            println!("wrote {}/puppet.{{skel,obj,attach}}, {} and {}", dir.display(), scene.display(), crowd.display());
         }
     }
     Ok(())

@@ -14,6 +14,7 @@
 pub mod bench;
 pub mod camera;
 pub mod commands;
+pub mod crowd;
 pub mod default_scene;
 pub mod document;
 pub mod draw;
@@ -72,6 +73,7 @@ pub fn run(paths: Vec<PathBuf>) {
             ..default()
         }))
         .add_plugins(bevy_egui::EguiPlugin::default())
+        .add_plugins(bevy::diagnostic::FrameTimeDiagnosticsPlugin::default())
         // egui lives on its own full-window camera (see `spawn_window_camera`).
         .insert_resource(bevy_egui::EguiGlobalSettings { auto_create_primary_context: false, ..default() })
         .insert_resource(ClearColor(stage::SKY))

@@ -109,6 +109,8 @@ fn the_shipped_assets_are_what_the_generator_makes() {
         assert!(made == shipped, "assets/puppet.{ext} is stale: run `marionette gen-assets assets`");
     }
     let _ = scene_to_string(&scene).expect("serialises");
+    let crowd = read_scene(&PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("assets/crowd_scene.ron")).unwrap();
+    assert_eq!(crowd, marionette::editor::crowd::shipped_crowd(), "assets/crowd_scene.ron is stale");
 }
 
 /// Renders a small scene headlessly (Vulkan; llvmpipe without a GPU) and checks the picture.

@@ -6,6 +6,7 @@ pub mod joint_panel;
 pub mod scene_panel;
 pub mod smpl_panel;
 
+use bevy::diagnostic::{DiagnosticsStore, FrameTimeDiagnosticsPlugin};
 use bevy::ecs::system::SystemParam;
 use bevy::prelude::*;
 use bevy_egui::{EguiContexts, EguiPrimaryContextPass, egui};
@@ -25,6 +26,8 @@ pub struct InspectorState {
     pub scene_path: String,
     /// The DOF being dragged and its value, shown in the viewport.
     pub active_dof: Option<String>,
+    /// How many characters "Add crowd" adds.
+    pub crowd_size: usize,
 }
 
 impl Default for InspectorState {
@@ -35,6 +38,7 @@ impl Default for InspectorState {
             recent: Vec::new(),
             scene_path: format!("{cwd}/scene.ron"),
             active_dof: None,
+            crowd_size: 16,
         }
     }
 }
@@ -78,6 +82,7 @@ fn inspector_ui(
     mut shot: ResMut<ScreenshotRequest>,
     mut viewport_area: ResMut<ViewportArea>,
     mut hold: ResMut<GestureHold>,
+    diagnostics: Res<DiagnosticsStore>,
 ) -> Result {
     if shot.hide_ui() {
         // A screenshot without panels shows the whole window.
@@ -100,6 +105,7 @@ fn inspector_ui(
     let central = ui.available_rect_before_wrap();
     let area = ViewportArea(Some(Rect::new(central.min.x, central.min.y, central.max.x, central.max.y)));
     viewport_area.set_if_neq(area);
+    frame_time_readout(&ctx, central, &diagnostics);
     if let Some(text) = &state.active_dof {
         egui::Area::new("active_dof".into()).anchor(egui::Align2::CENTER_TOP, [0.0, 12.0]).show(&ctx, |ui| {
             egui::Frame::popup(ui.style()).show(ui, |ui| ui.label(egui::RichText::new(text).size(20.0).strong()));
@@ -107,4 +113,17 @@ fn inspector_ui(
     }
     hold.set_if_neq(GestureHold(ctx.egui_is_using_pointer() || ctx.egui_wants_keyboard_input()));
     Ok(())
+}
+
+/// The frame time (ms, smoothed) and frames per second in the viewport's top-right corner.
+fn frame_time_readout(ctx: &egui::Context, viewport: egui::Rect, diagnostics: &DiagnosticsStore) {
+    let smoothed = |path| diagnostics.get(path).and_then(bevy::diagnostic::Diagnostic::smoothed);
+    let (Some(ms), Some(fps)) =
+        (smoothed(&FrameTimeDiagnosticsPlugin::FRAME_TIME), smoothed(&FrameTimeDiagnosticsPlugin::FPS))
+    else {
+        return;
+    };
+    egui::Area::new("frame_time".into()).fixed_pos(viewport.right_top() + egui::vec2(-130.0, 8.0)).show(ctx, |ui| {
+        ui.label(egui::RichText::new(format!("{ms:.1} ms · {fps:.0} fps")).monospace().color(egui::Color32::WHITE));
+    });
 }

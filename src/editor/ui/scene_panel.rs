@@ -75,6 +75,14 @@ fn add_row(ui: &mut egui::Ui, state: &mut InspectorState, panels: &mut Panels) {
             add_character(&path, state, panels);
         }
     });
+    ui.horizontal(|ui| {
+        ui.add(egui::DragValue::new(&mut state.crowd_size).range(1..=512).suffix(" characters"));
+        let hint = "SMPL bodies (clips and shapes varied, playing) from the selected body's folder or the \
+                    SMPL folder above; puppets otherwise. One undo step.";
+        if ui.button("Add crowd").on_hover_text(hint).clicked() {
+            add_crowd(state, panels);
+        }
+    });
     if state.recent.is_empty() {
         return;
     }
@@ -122,6 +130,32 @@ fn add_character(path: &str, state: &mut InspectorState, panels: &mut Panels) {
     state.recent.truncate(8);
     if let Some(dir) = Path::new(path).parent() {
         state.add_path = format!("{}/", dir.display());
+    }
+}
+
+/// Adds a crowd right of the characters already there (one undo step: its edits land in
+/// one frame).
+fn add_crowd(state: &InspectorState, panels: &mut Panels) {
+    let selected_body = panels.selection.character.and_then(|id| {
+        panels.scene.characters.iter().find(|c| c.1.id == id).and_then(|c| c.5.map(|body| body.dir.clone()))
+    });
+    let typed = PathBuf::from(state.add_path.trim());
+    let folder = selected_body.or_else(|| crate::formats::smpl::is_smpl_dir(&typed).then_some(typed));
+    let crowd = match &folder {
+        Some(dir) => crate::editor::crowd::smpl_crowd(dir, state.crowd_size),
+        None => Ok(crate::editor::crowd::puppet_crowd(state.crowd_size)),
+    };
+    let crowd = match crowd {
+        Ok(doc) => doc,
+        Err(e) => return panels.messages.push(e),
+    };
+    let right = panels.scene.characters.iter().map(|c| c.3.translation.x).fold(f32::NEG_INFINITY, f32::max);
+    let width = crowd.characters.iter().map(|c| c.placement.translation.x).fold(0.0f32, |m, x| m.max(x.abs()));
+    let shift = if right.is_finite() { right + 1.0 + width } else { 0.0 };
+    for mut c in crowd.characters {
+        c.id = Some(panels.ids.take());
+        c.placement.translation.x += shift;
+        panels.push(Edit::Add(Box::new(c)));
     }
 }
 
