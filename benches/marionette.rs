@@ -1,8 +1,8 @@
 //! Benchmarks: the skinning kernel; one frame of the ECS systems for 1 and 16 characters
 //! (one joint changed per character per frame, so every character re-skins); one of 16
 //! moved or posed (with the bytes of mesh data handed on); an editing frame through the
-//! editor's commands (three SMPL bodies playing, a puppet dragged by IK, extraction's mesh
-//! clones), with and without the old per-frame document capture; FABRIK on 3-, 6- and 20-joint chains; the
+//! editor's commands (three SMPL bodies playing, a puppet dragged by IK), with and without
+//! the old per-frame document capture; FABRIK on 3-, 6- and 20-joint chains; the
 //! rotation-space IK solve of the CSE169 dragon's tail.
 //!
 //! Run: `cargo bench --profile dev --bench marionette` (with `MARIONETTE_DATA` set, the
@@ -160,8 +160,7 @@ fn ecs_frame(bencher: Bencher, characters: usize) {
 }
 
 /// 16 characters, one of which is moved (placement) or posed (a joint) each frame: the
-/// frame's cost, and (printed once) the bytes of mesh data handed on to rendering per frame,
-/// i.e. the vertex buffers of the meshes modified that frame.
+/// frame's cost, and (printed once) the bytes of vertex data handed to the GPU per frame.
 #[divan::bench(args = ["moved", "posed"])]
 fn ecs_frame_one_of_16_edited(bencher: Bencher, edit: &str) {
     let asset = asset();
@@ -180,46 +179,14 @@ fn ecs_frame_one_of_16_edited(bencher: Bencher, edit: &str) {
         }
         app.update();
     };
-    // Bytes handed on per frame: modified meshes' vertex data, over a few frames.
-    app.world_mut().resource_mut::<bevy::ecs::message::Messages<AssetEvent<Mesh>>>().clear();
+    // Bytes handed to the GPU per frame (the packed vertices of re-skinned characters).
+    let mut bytes = 0;
     for _ in 0..4 {
         edit_once(&mut app);
+        bytes += app.world().resource::<marionette::scene::upload::HandedOn>().0;
     }
-    app.update();
-    let modified: Vec<AssetId<Mesh>> = app
-        .world_mut()
-        .resource_mut::<bevy::ecs::message::Messages<AssetEvent<Mesh>>>()
-        .drain()
-        .filter_map(|e| if let AssetEvent::Modified { id } = e { Some(id) } else { None })
-        .collect();
-    let meshes = app.world().resource::<Assets<Mesh>>();
-    let bytes: usize = modified.iter().filter_map(|id| meshes.get(*id)).map(|m| m.get_vertex_buffer_size()).sum();
     eprintln!("ecs_frame_one_of_16_edited({edit}): {} bytes of mesh data per frame", bytes / 4);
     bencher.bench_local(|| edit_once(&mut app));
-}
-
-/// Mesh data handed to the render world: Bevy's extraction clones every main-world mesh
-/// that changed (`RenderAssetUsages::MAIN_WORLD`); this stand-in does the same clone.
-#[derive(Resource, Default)]
-struct Extracted {
-    frames: usize,
-    bytes: usize,
-}
-
-fn extract_modified_meshes(
-    mut events: MessageReader<AssetEvent<Mesh>>,
-    meshes: Res<Assets<Mesh>>,
-    mut out: ResMut<Extracted>,
-) {
-    out.frames += 1;
-    for event in events.read() {
-        if let AssetEvent::Modified { id } = event
-            && let Some(mesh) = meshes.get(*id)
-        {
-            let copy = divan::black_box(mesh.clone());
-            out.bytes += copy.get_vertex_buffer_size();
-        }
-    }
 }
 
 /// The document capture the editor ran every frame before edits became commands.
@@ -230,9 +197,9 @@ fn capture_scene_document(reader: marionette::editor::document::SceneReader) {
 /// An editing frame through the editor's own path: a scene of the puppet and three SMPL
 /// bodies each playing its own clip with its own β (from `MARIONETTE_DATA`; without it only
 /// the puppet), opened from a document; each frame the puppet's hand is dragged by IK (the
-/// solve, then an `Edit::Pose` applied in `Animate`), the chain runs, and every modified
-/// mesh is cloned as extraction does. `before`: the same frame plus the scene document the
-/// editor captured every frame before edits became commands.
+/// solve, then an `Edit::Pose` applied in `Animate`), the chain runs and packs the vertices
+/// handed to the GPU. `before`: the same frame plus the scene document the editor captured
+/// every frame before edits became commands.
 #[divan::bench(args = ["after", "before"])]
 fn editing_frame_3_smpl_playing_1_puppet_dragged(bencher: Bencher, variant: &str) {
     use marionette::editor::commands::{Edit, EditQueue};
@@ -241,9 +208,7 @@ fn editing_frame_3_smpl_playing_1_puppet_dragged(bencher: Bencher, variant: &str
     use marionette::rig::ik::{IkGoal, solve_ik};
     let mut app = App::new();
     app.add_plugins((MinimalPlugins, AssetPlugin::default(), bevy::mesh::MeshPlugin, RigCorePlugin, SkinningPlugin))
-        .add_plugins(marionette::editor::ScenePlugin)
-        .init_resource::<Extracted>()
-        .add_systems(Last, extract_modified_meshes);
+        .add_plugins(marionette::editor::ScenePlugin);
     if variant == "before" {
         app.add_systems(Update, capture_scene_document);
     }
@@ -292,15 +257,15 @@ fn editing_frame_3_smpl_playing_1_puppet_dragged(bencher: Bencher, variant: &str
         world.resource_mut::<EditQueue>().push(Edit::Pose { character: CharacterId(1), joints });
         app.update();
     };
-    *app.world_mut().resource_mut::<Extracted>() = Extracted::default();
+    let mut bytes = 0;
     for _ in 0..8 {
         drag_once(&mut app);
+        bytes += app.world().resource::<marionette::scene::upload::HandedOn>().0;
     }
-    let extracted = app.world().resource::<Extracted>();
     eprintln!(
-        "editing frame ({variant}): {} characters, {} bytes of mesh data extracted per frame",
+        "editing frame ({variant}): {} characters, {} bytes of vertex data handed to the GPU per frame",
         app.world().resource::<CharacterIndex>().len(),
-        extracted.bytes / extracted.frames
+        bytes / 8
     );
     bencher.bench_local(|| drag_once(&mut app));
 }

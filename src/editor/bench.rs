@@ -7,7 +7,6 @@ use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
 use bevy::app::AppExit;
-use bevy::asset::AssetEvent;
 use bevy::camera::RenderTarget;
 use bevy::prelude::*;
 use bevy::render::pipelined_rendering::PipelinedRenderingPlugin;
@@ -22,6 +21,7 @@ use crate::editor::document::PendingScene;
 use crate::editor::readiness::CaptureGate;
 use crate::rig::{CharacterAsset, JointRotation};
 use crate::scene::smpl::SmplCharacter;
+use crate::scene::upload::HandedOn;
 use crate::scene::{Character, JointPose, MarionetteSystems, RigCorePlugin, SkinningPlugin};
 
 /// What one run measured.
@@ -57,10 +57,6 @@ struct MainClock([Option<Instant>; 4]);
 /// Instants around the render world's asset preparation.
 #[derive(Resource, Default)]
 struct RenderClock([Option<Instant>; 2]);
-
-/// Mesh data handed on this frame (vertex buffer sizes of modified meshes).
-#[derive(Resource, Default)]
-struct HandedOn(usize);
 
 /// Runs the crowd bench: `characters` SMPL bodies from `data` (clips and β varied, all
 /// playing), or puppets swaying when there is no SMPL folder.
@@ -153,13 +149,11 @@ fn crowd_app(sway: bool) -> App {
     )
     .add_plugins((RigCorePlugin, SkinningPlugin, crate::editor::ViewPlugin))
     .init_resource::<MainClock>()
-    .init_resource::<HandedOn>()
     .add_systems(Startup, spawn_offscreen_camera)
     .add_systems(PostUpdate, stamp::<0>.before(MarionetteSystems::Animate))
     .add_systems(PostUpdate, stamp::<1>.after(MarionetteSystems::Animate).before(MarionetteSystems::Solve))
     .add_systems(PostUpdate, stamp::<2>.after(MarionetteSystems::MatrixStack).before(MarionetteSystems::Skin))
-    .add_systems(PostUpdate, stamp::<3>.after(MarionetteSystems::Skin))
-    .add_systems(Last, count_handed_on);
+    .add_systems(PostUpdate, stamp::<3>.after(MarionetteSystems::Skin));
     if sway {
         app.add_systems(PostUpdate, sway_puppets.in_set(MarionetteSystems::Animate));
     }
@@ -184,19 +178,6 @@ fn spawn_offscreen_camera(mut commands: Commands, mut images: ResMut<Assets<Imag
     let target = images.add(image);
     let orbit = OrbitCamera::default();
     commands.spawn((Camera3d::default(), RenderTarget::Image(target.into()), orbit, orbit.transform()));
-}
-
-/// The vertex data of the meshes modified this frame (what extraction clones).
-fn count_handed_on(
-    mut events: MessageReader<AssetEvent<Mesh>>,
-    meshes: Res<Assets<Mesh>>,
-    mut handed: ResMut<HandedOn>,
-) {
-    handed.0 = events
-        .read()
-        .filter_map(|e| if let AssetEvent::Modified { id } = e { meshes.get(*id) } else { None })
-        .map(Mesh::get_vertex_buffer_size)
-        .sum();
 }
 
 /// Puppets have no clips: every joint sways with time, so every puppet re-skins each frame.
@@ -271,15 +252,7 @@ fn timed_frame(app: &mut App) -> [f64; 7] {
         [Some(a), Some(b)] => ms(b.saturating_duration_since(a)),
         _ => 0.0,
     });
-    [
-        ms(total),
-        between(0, 1),
-        between(1, 2),
-        between(2, 3),
-        ms(extract),
-        upload,
-        (ms(render) - upload).max(0.0),
-    ]
+    [ms(total), between(0, 1), between(1, 2), between(2, 3), ms(extract), upload, (ms(render) - upload).max(0.0)]
 }
 
 /// Waits until the GPU has finished the frame: on llvmpipe its rasterising threads would

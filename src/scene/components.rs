@@ -10,7 +10,7 @@ use crate::rig::{CharacterAsset, DofLimits, JointRotation};
 /// A character: the loaded asset it was made from (shared by every character made from
 /// the same files), its joint entities by joint index and the entity that draws its skin.
 #[derive(Component, Clone)]
-#[require(Placement, CharacterView, HeatJoint, PoseDirty, Transform, Visibility)]
+#[require(Placement, CharacterView, HeatJoint, PoseDirty, Transform, Visibility, super::upload::SkinUpload)]
 pub struct Character {
     pub asset: Arc<CharacterAsset>,
     /// `joints[i]` is the entity of joint `i` of `asset.skeleton`.
@@ -143,7 +143,12 @@ pub struct JointScratch {
 #[derive(Component, Default)]
 pub struct SkinScratch {
     pub palette: Vec<Mat4>,
+    /// The skinned vertices, model space.
     pub positions: Vec<Vec3>,
+    /// The vertex colours.
+    pub colors: Vec<[f32; 4]>,
+    /// The skinned vertices' box.
+    pub bounds: (Vec3, Vec3),
     /// What the mesh's colours were last written from.
     pub colored_with: Option<Coloring>,
 }

@@ -15,6 +15,7 @@ pub mod components;
 pub mod smpl;
 pub mod spawn;
 pub mod systems;
+pub mod upload;
 
 use bevy::prelude::*;
 
@@ -74,9 +75,11 @@ pub struct SkinningPlugin;
 
 impl Plugin for SkinningPlugin {
     fn build(&self, app: &mut App) {
-        app.add_systems(
+        app.add_plugins(upload::SkinUploadPlugin).add_systems(
             PostUpdate,
-            (systems::skin_changed_characters, systems::write_skinned_meshes).chain().in_set(MarionetteSystems::Skin),
+            (systems::skin_changed_characters, systems::finish_skinned_characters)
+                .chain()
+                .in_set(MarionetteSystems::Skin),
         );
     }
 }

@@ -78,10 +78,11 @@ pub fn spawn_character_posed(
 
 /// A render mesh of the skin's own vertices and triangles: positions and colours, no
 /// normals (the skin material lights each triangle with its own normal, from the
-/// derivatives of the position). Kept in the main world so the skinning system can rewrite
-/// its positions.
+/// derivatives of the position). Its vertex data is what `upload::pack_vertices` packs.
 pub fn empty_skin_mesh(triangles: &[[u32; 3]], vertex_count: usize) -> Mesh {
-    Mesh::new(PrimitiveTopology::TriangleList, RenderAssetUsages::default())
+    // Only the render world keeps it: the skinning system writes vertices straight into its
+    // GPU slot (see `upload`), never into this asset.
+    Mesh::new(PrimitiveTopology::TriangleList, RenderAssetUsages::RENDER_WORLD)
         .with_inserted_attribute(Mesh::ATTRIBUTE_POSITION, vec![[0.0f32; 3]; vertex_count])
         .with_inserted_attribute(Mesh::ATTRIBUTE_COLOR, vec![[1.0f32; 4]; vertex_count])
         .with_inserted_indices(Indices::U32(triangles.iter().flatten().copied().collect()))

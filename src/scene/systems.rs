@@ -1,10 +1,10 @@
 //! The systems of the rig chain: mark what changed, bind, run the matrix stack, skin.
 
 use bevy::camera::primitives::Aabb;
-use bevy::mesh::VertexAttributeValues;
 use bevy::prelude::*;
 
 use super::components::*;
+use super::upload::{SkinUpload, pack_vertices};
 use crate::rig::JointRotation;
 use crate::rig::fk::forward_kinematics;
 use crate::rig::lbs;
@@ -90,71 +90,64 @@ pub fn compute_joint_to_world(
 }
 
 /// Skins characters marked dirty, in model space and in parallel on Bevy's compute task
-/// pool: palette `CurrentJointToWorld · BindWorldToJoint`, then the LBS kernel of the bind
-/// vertices into the character's scratch (reads joint matrices; writes `SkinScratch`).
+/// pool: palette `CurrentJointToWorld · BindWorldToJoint`, the LBS kernel of the bind
+/// vertices and their bounds; the colours when they changed; then packs the vertices for
+/// the GPU (reads joint matrices; writes `SkinScratch`, `SkinUpload`).
 pub fn skin_changed_characters(
-    mut characters: Query<(&Character, &PoseDirty, &mut SkinScratch)>,
+    mut characters: Query<(&Character, &CharacterView, &HeatJoint, &PoseDirty, &mut SkinScratch, &mut SkinUpload)>,
     joints: Query<(&CurrentJointToWorld, &BindWorldToJoint)>,
 ) {
-    characters.par_iter_mut().for_each(|(character, dirty, mut scratch)| {
-        if !(dirty.matrices || dirty.bind) {
+    characters.par_iter_mut().for_each(|(character, view, heat, dirty, mut scratch, mut upload)| {
+        if *dirty == PoseDirty::default() {
             return;
         }
         let skin = &character.asset.skin;
-        let SkinScratch { palette, positions, .. } = &mut *scratch;
-        palette.clear();
-        palette.extend(character.joints.iter().map(|&e| joints.get(e).map_or(Mat4::IDENTITY, |(c, b)| c.0 * b.0)));
-        positions.resize(skin.bind_positions.len(), Vec3::ZERO);
-        lbs::skin(&skin.bind_positions, &skin.weights, palette, positions);
+        let scratch = &mut *scratch;
+        if dirty.matrices || dirty.bind || scratch.positions.len() != skin.bind_positions.len() {
+            scratch.palette.clear();
+            scratch
+                .palette
+                .extend(character.joints.iter().map(|&e| joints.get(e).map_or(Mat4::IDENTITY, |(c, b)| c.0 * b.0)));
+            scratch.positions.resize(skin.bind_positions.len(), Vec3::ZERO);
+            lbs::skin(&skin.bind_positions, &skin.weights, &scratch.palette, &mut scratch.positions);
+            scratch.bounds = bounds(&scratch.positions);
+        }
+        if dirty.colors || scratch.colors.len() != skin.bind_positions.len() {
+            vertex_colors(character, view, heat.0, &mut scratch.colors);
+        }
+        pack_vertices(&scratch.positions, &scratch.colors, upload.buffer());
     });
 }
 
-/// Hands each re-skinned character's vertices to its render mesh (the material lights each
-/// triangle with its own normal), keeps the skin's bounds right (so culling follows the
-/// deformed mesh), rewrites colours when they changed, and clears `PoseDirty` (reads
-/// `SkinScratch`; writes `Mesh` assets, `Aabb`).
-pub fn write_skinned_meshes(
+/// Keeps each re-skinned character's bounds right (so culling follows the deformed mesh),
+/// notes what its colours were made from and clears `PoseDirty` (reads `SkinScratch`;
+/// writes `Aabb`).
+pub fn finish_skinned_characters(
     mut characters: Query<(&Character, &CharacterView, &HeatJoint, &mut PoseDirty, &mut SkinScratch)>,
     mut skin_bounds: Query<&mut Aabb, With<SkinMesh>>,
-    mut meshes: ResMut<Assets<Mesh>>,
 ) {
     for (character, view, heat, mut dirty, mut scratch) in &mut characters {
         if *dirty == PoseDirty::default() {
             continue;
         }
-        let Some(mut mesh) = meshes.get_mut(&character.mesh) else {
-            continue;
-        };
-        if dirty.matrices || dirty.bind {
-            if let Ok(mut aabb) = skin_bounds.get_mut(character.skin_entity) {
-                let (lo, hi) = bounds(&scratch.positions);
-                aabb.set_if_neq(Aabb::from_min_max(lo, hi));
-            }
-            if let Some(VertexAttributeValues::Float32x3(out)) = mesh.attribute_mut(Mesh::ATTRIBUTE_POSITION) {
-                out.iter_mut().zip(&scratch.positions).for_each(|(o, p)| *o = p.to_array());
-            }
+        if let Ok(mut aabb) = skin_bounds.get_mut(character.skin_entity) {
+            let (lo, hi) = scratch.bounds;
+            aabb.set_if_neq(Aabb::from_min_max(lo, hi));
         }
-        if dirty.colors {
-            write_colors(&mut mesh, character, view, heat.0);
-            scratch.colored_with = Some(Coloring::of(view, heat));
-        }
+        scratch.colored_with = Some(Coloring::of(view, heat));
         *dirty = PoseDirty::default();
     }
 }
 
-/// Rewrites the vertex colours: the tint, the weight colours or a joint's heat map.
-fn write_colors(mesh: &mut Mesh, character: &Character, view: &CharacterView, heat_joint: Option<usize>) {
+/// The vertex colours: the tint, the weight colours or a joint's heat map.
+fn vertex_colors(character: &Character, view: &CharacterView, heat_joint: Option<usize>, out: &mut Vec<[f32; 4]>) {
     let skin = &character.asset.skin;
-    let n = skin.bind_positions.len();
-    let mut per_vertex = vec![view.tint; n];
+    let mut per_vertex = vec![view.tint; skin.bind_positions.len()];
     if let Some(j) = heat_joint.filter(|&j| j < character.joints.len()) {
         heat_colors(&skin.weights, j, &mut per_vertex);
     } else if view.weight_colors {
         weight_colors(&skin.weights, &joint_colors(character.joints.len()), &mut per_vertex);
     }
-    if let Some(VertexAttributeValues::Float32x4(out)) = mesh.attribute_mut(Mesh::ATTRIBUTE_COLOR) {
-        for (o, [r, g, b]) in out.iter_mut().zip(per_vertex) {
-            *o = [r, g, b, 1.0];
-        }
-    }
+    out.clear();
+    out.extend(per_vertex.into_iter().map(|[r, g, b]| [r, g, b, 1.0]));
 }

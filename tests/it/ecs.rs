@@ -4,7 +4,6 @@ use std::sync::Arc;
 
 use bevy::asset::AssetEvent;
 use bevy::ecs::message::Messages;
-use bevy::mesh::VertexAttributeValues;
 use bevy::prelude::*;
 use marionette::cli::posing::posed_positions;
 use marionette::formats::puppet::embedded_puppet;
@@ -32,13 +31,14 @@ pub fn spawn(app: &mut App, asset: Arc<CharacterAsset>, placement: Placement) ->
     entity
 }
 
+/// The positions and colours a character hands to the GPU (decoded from its packed upload).
+fn uploaded_vertices(app: &App, character: Entity) -> (Vec<[f32; 3]>, Vec<[f32; 4]>) {
+    let upload = app.world().get::<marionette::scene::upload::SkinUpload>(character).unwrap();
+    upload.vertices.iter().map(|v| ([v[0], v[1], v[2]], [v[3], v[4], v[5], v[6]])).unzip()
+}
+
 fn mesh_positions(app: &App, character: Entity) -> Vec<[f32; 3]> {
-    let handle = app.world().get::<Character>(character).unwrap().mesh.clone();
-    let meshes = app.world().resource::<Assets<Mesh>>();
-    match meshes.get(&handle).unwrap().attribute(Mesh::ATTRIBUTE_POSITION).unwrap() {
-        VertexAttributeValues::Float32x3(p) => p.clone(),
-        _ => panic!("positions are Float32x3"),
-    }
+    uploaded_vertices(app, character).0
 }
 
 /// The kernel's expected render positions: the skinned vertices (the mesh shares them
@@ -109,9 +109,10 @@ fn posing_a_joint_reskins_the_mesh_like_the_kernel() {
     assert_positions_close(&placed, &oracle(&asset, &pose, &placement), 1e-4);
 }
 
-/// The mesh is the skin's own vertices and triangles: its positions and colours are what
-/// the kernels give, its indices the triangles; it carries no normals (the skin material
-/// lights each triangle with its own, from the position's derivatives).
+/// The skin is drawn from its own vertices and triangles: the positions and colours handed
+/// to the GPU are what the kernels give, the mesh's indices are the triangles, and it
+/// carries no normals (the skin material lights each triangle with its own, from the
+/// position's derivatives).
 #[test]
 fn mesh_triangles_and_weight_colours_match_the_kernels() {
     use marionette::rig::skinning::{joint_colors, weight_colors};
@@ -130,50 +131,77 @@ fn mesh_triangles_and_weight_colours_match_the_kernels() {
     weight_colors(&asset.skin.weights, &joint_colors(asset.skeleton.len()), &mut per_vertex);
     let handle = app.world().get::<Character>(character).unwrap().mesh.clone();
     let mesh = app.world().resource::<Assets<Mesh>>().get(&handle).unwrap();
-    assert_positions_close(&mesh_positions(&app, character), &skinned, 1e-5);
+    let (positions, colors) = uploaded_vertices(&app, character);
+    assert_positions_close(&positions, &skinned, 1e-5);
     assert!(mesh.attribute(Mesh::ATTRIBUTE_NORMAL).is_none(), "no normals are written");
     let Some(bevy::mesh::Indices::U32(indices)) = mesh.indices() else { panic!("indices are u32") };
     assert_eq!(indices.as_slice(), asset.skin.triangles.as_flattened());
-    let Some(VertexAttributeValues::Float32x4(colors)) = mesh.attribute(Mesh::ATTRIBUTE_COLOR) else {
-        panic!("colours are Float32x4")
-    };
     for (color, [r, g, b]) in colors.iter().zip(per_vertex) {
         assert_eq!(*color, [r, g, b, 1.0]);
     }
 }
 
-/// Which meshes were modified since the last call.
-fn modified_meshes(app: &mut App) -> Vec<AssetId<Mesh>> {
-    let mut messages = app.world_mut().resource_mut::<Messages<AssetEvent<Mesh>>>();
-    messages
-        .drain()
-        .filter_map(|e| match e {
-            AssetEvent::Modified { id } => Some(id),
-            _ => None,
-        })
-        .collect()
+/// The characters whose packed vertices changed in the last update, recorded by a system.
+#[derive(Resource, Default)]
+struct Uploaded(Vec<Entity>);
+
+fn record_uploads(
+    changed: Query<Entity, Changed<marionette::scene::upload::SkinUpload>>,
+    mut uploaded: ResMut<Uploaded>,
+) {
+    uploaded.0 = changed.iter().collect();
 }
 
+/// Bytes handed to the GPU follow what changed: none for a move (the placement is the
+/// character's `Transform`), the posed character's only for a pose; the mesh assets are
+/// never modified (no whole-mesh extraction).
 #[test]
-fn moving_a_character_rewrites_no_mesh_and_posing_one_rewrites_only_its_own() {
+fn moving_a_character_uploads_nothing_and_posing_one_uploads_only_its_own() {
     let asset = Arc::new(embedded_puppet());
     let mut app = app();
+    app.init_resource::<Uploaded>().add_systems(Last, record_uploads);
     let a = spawn(&mut app, asset.clone(), Placement::default());
-    let _other = spawn(&mut app, asset.clone(), Placement::at(Vec3::X));
+    let other = spawn(&mut app, asset.clone(), Placement::at(Vec3::X));
     app.update();
+    let mut first = app.world().resource::<Uploaded>().0.clone();
+    first.sort();
+    let mut both = vec![a, other];
+    both.sort();
+    assert_eq!(first, both, "both are uploaded once");
     app.update();
-    modified_meshes(&mut app);
-    let mesh_a = app.world().get::<Character>(a).unwrap().mesh.id();
+    app.world_mut().resource_mut::<Messages<AssetEvent<Mesh>>>().clear();
     app.world_mut().get_mut::<Placement>(a).unwrap().translation = Vec3::new(3.0, 0.0, 1.0);
-    // Asset events reach `Messages` one frame after the change: two updates.
     app.update();
-    app.update();
-    assert_eq!(modified_meshes(&mut app), Vec::<AssetId<Mesh>>::new(), "moving re-skins nothing");
+    assert_eq!(app.world().resource::<Uploaded>().0, Vec::<Entity>::new(), "moving re-skins nothing");
     assert_eq!(app.world().get::<Transform>(a).unwrap().translation, Vec3::new(3.0, 0.0, 1.0));
     set_joint(&mut app, a, 3, JointRotation::euler_xyz(0.5, 0.0, 0.0));
     app.update();
+    assert_eq!(app.world().resource::<Uploaded>().0, vec![a], "posing a re-skins a only");
     app.update();
-    assert_eq!(modified_meshes(&mut app), vec![mesh_a], "posing a re-skins a only");
+    let modified = app
+        .world_mut()
+        .resource_mut::<Messages<AssetEvent<Mesh>>>()
+        .drain()
+        .filter(|e| matches!(e, AssetEvent::Modified { .. }))
+        .count();
+    assert_eq!(modified, 0, "no mesh asset is modified");
+}
+
+/// The packed upload is byte for byte what Bevy would pack from a mesh holding the same
+/// positions and colours (the skin mesh's layout).
+#[test]
+fn packed_vertices_match_bevys_vertex_buffer() {
+    use marionette::scene::upload::pack_vertices;
+    let triangles = [[0u32, 1, 2], [2, 1, 3]];
+    let positions = [Vec3::new(0.0, 1.0, 2.0), Vec3::X, Vec3::new(-1.5, 0.25, 8.0), Vec3::splat(3.0)];
+    let colors = [[0.1, 0.2, 0.3, 1.0], [1.0, 0.0, 0.5, 1.0], [0.0; 4], [0.7, 0.7, 0.7, 1.0]];
+    let mut mesh = marionette::scene::spawn::empty_skin_mesh(&triangles, positions.len());
+    mesh.insert_attribute(Mesh::ATTRIBUTE_POSITION, positions.map(|p| p.to_array()).to_vec());
+    mesh.insert_attribute(Mesh::ATTRIBUTE_COLOR, colors.to_vec());
+    let mut upload = marionette::scene::upload::SkinUpload::default();
+    pack_vertices(&positions, &colors, upload.buffer());
+    assert_eq!(upload.bytes(), mesh.create_packed_vertex_buffer_data());
+    assert_eq!(upload.bytes().len(), positions.len() * marionette::scene::upload::SKIN_VERTEX_BYTES);
 }
 
 #[test]
