@@ -143,15 +143,19 @@ mod avx2 {
         let rows = group.joints.chunks_exact(K).zip(group.weights.chunks_exact(K));
         for (&v, (joints, weights)) in group.vertices.iter().zip(rows) {
             let (joints, weights): (&[u16; K], &[f32; K]) = (joints.try_into().unwrap(), weights.try_into().unwrap());
-            let mut c = [_mm_setzero_ps(); 4];
+            // Two accumulators (even and odd influences) halve the chain of dependent
+            // multiply-adds each column waits on.
+            let mut c = [[_mm_setzero_ps(); 4]; 2];
             for k in 0..K {
                 let m = &palette[joints[k] as usize];
                 let w = _mm_set1_ps(weights[k]);
-                c[0] = _mm_fmadd_ps(w, m.x_axis.into(), c[0]);
-                c[1] = _mm_fmadd_ps(w, m.y_axis.into(), c[1]);
-                c[2] = _mm_fmadd_ps(w, m.z_axis.into(), c[2]);
-                c[3] = _mm_fmadd_ps(w, m.w_axis.into(), c[3]);
+                let acc = &mut c[k % 2];
+                acc[0] = _mm_fmadd_ps(w, m.x_axis.into(), acc[0]);
+                acc[1] = _mm_fmadd_ps(w, m.y_axis.into(), acc[1]);
+                acc[2] = _mm_fmadd_ps(w, m.z_axis.into(), acc[2]);
+                acc[3] = _mm_fmadd_ps(w, m.w_axis.into(), acc[3]);
             }
+            let c: [__m128; 4] = std::array::from_fn(|i| _mm_add_ps(c[0][i], c[1][i]));
             let b = bind[v as usize];
             let p = _mm_fmadd_ps(
                 c[0],
