@@ -138,6 +138,7 @@ fn crowd_app(sway: bool) -> App {
     let mut app = App::new();
     app.add_plugins(
         DefaultPlugins
+            .set(crate::editor::task_pools())
             .set(WindowPlugin {
                 primary_window: None,
                 exit_condition: ExitCondition::DontExit,

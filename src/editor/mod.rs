@@ -61,10 +61,32 @@ impl Plugin for InteractionPlugin {
     }
 }
 
+/// Bevy's task pools with every core for compute (systems and the parallel skinning):
+/// one thread each for IO and async tasks on top, instead of taking them from the cores
+/// (on 2 cores Bevy's default leaves compute a single thread).
+pub fn task_pools() -> bevy::app::TaskPoolPlugin {
+    let one = |policy: bevy::app::TaskPoolThreadAssignmentPolicy| bevy::app::TaskPoolThreadAssignmentPolicy {
+        min_threads: 1,
+        max_threads: 1,
+        ..policy
+    };
+    let defaults = bevy::app::TaskPoolOptions::default();
+    let cores = bevy::tasks::available_parallelism();
+    bevy::app::TaskPoolPlugin {
+        task_pool_options: bevy::app::TaskPoolOptions {
+            min_total_threads: cores + 2,
+            max_total_threads: cores + 2,
+            io: one(defaults.io),
+            async_compute: one(defaults.async_compute),
+            compute: defaults.compute,
+        },
+    }
+}
+
 /// Opens the editor window on `paths` (or on the default scene) and runs until closed.
 pub fn run(paths: Vec<PathBuf>) {
     App::new()
-        .add_plugins(DefaultPlugins.set(WindowPlugin {
+        .add_plugins(DefaultPlugins.set(task_pools()).set(WindowPlugin {
             primary_window: Some(Window {
                 title: "Marionette".into(),
                 resolution: WindowResolution::new(1280, 800),

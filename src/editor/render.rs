@@ -53,6 +53,7 @@ pub fn render(
     let mut app = App::new();
     app.add_plugins(
         DefaultPlugins
+            .set(super::task_pools())
             .set(WindowPlugin {
                 primary_window: None,
                 exit_condition: ExitCondition::DontExit,
