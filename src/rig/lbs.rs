@@ -58,23 +58,34 @@ impl InfluenceGroups {
 /// When the lengths of `bind_positions`, `weights` and `out` differ, or an influence names
 /// a joint beyond the palette.
 pub fn skin(bind_positions: &[Vec3], weights: &SkinWeights, palette: &[Mat4], out: &mut [Vec3]) {
-    assert_eq!(bind_positions.len(), weights.vertex_count(), "one weight row per vertex");
     assert_eq!(out.len(), bind_positions.len(), "one output per vertex");
+    skin_chunk(bind_positions, weights, palette, 0, out);
+}
+
+/// Skins the vertices `first..first + out.len()` into `out` (a large mesh is skinned in
+/// chunks on several threads, each writing its own part of the output).
+///
+/// # Panics
+/// When `bind_positions` and `weights` differ in length, the chunk runs past the mesh, or
+/// an influence names a joint beyond the palette.
+pub fn skin_chunk(bind_positions: &[Vec3], weights: &SkinWeights, palette: &[Mat4], first: usize, out: &mut [Vec3]) {
+    assert_eq!(bind_positions.len(), weights.vertex_count(), "one weight row per vertex");
+    assert!(first + out.len() <= bind_positions.len(), "the chunk lies inside the mesh");
     let groups = weights.groups();
     assert!(groups.joint_bound <= palette.len(), "an influence names a joint beyond the palette");
     #[cfg(target_arch = "x86_64")]
     if std::arch::is_x86_feature_detected!("avx2") && std::arch::is_x86_feature_detected!("fma") {
         // SAFETY: the CPU has AVX2 and FMA (checked above).
         unsafe {
-            avx2::skin_fixed::<1>(bind_positions, &groups.fixed[0], palette, out);
-            avx2::skin_fixed::<2>(bind_positions, &groups.fixed[1], palette, out);
-            avx2::skin_fixed::<3>(bind_positions, &groups.fixed[2], palette, out);
-            avx2::skin_fixed::<4>(bind_positions, &groups.fixed[3], palette, out);
+            avx2::skin_fixed::<1>(bind_positions, &groups.fixed[0], palette, first, out);
+            avx2::skin_fixed::<2>(bind_positions, &groups.fixed[1], palette, first, out);
+            avx2::skin_fixed::<3>(bind_positions, &groups.fixed[2], palette, first, out);
+            avx2::skin_fixed::<4>(bind_positions, &groups.fixed[3], palette, first, out);
         }
-        skin_wide(bind_positions, weights, &groups.wide, palette, out);
+        skin_wide(bind_positions, weights, &groups.wide, palette, first, out);
         return;
     }
-    skin_portable(bind_positions, weights, palette, out);
+    skin_portable_chunk(bind_positions, weights, palette, first, out);
 }
 
 /// [`skin`] without the AVX2 path: glam's `Vec4` on any target (what other CPUs run).
@@ -84,18 +95,35 @@ pub fn skin(bind_positions: &[Vec3], weights: &SkinWeights, palette: &[Mat4], ou
 pub fn skin_portable(bind_positions: &[Vec3], weights: &SkinWeights, palette: &[Mat4], out: &mut [Vec3]) {
     assert_eq!(bind_positions.len(), weights.vertex_count(), "one weight row per vertex");
     assert_eq!(out.len(), bind_positions.len(), "one output per vertex");
+    skin_portable_chunk(bind_positions, weights, palette, 0, out);
+}
+
+fn skin_portable_chunk(bind: &[Vec3], weights: &SkinWeights, palette: &[Mat4], first: usize, out: &mut [Vec3]) {
     let groups = weights.groups();
-    skin_fixed_portable::<1>(bind_positions, &groups.fixed[0], palette, out);
-    skin_fixed_portable::<2>(bind_positions, &groups.fixed[1], palette, out);
-    skin_fixed_portable::<3>(bind_positions, &groups.fixed[2], palette, out);
-    skin_fixed_portable::<4>(bind_positions, &groups.fixed[3], palette, out);
-    skin_wide(bind_positions, weights, &groups.wide, palette, out);
+    skin_fixed_portable::<1>(bind, &groups.fixed[0], palette, first, out);
+    skin_fixed_portable::<2>(bind, &groups.fixed[1], palette, first, out);
+    skin_fixed_portable::<3>(bind, &groups.fixed[2], palette, first, out);
+    skin_fixed_portable::<4>(bind, &groups.fixed[3], palette, first, out);
+    skin_wide(bind, weights, &groups.wide, palette, first, out);
+}
+
+/// The rows of `group` whose vertices lie in `first..first + len` (vertices ascend).
+fn rows_in<const K: usize>(group: &FixedGroup, first: usize, len: usize) -> (&[u32], &[u16], &[f32]) {
+    let lo = group.vertices.partition_point(|&v| (v as usize) < first);
+    let hi = group.vertices.partition_point(|&v| (v as usize) < first + len);
+    (&group.vertices[lo..hi], &group.joints[lo * K..hi * K], &group.weights[lo * K..hi * K])
 }
 
 /// The portable path of one fixed group: blend `K` matrices with glam's `Vec4`.
-fn skin_fixed_portable<const K: usize>(bind: &[Vec3], group: &FixedGroup, palette: &[Mat4], out: &mut [Vec3]) {
-    let rows = group.joints.chunks_exact(K).zip(group.weights.chunks_exact(K));
-    for (&v, (joints, weights)) in group.vertices.iter().zip(rows) {
+fn skin_fixed_portable<const K: usize>(
+    bind: &[Vec3],
+    group: &FixedGroup,
+    palette: &[Mat4],
+    first: usize,
+    out: &mut [Vec3],
+) {
+    let (vertices, joints, weights) = rows_in::<K>(group, first, out.len());
+    for (&v, (joints, weights)) in vertices.iter().zip(joints.chunks_exact(K).zip(weights.chunks_exact(K))) {
         let mut m = [Vec4::ZERO; 4];
         for (&j, &w) in joints.iter().zip(weights) {
             let p = &palette[j as usize];
@@ -105,13 +133,15 @@ fn skin_fixed_portable<const K: usize>(bind: &[Vec3], group: &FixedGroup, palett
             m[3] += p.w_axis * w;
         }
         let b = bind[v as usize];
-        out[v as usize] = (m[0] * b.x + m[1] * b.y + m[2] * b.z + m[3]).truncate();
+        out[v as usize - first] = (m[0] * b.x + m[1] * b.y + m[2] * b.z + m[3]).truncate();
     }
 }
 
 /// Vertices with more than four influences, blended the same way from the compressed rows.
-fn skin_wide(bind: &[Vec3], weights: &SkinWeights, wide: &[u32], palette: &[Mat4], out: &mut [Vec3]) {
-    for &v in wide {
+fn skin_wide(bind: &[Vec3], weights: &SkinWeights, wide: &[u32], palette: &[Mat4], first: usize, out: &mut [Vec3]) {
+    let lo = wide.partition_point(|&v| (v as usize) < first);
+    let hi = wide.partition_point(|&v| (v as usize) < first + out.len());
+    for &v in &wide[lo..hi] {
         let mut m = Mat4::ZERO;
         for inf in weights.of_vertex(v as usize) {
             let p = &palette[inf.joint as usize];
@@ -120,7 +150,7 @@ fn skin_wide(bind: &[Vec3], weights: &SkinWeights, wide: &[u32], palette: &[Mat4
             m.z_axis += p.z_axis * inf.weight;
             m.w_axis += p.w_axis * inf.weight;
         }
-        out[v as usize] = m.transform_point3(bind[v as usize]);
+        out[v as usize - first] = m.transform_point3(bind[v as usize]);
     }
 }
 
@@ -139,9 +169,16 @@ mod avx2 {
     /// The CPU must have AVX2 and FMA. (Indices are checked: a joint beyond the palette or a
     /// vertex beyond the buffers panics.)
     #[target_feature(enable = "avx2,fma")]
-    pub unsafe fn skin_fixed<const K: usize>(bind: &[Vec3], group: &FixedGroup, palette: &[Mat4], out: &mut [Vec3]) {
-        let rows = group.joints.chunks_exact(K).zip(group.weights.chunks_exact(K));
-        for (&v, (joints, weights)) in group.vertices.iter().zip(rows) {
+    pub unsafe fn skin_fixed<const K: usize>(
+        bind: &[Vec3],
+        group: &FixedGroup,
+        palette: &[Mat4],
+        first: usize,
+        out: &mut [Vec3],
+    ) {
+        let (vertices, joints, weights) = super::rows_in::<K>(group, first, out.len());
+        let rows = joints.chunks_exact(K).zip(weights.chunks_exact(K));
+        for (&v, (joints, weights)) in vertices.iter().zip(rows) {
             let (joints, weights): (&[u16; K], &[f32; K]) = (joints.try_into().unwrap(), weights.try_into().unwrap());
             // Two accumulators (even and odd influences) halve the chain of dependent
             // multiply-adds each column waits on.
@@ -162,7 +199,7 @@ mod avx2 {
                 _mm_set1_ps(b.x),
                 _mm_fmadd_ps(c[1], _mm_set1_ps(b.y), _mm_fmadd_ps(c[2], _mm_set1_ps(b.z), c[3])),
             );
-            out[v as usize] = Vec4::from(p).truncate();
+            out[v as usize - first] = Vec4::from(p).truncate();
         }
     }
 }

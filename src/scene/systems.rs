@@ -109,13 +109,31 @@ pub fn skin_changed_characters(
                 .palette
                 .extend(character.joints.iter().map(|&e| joints.get(e).map_or(Mat4::IDENTITY, |(c, b)| c.0 * b.0)));
             scratch.positions.resize(skin.bind_positions.len(), Vec3::ZERO);
-            lbs::skin(&skin.bind_positions, &skin.weights, &scratch.palette, &mut scratch.positions);
+            skin_in_chunks(skin, &scratch.palette, &mut scratch.positions);
             scratch.bounds = bounds(&scratch.positions);
         }
         if dirty.colors || scratch.colors.len() != skin.bind_positions.len() {
             vertex_colors(character, view, heat.0, &mut scratch.colors);
         }
         pack_vertices(&scratch.positions, &scratch.colors, upload.buffer());
+    });
+}
+
+/// Vertices per task when one mesh is skinned on several threads.
+pub const SKIN_CHUNK_VERTICES: usize = 16_384;
+
+/// Skins a mesh, in chunks of [`SKIN_CHUNK_VERTICES`] on the compute task pool when it is
+/// larger than one.
+fn skin_in_chunks(skin: &crate::rig::Skin, palette: &[Mat4], out: &mut [Vec3]) {
+    if out.len() <= SKIN_CHUNK_VERTICES {
+        return lbs::skin(&skin.bind_positions, &skin.weights, palette, out);
+    }
+    bevy::tasks::ComputeTaskPool::get().scope(|scope| {
+        for (k, chunk) in out.chunks_mut(SKIN_CHUNK_VERTICES).enumerate() {
+            scope.spawn(async move {
+                lbs::skin_chunk(&skin.bind_positions, &skin.weights, palette, k * SKIN_CHUNK_VERTICES, chunk);
+            });
+        }
     });
 }
 

@@ -241,8 +241,22 @@ fn poses_set_outside_the_limits_are_clamped() {
 #[test]
 #[cfg_attr(not(marionette_data), ignore = "needs MARIONETTE_DATA (the course data)")]
 fn model1_in_the_ecs_matches_the_kernel() {
-    let data = data_dir();
-    let asset = Arc::new(marionette::formats::load_character(&data.join("mit6837/Model1.skel")).unwrap());
+    ecs_matches_the_kernel("mit6837/Model1.skel");
+}
+
+/// Homer's 24,421-vertex mesh is larger than one skinning chunk: it is skinned in parts on
+/// several threads, and the result is the kernel's.
+#[test]
+#[cfg_attr(not(marionette_data), ignore = "needs MARIONETTE_DATA (the course data)")]
+fn a_mesh_skinned_in_chunks_matches_the_kernel() {
+    let vertices = ecs_matches_the_kernel("homer/homerskel.json");
+    assert!(vertices > marionette::scene::systems::SKIN_CHUNK_VERTICES, "{vertices} vertices: more than one chunk");
+}
+
+/// Poses joint 6 of the character in the ECS and compares its skin with the kernel's;
+/// returns its vertex count.
+fn ecs_matches_the_kernel(file: &str) -> usize {
+    let asset = Arc::new(marionette::formats::load_character(&data_dir().join(file)).unwrap());
     let mut app = app();
     let character = spawn(&mut app, asset.clone(), Placement::default());
     app.update();
@@ -252,6 +266,7 @@ fn model1_in_the_ecs_matches_the_kernel() {
     let mut pose = asset.skeleton.initial_pose();
     pose[6] = rotation;
     assert_positions_close(&mesh_positions(&app, character), &oracle(&asset, &pose, &Placement::default()), 1e-5);
+    asset.vertex_count()
 }
 
 /// SMPL in the ECS (shape change, clip pose) against the pure SMPL poser.

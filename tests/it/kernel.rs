@@ -61,6 +61,14 @@ fn the_kernel_matches_the_oracle_on_rows_of_1_to_13_influences() {
     let (weights, _) = SkinWeights::from_rows(rows, joints).unwrap();
     assert!(weights.groups().fixed.iter().all(|g| !g.vertices.is_empty()) && !weights.groups().wide.is_empty());
     assert_kernel_matches_oracle("synthetic", &bind, &weights, &palette);
+    // In chunks (how a large mesh is split across threads): the same output exactly.
+    let mut whole = vec![Vec3::ZERO; n];
+    skin(&bind, &weights, &palette, &mut whole);
+    let mut chunked = vec![Vec3::splat(f32::NAN); n];
+    for (k, chunk) in chunked.chunks_mut(300).enumerate() {
+        marionette::rig::lbs::skin_chunk(&bind, &weights, &palette, k * 300, chunk);
+    }
+    assert_eq!(chunked, whole);
 }
 
 #[test]
