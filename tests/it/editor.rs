@@ -181,3 +181,48 @@ fn model1_and_model2_render_side_by_side() {
     assert!(output.status.success(), "{}", String::from_utf8_lossy(&output.stderr));
     assert_eq!(image::open(&out).unwrap().to_rgb8().dimensions(), (160, 120));
 }
+
+/// `marionette bench --json` runs a small crowd through the app and the render world
+/// (puppets: no data folder) and reports every figure the issue asks for.
+#[test]
+fn bench_reports_a_crowds_frame_times_as_json() {
+    let output = Command::new(env!("CARGO_BIN_EXE_marionette"))
+        .args(["bench", "--characters", "3", "--frames", "5", "--json"])
+        .env_remove("MARIONETTE_DATA")
+        .output()
+        .unwrap();
+    assert!(output.status.success(), "{}", String::from_utf8_lossy(&output.stderr));
+    let stdout = String::from_utf8_lossy(&output.stdout);
+    let report: serde_json::Value = serde_json::from_str(stdout.trim()).expect("one JSON object");
+    assert_eq!(report["characters"], 3);
+    assert_eq!(report["kind"], "puppet");
+    for key in ["frame_ms_p50", "frame_ms_p95", "kernel_mvps", "baseline_kernel_mvps"] {
+        let value = report[key].as_f64().unwrap_or_else(|| panic!("{key} is a number: {report}"));
+        assert!(value > 0.0, "{key} = {value}");
+    }
+    assert!(report["frame_ms_p95"].as_f64() >= report["frame_ms_p50"].as_f64());
+    // Three swaying puppets re-skin every frame: their packed vertices go to the GPU.
+    let puppet = marionette::formats::puppet::embedded_puppet();
+    let per_frame = 3 * puppet.vertex_count() * marionette::scene::upload::SKIN_VERTEX_BYTES;
+    assert_eq!(report["upload_bytes_per_frame"], per_frame);
+}
+
+/// Crowds: every member in its own place on the grid; SMPL members each with their own
+/// shape and a clip, every third blending a second.
+#[test]
+fn crowd_members_stand_apart_with_their_own_shape_and_clip() {
+    let doc = marionette::editor::crowd::puppet_crowd(10);
+    let places: Vec<_> = doc.characters.iter().map(|c| c.placement.translation).collect();
+    for (i, a) in places.iter().enumerate() {
+        for b in &places[i + 1..] {
+            assert!(a.distance(*b) >= 0.79, "{a} and {b} overlap");
+        }
+    }
+    if let Some(data) = crate::common::optional_data_dir() {
+        let crowd = marionette::editor::crowd::smpl_crowd(&data.join("smpl"), 6).unwrap();
+        let smpl: Vec<_> = crowd.characters.iter().map(|c| c.smpl.clone().unwrap()).collect();
+        assert!(smpl.iter().all(|s| s.playing && s.clip.is_some()));
+        assert_ne!(smpl[0].betas, smpl[1].betas);
+        assert_eq!(smpl.iter().filter(|s| s.blend_clip.is_some()).count(), 2);
+    }
+}
