@@ -8,7 +8,7 @@ use clap::{Parser, Subcommand};
 use glam::Mat4;
 
 use marionette::cli::posing::{
-    IkSpec, PoseSpec, apply_ik_specs, apply_pose_specs, describe, describe_ik, posed_positions,
+    IkSpec, PoseSpec, apply_ik_specs, apply_pose_specs, describe, describe_ik, posed_positions_by,
 };
 use marionette::formats::{load_character, obj};
 
@@ -45,6 +45,9 @@ enum Command {
         /// (FABRIK), after --pose. Repeatable.
         #[arg(long = "ik", value_name = "JOINT=x,y,z")]
         ik: Vec<IkSpec>,
+        /// Linear blend (`lbs`) or dual quaternion (`dq`) skinning.
+        #[arg(long, value_enum, default_value_t = Skinning::Lbs)]
+        skinning: Skinning,
     },
     /// Bind a mesh without weights to a skeleton (each vertex to its nearest bone, or
     /// smoothly to the nearest few) and write 6.837-style weights.
@@ -75,6 +78,10 @@ enum Command {
         /// `JOINT=x,y,z` world-space IK target for every character that has the joint.
         #[arg(long = "ik", value_name = "JOINT=x,y,z")]
         ik: Vec<IkSpec>,
+        /// Skin every character by linear blend (`lbs`) or dual quaternion (`dq`) skinning
+        /// (default: as the scene file says).
+        #[arg(long, value_enum)]
+        skinning: Option<Skinning>,
     },
     /// The SMPL exercise: writes frame000.obj, frame001.obj, ... into --out.
     ///
@@ -131,6 +138,24 @@ enum Command {
     },
 }
 
+/// `--skinning`.
+#[derive(Clone, Copy, Debug, clap::ValueEnum)]
+enum Skinning {
+    /// Linear blend skinning.
+    Lbs,
+    /// Dual quaternion skinning.
+    Dq,
+}
+
+impl From<Skinning> for marionette::rig::dqs::SkinningMethod {
+    fn from(s: Skinning) -> Self {
+        match s {
+            Skinning::Lbs => Self::Linear,
+            Skinning::Dq => Self::DualQuaternion,
+        }
+    }
+}
+
 fn main() -> ExitCode {
     match run(Cli::parse()) {
         Ok(()) => ExitCode::SUCCESS,
@@ -146,7 +171,7 @@ fn run(cli: Cli) -> Result<()> {
         None => marionette::editor::run(Vec::new()),
         Some(Command::Edit { paths }) => marionette::editor::run(paths),
         Some(Command::Info { path }) => print!("{}", describe(&load_character(&path)?)),
-        Some(Command::Export { path, out, poses, ik }) => {
+        Some(Command::Export { path, out, poses, ik, skinning }) => {
             let asset = load_character(&path)?;
             for w in &asset.warnings {
                 eprintln!("warning: {w}");
@@ -156,13 +181,13 @@ fn run(cli: Cli) -> Result<()> {
             for report in apply_ik_specs(&asset.skeleton, &mut pose, Mat4::IDENTITY, &ik)? {
                 eprintln!("{}", describe_ik(&asset.skeleton, &report));
             }
-            let positions = posed_positions(&asset, &pose, Mat4::IDENTITY);
+            let positions = posed_positions_by(&asset, &pose, Mat4::IDENTITY, skinning.into());
             write_file(&out, |w| obj::write_obj(w, &positions, &asset.skin.triangles))?;
             println!("wrote {} ({} vertices, {} triangles)", out.display(), positions.len(), asset.triangle_count());
         }
-        Some(Command::Render { paths, out, width, height, poses, ik }) => {
+        Some(Command::Render { paths, out, width, height, poses, ik, skinning }) => {
             let started = std::time::Instant::now();
-            let edits = marionette::editor::StartupEdits { poses, ik };
+            let edits = marionette::editor::StartupEdits { poses, ik, skinning: skinning.map(Into::into) };
             let notes = marionette::editor::render::render(paths, edits, out.clone(), width, height)
                 .map_err(anyhow::Error::msg)?;
             for n in notes {

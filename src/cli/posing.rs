@@ -3,6 +3,7 @@
 
 use glam::{Mat4, Vec3};
 
+use crate::rig::dqs::SkinningMethod;
 use crate::rig::fk::{forward_kinematics, skinning_palette};
 use crate::rig::lbs::skin;
 use crate::rig::{CharacterAsset, JointRotation, Skeleton};
@@ -70,13 +71,30 @@ fn joint_list(skeleton: &Skeleton) -> String {
 
 /// The skin's vertices at `pose`, in source order, with the character placed by `placement`.
 pub fn posed_positions(asset: &CharacterAsset, pose: &[JointRotation], placement: Mat4) -> Vec<Vec3> {
+    posed_positions_by(asset, pose, placement, SkinningMethod::Linear)
+}
+
+/// As [`posed_positions`], by linear blend or dual quaternion skinning.
+pub fn posed_positions_by(
+    asset: &CharacterAsset,
+    pose: &[JointRotation],
+    placement: Mat4,
+    method: SkinningMethod,
+) -> Vec<Vec3> {
     let n = asset.skeleton.len();
     let mut current = vec![Mat4::IDENTITY; n];
     forward_kinematics(&asset.skeleton, pose, placement, &mut current);
     let mut palette = vec![Mat4::IDENTITY; n];
     skinning_palette(&current, &asset.bind_world_to_joint, &mut palette);
     let mut out = vec![Vec3::ZERO; asset.vertex_count()];
-    skin(&asset.skin.bind_positions, &asset.skin.weights, &palette, &mut out);
+    match method {
+        SkinningMethod::Linear => skin(&asset.skin.bind_positions, &asset.skin.weights, &palette, &mut out),
+        SkinningMethod::DualQuaternion => {
+            let mut dq = Vec::new();
+            crate::rig::dqs::dual_quaternion_palette(&palette, &mut dq);
+            crate::rig::dqs::skin_dq(&asset.skin.bind_positions, &asset.skin.weights, &dq, &mut out);
+        }
+    }
     out
 }
 

@@ -11,10 +11,14 @@ use super::document::{AssetLibrary, CharacterIndex, NextCharacterId, SceneCharac
 use super::history::History;
 use super::stage::StageSettings;
 use super::state::Messages;
-use crate::formats::scene::{BindingDoc, CharacterDoc, CharacterId, PlacementDoc, SmplDoc, StageDoc, ViewDoc};
+use crate::formats::scene::{
+    BindingDoc, CharacterDoc, CharacterId, PlacementDoc, SkinningDoc, SmplDoc, StageDoc, ViewDoc,
+};
 use crate::rig::JointRotation;
 use crate::scene::smpl::SmplCharacter;
-use crate::scene::{Character, CharacterView, JointLimits, JointPose, MarionetteSystems, Placement, PoseDirty};
+use crate::scene::{
+    Character, CharacterSkinning, CharacterView, JointLimits, JointPose, MarionetteSystems, Placement, PoseDirty,
+};
 
 /// One user action on the scene.
 #[derive(Clone, Debug, PartialEq)]
@@ -48,6 +52,11 @@ pub enum Edit {
         character: CharacterId,
         binding: Option<BindingDoc>,
     },
+    /// Linear blend or dual quaternion skinning.
+    Skinning {
+        character: CharacterId,
+        method: SkinningDoc,
+    },
     /// Floor, shadows, axes.
     Stage(StageDoc),
     /// A character from its document (a fresh id is given when it has none).
@@ -65,6 +74,7 @@ impl Edit {
             | Edit::Rename { character, .. }
             | Edit::Smpl { character, .. }
             | Edit::Rebind { character, .. }
+            | Edit::Skinning { character, .. }
             | Edit::Remove(character) => Some(*character),
             Edit::Add(doc) => doc.id,
             Edit::Stage(_) => None,
@@ -226,6 +236,10 @@ pub fn inverse_of(world: &mut World, edit: &Edit) -> Result<Option<Edit>, String
             let old = component::<SceneCharacter>(world, *character)?.binding;
             unless(old == *binding, Edit::Rebind { character: *character, binding: old })
         }
+        Edit::Skinning { character, method } => {
+            let old = component::<CharacterSkinning>(world, *character)?.0;
+            unless(old == *method, Edit::Skinning { character: *character, method: old })
+        }
         Edit::Stage(stage) => {
             let old = world.resource::<StageSettings>().0;
             unless(old == *stage, Edit::Stage(old))
@@ -268,6 +282,7 @@ fn write(world: &mut World, edit: Edit) -> Result<(), String> {
         }
         Edit::Smpl { character, state } => component_mut::<SmplCharacter>(world, character)?.state = state,
         Edit::Rebind { character, binding } => rebind_character(world, character, binding)?,
+        Edit::Skinning { character, method } => component_mut::<CharacterSkinning>(world, character)?.0 = method,
         Edit::Stage(stage) => world.resource_mut::<StageSettings>().0 = stage,
         Edit::Add(doc) => add_character(world, &doc)?,
         Edit::Remove(id) => {

@@ -26,6 +26,7 @@ fn crowd_member(i: usize, n: usize, source: SourceDoc, spacing: f32, lift: f32, 
         view: ViewDoc::default(),
         smpl,
         binding: None,
+        skinning: Default::default(),
     }
 }
 

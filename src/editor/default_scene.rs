@@ -29,6 +29,7 @@ fn puppet(
         view,
         smpl: None,
         binding: None,
+        skinning: Default::default(),
     }
 }
 

@@ -20,7 +20,7 @@ use crate::formats::{FormatError, load_character};
 use crate::rig::smpl::{Clip, SmplModel};
 use crate::rig::{CharacterAsset, JointRotation};
 use crate::scene::smpl::SmplCharacter;
-use crate::scene::{Character, CharacterView, JointPose, Placement, spawn_character_posed};
+use crate::scene::{Character, CharacterSkinning, CharacterView, JointPose, Placement, spawn_character_posed};
 
 /// A character as the scene knows it: its stable id, where it comes from, its name and
 /// whether its weights were computed from the bones. The rest of its document lives in
@@ -190,6 +190,7 @@ pub struct SceneReader<'w, 's> {
             &'static Placement,
             &'static CharacterView,
             Option<&'static SmplCharacter>,
+            &'static CharacterSkinning,
         ),
     >,
     pub poses: Query<'w, 's, &'static JointPose>,
@@ -216,7 +217,7 @@ impl SceneReader<'_, '_> {
     /// The document of one live character: joints listed where they differ from the
     /// source's pose.
     pub fn character_doc(&self, entity: Entity) -> Option<CharacterDoc> {
-        let (_, sc, character, placement, view, smpl) = self.characters.get(entity).ok()?;
+        let (_, sc, character, placement, view, smpl, skinning) = self.characters.get(entity).ok()?;
         let skeleton = &character.asset.skeleton;
         let initial = skeleton.initial_pose();
         let pose = character
@@ -237,6 +238,7 @@ impl SceneReader<'_, '_> {
             view: view.0.clone(),
             smpl: smpl.map(|body| body.state.clone()),
             binding: sc.binding,
+            skinning: skinning.0,
         })
     }
 }
@@ -280,6 +282,7 @@ pub fn spawn_from_doc(
     commands.entity(entity).insert((
         SceneCharacter { id, source: doc.source.clone(), name: doc.name.clone(), binding: doc.binding },
         CharacterView(doc.view.clone()),
+        CharacterSkinning(doc.skinning),
         visibility_of(&doc.view),
     ));
     if let Some((dir, set)) = smpl {
@@ -333,6 +336,7 @@ pub fn doc_side_by_side(library: &mut AssetLibrary, sources: Vec<SourceDoc>, mes
                 view: ViewDoc::default(),
                 smpl: None,
                 binding: None,
+                skinning: Default::default(),
             };
             x += w + gap;
             doc

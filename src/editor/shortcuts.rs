@@ -64,7 +64,7 @@ pub fn scene_shortcuts(
     }
     if keys.just_pressed(KeyCode::KeyS) {
         // The selected character, or every character when none is selected.
-        for (_, sc, _, _, view, _) in &scene.characters {
+        for (_, sc, _, _, view, ..) in &scene.characters {
             if selection.character.is_none_or(|id| id == sc.id) {
                 let view = ViewDoc { display: view.display.next(), ..view.0.clone() };
                 edits.push(Edit::View { character: sc.id, view });

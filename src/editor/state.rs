@@ -13,11 +13,13 @@ use crate::formats::scene::CharacterId;
 pub struct StartupPaths(pub Vec<PathBuf>);
 
 /// Pose and IK edits from the command line, applied to every character of the startup
-/// scene that has the named joint (`--pose`, then `--ik`).
+/// scene that has the named joint (`--pose`, then `--ik`), and the skinning method.
 #[derive(Resource, Clone, Debug, Default)]
 pub struct StartupEdits {
     pub poses: Vec<crate::cli::posing::PoseSpec>,
     pub ik: Vec<crate::cli::posing::IkSpec>,
+    /// `--skinning`: every character skinned this way.
+    pub skinning: Option<crate::rig::dqs::SkinningMethod>,
 }
 
 /// Messages for the user (load errors, warnings, where files went), newest last.

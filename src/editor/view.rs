@@ -90,6 +90,9 @@ fn apply_startup_edits(
     messages: &mut Messages,
 ) {
     use crate::formats::scene::pose_key;
+    if let Some(method) = edits.skinning {
+        doc.characters.iter_mut().for_each(|c| c.skinning = method);
+    }
     if edits.poses.is_empty() && edits.ik.is_empty() {
         return;
     }

@@ -204,10 +204,16 @@ pub struct CharacterDoc {
     /// Weights computed from the bones instead of the source's.
     #[serde(default)]
     pub binding: Option<BindingDoc>,
+    /// Linear blend or dual quaternion skinning (files without it: linear).
+    #[serde(default, skip_serializing_if = "SkinningDoc::is_linear")]
+    pub skinning: SkinningDoc,
 }
 
 /// How to bind a skin from its skeleton's bones (stored as `Nearest` or `Smooth`).
 pub use crate::rig::bind::Binding as BindingDoc;
+
+/// How a character's vertices follow its joints (stored as `Linear` or `DualQuaternion`).
+pub use crate::rig::dqs::SkinningMethod as SkinningDoc;
 
 /// The orbit camera: an orbit around `focus` (world space) at `distance`, with `yaw` and
 /// `pitch` in radians (the editor holds this very type on its camera).

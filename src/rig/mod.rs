@@ -3,6 +3,7 @@
 
 pub mod bind;
 pub mod character;
+pub mod dqs;
 pub mod fk;
 pub mod ik;
 pub mod lbs;

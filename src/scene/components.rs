@@ -10,7 +10,16 @@ use crate::rig::{CharacterAsset, DofLimits, JointRotation};
 /// A character: the loaded asset it was made from (shared by every character made from
 /// the same files), its joint entities by joint index and the entity that draws its skin.
 #[derive(Component, Clone)]
-#[require(Placement, CharacterView, HeatJoint, PoseDirty, Transform, Visibility, super::upload::SkinUpload)]
+#[require(
+    Placement,
+    CharacterView,
+    CharacterSkinning,
+    HeatJoint,
+    PoseDirty,
+    Transform,
+    Visibility,
+    super::upload::SkinUpload
+)]
 pub struct Character {
     pub asset: Arc<CharacterAsset>,
     /// `joints[i]` is the entity of joint `i` of `asset.skeleton`.
@@ -48,6 +57,11 @@ impl Placement {
 /// map of the selected joint (the scene file's own `ViewDoc`, on the character entity).
 #[derive(Component, Clone, Debug, Default, PartialEq, Deref, DerefMut)]
 pub struct CharacterView(pub ViewDoc);
+
+/// Linear blend or dual quaternion skinning: the scene file's own `SkinningDoc`, on the
+/// character entity.
+#[derive(Component, Clone, Copy, Debug, Default, PartialEq, Eq, Deref, DerefMut)]
+pub struct CharacterSkinning(pub crate::rig::dqs::SkinningMethod);
 
 /// The joint whose weights the skin shows as a heat map (overrides weight colours); set
 /// from the selection where the view asks for it.
@@ -149,6 +163,8 @@ pub struct SkinScratch {
     pub colors: Vec<[f32; 4]>,
     /// The skinned vertices' box.
     pub bounds: (Vec3, Vec3),
+    /// The palette as dual quaternions (dual quaternion skinning).
+    pub dual_quaternions: Vec<crate::rig::dqs::DualQuat>,
     /// What the mesh's colours were last written from.
     pub colored_with: Option<Coloring>,
 }

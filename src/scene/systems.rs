@@ -7,8 +7,8 @@ use super::components::*;
 use super::upload::{SkinUpload, pack_vertices};
 use crate::rig::JointRotation;
 use crate::rig::fk::forward_kinematics;
-use crate::rig::lbs;
 use crate::rig::skinning::{bounds, heat_colors, joint_colors, weight_colors};
+use crate::rig::{dqs, lbs};
 
 /// Clamps changed joint poses to their limits (reads `JointLimits`, writes `JointPose`).
 pub fn clamp_poses_to_limits(mut joints: Query<(&mut JointPose, &JointLimits), Changed<JointPose>>) {
@@ -25,16 +25,19 @@ pub fn clamp_poses_to_limits(mut joints: Query<(&mut JointPose, &JointLimits), C
 /// reshape) sets `PoseDirty::bind` itself.
 pub fn mark_changed_characters(
     posed: Query<&Joint, Changed<JointPose>>,
-    mut characters: Query<(&CharacterView, &HeatJoint, &SkinScratch, &mut PoseDirty)>,
+    mut characters: Query<(&CharacterView, &HeatJoint, &SkinScratch, Ref<CharacterSkinning>, &mut PoseDirty)>,
 ) {
     for joint in &posed {
         if let Ok((.., mut dirty)) = characters.get_mut(joint.character) {
             dirty.matrices = true;
         }
     }
-    for (view, heat, scratch, mut dirty) in &mut characters {
+    for (view, heat, scratch, method, mut dirty) in &mut characters {
         if scratch.colored_with != Some(Coloring::of(view, heat)) {
             dirty.colors = true;
+        }
+        if method.is_changed() {
+            dirty.matrices = true;
         }
     }
 }
@@ -94,10 +97,18 @@ pub fn compute_joint_to_world(
 /// vertices and their bounds; the colours when they changed; then packs the vertices for
 /// the GPU (reads joint matrices; writes `SkinScratch`, `SkinUpload`).
 pub fn skin_changed_characters(
-    mut characters: Query<(&Character, &CharacterView, &HeatJoint, &PoseDirty, &mut SkinScratch, &mut SkinUpload)>,
+    mut characters: Query<(
+        &Character,
+        &CharacterView,
+        &CharacterSkinning,
+        &HeatJoint,
+        &PoseDirty,
+        &mut SkinScratch,
+        &mut SkinUpload,
+    )>,
     joints: Query<(&CurrentJointToWorld, &BindWorldToJoint)>,
 ) {
-    characters.par_iter_mut().for_each(|(character, view, heat, dirty, mut scratch, mut upload)| {
+    characters.par_iter_mut().for_each(|(character, view, method, heat, dirty, mut scratch, mut upload)| {
         if *dirty == PoseDirty::default() {
             return;
         }
@@ -109,7 +120,12 @@ pub fn skin_changed_characters(
                 .palette
                 .extend(character.joints.iter().map(|&e| joints.get(e).map_or(Mat4::IDENTITY, |(c, b)| c.0 * b.0)));
             scratch.positions.resize(skin.bind_positions.len(), Vec3::ZERO);
-            skin_in_chunks(skin, &scratch.palette, &mut scratch.positions);
+            if method.is_linear() {
+                skin_in_chunks(skin, &scratch.palette, &mut scratch.positions);
+            } else {
+                dqs::dual_quaternion_palette(&scratch.palette, &mut scratch.dual_quaternions);
+                dqs::skin_dq(&skin.bind_positions, &skin.weights, &scratch.dual_quaternions, &mut scratch.positions);
+            }
             scratch.bounds = bounds(&scratch.positions);
         }
         if dirty.colors || scratch.colors.len() != skin.bind_positions.len() {

@@ -53,7 +53,7 @@ fn assert_positions_close(a: &[[f32; 3]], b: &[[f32; 3]], tol: f32) {
     assert!(worst <= tol, "largest difference {worst}");
 }
 
-fn set_joint(app: &mut App, character: Entity, joint: usize, rotation: JointRotation) {
+pub fn set_joint(app: &mut App, character: Entity, joint: usize, rotation: JointRotation) {
     let entity = app.world().get::<Character>(character).unwrap().joints[joint];
     app.world_mut().get_mut::<JointPose>(entity).unwrap().0 = rotation;
 }

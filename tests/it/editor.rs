@@ -25,6 +25,7 @@ pub fn doc_with(source: SourceDoc, pose: &[(&str, JointRotation)]) -> SceneDoc {
             view: ViewDoc { weight_colors: true, ..ViewDoc::default() },
             smpl: None,
             binding: None,
+            skinning: Default::default(),
         }],
         camera: None,
         stage: Default::default(),

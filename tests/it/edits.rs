@@ -89,6 +89,7 @@ fn commands_then_undo_all_return_the_ecs_to_its_start_and_redo_to_its_end() {
         Edit::Rename { character: CharacterId(2), name: "Bea".into() },
         Edit::Stage(StageDoc { axes: true, floor: false, ..StageDoc::default() }),
         Edit::Rebind { character: CharacterId(1), binding: Some(BindingDoc::Nearest) },
+        Edit::Skinning { character: CharacterId(2), method: marionette::formats::scene::SkinningDoc::DualQuaternion },
         Edit::Add(Box::new(added)),
         Edit::Pose { character: CharacterId(10), joints: vec![(elbow, JointRotation::euler_xyz(0.3, 0.0, 0.0))] },
         Edit::Remove(CharacterId(2)),
@@ -250,6 +251,7 @@ fn smpl_shape_and_clip_edits_undo_and_redo() {
         view: ViewDoc::default(),
         smpl: Some(SmplDoc::default()),
         binding: None,
+        skinning: Default::default(),
     };
     *app.world_mut().resource_mut::<PendingScene>() =
         PendingScene { doc: Some(SceneDoc { characters: vec![body], ..SceneDoc::default() }), frame: false };

@@ -3,6 +3,7 @@
 mod alloc;
 mod common;
 mod data;
+mod dqs;
 mod ecs;
 mod editor;
 mod edits;

@@ -165,6 +165,7 @@ fn saving_a_scene_whose_source_path_is_not_utf8_is_an_error_not_a_panic() {
         view: Default::default(),
         smpl: None,
         binding: None,
+        skinning: Default::default(),
     });
     let out = dir.join("scene.ron");
     let e = save_scene(&out, &doc).unwrap_err();

@@ -13,7 +13,9 @@ use crate::editor::document::{open_scene_from, save_scene_to};
 use crate::editor::history::HistoryRequest;
 use crate::editor::screenshot::ScreenshotRequest;
 use crate::editor::state::Selection;
-use crate::formats::scene::{BindingDoc, CharacterDoc, CharacterId, DisplayDoc, PlacementDoc, SourceDoc, ViewDoc};
+use crate::formats::scene::{
+    BindingDoc, CharacterDoc, CharacterId, DisplayDoc, PlacementDoc, SkinningDoc, SourceDoc, ViewDoc,
+};
 
 /// Space left between a character added and the rightmost one.
 const ADD_GAP: f32 = 0.3;
@@ -123,6 +125,7 @@ fn add_character(path: &str, state: &mut InspectorState, panels: &mut Panels) {
         view: ViewDoc::default(),
         smpl: None,
         binding: None,
+        skinning: Default::default(),
     })));
     *panels.selection = Selection { character: Some(id), joints: Vec::new() };
     state.recent.retain(|r| r != path);
@@ -161,7 +164,7 @@ fn add_crowd(state: &InspectorState, panels: &mut Panels) {
 
 /// The character's name (a click selects it) and its visibility.
 fn character_row(ui: &mut egui::Ui, panels: &mut Panels, entity: Entity, id: CharacterId) {
-    let Ok((_, sc, _, _, view, _)) = panels.scene.characters.get(entity) else { return };
+    let Ok((_, sc, _, _, view, ..)) = panels.scene.characters.get(entity) else { return };
     let selected = panels.selection.character == Some(id);
     let mut shown = view.visible;
     let (name, view) = (sc.name.clone(), view.0.clone());
@@ -178,7 +181,10 @@ fn character_row(ui: &mut egui::Ui, panels: &mut Panels, entity: Entity, id: Cha
 /// Name, source, duplicate/remove, placement, display and colours, weights, SMPL state of
 /// the selected character.
 fn selected_character(ui: &mut egui::Ui, panels: &mut Panels, entity: Entity, id: CharacterId) {
-    let Ok((_, sc, character, placement, view, smpl)) = panels.scene.characters.get(entity) else { return };
+    let Ok((_, sc, character, placement, view, smpl, skinning)) = panels.scene.characters.get(entity) else {
+        return;
+    };
+    let skinning = skinning.0;
     let (mut name, source, binding) = (sc.name.clone(), sc.source.label(), sc.binding);
     let (mut p, mut v) = (placement.0, view.0.clone());
     let counts = format!("{} joints, {} vertices", character.asset.skeleton.len(), character.asset.vertex_count());
@@ -219,6 +225,14 @@ fn selected_character(ui: &mut egui::Ui, panels: &mut Panels, entity: Entity, id
         {
             if ui.selectable_label(binding == b, label).clicked() && binding != b {
                 edits.push(Edit::Rebind { character: id, binding: b });
+            }
+        }
+    });
+    ui.horizontal(|ui| {
+        ui.label("Skinning:");
+        for (label, m) in [("linear blend", SkinningDoc::Linear), ("dual quaternion", SkinningDoc::DualQuaternion)] {
+            if ui.selectable_label(skinning == m, label).clicked() && skinning != m {
+                edits.push(Edit::Skinning { character: id, method: m });
             }
         }
     });

@@ -1,0 +1,116 @@
+//! Dual quaternion skinning: identity at the bind pose, LBS where a vertex has one
+//! influence, volume kept where LBS collapses a twist, and the same in the ECS.
+
+use std::sync::Arc;
+
+use glam::{Mat4, Quat, Vec3};
+use marionette::rig::dqs::{DualQuat, SkinningMethod, dual_quaternion_palette, skin_dq};
+use marionette::rig::lbs::skin;
+use marionette::rig::{JointRotation, SkinWeights};
+
+fn dq(palette: &[Mat4]) -> Vec<DualQuat> {
+    let mut out = Vec::new();
+    dual_quaternion_palette(palette, &mut out);
+    out
+}
+
+#[test]
+fn at_the_bind_pose_dual_quaternions_return_the_input() {
+    let asset = marionette::formats::puppet::embedded_puppet();
+    let identity = vec![Mat4::IDENTITY; asset.skeleton.len()];
+    let mut out = vec![Vec3::ZERO; asset.vertex_count()];
+    skin_dq(&asset.skin.bind_positions, &asset.skin.weights, &dq(&identity), &mut out);
+    for (a, b) in out.iter().zip(&asset.skin.bind_positions) {
+        assert!(a.distance(*b) < 1e-6, "{a} vs {b}");
+    }
+}
+
+#[test]
+fn a_vertex_with_one_influence_moves_as_in_linear_blend_skinning() {
+    let asset = marionette::formats::puppet::embedded_puppet();
+    let n = asset.skeleton.len();
+    let palette: Vec<Mat4> = (0..n)
+        .map(|j| {
+            let q = Quat::from_euler(glam::EulerRot::XYZ, 0.3 * j as f32, -0.2, 0.1 * j as f32);
+            Mat4::from_rotation_translation(q, Vec3::new(0.1 * j as f32, 0.5, -0.3))
+        })
+        .collect();
+    let rigid = SkinWeights::rigid(&(0..asset.vertex_count()).map(|v| (v % n) as u16).collect::<Vec<_>>());
+    let (mut lbs, mut dqs) = (vec![Vec3::ZERO; asset.vertex_count()], vec![Vec3::ZERO; asset.vertex_count()]);
+    skin(&asset.skin.bind_positions, &rigid, &palette, &mut lbs);
+    skin_dq(&asset.skin.bind_positions, &rigid, &dq(&palette), &mut dqs);
+    for (a, b) in lbs.iter().zip(&dqs) {
+        assert!(a.distance(*b) < 1e-5, "{a} vs {b}");
+    }
+}
+
+/// The area of a closed polygon of points in the plane x = const (shoelace over y, z).
+fn area_yz(ring: &[Vec3]) -> f32 {
+    let n = ring.len();
+    (0..n).map(|i| ring[i].y * ring[(i + 1) % n].z - ring[(i + 1) % n].y * ring[i].z).sum::<f32>().abs() / 2.0
+}
+
+/// A cylinder along x over two bones (the joint at x = 1, weights blending over
+/// 0.5..1.5) and the cross-section at the joint after the second bone twists by `angle`,
+/// as a fraction of the rest area: (LBS, DQ).
+fn twisted_cross_section(angle: f32) -> (f32, f32) {
+    let (slices, around, radius) = (21usize, 32usize, 0.2f32);
+    let mut bind = Vec::new();
+    let mut rows = Vec::new();
+    for s in 0..slices {
+        let x = 2.0 * s as f32 / (slices - 1) as f32;
+        let w1 = ((x - 0.5).clamp(0.0, 1.0) * std::f32::consts::PI / 2.0).sin().powi(2);
+        for k in 0..around {
+            let a = std::f32::consts::TAU * k as f32 / around as f32;
+            bind.push(Vec3::new(x, radius * a.cos(), radius * a.sin()));
+            rows.push(vec![(0, 1.0 - w1), (1, w1)]);
+        }
+    }
+    let (weights, _) = SkinWeights::from_rows(rows, 2).unwrap();
+    let twist = Mat4::from_translation(Vec3::X) * Mat4::from_rotation_x(angle) * Mat4::from_translation(-Vec3::X);
+    let palette = [Mat4::IDENTITY, twist];
+    let (mut lbs, mut dqs) = (vec![Vec3::ZERO; bind.len()], vec![Vec3::ZERO; bind.len()]);
+    skin(&bind, &weights, &palette, &mut lbs);
+    skin_dq(&bind, &weights, &dq(&palette), &mut dqs);
+    let middle = (slices / 2) * around..(slices / 2 + 1) * around;
+    let rest = area_yz(&bind[middle.clone()]);
+    (area_yz(&lbs[middle.clone()]) / rest, area_yz(&dqs[middle]) / rest)
+}
+
+#[test]
+fn a_twisted_joint_keeps_its_cross_section_with_dual_quaternions() {
+    let (lbs, dq) = twisted_cross_section(std::f32::consts::FRAC_PI_2);
+    eprintln!(
+        "90° twist, cross-section at the joint: LBS {:.1} %, DQ {:.1} % of the rest area",
+        lbs * 100.0,
+        dq * 100.0
+    );
+    assert!((dq - 1.0).abs() < 0.05, "DQ keeps the area within 5 %: {dq}");
+    assert!(lbs < 0.6, "LBS loses area: {lbs}");
+    let (lbs, dq) = twisted_cross_section(2.8);
+    eprintln!("160° twist: LBS {:.1} %, DQ {:.1} %", lbs * 100.0, dq * 100.0);
+    assert!(lbs < 0.1 && (dq - 1.0).abs() < 0.05);
+}
+
+/// A character switched to dual quaternion skinning in the ECS skins like the kernel.
+#[test]
+fn dual_quaternion_skinning_in_the_ecs_matches_the_kernel() {
+    use marionette::scene::{CharacterSkinning, Placement};
+    let asset = Arc::new(marionette::formats::puppet::embedded_puppet());
+    let mut app = crate::ecs::app();
+    let character = crate::ecs::spawn(&mut app, asset.clone(), Placement::default());
+    app.world_mut().get_mut::<CharacterSkinning>(character).unwrap().0 = SkinningMethod::DualQuaternion;
+    let elbow = asset.skeleton.find("l_elbow").unwrap();
+    let rotation = JointRotation::euler_xyz(0.0, 1.2, 0.4);
+    crate::ecs::set_joint(&mut app, character, elbow, rotation);
+    app.update();
+    let mut pose = asset.skeleton.initial_pose();
+    pose[elbow] = rotation;
+    let expected =
+        marionette::cli::posing::posed_positions_by(&asset, &pose, Mat4::IDENTITY, SkinningMethod::DualQuaternion);
+    let got = &app.world().get::<marionette::scene::SkinScratch>(character).unwrap().positions;
+    let worst = got.iter().zip(&expected).map(|(a, b)| a.distance(*b)).fold(0.0f32, f32::max);
+    assert!(worst < 1e-5, "largest difference {worst}");
+    let linear = marionette::cli::posing::posed_positions(&asset, &pose, Mat4::IDENTITY);
+    assert!(linear.iter().zip(&expected).any(|(a, b)| a.distance(*b) > 1e-3), "DQ differs from LBS at the elbow");
+}
