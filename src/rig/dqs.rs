@@ -7,6 +7,7 @@
 
 use glam::{Mat4, Quat, Vec3, Vec4};
 
+use super::lbs::FixedGroup;
 use super::skinning::SkinWeights;
 
 /// How a character's vertices follow its joints.
@@ -64,7 +65,8 @@ pub fn dual_quaternion_palette(palette: &[Mat4], out: &mut Vec<DualQuat>) {
     out.extend(palette.iter().map(DualQuat::from_rigid));
 }
 
-/// Skins bind-pose vertices with dual quaternions.
+/// Skins bind-pose vertices with dual quaternions (rows taken from the influence groups
+/// the LBS kernel uses: fixed-size rows for up to four influences, the general rows beyond).
 ///
 /// # Panics
 /// When the lengths of `bind_positions`, `weights` and `out` differ, or an influence names
@@ -72,19 +74,48 @@ pub fn dual_quaternion_palette(palette: &[Mat4], out: &mut Vec<DualQuat>) {
 pub fn skin_dq(bind_positions: &[Vec3], weights: &SkinWeights, palette: &[DualQuat], out: &mut [Vec3]) {
     assert_eq!(bind_positions.len(), weights.vertex_count(), "one weight row per vertex");
     assert_eq!(out.len(), bind_positions.len(), "one output per vertex");
-    for (v, (p, o)) in bind_positions.iter().zip(out.iter_mut()).enumerate() {
-        let row = weights.of_vertex(v);
-        let Some(heaviest) = row.iter().max_by(|a, b| a.weight.total_cmp(&b.weight)) else { continue };
-        let pivot = palette[heaviest.joint as usize].real;
-        let (mut real, mut dual) = (Vec4::ZERO, Vec4::ZERO);
-        for inf in row {
-            let q = &palette[inf.joint as usize];
-            // Into the heaviest influence's hemisphere: q and -q are the same rotation.
-            let w = if q.real.dot(pivot) < 0.0 { -inf.weight } else { inf.weight };
-            real += q.real * w;
-            dual += q.dual * w;
-        }
-        let n = real.length();
-        *o = DualQuat { real: real / n, dual: dual / n }.transform_point(*p);
+    let groups = weights.groups();
+    fixed_rows::<1>(bind_positions, &groups.fixed[0], palette, out);
+    fixed_rows::<2>(bind_positions, &groups.fixed[1], palette, out);
+    fixed_rows::<3>(bind_positions, &groups.fixed[2], palette, out);
+    fixed_rows::<4>(bind_positions, &groups.fixed[3], palette, out);
+    for &v in &groups.wide {
+        let row = weights.of_vertex(v as usize);
+        let joints: Vec<u16> = row.iter().map(|i| i.joint).collect();
+        let w: Vec<f32> = row.iter().map(|i| i.weight).collect();
+        out[v as usize] = blend_and_apply(&joints, &w, palette, bind_positions[v as usize]);
     }
+}
+
+fn fixed_rows<const K: usize>(bind: &[Vec3], group: &FixedGroup, palette: &[DualQuat], out: &mut [Vec3]) {
+    let rows = group.joints.chunks_exact(K).zip(group.weights.chunks_exact(K));
+    for (&v, (joints, weights)) in group.vertices.iter().zip(rows) {
+        out[v as usize] = blend_and_apply(joints, weights, palette, bind[v as usize]);
+    }
+}
+
+/// Blends one vertex's dual quaternions in its heaviest influence's hemisphere (q and -q
+/// are the same rotation), normalises and applies the blend to `p`.
+#[inline]
+fn blend_and_apply(joints: &[u16], weights: &[f32], palette: &[DualQuat], p: Vec3) -> Vec3 {
+    let mut heaviest = 0;
+    for k in 1..weights.len() {
+        if weights[k] > weights[heaviest] {
+            heaviest = k;
+        }
+    }
+    let pivot = palette[joints[heaviest] as usize].real;
+    let (mut real, mut dual) = (Vec4::ZERO, Vec4::ZERO);
+    for (&j, &w) in joints.iter().zip(weights) {
+        let q = &palette[j as usize];
+        let w = if q.real.dot(pivot) < 0.0 { -w } else { w };
+        real += q.real * w;
+        dual += q.dual * w;
+    }
+    let inv = real.length_recip();
+    let (real, dual) = (real * inv, dual * inv);
+    // Rotation by the unit quaternion, then the translation 2 (w_r d - w_d r + r × d).
+    let (r, d) = (real.truncate(), dual.truncate());
+    let t = 2.0 * (real.w * d - dual.w * r + r.cross(d));
+    Quat::from_vec4(real) * p + t
 }
