@@ -96,7 +96,7 @@ fn fixed_rows<const K: usize>(bind: &[Vec3], group: &FixedGroup, palette: &[Dual
 
 /// Blends one vertex's dual quaternions in its heaviest influence's hemisphere (q and -q
 /// are the same rotation), normalises and applies the blend to `p`.
-#[inline]
+#[inline(always)]
 fn blend_and_apply(joints: &[u16], weights: &[f32], palette: &[DualQuat], p: Vec3) -> Vec3 {
     let mut heaviest = 0;
     for k in 1..weights.len() {
