@@ -114,3 +114,34 @@ fn dual_quaternion_skinning_in_the_ecs_matches_the_kernel() {
     let linear = marionette::cli::posing::posed_positions(&asset, &pose, Mat4::IDENTITY);
     assert!(linear.iter().zip(&expected).any(|(a, b)| a.distance(*b) > 1e-3), "DQ differs from LBS at the elbow");
 }
+
+/// The SIMD path (where the CPU has AVX2 and FMA) against the portable one on the puppet
+/// and, with the data, every character of the courses, posed.
+#[test]
+fn the_dual_quaternion_kernel_paths_agree() {
+    use marionette::rig::dqs::skin_dq_portable;
+    let mut assets = vec![marionette::formats::puppet::embedded_puppet()];
+    if let Some(data) = crate::common::optional_data_dir() {
+        for f in ["mit6837/Model1.skel", "mit6837/Model3.skel", "homer/homer.json", "cse169/project1/dragon.skel"] {
+            assets.push(marionette::formats::load_character(&data.join(f)).unwrap());
+        }
+        let (model, _) = marionette::formats::smpl::load_smpl_dir(&data.join("smpl")).unwrap();
+        assets.push(model.asset("smpl", &[0.5]).unwrap());
+    }
+    for asset in assets {
+        let n = asset.skeleton.len();
+        let pose: Vec<JointRotation> =
+            (0..n).map(|i| JointRotation::euler_xyz(0.2 * i as f32, -0.1, 0.15 * i as f32)).collect();
+        let mut current = vec![Mat4::IDENTITY; n];
+        marionette::rig::fk::forward_kinematics(&asset.skeleton, &pose, Mat4::IDENTITY, &mut current);
+        let mut palette = vec![Mat4::IDENTITY; n];
+        marionette::rig::fk::skinning_palette(&current, &asset.bind_world_to_joint, &mut palette);
+        let dq = dq(&palette);
+        let (mut a, mut b) = (vec![Vec3::ZERO; asset.vertex_count()], vec![Vec3::ZERO; asset.vertex_count()]);
+        skin_dq(&asset.skin.bind_positions, &asset.skin.weights, &dq, &mut a);
+        skin_dq_portable(&asset.skin.bind_positions, &asset.skin.weights, &dq, &mut b);
+        let scale = b.iter().fold(1.0f32, |m, p| m.max(p.abs().max_element()));
+        let worst = a.iter().zip(&b).map(|(x, y)| (*x - *y).abs().max_element()).fold(0.0f32, f32::max);
+        assert!(worst <= 1e-5 * scale, "{}: worst {worst:e}", asset.name);
+    }
+}
