@@ -125,7 +125,12 @@ fn fixed_rows<const K: usize>(bind: &[Vec3], group: &FixedGroup, palette: &[Dual
 /// are the same rotation), normalises and applies the blend to `p`.
 #[inline(always)]
 fn blend_and_apply(row: impl Iterator<Item = (u16, f32)> + Clone, palette: &[DualQuat], p: Vec3) -> Vec3 {
-    let Some((heaviest, _)) = row.clone().max_by(|a, b| a.1.total_cmp(&b.1)) else { return p };
+    // The first of the heaviest influences (as the SIMD path picks it).
+    let heaviest = row.clone().fold(None, |best, (j, w)| match best {
+        Some((_, bw)) if bw >= w => best,
+        _ => Some((j, w)),
+    });
+    let Some((heaviest, _)) = heaviest else { return p };
     let pivot = palette[heaviest as usize].real;
     let (mut real, mut dual) = (Vec4::ZERO, Vec4::ZERO);
     for (j, w) in row {
