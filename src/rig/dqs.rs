@@ -205,10 +205,8 @@ mod avx2 {
             // 23 bits, the same as the division it replaces; a shorter chain of latency).
             let n2 = _mm_dp_ps::<0xFF>(real, real);
             let y = _mm_rsqrt_ps(n2);
-            let inv = _mm_mul_ps(
-                _mm_mul_ps(_mm_set1_ps(0.5), y),
-                _mm_fnmadd_ps(_mm_mul_ps(n2, y), y, _mm_set1_ps(3.0)),
-            );
+            let inv =
+                _mm_mul_ps(_mm_mul_ps(_mm_set1_ps(0.5), y), _mm_fnmadd_ps(_mm_mul_ps(n2, y), y, _mm_set1_ps(3.0)));
             let (real, dual) = (_mm_mul_ps(real, inv), _mm_mul_ps(dual, inv));
             let wr = _mm_shuffle_ps::<0xFF>(real, real);
             let wd = _mm_shuffle_ps::<0xFF>(dual, dual);

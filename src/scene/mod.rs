@@ -3,13 +3,16 @@
 //! System order, configured once in [`RigCorePlugin`] (all in `PostUpdate`, before Bevy's
 //! transform propagation, which plays no part in joint matrices):
 //!
-//! `Animate` (clips, sliders) → `Solve` (IK, limits) → `MatrixStack` (place, mark, bind,
-//! FK) → `Skin` (LBS, normals, colours, bounds) → `Draw` (skeleton gizmos, overlays).
+//! `Animate` (edits, clips) → `Solve` (IK, limits) → `MatrixStack` (place, mark, bind,
+//! FK) → `Skin` (LBS or DQ, colours, bounds, packed vertices) → `Draw` (skeleton gizmos,
+//! overlays).
 //!
 //! Joint matrices and skins are in each character's model space; its `Transform` (set from
 //! `Placement`) places it, so moving a character re-skins nothing. Forward kinematics is
 //! `rig::fk` over the asset's skeleton (the one source of rest offsets); inverse binds are
-//! the asset's, shared by its instances.
+//! the asset's, shared by its instances. Skinning runs in parallel and hands its packed
+//! vertices straight to each mesh's GPU slot ([`upload`]); skins carry no normals (the
+//! skin material lights each triangle with its own).
 
 pub mod components;
 pub mod smpl;
@@ -32,7 +35,7 @@ pub enum MarionetteSystems {
     /// Placement to `Transform`; bind pass and matrix stack write `BindWorldToJoint` and
     /// `CurrentJointToWorld` (model space).
     MatrixStack,
-    /// Skinning rewrites render meshes.
+    /// Skinning packs the vertices handed to the GPU (see [`upload`]).
     Skin,
     /// Drawing of skeletons and overlays.
     Draw,
@@ -70,7 +73,8 @@ impl Plugin for RigCorePlugin {
     }
 }
 
-/// CPU skinning of changed characters (in parallel) into their render meshes.
+/// CPU skinning of changed characters (in parallel), handed straight to their meshes' GPU
+/// slots.
 pub struct SkinningPlugin;
 
 impl Plugin for SkinningPlugin {
