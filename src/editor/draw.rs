@@ -26,6 +26,7 @@ pub fn setup_skeleton_gizmos(app: &mut App) {
 const JOINT_COLOR: Color = Color::srgb(1.0, 0.85, 0.2);
 const BONE_COLOR: Color = Color::srgb(0.92, 0.94, 1.0);
 const SELECTED_COLOR: Color = Color::srgb(1.0, 0.15, 0.3);
+const HOVER_COLOR: Color = Color::srgb(0.3, 1.0, 1.0);
 
 /// Draws skeletons of characters in skeleton or both view, and the selected joints of
 /// any character (reads joint matrices, `Selection`; draws gizmos).
@@ -33,8 +34,15 @@ pub fn draw_skeletons(
     characters: Query<(&Character, &CharacterView, &Placement, Option<&SceneCharacter>, &InheritedVisibility)>,
     joints: Query<&CurrentJointToWorld>,
     selection: Res<Selection>,
+    hovered: Option<Res<super::picking::HoveredJoint>>,
     mut gizmos: Gizmos<SkeletonGizmos>,
 ) {
+    if let Some(hit) = hovered.as_ref().and_then(|h| h.0)
+        && let Ok((character, _, placement, ..)) = characters.get(hit.entity)
+    {
+        let radius = (character_size(character) * placement.scale * 0.012).max(0.003);
+        gizmos.sphere(Isometry3d::from_translation(hit.position), radius * 3.0, HOVER_COLOR);
+    }
     for (character, view, placement, sc, visible) in &characters {
         if !visible.get() {
             continue;

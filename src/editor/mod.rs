@@ -47,17 +47,21 @@ pub struct InteractionPlugin;
 impl Plugin for InteractionPlugin {
     fn build(&self, app: &mut App) {
         app.add_plugins(ik_drag::IkDragPlugin);
-        app.init_resource::<camera::ViewportHasPointer>().init_resource::<picking::PointerPress>().add_systems(
-            Update,
-            (
-                camera::track_egui_pointer,
-                orbit_camera_input,
-                picking::pick_joint_on_click,
-                shortcuts::scene_shortcuts,
-                shortcuts::frame_selection,
-            )
-                .chain(),
-        );
+        app.init_resource::<camera::ViewportHasPointer>()
+            .init_resource::<picking::PointerPress>()
+            .init_resource::<picking::HoveredJoint>()
+            .add_systems(
+                Update,
+                (
+                    camera::track_egui_pointer,
+                    picking::hover_joint,
+                    orbit_camera_input,
+                    picking::pick_joint_on_click,
+                    shortcuts::scene_shortcuts,
+                    shortcuts::frame_selection,
+                )
+                    .chain(),
+            );
     }
 }
 

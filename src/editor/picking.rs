@@ -13,6 +13,40 @@ use crate::scene::{Character, CurrentJointToWorld, Placement};
 #[derive(Resource, Default)]
 pub struct PointerPress(pub Option<Vec2>);
 
+/// The joint under the cursor (highlighted, and named in a tooltip, before a click).
+#[derive(Resource, Default, Debug)]
+pub struct HoveredJoint(pub Option<JointHit>);
+
+/// Finds the joint under the cursor while nothing is held or dragged (reads input, joint
+/// matrices; writes `HoveredJoint`).
+#[allow(clippy::too_many_arguments)]
+pub fn hover_joint(
+    buttons: Res<ButtonInput<MouseButton>>,
+    windows: Query<&Window, With<PrimaryWindow>>,
+    cameras: Query<(&Camera, &GlobalTransform), With<OrbitCamera>>,
+    characters: PickableCharacters,
+    joints: Query<&CurrentJointToWorld>,
+    pointer: Res<ViewportHasPointer>,
+    drag: Res<super::state::JointDrag>,
+    mut hovered: ResMut<HoveredJoint>,
+) {
+    let hit = (pointer.0 && drag.active.is_none() && buttons.get_pressed().next().is_none())
+        .then(|| {
+            let (window, (camera, camera_transform)) = (windows.single().ok()?, cameras.single().ok()?);
+            let cursor = window.cursor_position()?;
+            nearest_joint_on_screen(camera, camera_transform, cursor, PICK_RADIUS_PX * 0.5, &characters, &joints)
+        })
+        .flatten();
+    let changed = match (&hovered.0, &hit) {
+        (Some(a), Some(b)) => a.entity != b.entity || a.joint != b.joint || a.position != b.position,
+        (None, None) => false,
+        _ => true,
+    };
+    if changed {
+        hovered.0 = hit;
+    }
+}
+
 /// Screen distance (pixels) within which a click picks a joint.
 pub const PICK_RADIUS_PX: f32 = 40.0;
 

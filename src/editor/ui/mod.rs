@@ -62,6 +62,13 @@ impl Panels<'_, '_> {
     }
 }
 
+/// What is drawn over the viewport besides the panels: the frame time, the hovered joint.
+#[derive(SystemParam)]
+pub struct ViewportOverlays<'w> {
+    diagnostics: Res<'w, DiagnosticsStore>,
+    hovered: Res<'w, super::picking::HoveredJoint>,
+}
+
 pub struct InspectorPlugin;
 
 impl Plugin for InspectorPlugin {
@@ -82,7 +89,7 @@ fn inspector_ui(
     mut shot: ResMut<ScreenshotRequest>,
     mut viewport_area: ResMut<ViewportArea>,
     mut hold: ResMut<GestureHold>,
-    diagnostics: Res<DiagnosticsStore>,
+    overlays: ViewportOverlays,
 ) -> Result {
     if shot.hide_ui() {
         // A screenshot without panels shows the whole window.
@@ -105,7 +112,8 @@ fn inspector_ui(
     let central = ui.available_rect_before_wrap();
     let area = ViewportArea(Some(Rect::new(central.min.x, central.min.y, central.max.x, central.max.y)));
     viewport_area.set_if_neq(area);
-    frame_time_readout(&ctx, central, &diagnostics);
+    frame_time_readout(&ctx, central, &overlays.diagnostics);
+    hovered_joint_tooltip(&ctx, &panels, &overlays.hovered);
     if let Some(text) = &state.active_dof {
         egui::Area::new("active_dof".into()).anchor(egui::Align2::CENTER_TOP, [0.0, 12.0]).show(&ctx, |ui| {
             egui::Frame::popup(ui.style()).show(ui, |ui| ui.label(egui::RichText::new(text).size(20.0).strong()));
@@ -125,5 +133,20 @@ fn frame_time_readout(ctx: &egui::Context, viewport: egui::Rect, diagnostics: &D
     };
     egui::Area::new("frame_time".into()).fixed_pos(viewport.right_top() + egui::vec2(-190.0, 8.0)).show(ctx, |ui| {
         ui.label(egui::RichText::new(format!("{ms:.1} ms · {fps:.0} fps")).monospace().color(egui::Color32::WHITE));
+    });
+}
+
+/// The joint under the cursor, named beside it: "character · joint (index)".
+fn hovered_joint_tooltip(ctx: &egui::Context, panels: &Panels, hovered: &super::picking::HoveredJoint) {
+    let Some(hit) = hovered.0 else { return };
+    let Ok((_, sc, character, ..)) = panels.scene.characters.get(hit.entity) else { return };
+    let (Some(pointer), Some(joint)) = (ctx.pointer_hover_pos(), character.asset.skeleton.joints().get(hit.joint))
+    else {
+        return;
+    };
+    egui::Area::new("hovered_joint".into()).fixed_pos(pointer + egui::vec2(14.0, 10.0)).show(ctx, |ui| {
+        let text = format!("{} · {} ({})", sc.name, joint.name, hit.joint);
+        egui::Frame::popup(ui.style())
+            .show(ui, |ui| ui.add(egui::Label::new(text).wrap_mode(egui::TextWrapMode::Extend)));
     });
 }
