@@ -36,7 +36,7 @@ impl Plugin for IkDragPlugin {
                     .after(super::camera::track_egui_pointer)
                     .before(super::camera::orbit_camera_input),
             )
-            .add_systems(PostUpdate, draw_handles.in_set(crate::scene::MarionetteSystems::Draw));
+            .add_systems(PostUpdate, (draw_handles, draw_dragged_chain).in_set(crate::scene::MarionetteSystems::Draw));
     }
 }
 
@@ -196,3 +196,30 @@ fn draw_handles(
         }
     }
 }
+
+/// While a joint is dragged, the chain IK moves (from the joint up to its sub-base) is
+/// drawn in red, as the exercise plots it (draws gizmos).
+fn draw_dragged_chain(
+    drag: Res<JointDrag>,
+    characters: Query<(&SceneCharacter, &Character, &Placement)>,
+    joints: Query<&CurrentJointToWorld>,
+    mut gizmos: Gizmos<SkeletonGizmos>,
+) {
+    let Some(active) = drag.active.as_ref().filter(|d| d.moved) else { return };
+    let Some((_, character, placement)) = characters.iter().find(|c| c.0.id == active.character) else { return };
+    let world = |j: usize| Some(joints.get(*character.joints.get(j)?).ok()?.world_position(placement));
+    let chain: Vec<Vec3> = crate::rig::ik::chain_to_sub_base(&character.asset.skeleton, active.joint)
+        .into_iter()
+        .filter_map(world)
+        .collect();
+    let radius = super::draw::character_size(character) * placement.scale * 0.02;
+    for pair in chain.windows(2) {
+        gizmos.line(pair[0], pair[1], CHAIN_COLOR);
+    }
+    for &p in &chain {
+        gizmos.sphere(Isometry3d::from_translation(p), radius, CHAIN_COLOR);
+    }
+}
+
+/// The dragged chain's colour.
+const CHAIN_COLOR: Color = Color::srgb(1.0, 0.1, 0.1);
