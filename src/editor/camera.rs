@@ -7,15 +7,59 @@ use crate::formats::scene::CameraDoc;
 
 /// The camera's orbit: the scene file's own type (focus, yaw, pitch, distance) on the
 /// camera entity.
+/// The share of the picture's half-height (and half-width) that framing fills.
+pub const FRAMING_FILL: f32 = 0.85;
+
+/// The width / height of the picture that opening a scene frames for (`render` sets its
+/// picture's; the editor uses its viewport's).
+#[derive(Resource, Clone, Copy, Debug)]
+pub struct FramingAspect(pub f32);
+
+impl Default for FramingAspect {
+    fn default() -> Self {
+        Self(1.6)
+    }
+}
+
 #[derive(Component, Clone, Copy, Debug, Default, PartialEq, Deref, DerefMut)]
 pub struct OrbitCamera(pub CameraDoc);
 
 impl OrbitCamera {
     /// A camera looking at a box so that it fills most of the view.
-    pub fn framing(lo: Vec3, hi: Vec3) -> Self {
-        let center = (lo + hi) / 2.0;
-        let radius = ((hi - lo).length() / 2.0).max(0.05);
-        Self(CameraDoc { focus: center, yaw: 0.35, pitch: -0.25, distance: radius * 2.6 })
+    /// A three-quarter view of the box `lo..hi` from as close as keeps every corner inside
+    /// [`FRAMING_FILL`] of a picture of `aspect` (width / height).
+    pub fn framing(lo: Vec3, hi: Vec3, aspect: f32) -> Self {
+        let corners = (0..8).map(|i| {
+            Vec3::new(
+                if i & 1 == 0 { lo.x } else { hi.x },
+                if i & 2 == 0 { lo.y } else { hi.y },
+                if i & 4 == 0 { lo.z } else { hi.z },
+            )
+        });
+        Self::framing_points(corners, aspect)
+    }
+
+    /// A three-quarter view of `points` (centred on their box) from as close as keeps every
+    /// one inside [`FRAMING_FILL`] of a picture of `aspect` (width / height), with Bevy's
+    /// default 45° vertical field of view. Framing the skinned vertices themselves fills
+    /// the picture with the silhouette, not with a box around it.
+    pub fn framing_points(points: impl Iterator<Item = Vec3> + Clone, aspect: f32) -> Self {
+        let (lo, hi) = points
+            .clone()
+            .fold((Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)), |(lo, hi), p| (lo.min(p), hi.max(p)));
+        let focus = if lo.x <= hi.x { (lo + hi) / 2.0 } else { Vec3::ZERO };
+        let mut view = Self(CameraDoc { focus, yaw: 0.6, pitch: -0.3, distance: 1.0 });
+        let rotation = Quat::from_euler(EulerRot::YXZ, view.yaw, view.pitch, 0.0);
+        let (right, up, back) = (rotation * Vec3::X, rotation * Vec3::Y, rotation * Vec3::Z);
+        let tan_y = (std::f32::consts::FRAC_PI_4 / 2.0).tan() * FRAMING_FILL;
+        let tan_x = tan_y * aspect.max(0.1);
+        // A point at depth z (towards the camera) and offsets x, y stays inside when the
+        // camera is at least z + |x| / tan_x (and z + |y| / tan_y) away.
+        view.distance = points
+            .map(|p| p - focus)
+            .map(|c| c.dot(back) + (c.dot(right).abs() / tan_x).max(c.dot(up).abs() / tan_y))
+            .fold(0.05f32, f32::max);
+        view
     }
 
     pub fn transform(&self) -> Transform {

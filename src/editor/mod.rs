@@ -104,6 +104,8 @@ pub fn run(paths: Vec<PathBuf>) {
         .insert_resource(bevy_egui::EguiGlobalSettings { auto_create_primary_context: false, ..default() })
         .insert_resource(ClearColor(stage::SKY))
         .insert_resource(StartupPaths(paths))
+        // The viewport between the default panels (1280 − 2 × 250 wide, 800 high).
+        .insert_resource(camera::FramingAspect(780.0 / 800.0))
         .add_plugins((
             RigCorePlugin,
             SkinningPlugin,

@@ -64,6 +64,7 @@ pub fn render(
     )
     .add_plugins(ScheduleRunnerPlugin::run_loop(Duration::from_millis(2)))
     .insert_resource(ClearColor(stage::SKY))
+    .insert_resource(super::camera::FramingAspect(width as f32 / height as f32))
     .insert_resource(StartupPaths(paths))
     .insert_resource(library)
     .insert_resource(edits)

@@ -107,7 +107,7 @@ pub fn frame_selection(
     let lo = points.iter().fold(Vec3::splat(f32::INFINITY), |a, p| a.min(*p));
     let hi = points.iter().fold(Vec3::splat(f32::NEG_INFINITY), |a, p| a.max(*p));
     for mut orbit in &mut cameras {
-        let framed = OrbitCamera::framing(lo, hi + Vec3::splat(0.15));
+        let framed = OrbitCamera::framing(lo, hi + Vec3::splat(0.15), 1.6);
         orbit.focus = (lo + hi) / 2.0;
         orbit.distance = framed.distance.max(0.4);
     }

@@ -4,7 +4,7 @@
 
 use bevy::prelude::*;
 
-use super::camera::{OrbitCamera, apply_orbit_camera};
+use super::camera::{FramingAspect, OrbitCamera, apply_orbit_camera};
 use super::document::{AssetLibrary, NextCharacterId, PendingScene, SceneCharacter, spawn_from_doc, startup_doc};
 use super::skin_material::SkinMaterial;
 use super::stage::{StageSettings, apply_stage_settings, draw_grid_and_axes, spawn_stage};
@@ -27,6 +27,8 @@ impl Plugin for ScenePlugin {
             .init_resource::<PendingScene>()
             .init_resource::<ik_drag::Pins>()
             .init_resource::<AssetLibrary>()
+            .init_resource::<FramingAspect>()
+            .init_resource::<FrameWhenSkinned>()
             .add_plugins((crate::scene::smpl::SmplPlugin, super::commands::CommandsPlugin))
             .add_systems(
                 PostUpdate,
@@ -56,6 +58,7 @@ impl Plugin for ViewPlugin {
                     attach_skin_material,
                     apply_display_mode,
                     apply_stage_settings,
+                    frame_when_skinned.before(apply_orbit_camera),
                     apply_orbit_camera,
                     draw::draw_skeletons,
                     draw_grid_and_axes,
@@ -130,6 +133,7 @@ pub fn apply_pending_scene(
     live: Query<(Entity, &Character)>,
     mut cameras: Query<&mut OrbitCamera>,
     mut reset: SceneReset,
+    mut frame: ResMut<FrameWhenSkinned>,
 ) {
     let Some(doc) = pending.doc.take() else {
         return;
@@ -138,21 +142,10 @@ pub fn apply_pending_scene(
     for (entity, character) in &live {
         crate::scene::despawn_character(&mut commands, entity, character);
     }
-    let (mut lo, mut hi) = (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY));
     let ids_of_doc = stable_ids(&doc.characters, &mut ids);
     for (c, id) in doc.characters.iter().zip(ids_of_doc) {
         match spawn_from_doc(&mut commands, &mut meshes, &mut library, c, id) {
-            Ok((_, notes)) => {
-                notes.into_iter().for_each(|m| messages.push(m));
-                if let Ok(asset) = library.load(&c.source) {
-                    let (a, b) = asset.bounds();
-                    let m = c.placement.to_mat4();
-                    for corner in [a, b, Vec3::new(a.x, b.y, a.z), Vec3::new(b.x, a.y, b.z)] {
-                        lo = lo.min(m.transform_point3(corner));
-                        hi = hi.max(m.transform_point3(corner));
-                    }
-                }
-            }
+            Ok((_, notes)) => notes.into_iter().for_each(|m| messages.push(m)),
             Err(e) => {
                 messages.push(format!("{e} (`{}` is kept in the scene file as it was)", c.name));
                 reset.unloaded.0.push(c.clone());
@@ -160,12 +153,35 @@ pub fn apply_pending_scene(
         }
     }
     stage.0 = doc.stage;
-    for mut orbit in &mut cameras {
-        if let Some(c) = doc.camera {
-            *orbit = OrbitCamera(c);
-        } else if pending.frame && lo.x <= hi.x {
-            *orbit = OrbitCamera::framing(lo, hi);
-        }
+    if let Some(c) = doc.camera {
+        cameras.iter_mut().for_each(|mut orbit| *orbit = OrbitCamera(c));
+    }
+    frame.0 = doc.camera.is_none() && pending.frame;
+}
+
+/// Asks for the camera to frame every character once they are skinned.
+#[derive(Resource, Default)]
+pub struct FrameWhenSkinned(pub bool);
+
+/// Frames the characters as they stand, posed (their skinned vertices, placed), once all
+/// are skinned after a scene opened (reads `SkinScratch`; writes `OrbitCamera`).
+pub fn frame_when_skinned(
+    mut frame: ResMut<FrameWhenSkinned>,
+    characters: Query<(&crate::scene::Placement, &crate::scene::SkinScratch, &crate::scene::PoseDirty)>,
+    aspect: Res<FramingAspect>,
+    mut cameras: Query<&mut OrbitCamera>,
+) {
+    if !frame.0 || characters.iter().any(|c| *c.2 != crate::scene::PoseDirty::default()) {
+        return;
+    }
+    frame.0 = false;
+    let points = characters.iter().flat_map(|(placement, scratch, _)| {
+        let m = placement.to_mat4();
+        scratch.positions.iter().map(move |&p| m.transform_point3(p))
+    });
+    if points.clone().next().is_some() {
+        let framed = OrbitCamera::framing_points(points, aspect.0);
+        cameras.iter_mut().for_each(|mut orbit| *orbit = framed);
     }
 }
 

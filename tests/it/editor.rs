@@ -227,3 +227,44 @@ fn crowd_members_stand_apart_with_their_own_shape_and_clip() {
         assert_eq!(smpl.iter().filter(|s| s.blend_clip.is_some()).count(), 2);
     }
 }
+
+/// The extent of the warm (skin-tinted) pixels of a render, as fractions of the picture's
+/// width and height: sky and floor are blue-grey, the default tint is warm.
+fn silhouette_extent(png: &std::path::Path) -> (f32, f32) {
+    let img = image::open(png).unwrap().to_rgb8();
+    let (w, h) = img.dimensions();
+    let (mut lo, mut hi) = ((w, h), (0, 0));
+    for (x, y, p) in img.enumerate_pixels() {
+        let [r, _, b] = p.0;
+        if r as i32 - b as i32 > 30 {
+            lo = (lo.0.min(x), lo.1.min(y));
+            hi = (hi.0.max(x), hi.1.max(y));
+        }
+    }
+    if hi.0 < lo.0 {
+        return (0.0, 0.0);
+    }
+    ((hi.0 - lo.0 + 1) as f32 / w as f32, (hi.1 - lo.1 + 1) as f32 / h as f32)
+}
+
+/// `render` without a saved camera frames what it loaded: the silhouette's larger side
+/// covers at least 60 % of the picture (the dragon used to fill a quarter of its width).
+#[test]
+#[cfg_attr(not(marionette_data), ignore = "needs MARIONETTE_DATA (the course data)")]
+fn render_frames_the_characters_to_fill_the_picture() {
+    let data = data_dir();
+    for file in ["cse169/project1/dragon.skel", "mit6837/Model1.skel"] {
+        let out = scratch("render-framing").join("framed.png");
+        let output = Command::new(env!("CARGO_BIN_EXE_marionette"))
+            .args(["render", "--width", "320", "--height", "200", "--out"])
+            .arg(&out)
+            .arg(data.join(file))
+            .output()
+            .unwrap();
+        assert!(output.status.success(), "{}", String::from_utf8_lossy(&output.stderr));
+        let (w, h) = silhouette_extent(&out);
+        eprintln!("{file}: silhouette {:.0} % × {:.0} % of the picture", w * 100.0, h * 100.0);
+        assert!(w.max(h) >= 0.6, "{file}: the silhouette covers {w:.2} × {h:.2}");
+        assert!(w < 1.0 && h < 1.0, "{file}: the silhouette is cut off ({w:.2} × {h:.2})");
+    }
+}
