@@ -7,7 +7,9 @@ use bevy::prelude::*;
 use super::camera::{FramingAspect, OrbitCamera, apply_orbit_camera};
 use super::document::{AssetLibrary, NextCharacterId, PendingScene, SceneCharacter, spawn_from_doc, startup_doc};
 use super::skin_material::SkinMaterial;
-use super::stage::{StageSettings, apply_stage_settings, draw_grid_and_axes, spawn_stage};
+use super::stage::{
+    StageExtent, StageSettings, apply_stage_settings, draw_grid_and_axes, fit_stage_to_scene, spawn_stage,
+};
 use super::state::{Messages, Selection, StartupEdits, StartupPaths, UnloadedCharacters};
 use super::{draw, history, ik_drag};
 use crate::formats::scene::{CharacterId, DisplayDoc};
@@ -48,6 +50,7 @@ impl Plugin for ViewPlugin {
     fn build(&self, app: &mut App) {
         draw::setup_skeleton_gizmos(app);
         app.init_resource::<StartupPaths>()
+            .init_resource::<StageExtent>()
             .init_resource::<StartupEdits>()
             .add_plugins((ScenePlugin, super::readiness::ReadinessPlugin))
             .add_plugins(super::skin_material::SkinMaterialPlugin)
@@ -61,6 +64,7 @@ impl Plugin for ViewPlugin {
                     frame_when_skinned.before(apply_orbit_camera),
                     apply_orbit_camera,
                     draw::draw_skeletons,
+                    fit_stage_to_scene.before(draw_grid_and_axes),
                     draw_grid_and_axes,
                 )
                     .in_set(MarionetteSystems::Draw),

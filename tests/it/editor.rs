@@ -268,3 +268,19 @@ fn render_frames_the_characters_to_fill_the_picture() {
         assert!(w < 1.0 && h < 1.0, "{file}: the silhouette is cut off ({w:.2} × {h:.2})");
     }
 }
+
+/// Floor and grid reach twice as far as the farthest character (at least 10 m), on a round
+/// spacing with at most 20 lines a side.
+#[test]
+fn the_stage_grows_with_the_scene() {
+    use marionette::editor::stage::StageExtent;
+    assert_eq!(StageExtent::reaching(0.0), StageExtent { half: 10.0, step: 0.5 });
+    assert_eq!(StageExtent::reaching(3.0), StageExtent { half: 10.0, step: 0.5 });
+    for reach in [6.0, 31.0, 250.0, 4000.0] {
+        let e = StageExtent::reaching(reach);
+        assert_eq!(e.half, 2.0 * reach);
+        assert!(e.half / e.step <= 20.0 && e.half / e.step >= 4.0, "{e:?}");
+        let mantissa = e.step / 10f32.powf(e.step.log10().floor());
+        assert!([1.0, 2.0, 5.0].iter().any(|m| (mantissa - m).abs() < 1e-3), "{e:?}");
+    }
+}
