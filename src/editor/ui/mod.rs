@@ -47,6 +47,8 @@ impl Default for InspectorState {
 #[derive(SystemParam)]
 pub struct Panels<'w, 's> {
     pub scene: SceneReader<'w, 's>,
+    /// Each character's skinned vertices (for heights).
+    pub skins: Query<'w, 's, &'static crate::scene::SkinScratch>,
     pub edits: ResMut<'w, EditQueue>,
     pub selection: ResMut<'w, Selection>,
     pub history: ResMut<'w, History>,
@@ -59,6 +61,13 @@ pub struct Panels<'w, 's> {
 impl Panels<'_, '_> {
     pub fn push(&mut self, edit: Edit) {
         self.edits.push(edit);
+    }
+
+    /// A character's height as it stands (its skinned vertices, times its scale).
+    pub fn height(&self, entity: Entity) -> Option<f32> {
+        let (_, _, _, placement, ..) = self.scene.characters.get(entity).ok()?;
+        let (lo, hi) = self.skins.get(entity).ok()?.bounds;
+        Some((hi.y - lo.y) * placement.scale)
     }
 }
 

@@ -187,7 +187,13 @@ fn selected_character(ui: &mut egui::Ui, panels: &mut Panels, entity: Entity, id
     let skinning = skinning.0;
     let (mut name, source, binding) = (sc.name.clone(), sc.source.label(), sc.binding);
     let (mut p, mut v) = (placement.0, view.0.clone());
-    let counts = format!("{} joints, {} vertices", character.asset.skeleton.len(), character.asset.vertex_count());
+    let height = panels.height(entity).unwrap_or(0.0);
+    let counts = format!(
+        "{} joints, {} vertices, {height:.2} m tall",
+        character.asset.skeleton.len(),
+        character.asset.vertex_count()
+    );
+    let mut match_height = false;
     let mut edits = Vec::new();
     let (mut duplicate, mut remove) = (false, false);
     egui::Frame::group(ui.style()).show(ui, |ui| {
@@ -202,6 +208,10 @@ fn selected_character(ui: &mut egui::Ui, panels: &mut Panels, entity: Entity, id
         ui.horizontal(|ui| {
             duplicate = ui.button("Duplicate").clicked();
             remove = ui.button("Remove").clicked();
+            match_height = ui
+                .button("Match height")
+                .on_hover_text("scale every other character to this one's height (one undo step)")
+                .clicked();
         });
         placement_rows(ui, &mut p);
         ui.horizontal(|ui| {
@@ -249,11 +259,34 @@ fn selected_character(ui: &mut egui::Ui, panels: &mut Panels, entity: Entity, id
         edits.push(Edit::Add(Box::new(copy)));
         *panels.selection = Selection { character: Some(copy_id), joints: Vec::new() };
     }
+    if match_height && height > 0.0 {
+        edits.extend(match_heights(panels, entity, height));
+    }
     if remove {
         edits.push(Edit::Remove(id));
         *panels.selection = Selection::default();
     }
     edits.into_iter().for_each(|e| panels.push(e));
+}
+
+/// Placement edits that scale every character other than `entity` to `height`, feet kept
+/// where they stood.
+fn match_heights(panels: &Panels, entity: Entity, height: f32) -> Vec<Edit> {
+    panels
+        .scene
+        .characters
+        .iter()
+        .filter(|c| c.0 != entity)
+        .filter_map(|(other, sc, _, placement, ..)| {
+            let own = panels.height(other).filter(|&h| h > 0.0)?;
+            let lowest = panels.skins.get(other).ok()?.bounds.0.y;
+            let scale = placement.scale * height / own;
+            // The feet stay where they stood.
+            let mut translation = placement.translation;
+            translation.y += lowest * (placement.scale - scale);
+            Some(Edit::Place { character: sc.id, placement: PlacementDoc { translation, scale, ..placement.0 } })
+        })
+        .collect()
 }
 
 /// Position, turn (degrees) and scale.
