@@ -12,7 +12,7 @@ use std::sync::{Arc, OnceLock};
 
 use bevy::prelude::*;
 use divan::Bencher;
-use marionette::rig::fk::{forward_kinematics, skinning_palette};
+use marionette::rig::fk::forward_kinematics;
 use marionette::rig::skinning::{flat_shade, skin_positions};
 use marionette::rig::{CharacterAsset, JointRotation};
 use marionette::scene::*;
@@ -44,11 +44,7 @@ fn posed_palette(asset: &CharacterAsset) -> Vec<Mat4> {
     let n = asset.skeleton.len();
     let pose: Vec<JointRotation> =
         (0..n).map(|i| JointRotation::euler_xyz(0.1 * i as f32, 0.05, -0.02 * i as f32)).collect();
-    let mut current = vec![Mat4::IDENTITY; n];
-    forward_kinematics(&asset.skeleton, &pose, Mat4::IDENTITY, &mut current);
-    let mut palette = vec![Mat4::IDENTITY; n];
-    skinning_palette(&current, &asset.bind_world_to_joint, &mut palette);
-    palette
+    marionette::rig::fk::posed_palette(&asset.skeleton, &asset.bind_world_to_joint, &pose, Mat4::IDENTITY)
 }
 
 /// The SMPL body (6,890 vertices, up to 4 influences) with a shape, when `MARIONETTE_DATA`

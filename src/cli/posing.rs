@@ -4,7 +4,7 @@
 use glam::{Mat4, Vec3};
 
 use crate::rig::dqs::SkinningMethod;
-use crate::rig::fk::{forward_kinematics, skinning_palette};
+use crate::rig::fk::posed_palette;
 use crate::rig::lbs::skin;
 use crate::rig::{CharacterAsset, JointRotation, Skeleton};
 
@@ -81,11 +81,7 @@ pub fn posed_positions_by(
     placement: Mat4,
     method: SkinningMethod,
 ) -> Vec<Vec3> {
-    let n = asset.skeleton.len();
-    let mut current = vec![Mat4::IDENTITY; n];
-    forward_kinematics(&asset.skeleton, pose, placement, &mut current);
-    let mut palette = vec![Mat4::IDENTITY; n];
-    skinning_palette(&current, &asset.bind_world_to_joint, &mut palette);
+    let palette = posed_palette(&asset.skeleton, &asset.bind_world_to_joint, pose, placement);
     let mut out = vec![Vec3::ZERO; asset.vertex_count()];
     match method {
         SkinningMethod::Linear => skin(&asset.skin.bind_positions, &asset.skin.weights, &palette, &mut out),

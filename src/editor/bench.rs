@@ -268,10 +268,7 @@ fn wait_for_the_gpu(app: &App) {
 fn kernel_speeds(asset: &CharacterAsset) -> (f64, f64) {
     let n = asset.skeleton.len();
     let pose: Vec<JointRotation> = (0..n).map(|i| JointRotation::euler_xyz(0.1 * i as f32, 0.05, -0.02)).collect();
-    let mut current = vec![Mat4::IDENTITY; n];
-    crate::rig::fk::forward_kinematics(&asset.skeleton, &pose, Mat4::IDENTITY, &mut current);
-    let mut palette = vec![Mat4::IDENTITY; n];
-    crate::rig::fk::skinning_palette(&current, &asset.bind_world_to_joint, &mut palette);
+    let palette = crate::rig::fk::posed_palette(&asset.skeleton, &asset.bind_world_to_joint, &pose, Mat4::IDENTITY);
     let mut out = vec![Vec3::ZERO; asset.vertex_count()];
     let skin = &asset.skin;
     let mut speed = |run: &mut dyn FnMut(&mut [Vec3])| {

@@ -6,13 +6,12 @@
 use std::collections::BTreeMap;
 
 use bevy::prelude::*;
-use bevy::window::PrimaryWindow;
 
-use super::camera::{OrbitCamera, ViewportHasPointer};
+use super::camera::ViewportHasPointer;
 use super::commands::{Edit, EditQueue};
 use super::document::SceneCharacter;
 use super::draw::SkeletonGizmos;
-use super::picking::{CLICK_SLOP_PX, PICK_RADIUS_PX, PickableCharacters, nearest_joint_on_screen};
+use super::picking::{CLICK_SLOP_PX, JointPicker, PICK_RADIUS_PX};
 use super::state::{Drag, JointDrag, Selection};
 use crate::cli::posing::{IK_ROUNDS, IK_TOLERANCE};
 use crate::formats::scene::CharacterId;
@@ -64,13 +63,9 @@ fn toggle_pins(
 
 /// On a left press near a joint, starts dragging it (reads input, joints; writes
 /// `JointDrag`).
-#[allow(clippy::too_many_arguments)]
 fn start_drag(
     buttons: Res<ButtonInput<MouseButton>>,
-    windows: Query<&Window, With<PrimaryWindow>>,
-    cameras: Query<(&Camera, &GlobalTransform), With<OrbitCamera>>,
-    characters: PickableCharacters,
-    joints: Query<&CurrentJointToWorld>,
+    picker: JointPicker,
     pointer: Res<ViewportHasPointer>,
     pins: Res<Pins>,
     mut drag: ResMut<JointDrag>,
@@ -78,22 +73,17 @@ fn start_drag(
     if !buttons.just_pressed(MouseButton::Left) || !pointer.0 {
         return;
     }
-    let (Ok(window), Ok((camera, camera_transform))) = (windows.single(), cameras.single()) else { return };
-    let Some(cursor) = window.cursor_position() else { return };
-    let Some(hit) =
-        nearest_joint_on_screen(camera, camera_transform, cursor, PICK_RADIUS_PX * 0.5, &characters, &joints)
-    else {
-        return;
-    };
+    let (Some(cursor), Some((_, camera_transform))) = (picker.cursor(), picker.camera()) else { return };
+    let Some(hit) = picker.joint_at(cursor, PICK_RADIUS_PX * 0.5) else { return };
     let (id, joint, at) = (hit.id, hit.joint, hit.position);
-    let Ok((_, _, character, placement, _)) = characters.get(hit.entity) else { return };
+    let Ok((_, _, character, placement, _)) = picker.characters.get(hit.entity) else { return };
     if character.asset.skeleton.parent(joint).is_none() {
         return;
     }
     let pins = pins.0.get(&id).map_or(Vec::new(), |list| {
         list.iter()
             .filter(|&&p| p != joint)
-            .filter_map(|&p| Some((p, joints.get(*character.joints.get(p)?).ok()?.world_position(placement))))
+            .filter_map(|&p| Some((p, picker.joints.get(*character.joints.get(p)?).ok()?.world_position(placement))))
             .collect()
     });
     drag.active = Some(Drag {
@@ -109,11 +99,9 @@ fn start_drag(
 
 /// While the button is held, moves the dragged joint to the cursor in its plane by IK;
 /// ends the drag on release (reads input, poses; writes `EditQueue`, `JointDrag`).
-#[allow(clippy::too_many_arguments)]
 fn drag_joint(
     buttons: Res<ButtonInput<MouseButton>>,
-    windows: Query<&Window, With<PrimaryWindow>>,
-    cameras: Query<(&Camera, &GlobalTransform), With<OrbitCamera>>,
+    picker: JointPicker,
     characters: Query<(&SceneCharacter, &Character, &Placement)>,
     poses: Query<&JointPose>,
     mut edits: ResMut<EditQueue>,
@@ -125,8 +113,7 @@ fn drag_joint(
         drag.active = None;
         return;
     }
-    let (Ok(window), Ok((camera, camera_transform))) = (windows.single(), cameras.single()) else { return };
-    let Some(cursor) = window.cursor_position() else { return };
+    let (Some(cursor), Some((camera, camera_transform))) = (picker.cursor(), picker.camera()) else { return };
     if !active.moved {
         if cursor.distance(active.pressed_at) <= CLICK_SLOP_PX {
             return;

@@ -1,5 +1,6 @@
 //! Clicking a joint (or the mesh near it) in the viewport selects that joint.
 
+use bevy::ecs::system::SystemParam;
 use bevy::prelude::*;
 use bevy::window::PrimaryWindow;
 
@@ -17,25 +18,45 @@ pub struct PointerPress(pub Option<Vec2>);
 #[derive(Resource, Default, Debug)]
 pub struct HoveredJoint(pub Option<JointHit>);
 
+/// What every pick in the viewport reads: the window's cursor, the orbit camera and the
+/// joints that can be picked.
+#[derive(SystemParam)]
+pub struct JointPicker<'w, 's> {
+    windows: Query<'w, 's, &'static Window, With<PrimaryWindow>>,
+    cameras: Query<'w, 's, (&'static Camera, &'static GlobalTransform), With<OrbitCamera>>,
+    pub characters: PickableCharacters<'w, 's>,
+    pub joints: Query<'w, 's, &'static CurrentJointToWorld>,
+}
+
+impl JointPicker<'_, '_> {
+    /// The cursor in window pixels, when it is over the window.
+    pub fn cursor(&self) -> Option<Vec2> {
+        self.windows.single().ok()?.cursor_position()
+    }
+
+    /// The orbit camera.
+    pub fn camera(&self) -> Option<(&Camera, &GlobalTransform)> {
+        self.cameras.single().ok()
+    }
+
+    /// The visible joint nearest to `cursor` on screen, within `radius` pixels.
+    pub fn joint_at(&self, cursor: Vec2, radius: f32) -> Option<JointHit> {
+        let (camera, camera_transform) = self.camera()?;
+        nearest_joint_on_screen(camera, camera_transform, cursor, radius, &self.characters, &self.joints)
+    }
+}
+
 /// Finds the joint under the cursor while nothing is held or dragged (reads input, joint
 /// matrices; writes `HoveredJoint`).
-#[allow(clippy::too_many_arguments)]
 pub fn hover_joint(
     buttons: Res<ButtonInput<MouseButton>>,
-    windows: Query<&Window, With<PrimaryWindow>>,
-    cameras: Query<(&Camera, &GlobalTransform), With<OrbitCamera>>,
-    characters: PickableCharacters,
-    joints: Query<&CurrentJointToWorld>,
+    picker: JointPicker,
     pointer: Res<ViewportHasPointer>,
     drag: Res<super::state::JointDrag>,
     mut hovered: ResMut<HoveredJoint>,
 ) {
     let hit = (pointer.0 && drag.active.is_none() && buttons.get_pressed().next().is_none())
-        .then(|| {
-            let (window, (camera, camera_transform)) = (windows.single().ok()?, cameras.single().ok()?);
-            let cursor = window.cursor_position()?;
-            nearest_joint_on_screen(camera, camera_transform, cursor, PICK_RADIUS_PX * 0.5, &characters, &joints)
-        })
+        .then(|| picker.joint_at(picker.cursor()?, PICK_RADIUS_PX * 0.5))
         .flatten();
     let changed = match (&hovered.0, &hit) {
         (Some(a), Some(b)) => a.entity != b.entity || a.joint != b.joint || a.position != b.position,
@@ -57,20 +78,15 @@ pub const CLICK_SLOP_PX: f32 = 4.0;
 /// On a left click (press and release within a few pixels) in the viewport, selects the
 /// visible joint nearest to the cursor on screen; Shift or Ctrl adds to the selection
 /// (reads input, joint matrices; writes `Selection`).
-#[allow(clippy::too_many_arguments)]
 pub fn pick_joint_on_click(
     buttons: Res<ButtonInput<MouseButton>>,
     keys: Res<ButtonInput<KeyCode>>,
-    windows: Query<&Window, With<PrimaryWindow>>,
-    cameras: Query<(&Camera, &GlobalTransform), With<OrbitCamera>>,
-    characters: PickableCharacters,
-    joints: Query<&CurrentJointToWorld>,
+    picker: JointPicker,
     pointer: Res<ViewportHasPointer>,
     mut press: ResMut<PointerPress>,
     mut selection: ResMut<Selection>,
 ) {
-    let (Ok(window), Ok((camera, camera_transform))) = (windows.single(), cameras.single()) else { return };
-    let cursor = window.cursor_position();
+    let cursor = picker.cursor();
     if buttons.just_pressed(MouseButton::Left) {
         press.0 = cursor.filter(|_| pointer.0);
     }
@@ -83,7 +99,7 @@ pub fn pick_joint_on_click(
     if start.distance(cursor) > CLICK_SLOP_PX {
         return;
     }
-    let best = nearest_joint_on_screen(camera, camera_transform, cursor, PICK_RADIUS_PX, &characters, &joints);
+    let best = picker.joint_at(cursor, PICK_RADIUS_PX);
     let additive =
         keys.any_pressed([KeyCode::ShiftLeft, KeyCode::ShiftRight, KeyCode::ControlLeft, KeyCode::ControlRight]);
     match best {

@@ -79,6 +79,22 @@ pub fn joint_positions(joint_to_world: &[Mat4]) -> Vec<Vec3> {
     joint_to_world.iter().map(|m| m.w_axis.truncate()).collect()
 }
 
+/// The skinning palette of `skeleton` at `pose`, placed by `placement`: forward
+/// kinematics, then each joint's current transform times its inverse bind.
+pub fn posed_palette(
+    skeleton: &Skeleton,
+    bind_world_to_joint: &[Mat4],
+    pose: &[JointRotation],
+    placement: Mat4,
+) -> Vec<Mat4> {
+    let n = skeleton.len();
+    let mut current = vec![Mat4::IDENTITY; n];
+    forward_kinematics(skeleton, pose, placement, &mut current);
+    let mut palette = vec![Mat4::IDENTITY; n];
+    skinning_palette(&current, bind_world_to_joint, &mut palette);
+    palette
+}
+
 /// Skinning palette: `current_joint_to_world[j] · bind_world_to_joint[j]`.
 pub fn skinning_palette(current_joint_to_world: &[Mat4], bind_world_to_joint: &[Mat4], palette: &mut [Mat4]) {
     assert_eq!(current_joint_to_world.len(), bind_world_to_joint.len());

@@ -132,10 +132,8 @@ fn the_dual_quaternion_kernel_paths_agree() {
         let n = asset.skeleton.len();
         let pose: Vec<JointRotation> =
             (0..n).map(|i| JointRotation::euler_xyz(0.2 * i as f32, -0.1, 0.15 * i as f32)).collect();
-        let mut current = vec![Mat4::IDENTITY; n];
-        marionette::rig::fk::forward_kinematics(&asset.skeleton, &pose, Mat4::IDENTITY, &mut current);
-        let mut palette = vec![Mat4::IDENTITY; n];
-        marionette::rig::fk::skinning_palette(&current, &asset.bind_world_to_joint, &mut palette);
+        let palette =
+            marionette::rig::fk::posed_palette(&asset.skeleton, &asset.bind_world_to_joint, &pose, Mat4::IDENTITY);
         let dq = dq(&palette);
         let (mut a, mut b) = (vec![Vec3::ZERO; asset.vertex_count()], vec![Vec3::ZERO; asset.vertex_count()]);
         skin_dq(&asset.skin.bind_positions, &asset.skin.weights, &dq, &mut a);

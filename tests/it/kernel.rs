@@ -3,7 +3,6 @@
 //! synthetic rows of 1 to 13 influences.
 
 use glam::{Mat4, Quat, Vec3};
-use marionette::rig::fk::{forward_kinematics, skinning_palette};
 use marionette::rig::lbs::{skin, skin_portable};
 use marionette::rig::skinning::skin_positions;
 use marionette::rig::{CharacterAsset, JointRotation, SkinWeights};
@@ -13,11 +12,8 @@ fn posed_palette(asset: &CharacterAsset) -> Vec<Mat4> {
     let n = asset.skeleton.len();
     let pose: Vec<JointRotation> =
         (0..n).map(|i| JointRotation::euler_xyz(0.1 * i as f32, 0.05 - 0.01 * i as f32, -0.02 * i as f32)).collect();
-    let mut current = vec![Mat4::IDENTITY; n];
-    forward_kinematics(&asset.skeleton, &pose, Mat4::from_translation(Vec3::new(0.3, -0.2, 0.1)), &mut current);
-    let mut palette = vec![Mat4::IDENTITY; n];
-    skinning_palette(&current, &asset.bind_world_to_joint, &mut palette);
-    palette
+    let placement = Mat4::from_translation(Vec3::new(0.3, -0.2, 0.1));
+    marionette::rig::fk::posed_palette(&asset.skeleton, &asset.bind_world_to_joint, &pose, placement)
 }
 
 /// Both paths of the kernel agree with the oracle within `1e-5` (relative to the mesh's size).
