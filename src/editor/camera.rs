@@ -86,9 +86,13 @@ pub fn orbit_camera_input(
     scroll: Res<AccumulatedMouseScroll>,
     pointer: Option<Res<ViewportHasPointer>>,
     drag: Option<Res<super::state::JointDrag>>,
+    gizmo: Option<Res<super::rotate_gizmo::RotateGizmo>>,
     mut cameras: Query<&mut OrbitCamera>,
 ) {
-    if pointer.is_some_and(|p| !p.0) || drag.is_some_and(|d| d.active.is_some()) {
+    if pointer.is_some_and(|p| !p.0)
+        || drag.is_some_and(|d| d.active.is_some())
+        || gizmo.is_some_and(|g| g.holds_pointer || g.turn.is_some())
+    {
         return;
     }
     let delta = motion.delta;

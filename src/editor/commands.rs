@@ -92,10 +92,20 @@ impl EditQueue {
     }
 }
 
-/// Set by the panels while a widget is held or typed into: the gesture (a slider drag, a
-/// name being typed) goes on, and stays one undo step, even between mouse presses.
+/// Held while a gesture goes on without a mouse button held: a widget of the panels held
+/// or typed into (a slider drag, a name being typed), or a rotation being typed in the
+/// viewport. The gesture stays one undo step, even between mouse presses.
 #[derive(Resource, Default, Debug, PartialEq, Eq)]
-pub struct GestureHold(pub bool);
+pub struct GestureHold {
+    pub panels: bool,
+    pub typing: bool,
+}
+
+impl GestureHold {
+    pub fn held(&self) -> bool {
+        self.panels || self.typing
+    }
+}
 
 /// Edits as commands, and their history.
 pub struct CommandsPlugin;
@@ -137,7 +147,7 @@ pub fn apply_edits(world: &mut World) {
         }
     }
     let held = world.get_resource::<ButtonInput<MouseButton>>().is_some_and(|b| b.get_pressed().next().is_some())
-        || world.resource::<GestureHold>().0;
+        || world.resource::<GestureHold>().held();
     world.resource_mut::<History>().gesture_ended = !held;
     if request.is_some() {
         // What is undone must be a step first.

@@ -63,14 +63,15 @@ fn toggle_pins(
 
 /// On a left press near a joint, starts dragging it (reads input, joints; writes
 /// `JointDrag`).
-fn start_drag(
+pub fn start_drag(
     buttons: Res<ButtonInput<MouseButton>>,
     picker: JointPicker,
     pointer: Res<ViewportHasPointer>,
     pins: Res<Pins>,
+    gizmo: Res<super::rotate_gizmo::RotateGizmo>,
     mut drag: ResMut<JointDrag>,
 ) {
-    if !buttons.just_pressed(MouseButton::Left) || !pointer.0 {
+    if !buttons.just_pressed(MouseButton::Left) || !pointer.0 || gizmo.holds_pointer {
         return;
     }
     let (Some(cursor), Some((_, camera_transform))) = (picker.cursor(), picker.camera()) else { return };
@@ -208,5 +209,5 @@ fn draw_dragged_chain(
     }
 }
 
-/// The dragged chain's colour.
-const CHAIN_COLOR: Color = Color::srgb(1.0, 0.1, 0.1);
+/// The colour of the joints a drag moves (the IK chain, what a gizmo turns).
+pub const CHAIN_COLOR: Color = Color::srgb(1.0, 0.1, 0.1);

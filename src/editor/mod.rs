@@ -23,6 +23,7 @@ pub mod ik_drag;
 pub mod picking;
 pub mod readiness;
 pub mod render;
+pub mod rotate_gizmo;
 pub mod screenshot;
 pub mod shortcuts;
 pub mod skin_material;
@@ -46,7 +47,7 @@ pub struct InteractionPlugin;
 
 impl Plugin for InteractionPlugin {
     fn build(&self, app: &mut App) {
-        app.add_plugins(ik_drag::IkDragPlugin);
+        app.add_plugins((ik_drag::IkDragPlugin, rotate_gizmo::RotateGizmoPlugin));
         app.init_resource::<camera::ViewportHasPointer>()
             .init_resource::<picking::PointerPress>()
             .init_resource::<picking::HoveredJoint>()

@@ -83,10 +83,16 @@ pub fn pick_joint_on_click(
     keys: Res<ButtonInput<KeyCode>>,
     picker: JointPicker,
     pointer: Res<ViewportHasPointer>,
+    gizmo: Res<super::rotate_gizmo::RotateGizmo>,
     mut press: ResMut<PointerPress>,
     mut selection: ResMut<Selection>,
 ) {
     let cursor = picker.cursor();
+    if gizmo.holds_pointer || gizmo.is_typing() {
+        // The press turns the joint (or applies a typed turn): no pick.
+        press.0 = None;
+        return;
+    }
     if buttons.just_pressed(MouseButton::Left) {
         press.0 = cursor.filter(|_| pointer.0);
     }

@@ -12,6 +12,7 @@ pub mod pose;
 pub mod skeleton;
 pub mod skinning;
 pub mod smpl;
+pub mod turn;
 
 pub use character::{CharacterAsset, Skin};
 pub use fk::{bind_world_to_joint, forward_kinematics, skinning_palette};

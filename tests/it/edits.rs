@@ -134,12 +134,12 @@ fn a_gesture_is_one_undo_step_and_a_click_is_none() {
     let turn =
         |a: f32| Edit::Pose { character: CharacterId(1), joints: vec![(elbow, JointRotation::euler_xyz(0.0, a, 0.0))] };
 
-    app.world_mut().resource_mut::<GestureHold>().0 = true;
+    app.world_mut().resource_mut::<GestureHold>().panels = true;
     for k in 1..=5 {
         edit(&mut app, turn(0.1 * k as f32));
     }
     assert_eq!(app.world().resource::<History>().undo_steps(), 0, "the gesture is still under way");
-    app.world_mut().resource_mut::<GestureHold>().0 = false;
+    app.world_mut().resource_mut::<GestureHold>().panels = false;
     app.update();
     app.update();
     assert_eq!(app.world().resource::<History>().undo_steps(), 1, "a drag is one step");
@@ -148,15 +148,15 @@ fn a_gesture_is_one_undo_step_and_a_click_is_none() {
     assert_eq!(app.world().resource::<History>().redo_steps(), 1);
 
     // A click on the slider: the same value again.
-    app.world_mut().resource_mut::<GestureHold>().0 = true;
+    app.world_mut().resource_mut::<GestureHold>().panels = true;
     edit(&mut app, Edit::Pose { character: CharacterId(1), joints: vec![(elbow, before)] });
-    app.world_mut().resource_mut::<GestureHold>().0 = false;
+    app.world_mut().resource_mut::<GestureHold>().panels = false;
     app.update();
     // A drag that comes back to where it began.
-    app.world_mut().resource_mut::<GestureHold>().0 = true;
+    app.world_mut().resource_mut::<GestureHold>().panels = true;
     edit(&mut app, turn(0.4));
     edit(&mut app, Edit::Pose { character: CharacterId(1), joints: vec![(elbow, before)] });
-    app.world_mut().resource_mut::<GestureHold>().0 = false;
+    app.world_mut().resource_mut::<GestureHold>().panels = false;
     app.update();
     app.update();
     let history = app.world().resource::<History>();
@@ -272,4 +272,48 @@ fn smpl_shape_and_clip_edits_undo_and_redo() {
     assert_eq!(entity(&app, 1), e);
     request(&mut app, HistoryRequest::Redo);
     assert_eq!((state(&mut app), shape(&app)), end);
+}
+
+/// A gizmo drag pushes one pose edit a frame; the drag is one undo step, and a drag that
+/// is cancelled (its start pushed back) leaves the pose exactly as it was and no step.
+#[test]
+fn a_gizmo_drag_is_one_undo_step_and_a_cancelled_one_none() {
+    use marionette::editor::rotate_gizmo::{Grip, Turn};
+    let mut app = scene_app();
+    open_puppets(&mut app, &[Some(1)]);
+    let elbow = joint(&app, 1, "l_elbow");
+    let pose_of = |app: &App| {
+        app.world().get::<JointPose>(app.world().get::<Character>(entity(app, 1)).unwrap().joints[elbow]).unwrap().0
+    };
+    let start = pose_of(&app);
+    let limits = app.world().get::<Character>(entity(&app, 1)).unwrap().asset.skeleton.joint(elbow).limits;
+    let drag = |app: &mut App, angles: &[f32]| {
+        let grip = Grip::Ring { axis: 2, normal: Vec3::Z, across: Vec3::X, last: 0.0, turned: 0.0 };
+        let mut turn = Turn { character: CharacterId(1), joint: elbow, start: pose_of(app), limits, grip };
+        app.world_mut().resource_mut::<GestureHold>().typing = true;
+        for &a in angles {
+            turn.ring_to(a);
+            edit(app, Edit::Pose { character: CharacterId(1), joints: vec![(elbow, turn.rotation())] });
+        }
+        turn
+    };
+    let release = |app: &mut App| {
+        app.world_mut().resource_mut::<GestureHold>().typing = false;
+        app.update();
+        app.update();
+    };
+
+    let turn = drag(&mut app, &[0.1, 0.2, 0.3]);
+    edit(&mut app, Edit::Pose { character: CharacterId(1), joints: vec![(elbow, turn.start)] });
+    release(&mut app);
+    assert_eq!(pose_of(&app), start, "cancel restores the pose exactly");
+    assert_eq!(app.world().resource::<History>().undo_steps(), 0, "a cancelled drag is no step");
+
+    let turn = drag(&mut app, &[0.1, 0.2, 0.3]);
+    release(&mut app);
+    assert_eq!(pose_of(&app), turn.rotation());
+    assert_ne!(pose_of(&app), start);
+    assert_eq!(app.world().resource::<History>().undo_steps(), 1, "a drag is one step");
+    request(&mut app, HistoryRequest::Undo);
+    assert_eq!(pose_of(&app), start, "undo returns to where the drag began");
 }

@@ -9,6 +9,7 @@ mod editor;
 mod edits;
 mod formats;
 mod fuzz;
+mod gizmo;
 mod ik;
 mod kernel;
 mod rig;

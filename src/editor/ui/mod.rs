@@ -76,6 +76,7 @@ impl Panels<'_, '_> {
 pub struct ViewportOverlays<'w> {
     diagnostics: Res<'w, DiagnosticsStore>,
     hovered: Res<'w, super::picking::HoveredJoint>,
+    gizmo: Res<'w, super::rotate_gizmo::RotateGizmo>,
 }
 
 pub struct InspectorPlugin;
@@ -123,12 +124,20 @@ fn inspector_ui(
     viewport_area.set_if_neq(area);
     frame_time_readout(&ctx, central, &overlays.diagnostics);
     hovered_joint_tooltip(&ctx, &panels, &overlays.hovered);
-    if let Some(text) = &state.active_dof {
-        egui::Area::new("active_dof".into()).anchor(egui::Align2::CENTER_TOP, [0.0, 12.0]).show(&ctx, |ui| {
-            egui::Frame::popup(ui.style()).show(ui, |ui| ui.label(egui::RichText::new(text).size(20.0).strong()));
+    if let Some(text) = state.active_dof.as_ref().or(overlays.gizmo.readout.as_ref()) {
+        egui::Area::new("active_dof".into()).anchor(egui::Align2::CENTER_TOP, [0.0, 36.0]).show(&ctx, |ui| {
+            egui::Frame::popup(ui.style()).show(ui, |ui| {
+                ui.add(
+                    egui::Label::new(egui::RichText::new(text).size(20.0).strong())
+                        .wrap_mode(egui::TextWrapMode::Extend),
+                )
+            });
         });
     }
-    hold.set_if_neq(GestureHold(ctx.egui_is_using_pointer() || ctx.egui_wants_keyboard_input()));
+    let panels = ctx.egui_is_using_pointer() || ctx.egui_wants_keyboard_input();
+    if hold.panels != panels {
+        hold.panels = panels;
+    }
     Ok(())
 }
 
