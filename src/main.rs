@@ -82,6 +82,10 @@ enum Command {
         /// (default: as the scene file says).
         #[arg(long, value_enum)]
         skinning: Option<Skinning>,
+        /// Scale every character to the first one's height (as they stand, feet on the
+        /// floor); characters named on the command line then stand side by side.
+        #[arg(long)]
+        match_height: bool,
     },
     /// The SMPL exercise: writes frame000.obj, frame001.obj, ... into --out.
     ///
@@ -185,9 +189,10 @@ fn run(cli: Cli) -> Result<()> {
             write_file(&out, |w| obj::write_obj(w, &positions, &asset.skin.triangles))?;
             println!("wrote {} ({} vertices, {} triangles)", out.display(), positions.len(), asset.triangle_count());
         }
-        Some(Command::Render { paths, out, width, height, poses, ik, skinning }) => {
+        Some(Command::Render { paths, out, width, height, poses, ik, skinning, match_height }) => {
             let started = std::time::Instant::now();
-            let edits = marionette::editor::StartupEdits { poses, ik, skinning: skinning.map(Into::into) };
+            let edits =
+                marionette::editor::StartupEdits { poses, ik, skinning: skinning.map(Into::into), match_height };
             let notes = marionette::editor::render::render(paths, edits, out.clone(), width, height)
                 .map_err(anyhow::Error::msg)?;
             for n in notes {

@@ -292,9 +292,10 @@ pub fn spawn_from_doc(
     Ok((entity, messages))
 }
 
-/// A document of characters placed side by side along x, each standing on y = 0.
+/// A document of characters placed side by side along x by their bind boxes, each
+/// standing on y = 0 (re-placed by their boxes as they stand once skinned, see
+/// [`super::arrange`]).
 pub fn doc_side_by_side(library: &mut AssetLibrary, sources: Vec<SourceDoc>, messages: &mut Vec<String>) -> SceneDoc {
-    let gap = 0.15;
     let loaded: Vec<(SourceDoc, Arc<CharacterAsset>)> = sources
         .into_iter()
         .filter_map(|s| match library.load(&s) {
@@ -308,38 +309,21 @@ pub fn doc_side_by_side(library: &mut AssetLibrary, sources: Vec<SourceDoc>, mes
             }
         })
         .collect();
-    let widths: Vec<f32> = loaded
-        .iter()
-        .map(|(_, a)| {
-            let (lo, hi) = a.bounds();
-            (hi.x - lo.x).max(0.1)
-        })
-        .collect();
-    let total: f32 = widths.iter().sum::<f32>() + gap * loaded.len().saturating_sub(1) as f32;
-    let mut x = -total / 2.0;
+    let boxes: Vec<(Vec3, Vec3)> = loaded.iter().map(|(_, a)| a.bounds()).collect();
+    let translations = super::arrange::side_by_side(&boxes, &vec![1.0; boxes.len()]);
     let characters = loaded
         .into_iter()
-        .zip(widths)
-        .map(|((source, asset), w)| {
-            let (lo, hi) = asset.bounds();
-            let center = (lo + hi) / 2.0;
-            let doc = CharacterDoc {
-                id: None,
-                name: asset.name.clone(),
-                source,
-                placement: PlacementDoc {
-                    translation: Vec3::new(x + w / 2.0 - center.x, -lo.y, -center.z),
-                    yaw: 0.0,
-                    scale: 1.0,
-                },
-                pose: Default::default(),
-                view: ViewDoc::default(),
-                smpl: None,
-                binding: None,
-                skinning: Default::default(),
-            };
-            x += w + gap;
-            doc
+        .zip(translations)
+        .map(|((source, asset), translation)| CharacterDoc {
+            id: None,
+            name: asset.name.clone(),
+            source,
+            placement: PlacementDoc { translation, yaw: 0.0, scale: 1.0 },
+            pose: Default::default(),
+            view: ViewDoc::default(),
+            smpl: None,
+            binding: None,
+            skinning: Default::default(),
         })
         .collect();
     SceneDoc { characters, camera: None, stage: Default::default() }

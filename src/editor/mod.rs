@@ -11,6 +11,7 @@
 //! [`ui::InspectorPlugin`], [`screenshot::ScreenshotPlugin`]. Children import shared state
 //! ([`state`], [`document`], [`commands`]), never this module.
 
+pub mod arrange;
 pub mod bench;
 pub mod camera;
 pub mod commands;

@@ -20,6 +20,8 @@ pub struct StartupEdits {
     pub ik: Vec<crate::cli::posing::IkSpec>,
     /// `--skinning`: every character skinned this way.
     pub skinning: Option<crate::rig::dqs::SkinningMethod>,
+    /// `--match-height`: every character scaled to the first one's height.
+    pub match_height: bool,
 }
 
 /// Messages for the user (load errors, warnings, where files went), newest last.

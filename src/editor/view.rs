@@ -5,7 +5,9 @@
 use bevy::prelude::*;
 
 use super::camera::{FramingAspect, OrbitCamera, apply_orbit_camera};
-use super::document::{AssetLibrary, NextCharacterId, PendingScene, SceneCharacter, spawn_from_doc, startup_doc};
+use super::document::{
+    AssetLibrary, NextCharacterId, PendingScene, SceneCharacter, scene_path, spawn_from_doc, startup_doc,
+};
 use super::skin_material::SkinMaterial;
 use super::stage::{
     StageExtent, StageSettings, apply_stage_settings, draw_grid_and_axes, fit_stage_to_scene, spawn_stage,
@@ -31,6 +33,7 @@ impl Plugin for ScenePlugin {
             .init_resource::<AssetLibrary>()
             .init_resource::<FramingAspect>()
             .init_resource::<FrameWhenSkinned>()
+            .init_resource::<super::arrange::ArrangeWhenSkinned>()
             .add_plugins((crate::scene::smpl::SmplPlugin, super::commands::CommandsPlugin))
             .add_systems(
                 PostUpdate,
@@ -38,7 +41,8 @@ impl Plugin for ScenePlugin {
                     .chain()
                     .in_set(MarionetteSystems::Animate)
                     .before(crate::scene::smpl::SmplPlayback),
-            );
+            )
+            .add_systems(PostUpdate, super::arrange::arrange_when_skinned.in_set(MarionetteSystems::Draw));
     }
 }
 
@@ -61,7 +65,7 @@ impl Plugin for ViewPlugin {
                     attach_skin_material,
                     apply_display_mode,
                     apply_stage_settings,
-                    frame_when_skinned.before(apply_orbit_camera),
+                    frame_when_skinned.after(super::arrange::arrange_when_skinned).before(apply_orbit_camera),
                     apply_orbit_camera,
                     draw::draw_skeletons,
                     fit_stage_to_scene.before(draw_grid_and_axes),
@@ -79,9 +83,14 @@ fn queue_startup_scene(
     mut library: ResMut<AssetLibrary>,
     mut messages: ResMut<Messages>,
     mut pending: ResMut<PendingScene>,
+    mut arrange: ResMut<super::arrange::ArrangeWhenSkinned>,
 ) {
     let mut notes = Vec::new();
     let doc = startup_doc(&paths.0, &mut library, &mut notes);
+    *arrange = super::arrange::ArrangeWhenSkinned {
+        side_by_side: !paths.0.is_empty() && scene_path(&paths.0).is_none(),
+        match_height: edits.match_height,
+    };
     notes.into_iter().for_each(|m| messages.push(m));
     if let Some(mut doc) = doc {
         apply_startup_edits(&mut doc, &edits, &mut library, &mut messages);

@@ -63,6 +63,18 @@ impl Panels<'_, '_> {
         self.edits.push(edit);
     }
 
+    /// Every character's box in the world as it stands (skinned, placed).
+    pub fn world_boxes(&self) -> Vec<(Vec3, Vec3)> {
+        self.scene
+            .characters
+            .iter()
+            .filter_map(|(entity, _, _, placement, ..)| {
+                let (lo, hi) = self.skins.get(entity).ok()?.bounds;
+                Some(crate::editor::arrange::world_box(lo, hi, &placement.0))
+            })
+            .collect()
+    }
+
     /// A character's height as it stands (its skinned vertices, times its scale).
     pub fn height(&self, entity: Entity) -> Option<f32> {
         let (_, _, _, placement, ..) = self.scene.characters.get(entity).ok()?;

@@ -8,6 +8,7 @@ use bevy::prelude::*;
 use bevy_egui::egui;
 
 use super::{InspectorState, Panels};
+use crate::editor::arrange::{beside, rescaled_keeping_feet};
 use crate::editor::commands::Edit;
 use crate::editor::document::{open_scene_from, save_scene_to};
 use crate::editor::history::HistoryRequest;
@@ -16,9 +17,6 @@ use crate::editor::state::Selection;
 use crate::formats::scene::{
     BindingDoc, CharacterDoc, CharacterId, DisplayDoc, PlacementDoc, SkinningDoc, SourceDoc, ViewDoc,
 };
-
-/// Space left between a character added and the rightmost one.
-const ADD_GAP: f32 = 0.3;
 
 pub fn scene_panel(ui: &mut egui::Ui, state: &mut InspectorState, panels: &mut Panels, shot: &mut ScreenshotRequest) {
     ui.heading("Scene");
@@ -111,16 +109,14 @@ fn add_character(path: &str, state: &mut InspectorState, panels: &mut Panels) {
         Err(e) => return panels.messages.push(e.to_string()),
     };
     panels.messages.0.extend(asset.warnings.iter().cloned());
-    let right = panels.scene.characters.iter().map(|c| c.3.translation.x).fold(f32::NEG_INFINITY, f32::max);
     let (lo, hi) = asset.bounds();
-    let x = if right.is_finite() { right + ADD_GAP + (hi.x - lo.x) } else { 0.0 };
-    let center = (lo + hi) / 2.0;
+    let translation = beside(&panels.world_boxes(), lo, hi, 1.0);
     let id = panels.ids.take();
     panels.push(Edit::Add(Box::new(CharacterDoc {
         id: Some(id),
         source,
         name: asset.name.clone(),
-        placement: PlacementDoc { translation: Vec3::new(x - center.x, -lo.y, -center.z), yaw: 0.0, scale: 1.0 },
+        placement: PlacementDoc { translation, yaw: 0.0, scale: 1.0 },
         pose: Default::default(),
         view: ViewDoc::default(),
         smpl: None,
@@ -255,7 +251,10 @@ fn selected_character(ui: &mut egui::Ui, panels: &mut Panels, entity: Entity, id
         let copy_id = panels.ids.take();
         copy.id = Some(copy_id);
         copy.name = format!("{} copy", copy.name);
-        copy.placement.translation.x += 0.5;
+        if let Ok((lo, hi)) = panels.skins.get(entity).map(|s| s.bounds) {
+            copy.placement.translation = beside(&panels.world_boxes(), lo, hi, copy.placement.scale);
+            copy.placement.yaw = 0.0;
+        }
         edits.push(Edit::Add(Box::new(copy)));
         *panels.selection = Selection { character: Some(copy_id), joints: Vec::new() };
     }
@@ -280,11 +279,8 @@ fn match_heights(panels: &Panels, entity: Entity, height: f32) -> Vec<Edit> {
         .filter_map(|(other, sc, _, placement, ..)| {
             let own = panels.height(other).filter(|&h| h > 0.0)?;
             let lowest = panels.skins.get(other).ok()?.bounds.0.y;
-            let scale = placement.scale * height / own;
-            // The feet stay where they stood.
-            let mut translation = placement.translation;
-            translation.y += lowest * (placement.scale - scale);
-            Some(Edit::Place { character: sc.id, placement: PlacementDoc { translation, scale, ..placement.0 } })
+            let placement = rescaled_keeping_feet(&placement.0, lowest, placement.scale * height / own);
+            Some(Edit::Place { character: sc.id, placement })
         })
         .collect()
 }

@@ -1,0 +1,122 @@
+//! Characters side by side by their bounds, and of one height: where characters opened
+//! together stand, where an added one goes, and `--match-height`. Boxes are axis-aligned,
+//! `(min, max)`; a character's own box is in its model space, as it stands (skinned).
+
+use bevy::math::Vec3;
+use bevy::prelude::*;
+
+use super::document::SceneCharacter;
+use crate::formats::scene::PlacementDoc;
+use crate::scene::{Placement, PoseDirty, SkinScratch};
+
+/// The gap between neighbours, as a share of the widest character's width.
+pub const GAP_SHARE: f32 = 0.15;
+
+/// The world box of a model box `lo..hi` placed by `placement` (its eight corners moved).
+pub fn world_box(lo: Vec3, hi: Vec3, placement: &PlacementDoc) -> (Vec3, Vec3) {
+    let m = Placement(*placement).to_mat4();
+    (0..8)
+        .map(|i| Vec3::new(corner(i, 0, lo, hi), corner(i, 1, lo, hi), corner(i, 2, lo, hi)))
+        .map(|c| m.transform_point3(c))
+        .fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(a, b), p| (a.min(p), b.max(p)))
+}
+
+fn corner(i: usize, axis: usize, lo: Vec3, hi: Vec3) -> f32 {
+    if i >> axis & 1 == 0 { lo[axis] } else { hi[axis] }
+}
+
+/// The gap between characters whose widest is `widest` wide.
+fn gap(widest: f32) -> f32 {
+    GAP_SHARE * widest.max(1e-3)
+}
+
+/// Translations that stand characters (model boxes `boxes`, scaled by `scales`, not
+/// turned) side by side along x in order, a gap apart, centred on the origin, on the
+/// floor (y = 0) and centred in z.
+pub fn side_by_side(boxes: &[(Vec3, Vec3)], scales: &[f32]) -> Vec<Vec3> {
+    let widths: Vec<f32> = boxes.iter().zip(scales).map(|((lo, hi), s)| (hi.x - lo.x) * s).collect();
+    let gap = gap(widths.iter().copied().fold(0.0, f32::max));
+    let total = widths.iter().sum::<f32>() + gap * boxes.len().saturating_sub(1) as f32;
+    let mut left = -total / 2.0;
+    boxes
+        .iter()
+        .zip(scales)
+        .zip(&widths)
+        .map(|(((lo, hi), &s), &w)| {
+            let at = stand_left_at(*lo, *hi, s, left);
+            left += w + gap;
+            at
+        })
+        .collect()
+}
+
+/// The translation that puts a model box's left side at x = `left`, on the floor,
+/// centred in z.
+fn stand_left_at(lo: Vec3, hi: Vec3, scale: f32, left: f32) -> Vec3 {
+    Vec3::new(left - lo.x * scale, -lo.y * scale, -(lo.z + hi.z) / 2.0 * scale)
+}
+
+/// Where a character (model box `lo..hi` at `scale`) goes beside those already in the
+/// world (their world boxes): right of all of them, a gap beyond, on the floor; at the
+/// origin when there are none.
+pub fn beside(world: &[(Vec3, Vec3)], lo: Vec3, hi: Vec3, scale: f32) -> Vec3 {
+    let Some(right) = world.iter().map(|b| b.1.x).reduce(f32::max) else {
+        return side_by_side(&[(lo, hi)], &[scale])[0];
+    };
+    let widest = world.iter().map(|(a, b)| b.x - a.x).fold((hi.x - lo.x) * scale, f32::max);
+    stand_left_at(lo, hi, scale, right + gap(widest))
+}
+
+/// What `--match-height` and a scene opened from character files ask of the characters
+/// once they are skinned (their boxes are then known as they stand).
+#[derive(Resource, Default, Clone, Copy, Debug)]
+pub struct ArrangeWhenSkinned {
+    /// Stand them side by side by their skinned boxes.
+    pub side_by_side: bool,
+    /// First scale every character to the first one's height.
+    pub match_height: bool,
+}
+
+/// `placement` scaled to `scale` with the feet (the model box's lowest point, `lowest`)
+/// kept where they stood.
+pub fn rescaled_keeping_feet(placement: &PlacementDoc, lowest: f32, scale: f32) -> PlacementDoc {
+    let mut translation = placement.translation;
+    translation.y += lowest * (placement.scale - scale);
+    PlacementDoc { translation, scale, ..*placement }
+}
+
+/// Once every character is skinned, scales them to the first one's height (when asked)
+/// and stands them side by side by their boxes as they stand (when asked; otherwise each
+/// keeps its place, feet where they stood) (reads `SkinScratch`; writes `Placement`).
+/// Runs once per scene opened.
+pub fn arrange_when_skinned(
+    mut arrange: ResMut<ArrangeWhenSkinned>,
+    mut characters: Query<(&SceneCharacter, &mut Placement, &SkinScratch, &PoseDirty)>,
+) {
+    let ArrangeWhenSkinned { side_by_side: in_a_row, match_height } = *arrange;
+    if !(in_a_row || match_height) || characters.iter().any(|c| *c.3 != PoseDirty::default()) {
+        return;
+    }
+    *arrange = ArrangeWhenSkinned::default();
+    let mut characters: Vec<_> = characters.iter_mut().map(|(sc, p, s, _)| (sc.id, p, s.bounds)).collect();
+    // Ids follow the document's order.
+    characters.sort_by_key(|c| c.0);
+    let height = |(lo, hi): (Vec3, Vec3)| hi.y - lo.y;
+    let target = characters.first().map(|c| height(c.2) * c.1.scale);
+    let scales: Vec<f32> = characters
+        .iter()
+        .map(|(_, placement, bounds)| match target {
+            Some(t) if match_height && height(*bounds) > 0.0 => t / height(*bounds),
+            _ => placement.scale,
+        })
+        .collect();
+    let boxes: Vec<(Vec3, Vec3)> = characters.iter().map(|c| c.2).collect();
+    let translations = side_by_side(&boxes, &scales);
+    for (((_, placement, bounds), scale), translation) in characters.iter_mut().zip(scales).zip(translations) {
+        placement.0 = if in_a_row {
+            PlacementDoc { translation, scale, yaw: 0.0 }
+        } else {
+            rescaled_keeping_feet(&placement.0, bounds.0.y, scale)
+        };
+    }
+}
