@@ -5,8 +5,6 @@ use bevy::prelude::*;
 
 use crate::formats::scene::CameraDoc;
 
-/// The camera's orbit: the scene file's own type (focus, yaw, pitch, distance) on the
-/// camera entity.
 /// The share of the picture's half-height (and half-width) that framing fills.
 pub const FRAMING_FILL: f32 = 0.85;
 
@@ -21,11 +19,12 @@ impl Default for FramingAspect {
     }
 }
 
+/// The camera's orbit: the scene file's own type (focus, yaw, pitch, distance) on the
+/// camera entity.
 #[derive(Component, Clone, Copy, Debug, Default, PartialEq, Deref, DerefMut)]
 pub struct OrbitCamera(pub CameraDoc);
 
 impl OrbitCamera {
-    /// A camera looking at a box so that it fills most of the view.
     /// A three-quarter view of the box `lo..hi` from as close as keeps every corner inside
     /// [`FRAMING_FILL`] of a picture of `aspect` (width / height).
     pub fn framing(lo: Vec3, hi: Vec3, aspect: f32) -> Self {
@@ -47,19 +46,39 @@ impl OrbitCamera {
         let (lo, hi) = points
             .clone()
             .fold((Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)), |(lo, hi), p| (lo.min(p), hi.max(p)));
-        let focus = if lo.x <= hi.x { (lo + hi) / 2.0 } else { Vec3::ZERO };
-        let mut view = Self(CameraDoc { focus, yaw: 0.6, pitch: -0.3, distance: 1.0 });
-        let rotation = Quat::from_euler(EulerRot::YXZ, view.yaw, view.pitch, 0.0);
+        let mut focus = if lo.x <= hi.x { (lo + hi) / 2.0 } else { Vec3::ZERO };
+        let (yaw, pitch) = (0.6, -0.3);
+        let rotation = Quat::from_euler(EulerRot::YXZ, yaw, pitch, 0.0);
         let (right, up, back) = (rotation * Vec3::X, rotation * Vec3::Y, rotation * Vec3::Z);
         let tan_y = (std::f32::consts::FRAC_PI_4 / 2.0).tan() * FRAMING_FILL;
         let tan_x = tan_y * aspect.max(0.1);
         // A point at depth z (towards the camera) and offsets x, y stays inside when the
         // camera is at least z + |x| / tan_x (and z + |y| / tan_y) away.
-        view.distance = points
-            .map(|p| p - focus)
-            .map(|c| c.dot(back) + (c.dot(right).abs() / tan_x).max(c.dot(up).abs() / tan_y))
-            .fold(0.05f32, f32::max);
-        view
+        let distance_from = |focus: Vec3| {
+            points
+                .clone()
+                .map(|p| p - focus)
+                .map(|c| c.dot(back) + (c.dot(right).abs() / tan_x).max(c.dot(up).abs() / tan_y))
+                .fold(0.05f32, f32::max)
+        };
+        // Seen in perspective, the near side of the points looks larger than the far side:
+        // a few rounds of moving the focus to the middle of what the camera sees, then
+        // backing off just enough, centre the picture on them.
+        for _ in 0..4 {
+            let distance = distance_from(focus);
+            // Where each point lands, as a share of the half picture, and their middle.
+            let seen = |c: Vec3| {
+                let depth = (distance - c.dot(back)).max(1e-6);
+                Vec2::new(c.dot(right) / (depth * tan_x), c.dot(up) / (depth * tan_y))
+            };
+            let (min, max) = points
+                .clone()
+                .map(|p| seen(p - focus))
+                .fold((Vec2::INFINITY, Vec2::NEG_INFINITY), |(a, b), s| (a.min(s), b.max(s)));
+            let middle = (min + max) / 2.0;
+            focus += (right * middle.x * tan_x + up * middle.y * tan_y) * distance;
+        }
+        Self(CameraDoc { focus, yaw, pitch, distance: distance_from(focus) })
     }
 
     pub fn transform(&self) -> Transform {

@@ -113,3 +113,42 @@ fn match_height_makes_heights_equal_and_the_row_does_not_overlap() {
     }
     assert!(!app.world().resource::<ArrangeWhenSkinned>().match_height, "done once");
 }
+
+/// Framing a box with Bevy's default perspective (45° vertically) at several aspects:
+/// every corner is in the picture, and the box covers at least 60 % of the picture's width
+/// or of its height.
+#[test]
+fn framing_sees_every_corner_and_fills_most_of_the_picture() {
+    use bevy::camera::CameraProjection;
+    use marionette::editor::camera::OrbitCamera;
+    let boxes = [
+        (Vec3::new(-0.5, 0.0, -0.3), Vec3::new(0.5, 1.8, 0.3)),
+        (Vec3::new(-8.0, 0.0, -2.0), Vec3::new(8.0, 1.0, 2.0)),
+        (Vec3::new(3.0, -1.0, 4.0), Vec3::new(3.2, 9.0, 4.1)),
+    ];
+    for (lo, hi) in boxes {
+        for aspect in [0.6f32, 1.0, 16.0 / 9.0, 3.0] {
+            let orbit = OrbitCamera::framing(lo, hi, aspect);
+            let view = orbit.transform().to_matrix().inverse();
+            let projection = PerspectiveProjection { aspect_ratio: aspect, ..Default::default() };
+            let clip = projection.get_clip_from_view() * view;
+            let ndc: Vec<Vec3> = (0..8)
+                .map(|i| {
+                    let pick = |bit: usize, a: f32, b: f32| if i >> bit & 1 == 0 { a } else { b };
+                    Vec3::new(pick(0, lo.x, hi.x), pick(1, lo.y, hi.y), pick(2, lo.z, hi.z))
+                })
+                .map(|c| clip.project_point3(c))
+                .collect();
+            for p in &ndc {
+                assert!(p.x.abs() <= 1.0 && p.y.abs() <= 1.0, "{lo} {hi} at {aspect}: a corner at {p} is outside");
+            }
+            let span = |f: fn(&Vec3) -> f32| {
+                ndc.iter().map(f).fold(f32::NEG_INFINITY, f32::max) - ndc.iter().map(f).fold(f32::INFINITY, f32::min)
+            };
+            // NDC spans 2 across: the share of the picture's width and of its height the box
+            // covers; its larger side must cover at least 60 % of the picture that way.
+            let fill = (span(|p| p.x) / 2.0).max(span(|p| p.y) / 2.0);
+            assert!(fill >= 0.6, "{lo} {hi} at {aspect}: fills {fill:.2}");
+        }
+    }
+}
