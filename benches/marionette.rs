@@ -232,6 +232,7 @@ fn editing_frame_3_smpl_playing_1_puppet_dragged(bencher: Bencher, variant: &str
         smpl,
         binding: None,
         skinning: Default::default(),
+        anim: None,
     };
     let mut characters = vec![character(1, SourceDoc::Embedded("puppet".into()), 0.0, None)];
     if let Some(dir) = std::env::var_os("MARIONETTE_DATA").map(|d| std::path::PathBuf::from(d).join("smpl")) {

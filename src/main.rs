@@ -28,6 +28,8 @@ enum Command {
     Edit {
         /// Character files; none opens the default scene.
         paths: Vec<PathBuf>,
+        #[command(flatten)]
+        clip: ClipArgs,
     },
     /// Print what a character file loads as: joints, vertices, triangles, weight checks.
     Info { path: PathBuf },
@@ -48,6 +50,8 @@ enum Command {
         /// Linear blend (`lbs`) or dual quaternion (`dq`) skinning.
         #[arg(long, value_enum, default_value_t = Skinning::Lbs)]
         skinning: Skinning,
+        #[command(flatten)]
+        clip: ClipArgs,
     },
     /// Bind a mesh without weights to a skeleton (each vertex to its nearest bone, or
     /// smoothly to the nearest few) and write 6.837-style weights.
@@ -86,6 +90,8 @@ enum Command {
         /// floor); characters named on the command line then stand side by side.
         #[arg(long)]
         match_height: bool,
+        #[command(flatten)]
+        clip: ClipArgs,
     },
     /// The SMPL exercise: writes frame000.obj, frame001.obj, ... into --out.
     ///
@@ -160,6 +166,37 @@ impl From<Skinning> for marionette::rig::dqs::SkinningMethod {
     }
 }
 
+/// `--anim FILE --time T`: pose characters from a keyframed clip.
+#[derive(clap::Args, Debug, Clone)]
+struct ClipArgs {
+    /// A CSE169 `.anim` clip: channels 0-2 move the root, then x, y, z rotation per joint
+    /// in the skeleton's order. On every character whose skeleton it fits.
+    #[arg(long, value_name = "FILE.anim")]
+    anim: Option<PathBuf>,
+    /// The clip's time in seconds (extrapolated outside its keys as the clip says).
+    #[arg(long, default_value_t = 0.0, value_parser = finite_seconds, requires = "anim")]
+    time: f32,
+}
+
+impl ClipArgs {
+    fn anim_doc(&self, playing: bool) -> Option<marionette::formats::scene::AnimDoc> {
+        let file = self.anim.clone()?;
+        Some(marionette::formats::scene::AnimDoc {
+            time: self.time,
+            playing,
+            ..marionette::formats::scene::AnimDoc::of(file)
+        })
+    }
+}
+
+/// A finite number of seconds.
+fn finite_seconds(text: &str) -> Result<f32, String> {
+    match text.parse::<f32>() {
+        Ok(t) if t.is_finite() => Ok(t),
+        _ => Err(format!("expected a finite number of seconds, found `{text}`")),
+    }
+}
+
 fn main() -> ExitCode {
     match run(Cli::parse()) {
         Ok(()) => ExitCode::SUCCESS,
@@ -172,27 +209,43 @@ fn main() -> ExitCode {
 
 fn run(cli: Cli) -> Result<()> {
     match cli.command {
-        None => marionette::editor::run(Vec::new()),
-        Some(Command::Edit { paths }) => marionette::editor::run(paths),
+        None => marionette::editor::run(Vec::new(), Default::default()),
+        Some(Command::Edit { paths, clip }) => {
+            let edits = marionette::editor::StartupEdits { anim: clip.anim_doc(true), ..Default::default() };
+            marionette::editor::run(paths, edits)
+        }
         Some(Command::Info { path }) => print!("{}", describe(&load_character(&path)?)),
-        Some(Command::Export { path, out, poses, ik, skinning }) => {
+        Some(Command::Export { path, out, poses, ik, skinning, clip }) => {
             let asset = load_character(&path)?;
             for w in &asset.warnings {
                 eprintln!("warning: {w}");
             }
             let mut pose = asset.skeleton.initial_pose();
+            let mut origin = Mat4::IDENTITY;
+            if let Some(file) = &clip.anim {
+                let anim = marionette::formats::cse169_skin::parse_anim(marionette::formats::error::open(file)?, file)?;
+                let (root, clip_pose) = anim.pose_at(&asset.skeleton, clip.time, &pose);
+                pose = clip_pose;
+                let root_offset = asset.skeleton.joint(0).rest_offset;
+                origin = marionette::scene::keyframes::RootTranslation(Some(root)).origin(root_offset);
+            }
             apply_pose_specs(&asset.skeleton, &mut pose, &poses)?;
-            for report in apply_ik_specs(&asset.skeleton, &mut pose, Mat4::IDENTITY, &ik)? {
+            for report in apply_ik_specs(&asset.skeleton, &mut pose, origin, &ik)? {
                 eprintln!("{}", describe_ik(&asset.skeleton, &report));
             }
-            let positions = posed_positions_by(&asset, &pose, Mat4::IDENTITY, skinning.into());
+            let positions = posed_positions_by(&asset, &pose, origin, skinning.into());
             write_file(&out, |w| obj::write_obj(w, &positions, &asset.skin.triangles))?;
             println!("wrote {} ({} vertices, {} triangles)", out.display(), positions.len(), asset.triangle_count());
         }
-        Some(Command::Render { paths, out, width, height, poses, ik, skinning, match_height }) => {
+        Some(Command::Render { paths, out, width, height, poses, ik, skinning, match_height, clip }) => {
             let started = std::time::Instant::now();
-            let edits =
-                marionette::editor::StartupEdits { poses, ik, skinning: skinning.map(Into::into), match_height };
+            let edits = marionette::editor::StartupEdits {
+                poses,
+                ik,
+                skinning: skinning.map(Into::into),
+                match_height,
+                anim: clip.anim_doc(false),
+            };
             let notes = marionette::editor::render::render(paths, edits, out.clone(), width, height)
                 .map_err(anyhow::Error::msg)?;
             for n in notes {

@@ -12,9 +12,10 @@ use super::history::History;
 use super::stage::StageSettings;
 use super::state::Messages;
 use crate::formats::scene::{
-    BindingDoc, CharacterDoc, CharacterId, PlacementDoc, SkinningDoc, SmplDoc, StageDoc, ViewDoc,
+    AnimDoc, BindingDoc, CharacterDoc, CharacterId, PlacementDoc, SkinningDoc, SmplDoc, StageDoc, ViewDoc,
 };
 use crate::rig::JointRotation;
+use crate::scene::keyframes::ClipPlayer;
 use crate::scene::smpl::SmplCharacter;
 use crate::scene::{
     Character, CharacterSkinning, CharacterView, JointLimits, JointPose, MarionetteSystems, Placement, PoseDirty,
@@ -57,6 +58,11 @@ pub enum Edit {
         character: CharacterId,
         method: SkinningDoc,
     },
+    /// A keyframed clip on a character, its time and playback (none: no clip).
+    Clip {
+        character: CharacterId,
+        anim: Option<AnimDoc>,
+    },
     /// Floor, shadows, axes.
     Stage(StageDoc),
     /// A character from its document (a fresh id is given when it has none).
@@ -75,6 +81,7 @@ impl Edit {
             | Edit::Smpl { character, .. }
             | Edit::Rebind { character, .. }
             | Edit::Skinning { character, .. }
+            | Edit::Clip { character, .. }
             | Edit::Remove(character) => Some(*character),
             Edit::Add(doc) => doc.id,
             Edit::Stage(_) => None,
@@ -250,6 +257,10 @@ pub fn inverse_of(world: &mut World, edit: &Edit) -> Result<Option<Edit>, String
             let old = component::<CharacterSkinning>(world, *character)?.0;
             unless(old == *method, Edit::Skinning { character: *character, method: old })
         }
+        Edit::Clip { character, anim } => {
+            let old = world.get::<ClipPlayer>(entity_of(world, *character)?).map(|p| p.state.clone());
+            unless(old == *anim, Edit::Clip { character: *character, anim: old })
+        }
         Edit::Stage(stage) => {
             let old = world.resource::<StageSettings>().0;
             unless(old == *stage, Edit::Stage(old))
@@ -293,6 +304,7 @@ fn write(world: &mut World, edit: Edit) -> Result<(), String> {
         Edit::Smpl { character, state } => component_mut::<SmplCharacter>(world, character)?.state = state,
         Edit::Rebind { character, binding } => rebind_character(world, character, binding)?,
         Edit::Skinning { character, method } => component_mut::<CharacterSkinning>(world, character)?.0 = method,
+        Edit::Clip { character, anim } => set_clip(world, character, anim)?,
         Edit::Stage(stage) => world.resource_mut::<StageSettings>().0 = stage,
         Edit::Add(doc) => add_character(world, &doc)?,
         Edit::Remove(id) => {
@@ -317,6 +329,32 @@ fn add_character(world: &mut World, doc: &CharacterDoc) -> Result<(), String> {
     let (_, notes) = spawned.map_err(|e| e.to_string())?;
     let mut messages = world.resource_mut::<Messages>();
     notes.into_iter().for_each(|m| messages.push(m));
+    Ok(())
+}
+
+/// Sets a character's keyframed clip state; a new file is loaded and put on, none takes
+/// the clip off (the pose stays where the clip left it).
+fn set_clip(world: &mut World, id: CharacterId, anim: Option<AnimDoc>) -> Result<(), String> {
+    let entity = entity_of(world, id)?;
+    let Some(anim) = anim else {
+        world.entity_mut(entity).remove::<ClipPlayer>();
+        return Ok(());
+    };
+    if let Some(mut player) = world.get_mut::<ClipPlayer>(entity)
+        && player.state.file == anim.file
+    {
+        player.state = anim;
+        return Ok(());
+    }
+    let found = character_of(world, id)?;
+    let name = component::<SceneCharacter>(world, id)?.name.clone();
+    let (player, note) =
+        super::document::clip_player(&mut world.resource_mut::<AssetLibrary>(), &found.asset, &name, &anim)
+            .map_err(|e| e.to_string())?;
+    if let Some(note) = note {
+        world.resource_mut::<Messages>().push(note);
+    }
+    world.entity_mut(entity).insert(player);
     Ok(())
 }
 

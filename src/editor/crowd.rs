@@ -27,6 +27,7 @@ fn crowd_member(i: usize, n: usize, source: SourceDoc, spacing: f32, lift: f32, 
         smpl,
         binding: None,
         skinning: Default::default(),
+        anim: None,
     }
 }
 

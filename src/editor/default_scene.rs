@@ -30,6 +30,7 @@ fn puppet(
         smpl: None,
         binding: None,
         skinning: Default::default(),
+        anim: None,
     }
 }
 

@@ -19,6 +19,7 @@ use crate::formats::scene::{
 use crate::formats::{FormatError, load_character};
 use crate::rig::smpl::{Clip, SmplModel};
 use crate::rig::{CharacterAsset, JointRotation};
+use crate::scene::keyframes::ClipPlayer;
 use crate::scene::smpl::SmplCharacter;
 use crate::scene::{Character, CharacterSkinning, CharacterView, JointPose, Placement, spawn_character_posed};
 
@@ -74,6 +75,7 @@ pub struct AssetLibrary {
     cache: HashMap<SourceDoc, Arc<CharacterAsset>>,
     smpl: HashMap<PathBuf, SmplSet>,
     bound: HashMap<(SourceDoc, BindingDoc), Arc<CharacterAsset>>,
+    keyframe_clips: HashMap<PathBuf, Arc<crate::rig::anim::Clip>>,
 }
 
 /// A copy of `asset` whose weights come from the distance to its bones at rest.
@@ -119,6 +121,16 @@ impl AssetLibrary {
         });
         self.cache.insert(source.clone(), asset.clone());
         Ok(asset)
+    }
+
+    /// The keyframed clip (`.anim`) at `path`, read once.
+    pub fn keyframe_clip(&mut self, path: &Path) -> Result<Arc<crate::rig::anim::Clip>, FormatError> {
+        if let Some(clip) = self.keyframe_clips.get(path) {
+            return Ok(clip.clone());
+        }
+        let clip = Arc::new(crate::formats::cse169_skin::parse_anim(crate::formats::error::open(path)?, path)?);
+        self.keyframe_clips.insert(path.to_path_buf(), clip.clone());
+        Ok(clip)
     }
 
     /// The character of `source` with weights computed from its bones (cached).
@@ -191,6 +203,7 @@ pub struct SceneReader<'w, 's> {
             &'static CharacterView,
             Option<&'static SmplCharacter>,
             &'static CharacterSkinning,
+            Option<&'static ClipPlayer>,
         ),
     >,
     pub poses: Query<'w, 's, &'static JointPose>,
@@ -217,7 +230,7 @@ impl SceneReader<'_, '_> {
     /// The document of one live character: joints listed where they differ from the
     /// source's pose.
     pub fn character_doc(&self, entity: Entity) -> Option<CharacterDoc> {
-        let (_, sc, character, placement, view, smpl, skinning) = self.characters.get(entity).ok()?;
+        let (_, sc, character, placement, view, smpl, skinning, player) = self.characters.get(entity).ok()?;
         let skeleton = &character.asset.skeleton;
         let initial = skeleton.initial_pose();
         let pose = character
@@ -239,6 +252,7 @@ impl SceneReader<'_, '_> {
             smpl: smpl.map(|body| body.state.clone()),
             binding: sc.binding,
             skinning: skinning.0,
+            anim: player.map(|p| p.state.clone()),
         })
     }
 }
@@ -277,8 +291,21 @@ pub fn spawn_from_doc(
         SourceDoc::File(dir) if crate::formats::smpl::is_smpl_dir(dir) => Some((dir, library.smpl(dir)?)),
         _ => None,
     };
-    let (pose, messages) = pose_from_doc(&asset, doc);
+    let (pose, mut messages) = pose_from_doc(&asset, doc);
+    let player = doc.anim.as_ref().and_then(|anim| match clip_player(library, &asset, &doc.name, anim) {
+        Ok((player, note)) => {
+            messages.extend(note);
+            Some(player)
+        }
+        Err(e) => {
+            messages.push(format!("{}: the clip was not loaded: {e}", doc.name));
+            None
+        }
+    });
     let entity = spawn_character_posed(commands, meshes, asset, Placement(doc.placement), &pose);
+    if let Some(player) = player {
+        commands.entity(entity).insert(player);
+    }
     commands.entity(entity).insert((
         SceneCharacter { id, source: doc.source.clone(), name: doc.name.clone(), binding: doc.binding },
         CharacterView(doc.view.clone()),
@@ -290,6 +317,26 @@ pub fn spawn_from_doc(
         commands.entity(entity).insert(SmplCharacter::new(set.model, dir.clone(), set.clips, state));
     }
     Ok((entity, messages))
+}
+
+/// The player of a character's keyframed clip, and a note when the clip's channels do not
+/// fit the skeleton (3 for the root, then 3 per joint).
+pub fn clip_player(
+    library: &mut AssetLibrary,
+    asset: &CharacterAsset,
+    name: &str,
+    anim: &crate::formats::scene::AnimDoc,
+) -> Result<(ClipPlayer, Option<String>), FormatError> {
+    let clip = library.keyframe_clip(&anim.file)?;
+    let wanted = 3 + 3 * asset.skeleton.len();
+    let note = (clip.channels.len() != wanted).then(|| {
+        format!(
+            "{name}: {} has {} channels; its skeleton takes {wanted} (3 for the root, 3 per joint)",
+            anim.file.display(),
+            clip.channels.len()
+        )
+    });
+    Ok((ClipPlayer { clip, state: anim.clone() }, note))
 }
 
 /// A document of characters placed side by side along x by their bind boxes, each
@@ -324,6 +371,7 @@ pub fn doc_side_by_side(library: &mut AssetLibrary, sources: Vec<SourceDoc>, mes
             smpl: None,
             binding: None,
             skinning: Default::default(),
+            anim: None,
         })
         .collect();
     SceneDoc { characters, camera: None, stage: Default::default() }
@@ -370,6 +418,9 @@ pub fn read_scene(path: &Path) -> Result<SceneDoc, FormatError> {
     let dir = path.parent().unwrap_or(Path::new("."));
     for c in &mut doc.characters {
         c.source = c.source.resolved(dir);
+        if let Some(anim) = &mut c.anim {
+            anim.file = dir.join(&anim.file);
+        }
     }
     Ok(doc)
 }
@@ -380,6 +431,9 @@ pub fn write_scene(path: &Path, doc: &SceneDoc) -> Result<(), FormatError> {
     let dir = path.parent().filter(|d| !d.as_os_str().is_empty()).unwrap_or(Path::new("."));
     for c in &mut doc.characters {
         c.source = c.source.relative_to(dir);
+        if let Some(anim) = &mut c.anim {
+            anim.file = crate::formats::scene::relative_path(&anim.file, dir);
+        }
     }
     crate::formats::scene::save_scene(path, &doc)
 }

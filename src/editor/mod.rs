@@ -90,7 +90,7 @@ pub fn task_pools() -> bevy::app::TaskPoolPlugin {
 }
 
 /// Opens the editor window on `paths` (or on the default scene) and runs until closed.
-pub fn run(paths: Vec<PathBuf>) {
+pub fn run(paths: Vec<PathBuf>, edits: StartupEdits) {
     App::new()
         .add_plugins(DefaultPlugins.set(task_pools()).set(WindowPlugin {
             primary_window: Some(Window {
@@ -106,6 +106,7 @@ pub fn run(paths: Vec<PathBuf>) {
         .insert_resource(bevy_egui::EguiGlobalSettings { auto_create_primary_context: false, ..default() })
         .insert_resource(ClearColor(stage::SKY))
         .insert_resource(StartupPaths(paths))
+        .insert_resource(edits)
         // The viewport between the default panels (1280 − 2 × 250 wide, 800 high).
         .insert_resource(camera::FramingAspect(780.0 / 800.0))
         .add_plugins((

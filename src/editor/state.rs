@@ -22,6 +22,8 @@ pub struct StartupEdits {
     pub skinning: Option<crate::rig::dqs::SkinningMethod>,
     /// `--match-height`: every character scaled to the first one's height.
     pub match_height: bool,
+    /// `--anim` and `--time`: a keyframed clip on every character it fits.
+    pub anim: Option<crate::formats::scene::AnimDoc>,
 }
 
 /// Messages for the user (load errors, warnings, where files went), newest last.

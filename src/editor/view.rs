@@ -34,7 +34,11 @@ impl Plugin for ScenePlugin {
             .init_resource::<FramingAspect>()
             .init_resource::<FrameWhenSkinned>()
             .init_resource::<super::arrange::ArrangeWhenSkinned>()
-            .add_plugins((crate::scene::smpl::SmplPlugin, super::commands::CommandsPlugin))
+            .add_plugins((
+                crate::scene::smpl::SmplPlugin,
+                crate::scene::keyframes::KeyframePlugin,
+                super::commands::CommandsPlugin,
+            ))
             .add_systems(
                 PostUpdate,
                 (apply_pending_scene, sync_character_views)
@@ -109,6 +113,9 @@ fn apply_startup_edits(
     if let Some(method) = edits.skinning {
         doc.characters.iter_mut().for_each(|c| c.skinning = method);
     }
+    if let Some(anim) = &edits.anim {
+        put_clip_on_fitting_characters(doc, anim, library, messages);
+    }
     if edits.poses.is_empty() && edits.ik.is_empty() {
         return;
     }
@@ -127,6 +134,34 @@ fn apply_startup_edits(
         let initial = skeleton.initial_pose();
         c.pose =
             (0..skeleton.len()).filter(|&j| pose[j] != initial[j]).map(|j| (pose_key(skeleton, j), pose[j])).collect();
+    }
+}
+
+/// Puts the clip on every character whose skeleton it fits (3 channels for the root, 3 per
+/// joint); says which it fits none of.
+fn put_clip_on_fitting_characters(
+    doc: &mut crate::formats::scene::SceneDoc,
+    anim: &crate::formats::scene::AnimDoc,
+    library: &mut AssetLibrary,
+    messages: &mut Messages,
+) {
+    let clip = match library.keyframe_clip(&anim.file) {
+        Ok(clip) => clip,
+        Err(e) => return messages.push(e.to_string()),
+    };
+    let mut fitted = 0;
+    for c in &mut doc.characters {
+        if library.load(&c.source).is_ok_and(|a| 3 + 3 * a.skeleton.len() == clip.channels.len()) {
+            c.anim = Some(anim.clone());
+            fitted += 1;
+        }
+    }
+    if fitted == 0 {
+        messages.push(format!(
+            "{}: its {} channels fit no character (3 for the root, then 3 per joint)",
+            anim.file.display(),
+            clip.channels.len()
+        ));
     }
 }
 

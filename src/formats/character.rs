@@ -1,5 +1,6 @@
 //! Loading a character from a path whose siblings complete it: `Model1.skel` finds
-//! `Model1.obj` and `Model1.attach`; a CSE169 `.skel` alone becomes bone boxes.
+//! `Model1.obj` and `Model1.attach`; a CSE169 `.skel` finds its `.skin` (without one it
+//! becomes bone boxes), and a `.skin` its `.skel`.
 
 use std::path::{Path, PathBuf};
 
@@ -12,8 +13,8 @@ use crate::rig::{CharacterAsset, Skeleton, Skin};
 pub enum CharacterSource {
     /// 6.837 `.skel` (+ `.obj` + `.attach` beside it, when present).
     Mit6837 { skel: PathBuf, obj: Option<PathBuf>, attach: Option<PathBuf> },
-    /// CSE169 `.skel` (drawn as bone boxes).
-    Cse169 { skel: PathBuf },
+    /// CSE169 `.skel`, with the `.skin` beside it (bone boxes without one).
+    Cse169 { skel: PathBuf, skin: Option<PathBuf> },
     /// A folder with the SMPL exercise's files.
     Smpl { dir: PathBuf },
     /// Homer's rig JSON (+ an OFF mesh beside it).
@@ -27,13 +28,24 @@ impl CharacterSource {
         match ext.as_deref() {
             Some("skel") => {
                 if is_cse169_skel(path)? {
-                    Ok(Self::Cse169 { skel: path.to_path_buf() })
+                    let skin = Some(path.with_extension("skin")).filter(|p| p.is_file());
+                    Ok(Self::Cse169 { skel: path.to_path_buf(), skin })
                 } else {
                     let sibling = |e: &str| Some(path.with_extension(e)).filter(|p| p.is_file());
                     Ok(Self::Mit6837 { skel: path.to_path_buf(), obj: sibling("obj"), attach: sibling("attach") })
                 }
             }
             Some("json") => Ok(Self::Homer { json: path.to_path_buf() }),
+            Some("skin") => {
+                let skel = path.with_extension("skel");
+                if !skel.is_file() {
+                    return Err(FormatError::other(
+                        path,
+                        format!("expected a skeleton beside it at {}, found none", skel.display()),
+                    ));
+                }
+                Ok(Self::Cse169 { skel, skin: Some(path.to_path_buf()) })
+            }
             Some("obj") | Some("attach") => {
                 let skel = path.with_extension("skel");
                 if !skel.is_file() {
@@ -67,7 +79,7 @@ fn is_cse169_skel(path: &Path) -> Result<bool, FormatError> {
 /// The skeleton alone of a `.skel` of either course or of a Homer rig `.json`.
 pub fn load_skeleton(path: &Path) -> Result<Skeleton, FormatError> {
     match CharacterSource::detect(path)? {
-        CharacterSource::Cse169 { skel } => cse169::parse_skel(open(&skel)?, &skel),
+        CharacterSource::Cse169 { skel, .. } => cse169::parse_skel(open(&skel)?, &skel),
         CharacterSource::Mit6837 { skel, .. } => mit6837::parse_skel(open(&skel)?, &skel),
         CharacterSource::Homer { json } => Ok(super::homer::parse_rig(open(&json)?, &json)?.skeleton),
         CharacterSource::Smpl { dir } => Ok(super::smpl::load_smpl_dir(&dir)?.0.skeleton),
@@ -78,9 +90,13 @@ pub fn load_skeleton(path: &Path) -> Result<Skeleton, FormatError> {
 pub fn load_character(path: &Path) -> Result<CharacterAsset, FormatError> {
     let name = path.file_stem().and_then(|s| s.to_str()).unwrap_or("character").to_string();
     match CharacterSource::detect(path)? {
-        CharacterSource::Cse169 { skel } => {
+        CharacterSource::Cse169 { skel, skin: None } => {
             let skeleton = cse169::parse_skel(open(&skel)?, &skel)?;
             Ok(CharacterAsset::with_bone_boxes(name, skeleton, Vec::new()))
+        }
+        CharacterSource::Cse169 { skel, skin: Some(skin_path) } => {
+            let skeleton = cse169::parse_skel(open(&skel)?, &skel)?;
+            load_cse169_skin(name, skeleton, &skin_path)
         }
         CharacterSource::Homer { json } => super::homer::load_homer(&json),
         CharacterSource::Smpl { dir } => {
@@ -105,6 +121,35 @@ pub fn load_character(path: &Path) -> Result<CharacterAsset, FormatError> {
             }
         }
     }
+}
+
+/// A CSE169 skeleton with its `.skin`: bound by the skin's own bind matrices.
+fn load_cse169_skin(name: String, skeleton: Skeleton, path: &Path) -> Result<CharacterAsset, FormatError> {
+    let file = super::cse169_skin::parse_skin(open(path)?, path)?;
+    if file.bindings.len() != skeleton.len() {
+        return Err(FormatError::other(
+            path,
+            format!(
+                "expected a binding for each of the skeleton's {} joints, found {}",
+                skeleton.len(),
+                file.bindings.len()
+            ),
+        ));
+    }
+    let singular = file.bindings.iter().position(|m| m.determinant().abs() < 1e-12 || !m.is_finite());
+    if let Some(j) = singular {
+        return Err(FormatError::other(
+            path,
+            format!("binding {j} (joint `{}`) cannot be inverted", skeleton.joint(j).name),
+        ));
+    }
+    let (weights, normalised) =
+        crate::rig::SkinWeights::from_rows(file.weights, skeleton.len()).map_err(|e| FormatError::rig(path, e))?;
+    let warnings = normalised_warnings(path, &normalised);
+    let inverse_binds = file.bindings.iter().map(|m| m.inverse()).collect();
+    let skin = Skin { bind_positions: file.positions, triangles: file.triangles, weights };
+    CharacterAsset::with_inverse_binds(name, skeleton, skin, inverse_binds, warnings)
+        .map_err(|e| FormatError::rig(path, e))
 }
 
 fn load_6837_skin(

@@ -71,6 +71,10 @@ impl<'a> Tokens<'a> {
         Self { tokens, pos: 0, path }
     }
 
+    pub fn path(&self) -> &Path {
+        self.path
+    }
+
     pub fn peek(&self) -> Option<&Token> {
         self.tokens.get(self.pos)
     }

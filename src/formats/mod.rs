@@ -4,6 +4,7 @@
 
 pub mod character;
 pub mod cse169;
+pub mod cse169_skin;
 pub mod error;
 pub mod homer;
 pub mod mit6837;

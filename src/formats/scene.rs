@@ -207,6 +207,33 @@ pub struct CharacterDoc {
     /// Linear blend or dual quaternion skinning (files without it: linear).
     #[serde(default, skip_serializing_if = "SkinningDoc::is_linear")]
     pub skinning: SkinningDoc,
+    /// A keyframed clip (CSE169 `.anim`) playing on the character.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub anim: Option<AnimDoc>,
+}
+
+/// A keyframed clip on a character: its file, the time (seconds) and playback.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default)]
+pub struct AnimDoc {
+    pub file: PathBuf,
+    pub time: f32,
+    pub playing: bool,
+    pub looping: bool,
+    pub speed: f32,
+}
+
+impl Default for AnimDoc {
+    fn default() -> Self {
+        Self { file: PathBuf::new(), time: 0.0, playing: true, looping: true, speed: 1.0 }
+    }
+}
+
+impl AnimDoc {
+    /// The clip `file` from its start, playing in a loop.
+    pub fn of(file: impl Into<PathBuf>) -> Self {
+        Self { file: file.into(), ..Self::default() }
+    }
 }
 
 /// How to bind a skin from its skeleton's bones (stored as `Nearest` or `Smooth`).

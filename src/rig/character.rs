@@ -70,6 +70,19 @@ impl CharacterAsset {
         Ok(Self { name: name.into(), skeleton, skin, skin_kind: SkinKind::Mesh, bind_world_to_joint, warnings })
     }
 
+    /// A skinned character bound by its own inverse bind matrices (one per joint), not
+    /// by the skeleton's rest pose.
+    pub fn with_inverse_binds(
+        name: impl Into<String>,
+        skeleton: Skeleton,
+        skin: Skin,
+        bind_world_to_joint: Vec<Mat4>,
+        warnings: Vec<String>,
+    ) -> Result<Self, RigError> {
+        debug_assert_eq!(bind_world_to_joint.len(), skeleton.len());
+        Self::new(name, skeleton, skin, warnings).map(|asset| Self { bind_world_to_joint, ..asset })
+    }
+
     /// A character without a mesh: each joint's bone box (its own, or ±0.1) rigidly
     /// bound to that joint.
     pub fn with_bone_boxes(name: impl Into<String>, skeleton: Skeleton, warnings: Vec<String>) -> Self {

@@ -1,6 +1,7 @@
 //! The rig core: skeletons, the matrix stack, poses, forward kinematics and skinning.
 //! Pure data and math; no Bevy.
 
+pub mod anim;
 pub mod bind;
 pub mod character;
 pub mod dqs;

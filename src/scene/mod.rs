@@ -3,7 +3,7 @@
 //! System order, configured once in [`RigCorePlugin`] (all in `PostUpdate`, before Bevy's
 //! transform propagation, which plays no part in joint matrices):
 //!
-//! `Animate` (edits, clips) → `Solve` (IK, limits) → `MatrixStack` (place, mark, bind,
+//! `Animate` (edits, SMPL and keyframed clips) → `Solve` (IK, limits) → `MatrixStack` (place, mark, bind,
 //! FK) → `Skin` (LBS or DQ, colours, bounds, packed vertices) → `Draw` (skeleton gizmos,
 //! overlays).
 //!
@@ -15,6 +15,7 @@
 //! skin material lights each triangle with its own).
 
 pub mod components;
+pub mod keyframes;
 pub mod smpl;
 pub mod spawn;
 pub mod systems;

@@ -69,6 +69,7 @@ pub fn spawn_character_posed(
         .id();
     commands.entity(character).insert((
         Character { asset, joints, skin_entity, mesh },
+        super::keyframes::RootTranslation::default(),
         SkinScratch::default(),
         JointScratch::default(),
         PoseDirty { matrices: true, bind: false, colors: true },

@@ -25,18 +25,25 @@ pub fn clamp_poses_to_limits(mut joints: Query<(&mut JointPose, &JointLimits), C
 /// reshape) sets `PoseDirty::bind` itself.
 pub fn mark_changed_characters(
     posed: Query<&Joint, Changed<JointPose>>,
-    mut characters: Query<(&CharacterView, &HeatJoint, &SkinScratch, Ref<CharacterSkinning>, &mut PoseDirty)>,
+    mut characters: Query<(
+        &CharacterView,
+        &HeatJoint,
+        &SkinScratch,
+        Ref<CharacterSkinning>,
+        Ref<super::keyframes::RootTranslation>,
+        &mut PoseDirty,
+    )>,
 ) {
     for joint in &posed {
         if let Ok((.., mut dirty)) = characters.get_mut(joint.character) {
             dirty.matrices = true;
         }
     }
-    for (view, heat, scratch, method, mut dirty) in &mut characters {
+    for (view, heat, scratch, method, root, mut dirty) in &mut characters {
         if scratch.colored_with != Some(Coloring::of(view, heat)) {
             dirty.colors = true;
         }
-        if method.is_changed() {
+        if method.is_changed() || root.is_changed() {
             dirty.matrices = true;
         }
     }
@@ -71,11 +78,11 @@ pub fn bind_rest_pose(characters: Query<(&Character, &PoseDirty)>, mut binds: Qu
 /// matrix stack: push `T(offset) · R(pose)`, write the top, descend, pop) from the
 /// model-space origin (reads `JointPose`, `Character`; writes `CurrentJointToWorld`).
 pub fn compute_joint_to_world(
-    mut characters: Query<(&Character, &PoseDirty, &mut JointScratch)>,
+    mut characters: Query<(&Character, &PoseDirty, &super::keyframes::RootTranslation, &mut JointScratch)>,
     poses: Query<&JointPose>,
     mut currents: Query<&mut CurrentJointToWorld>,
 ) {
-    for (character, dirty, mut scratch) in &mut characters {
+    for (character, dirty, root, mut scratch) in &mut characters {
         if !dirty.matrices && !dirty.bind {
             continue;
         }
@@ -83,7 +90,9 @@ pub fn compute_joint_to_world(
         pose.clear();
         pose.extend(character.joints.iter().map(|&e| poses.get(e).map_or(JointRotation::IDENTITY, |p| p.0)));
         matrices.resize(character.joints.len(), Mat4::IDENTITY);
-        forward_kinematics(&character.asset.skeleton, pose, Mat4::IDENTITY, matrices);
+        let skeleton = &character.asset.skeleton;
+        let origin = root.origin(skeleton.joints().first().map_or(Vec3::ZERO, |j| j.rest_offset));
+        forward_kinematics(skeleton, pose, origin, matrices);
         for (&entity, &m) in character.joints.iter().zip(matrices.iter()) {
             if let Ok(mut current) = currents.get_mut(entity) {
                 current.0 = m;

@@ -26,6 +26,7 @@ pub fn doc_with(source: SourceDoc, pose: &[(&str, JointRotation)]) -> SceneDoc {
             smpl: None,
             binding: None,
             skinning: Default::default(),
+            anim: None,
         }],
         camera: None,
         stage: Default::default(),

@@ -252,6 +252,7 @@ fn smpl_shape_and_clip_edits_undo_and_redo() {
         smpl: Some(SmplDoc::default()),
         binding: None,
         skinning: Default::default(),
+        anim: None,
     };
     *app.world_mut().resource_mut::<PendingScene>() =
         PendingScene { doc: Some(SceneDoc { characters: vec![body], ..SceneDoc::default() }), frame: false };

@@ -1,6 +1,7 @@
 //! The one integration-test binary (each test binary links bevy, so there is only one).
 
 mod alloc;
+mod anim;
 mod arrange;
 mod common;
 mod data;

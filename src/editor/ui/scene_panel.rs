@@ -15,7 +15,7 @@ use crate::editor::history::HistoryRequest;
 use crate::editor::screenshot::ScreenshotRequest;
 use crate::editor::state::Selection;
 use crate::formats::scene::{
-    BindingDoc, CharacterDoc, CharacterId, DisplayDoc, PlacementDoc, SkinningDoc, SourceDoc, ViewDoc,
+    AnimDoc, BindingDoc, CharacterDoc, CharacterId, DisplayDoc, PlacementDoc, SkinningDoc, SourceDoc, ViewDoc,
 };
 
 pub fn scene_panel(ui: &mut egui::Ui, state: &mut InspectorState, panels: &mut Panels, shot: &mut ScreenshotRequest) {
@@ -97,11 +97,22 @@ fn add_row(ui: &mut egui::Ui, state: &mut InspectorState, panels: &mut Panels) {
     });
 }
 
-/// Loads a character file and adds it right of the others, standing on the floor, and
+/// Puts the clip at `path` on the selected character, playing.
+fn add_clip(path: &str, panels: &mut Panels) {
+    match panels.selection.character {
+        Some(character) => panels.push(Edit::Clip { character, anim: Some(AnimDoc::of(path)) }),
+        None => panels.messages.push(format!("select the character that {path} should play on")),
+    }
+}
+
+/// Loads a character file (or a `.anim` clip for the selected one) and adds it right of the others, standing on the floor, and
 /// selects it; errors go to the messages.
 fn add_character(path: &str, state: &mut InspectorState, panels: &mut Panels) {
     if path.is_empty() {
         return;
+    }
+    if path.ends_with(".anim") {
+        return add_clip(path, panels);
     }
     let source = SourceDoc::File(PathBuf::from(path));
     let asset = match panels.library.load(&source) {
@@ -122,6 +133,7 @@ fn add_character(path: &str, state: &mut InspectorState, panels: &mut Panels) {
         smpl: None,
         binding: None,
         skinning: Default::default(),
+        anim: None,
     })));
     *panels.selection = Selection { character: Some(id), joints: Vec::new() };
     state.recent.retain(|r| r != path);
@@ -177,7 +189,7 @@ fn character_row(ui: &mut egui::Ui, panels: &mut Panels, entity: Entity, id: Cha
 /// Name, source, duplicate/remove, placement, display and colours, weights, SMPL state of
 /// the selected character.
 fn selected_character(ui: &mut egui::Ui, panels: &mut Panels, entity: Entity, id: CharacterId) {
-    let Ok((_, sc, character, placement, view, smpl, skinning)) = panels.scene.characters.get(entity) else {
+    let Ok((_, sc, character, placement, view, smpl, skinning, player)) = panels.scene.characters.get(entity) else {
         return;
     };
     let skinning = skinning.0;
@@ -246,6 +258,11 @@ fn selected_character(ui: &mut egui::Ui, panels: &mut Panels, entity: Entity, id
         && let Some(state) = super::smpl_panel::smpl_panel(ui, body)
     {
         edits.push(Edit::Smpl { character: id, state });
+    }
+    if let Some(player) = player
+        && let Some(anim) = super::clip_panel::clip_panel(ui, player)
+    {
+        edits.push(Edit::Clip { character: id, anim });
     }
     if duplicate && let Some(mut copy) = panels.scene.character_doc(entity) {
         let copy_id = panels.ids.take();

@@ -72,6 +72,6 @@ fn clip_choice(ui: &mut egui::Ui, label: &str, names: &[&str], choice: &mut Opti
 
 /// A slider that leaves a value from a file outside its range as it is until it is moved
 /// (so showing it is no edit).
-fn slider(value: &mut f32, range: std::ops::RangeInclusive<f32>) -> egui::Slider<'_> {
+pub fn slider(value: &mut f32, range: std::ops::RangeInclusive<f32>) -> egui::Slider<'_> {
     egui::Slider::new(value, range).clamping(egui::SliderClamping::Edits)
 }

@@ -1,0 +1,92 @@
+//! Keyframed clips (CSE169 `.anim`) playing on any character: the clip's channels give the
+//! root's translation and every joint's x, y, z rotation at the playback time. Scene files
+//! keep the clip's file, time and playback (`AnimDoc`).
+
+use std::sync::Arc;
+
+use bevy::prelude::*;
+
+use crate::formats::scene::AnimDoc;
+use crate::rig::anim::Clip;
+use crate::scene::{Character, JointPose, MarionetteSystems};
+
+/// A keyframed clip on a character and its playback state (the scene file's `AnimDoc`).
+#[derive(Component, Clone)]
+pub struct ClipPlayer {
+    pub clip: Arc<Clip>,
+    pub state: AnimDoc,
+}
+
+/// The root joint's translation (model space) where a clip moves it, in place of the
+/// root's offset; none keeps the offset.
+#[derive(Component, Clone, Copy, Debug, Default, PartialEq)]
+pub struct RootTranslation(pub Option<Vec3>);
+
+impl RootTranslation {
+    /// What the matrix stack starts from: the move from the root's offset to here.
+    pub fn origin(&self, root_offset: Vec3) -> Mat4 {
+        self.0.map_or(Mat4::IDENTITY, |t| Mat4::from_translation(t - root_offset))
+    }
+}
+
+/// Keyframed playback within `Animate`, after the edits and SMPL playback.
+#[derive(SystemSet, Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub struct KeyframePlayback;
+
+pub struct KeyframePlugin;
+
+impl Plugin for KeyframePlugin {
+    fn build(&self, app: &mut App) {
+        app.add_systems(
+            PostUpdate,
+            (advance_clips, pose_from_keyframes)
+                .chain()
+                .in_set(MarionetteSystems::Animate)
+                .in_set(KeyframePlayback)
+                .after(crate::scene::smpl::SmplPlayback),
+        );
+    }
+}
+
+/// Advances playing clips by the frame time over the clip's range, looping or stopping
+/// at its end (reads `Time`; writes `ClipPlayer`).
+fn advance_clips(time: Res<Time>, mut players: Query<&mut ClipPlayer>) {
+    for mut player in &mut players {
+        if !player.state.playing {
+            continue;
+        }
+        let (start, end) = player.clip.range;
+        let length = end - start;
+        let state = &mut player.state;
+        let t = state.time + time.delta_secs() * state.speed;
+        state.time = if length <= 0.0 {
+            start
+        } else if state.looping {
+            start + (t - start).rem_euclid(length)
+        } else if t >= end {
+            state.playing = false;
+            end
+        } else {
+            t
+        };
+    }
+}
+
+/// Poses the joints and moves the root from the clip at its time, when the clip or time
+/// changed (writes `JointPose`, `RootTranslation`). A paused clip keeps slider edits.
+pub fn pose_from_keyframes(
+    mut players: Query<(&ClipPlayer, &Character, &mut RootTranslation), Changed<ClipPlayer>>,
+    mut poses: Query<&mut JointPose>,
+) {
+    for (player, character, mut root) in &mut players {
+        let skeleton = &character.asset.skeleton;
+        let now: Vec<_> = character.joints.iter().map(|&e| poses.get(e).map_or(Default::default(), |p| p.0)).collect();
+        let (translation, pose) = player.clip.pose_at(skeleton, player.state.time, &now);
+        root.set_if_neq(RootTranslation(Some(translation)));
+        for (&entity, rotation) in character.joints.iter().zip(pose) {
+            if let Ok(mut p) = poses.get_mut(entity) {
+                p.set_if_neq(JointPose(rotation));
+            }
+        }
+    }
+}
