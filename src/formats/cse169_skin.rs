@@ -134,10 +134,11 @@ pub fn parse_skin(reader: impl BufRead, path: &Path) -> Result<SkinFile, FormatE
         }
     }
     if skin.weights.len() != skin.positions.len() {
-        return Err(FormatError::other(
+        return Err(FormatError::syntax(
             path,
+            tokens.line(),
             format!(
-                "expected skinweights for each of the {} positions, found {}",
+                "expected skinweights for each of the {} positions by the end of the file, found {}",
                 skin.positions.len(),
                 skin.weights.len()
             ),

@@ -13,7 +13,7 @@ use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
 use arbitrary::Unstructured;
-use marionette::formats::{FormatError, cse169, homer, mit6837, obj, off, scene, smpl};
+use marionette::formats::{FormatError, cse169, cse169_skin, homer, mit6837, obj, off, scene, smpl};
 
 use crate::common::optional_data_dir;
 
@@ -36,6 +36,12 @@ enum Reader {
         vertices: usize,
     },
     Cse169Skel,
+    Cse169Skin,
+    /// A morph for a skin of this many vertices.
+    Cse169Morph {
+        vertices: usize,
+    },
+    Cse169Anim,
     Obj,
     Off,
     SmplHierarchy,
@@ -56,6 +62,9 @@ fn read(reader: Reader, bytes: &[u8]) -> Result<(), FormatError> {
         Reader::Skel6837 => mit6837::parse_skel(input, path).map(drop),
         Reader::Attach { joints, vertices } => mit6837::parse_attach(input, path, joints, vertices).map(drop),
         Reader::Cse169Skel => cse169::parse_skel(input, path).map(drop),
+        Reader::Cse169Skin => cse169_skin::parse_skin(input, path).map(drop),
+        Reader::Cse169Morph { vertices } => cse169_skin::parse_morph(input, path, vertices).map(drop),
+        Reader::Cse169Anim => cse169_skin::parse_anim(input, path).map(drop),
         Reader::Obj => obj::parse_obj(input, path).map(drop),
         Reader::Off => off::parse_off(input, path).map(drop),
         Reader::SmplHierarchy => smpl::parse_hierarchy(input, path).map(drop),
@@ -112,6 +121,15 @@ fn inline_seeds() -> Vec<Seed> {
         s(
             Reader::Cse169Skel,
             "balljoint root {\n offset 0 0 0\n boxmin -1 -1 -1 boxmax 1 1 1\n rotxlimit -1 1\n pose 0 0.5 0\n balljoint a{ offset 0 1 0 balljoint b { offset 0 1 0 } }\n}\n",
+        ),
+        s(
+            Reader::Cse169Skin,
+            "positions 3 {0 0 0 1 0 0 0 1 0}\nnormals 3 {0 0 1 0 0 1 0 0 1}\ntexcoords 3 {0 0 1 0 0 1}\nskinweights 3 {1 0 1 2 0 0.5 1 0.5 1 1 1}\nmaterial m {texture t.bmp}\ntriangles 1 {0 1 2}\nbindings 2 {matrix {1 0 0 0 1 0 0 0 1 0 0 0} matrix {1 0 0 0 1 0 0 0 1 0 1 0}}\n",
+        ),
+        s(Reader::Cse169Morph { vertices: 4 }, "positions 2 {\n0 0 0 1\n3 1 1 1\n}\nnormals 1 {\n0 0 0 1\n}\n"),
+        s(
+            Reader::Cse169Anim,
+            "animation {\n range 0 2\n numchannels 2\n channel {\n extrapolate cycle_offset bounce\n keys 3 {\n 0 0 smooth smooth\n 1 1 linear flat\n 2 0 0.5 -1\n }\n }\n channel 1{\n extrapolate linear constant\n keys 1 {\n 0 1 flat flat\n }\n }\n}\n",
         ),
         s(Reader::Obj, "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\nf 1 2 3\nf 2/1 4/2 3/3\nf -1 -2 -3\n"),
         s(Reader::Off, SMALL_OFF),
@@ -183,6 +201,16 @@ fn file_seeds() -> Vec<Seed> {
     }
     for f in ["test.skel", "wasp.skel", "dragon.skel"] {
         seeds.push(seed(Reader::Cse169Skel, data.join("cse169/project1").join(f)));
+    }
+    let cse169 = data.join("cse169");
+    for f in ["project2/tube.skin", "project2/wasp.skin", "legacy/triangle.skin"] {
+        seeds.push(seed(Reader::Cse169Skin, cse169.join(f)));
+    }
+    for f in ["extras/head1.morph", "extras/head2.morph"] {
+        seeds.push(seed(Reader::Cse169Morph { vertices: 3078 }, cse169.join(f)));
+    }
+    for f in ["project3/wasp_walk.anim", "project3/sample.anim", "legacy/wasp_walk.anim"] {
+        seeds.push(seed(Reader::Cse169Anim, cse169.join(f)));
     }
     let homer = data.join("homer");
     seeds.push(seed(Reader::Off, homer.join("homer.off")));
@@ -380,6 +408,8 @@ fn regressions_are_rejected_with_a_place() {
         let reader = match name.rsplit('.').next().unwrap() {
             "skel" if name.contains("cse169") => Reader::Cse169Skel,
             "skel" => Reader::Skel6837,
+            "skin" => Reader::Cse169Skin,
+            "anim" => Reader::Cse169Anim,
             "off" => Reader::Off,
             "obj" => Reader::Obj,
             "json" if name.contains("character") => Reader::HomerCharacter,

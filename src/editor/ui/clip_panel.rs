@@ -2,8 +2,8 @@
 
 use bevy_egui::egui;
 
-use crate::formats::scene::AnimDoc;
 use super::smpl_panel::slider;
+use crate::formats::scene::AnimDoc;
 use crate::scene::keyframes::ClipPlayer;
 
 /// Draws the clip's controls; returns the new state (none: the clip taken off) when one
