@@ -327,7 +327,10 @@ pub fn clip_player(
     name: &str,
     anim: &crate::formats::scene::AnimDoc,
 ) -> Result<(ClipPlayer, Option<String>), FormatError> {
-    let clip = library.keyframe_clip(&anim.file)?;
+    let clip = match &anim.keys {
+        Some(keys) => Arc::new(keys.clone()),
+        None => library.keyframe_clip(&anim.file)?,
+    };
     let wanted = 3 + 3 * asset.skeleton.len();
     let note = (clip.channels.len() != wanted).then(|| {
         format!(
@@ -418,7 +421,7 @@ pub fn read_scene(path: &Path) -> Result<SceneDoc, FormatError> {
     let dir = path.parent().unwrap_or(Path::new("."));
     for c in &mut doc.characters {
         c.source = c.source.resolved(dir);
-        if let Some(anim) = &mut c.anim {
+        if let Some(anim) = c.anim.as_mut().filter(|a| !a.file.as_os_str().is_empty()) {
             anim.file = dir.join(&anim.file);
         }
     }
@@ -431,7 +434,7 @@ pub fn write_scene(path: &Path, doc: &SceneDoc) -> Result<(), FormatError> {
     let dir = path.parent().filter(|d| !d.as_os_str().is_empty()).unwrap_or(Path::new("."));
     for c in &mut doc.characters {
         c.source = c.source.relative_to(dir);
-        if let Some(anim) = &mut c.anim {
+        if let Some(anim) = c.anim.as_mut().filter(|a| !a.file.as_os_str().is_empty()) {
             anim.file = crate::formats::scene::relative_path(&anim.file, dir);
         }
     }

@@ -59,6 +59,15 @@ pub fn scene_shortcuts(
         }
         return;
     }
+    if keys.just_pressed(KeyCode::KeyK)
+        && let Some(id) = selection.character
+        && let Some((_, _, character, .., player)) = scene.characters.iter().find(|c| c.1.id == id)
+    {
+        let pose: Vec<_> =
+            character.joints.iter().map(|&e| scene.poses.get(e).map_or(Default::default(), |p| p.0)).collect();
+        let anim = crate::scene::keyframes::keyed(player, character.joints.len(), &selection.joints, &pose);
+        edits.push(Edit::Clip { character: id, anim: Some(anim) });
+    }
     if keys.just_pressed(KeyCode::KeyA) {
         edits.push(Edit::Stage(crate::formats::scene::StageDoc { axes: !scene.stage.axes, ..scene.stage.0 }));
     }

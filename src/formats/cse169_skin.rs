@@ -264,3 +264,34 @@ fn tangent(tokens: &mut Tokens) -> Result<Tangent, FormatError> {
     tokens.next_token("a tangent")?;
     Ok(rule)
 }
+
+/// Writes `clip` as a `.anim` (numbers as Rust prints them, which read back exactly).
+pub fn write_anim(w: &mut impl std::io::Write, clip: &Clip) -> std::io::Result<()> {
+    let extrapolation = |e: Extrapolation| match e {
+        Extrapolation::Constant => "constant",
+        Extrapolation::Linear => "linear",
+        Extrapolation::Cycle => "cycle",
+        Extrapolation::CycleOffset => "cycle_offset",
+        Extrapolation::Bounce => "bounce",
+    };
+    let tangent = |t: Tangent| match t {
+        Tangent::Flat => "flat".to_string(),
+        Tangent::Linear => "linear".to_string(),
+        Tangent::Smooth => "smooth".to_string(),
+        Tangent::Fixed(s) => format!("{s:?}"),
+    };
+    writeln!(w, "animation {{")?;
+    writeln!(w, "  range {:?} {:?}", clip.range.0, clip.range.1)?;
+    writeln!(w, "  numchannels {}", clip.channels.len())?;
+    for (i, c) in clip.channels.iter().enumerate() {
+        writeln!(w, "  channel {i} {{")?;
+        writeln!(w, "    extrapolate {} {}", extrapolation(c.before), extrapolation(c.after))?;
+        writeln!(w, "    keys {} {{", c.keys().len())?;
+        for k in c.keys() {
+            writeln!(w, "      {:?} {:?} {} {}", k.time, k.value, tangent(k.tangent_in), tangent(k.tangent_out))?;
+        }
+        writeln!(w, "    }}")?;
+        writeln!(w, "  }}")?;
+    }
+    writeln!(w, "}}")
+}

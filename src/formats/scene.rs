@@ -212,11 +212,17 @@ pub struct CharacterDoc {
     pub anim: Option<AnimDoc>,
 }
 
-/// A keyframed clip on a character: its file, the time (seconds) and playback.
+/// A keyframed clip on a character: its keys (set in the editor, kept in the scene file)
+/// or the `.anim` file they came from, the time (seconds) and playback.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(default)]
 pub struct AnimDoc {
+    /// The `.anim` file (empty when the keys are the scene's own).
+    #[serde(skip_serializing_if = "crate::formats::scene::is_empty_path")]
     pub file: PathBuf,
+    /// The keys themselves, once edited: these play, not the file.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub keys: Option<crate::rig::anim::Clip>,
     pub time: f32,
     pub playing: bool,
     pub looping: bool,
@@ -225,8 +231,12 @@ pub struct AnimDoc {
 
 impl Default for AnimDoc {
     fn default() -> Self {
-        Self { file: PathBuf::new(), time: 0.0, playing: true, looping: true, speed: 1.0 }
+        Self { file: PathBuf::new(), keys: None, time: 0.0, playing: true, looping: true, speed: 1.0 }
     }
+}
+
+fn is_empty_path(p: &Path) -> bool {
+    p.as_os_str().is_empty()
 }
 
 impl AnimDoc {

@@ -12,7 +12,7 @@ use super::pose::{EulerOrder, JointRotation};
 use super::skeleton::Skeleton;
 
 /// How a key's tangent (its slope, value per second) is chosen.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
 pub enum Tangent {
     /// Zero slope.
     Flat,
@@ -25,7 +25,7 @@ pub enum Tangent {
 }
 
 /// What a channel does before its first key or after its last.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 pub enum Extrapolation {
     /// Holds the end key's value.
     Constant,
@@ -39,7 +39,7 @@ pub enum Extrapolation {
     Bounce,
 }
 
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Key {
     pub time: f32,
     pub value: f32,
@@ -48,8 +48,9 @@ pub struct Key {
 }
 
 /// One animated number: keys in time order and the extrapolation on each side. Tangent
-/// slopes are worked out once, when the channel is made.
-#[derive(Debug, Clone, PartialEq)]
+/// slopes are worked out once, when the channel is made (scene files keep the keys).
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(from = "ChannelKeys", into = "ChannelKeys")]
 pub struct Channel {
     keys: Vec<Key>,
     /// Each key's in and out slopes.
@@ -70,6 +71,27 @@ impl Channel {
 
     pub fn keys(&self) -> &[Key] {
         &self.keys
+    }
+
+    /// A channel with no keys, extrapolated as `constant` (it animates nothing).
+    pub fn empty() -> Self {
+        Self::new(Vec::new(), Extrapolation::Constant, Extrapolation::Constant)
+    }
+
+    /// This channel with its keys edited by `change` (slopes worked out again).
+    pub fn with_keys(&self, change: impl FnOnce(&mut Vec<Key>)) -> Self {
+        let mut keys = self.keys.clone();
+        change(&mut keys);
+        Self::new(keys, self.before, self.after)
+    }
+
+    /// This channel with a key of `value` at `time` (replacing one within
+    /// [`SAME_TIME`] of it), its tangents smooth unless it replaces a key.
+    pub fn with_key_at(&self, time: f32, value: f32) -> Self {
+        self.with_keys(|keys| match keys.iter_mut().find(|k| (k.time - time).abs() <= SAME_TIME) {
+            Some(k) => k.value = value,
+            None => keys.push(Key { time, value, tangent_in: Tangent::Smooth, tangent_out: Tangent::Smooth }),
+        })
     }
 
     /// The key's (in, out) slopes.
@@ -140,6 +162,29 @@ impl Channel {
     }
 }
 
+/// Keys closer in time than this (seconds) are one key.
+pub const SAME_TIME: f32 = 1e-4;
+
+/// What scene files keep of a channel.
+#[derive(serde::Serialize, serde::Deserialize)]
+struct ChannelKeys {
+    before: Extrapolation,
+    after: Extrapolation,
+    keys: Vec<Key>,
+}
+
+impl From<ChannelKeys> for Channel {
+    fn from(c: ChannelKeys) -> Self {
+        Channel::new(c.keys, c.before, c.after)
+    }
+}
+
+impl From<Channel> for ChannelKeys {
+    fn from(c: Channel) -> Self {
+        ChannelKeys { before: c.before, after: c.after, keys: c.keys }
+    }
+}
+
 /// Cubic Hermite on [0, 1]: values p0, p1 and (already span-scaled) tangents m0, m1.
 pub fn hermite(p0: f32, m0: f32, p1: f32, m1: f32, u: f32) -> f32 {
     let (u2, u3) = (u * u, u * u * u);
@@ -171,7 +216,7 @@ fn slope(keys: &[Key], k: usize, rule: Tangent, incoming: bool) -> f32 {
 
 /// A clip: channels over a time range. Channels 0–2 move the root (x, y, z translation);
 /// then three per joint (x, y, z rotation, radians) in the skeleton's depth-first order.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Clip {
     pub range: (f32, f32),
     pub channels: Vec<Channel>,
@@ -183,23 +228,61 @@ impl Clip {
         self.channels.iter().map(|c| c.value_at(t)).collect()
     }
 
+    /// An empty clip for `joints` joints: a channel without keys per root axis and DOF.
+    pub fn empty(joints: usize) -> Self {
+        Self { range: (0.0, 1.0), channels: vec![Channel::empty(); 3 + 3 * joints] }
+    }
+
+    /// The channel of `axis` (0–2) of joint `joint`.
+    pub fn joint_channel(joint: usize, axis: usize) -> usize {
+        3 + 3 * joint + axis
+    }
+
     /// The root's translation and the joints' rotations at `t` for `skeleton`, each
-    /// rotation clamped to its joint's limits. Joints the clip has no channels for keep
-    /// `fallback`'s rotation; without translation channels the root stays at its offset.
+    /// rotation clamped to its joint's limits. A channel that is missing or has no keys
+    /// leaves its number as `fallback` (and the root's offset) has it.
     pub fn pose_at(&self, skeleton: &Skeleton, t: f32, fallback: &[JointRotation]) -> (Vec3, Vec<JointRotation>) {
-        let values = self.values_at(t);
-        let root_offset = skeleton.joints().first().map_or(Vec3::ZERO, |j| j.rest_offset);
-        let root = match values.get(0..3) {
-            Some(v) => Vec3::new(v[0], v[1], v[2]),
-            None => root_offset,
+        let value = |c: usize, otherwise: f32| match self.channels.get(c) {
+            Some(channel) if !channel.keys.is_empty() => channel.value_at(t),
+            _ => otherwise,
         };
+        let root_offset = skeleton.joints().first().map_or(Vec3::ZERO, |j| j.rest_offset);
+        let root = Vec3::new(value(0, root_offset.x), value(1, root_offset.y), value(2, root_offset.z));
         let pose = (0..skeleton.len())
-            .map(|j| match values.get(3 + 3 * j..6 + 3 * j) {
-                Some(v) => JointRotation::Euler(Vec3::new(v[0], v[1], v[2]), EulerOrder::Xyz)
-                    .clamped(&skeleton.joint(j).limits),
-                None => fallback.get(j).copied().unwrap_or_default(),
+            .map(|j| {
+                let before = fallback.get(j).copied().unwrap_or_default();
+                let channels = Self::joint_channel(j, 0)..Self::joint_channel(j, 3);
+                if channels.clone().all(|c| self.channels.get(c).is_none_or(|ch| ch.keys.is_empty())) {
+                    return before;
+                }
+                let old = before.to_euler(EulerOrder::Xyz);
+                let angles = Vec3::new(
+                    value(channels.start, old.x),
+                    value(channels.start + 1, old.y),
+                    value(channels.start + 2, old.z),
+                );
+                JointRotation::Euler(angles, EulerOrder::Xyz).clamped(&skeleton.joint(j).limits)
             })
             .collect();
         (root, pose)
+    }
+
+    /// This clip with keys at `time` for the joints `joints` of `pose` (their x, y, z
+    /// angles), the range grown to hold `time`.
+    pub fn with_pose_keyed(&self, joints: &[usize], pose: &[JointRotation], time: f32) -> Self {
+        let mut clip = self.clone();
+        for &j in joints {
+            let Some(rotation) = pose.get(j) else { continue };
+            let angles = rotation.to_euler(EulerOrder::Xyz);
+            for axis in 0..3 {
+                let c = Self::joint_channel(j, axis);
+                if c >= clip.channels.len() {
+                    clip.channels.resize(c + 1, Channel::empty());
+                }
+                clip.channels[c] = clip.channels[c].with_key_at(time, angles[axis]);
+            }
+        }
+        clip.range = (clip.range.0.min(time), clip.range.1.max(time));
+        clip
     }
 }

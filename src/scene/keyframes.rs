@@ -7,6 +7,7 @@ use std::sync::Arc;
 use bevy::prelude::*;
 
 use crate::formats::scene::AnimDoc;
+use crate::rig::JointRotation;
 use crate::rig::anim::Clip;
 use crate::scene::{Character, JointPose, MarionetteSystems};
 
@@ -89,4 +90,17 @@ pub fn pose_from_keyframes(
             }
         }
     }
+}
+
+/// The clip state after keying `joints` (all of them when none is given) at `pose` at the
+/// clip's current time. A character without a clip gets keys of its own at 0 s, paused.
+pub fn keyed(player: Option<&ClipPlayer>, joint_count: usize, joints: &[usize], pose: &[JointRotation]) -> AnimDoc {
+    let (clip, mut state) = match player {
+        Some(p) => ((*p.clip).clone(), p.state.clone()),
+        None => (Clip::empty(joint_count), AnimDoc { playing: false, ..AnimDoc::default() }),
+    };
+    let all: Vec<usize> = (0..joint_count).collect();
+    let joints = if joints.is_empty() { &all[..] } else { joints };
+    state.keys = Some(clip.with_pose_keyed(joints, pose, state.time));
+    state
 }

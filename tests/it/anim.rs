@@ -391,3 +391,55 @@ fn a_scene_plays_a_clip_on_the_wasp_and_keeps_it_in_the_file() {
     reloaded.file = anim.file.clone();
     assert_eq!(reloaded, anim, "its time and playback, exactly");
 }
+
+/// Keys set on a pose play back exactly at their times, channels without keys leave the
+/// rest of the pose alone, and the keys survive `.anim` export and a scene file exactly.
+#[test]
+fn keyed_poses_play_back_and_survive_anim_export_and_scene_files() {
+    use marionette::formats::cse169_skin::write_anim;
+    use marionette::formats::scene::{AnimDoc, CharacterDoc, SceneDoc, SourceDoc, parse_scene, save_scene};
+    use marionette::rig::JointRotation;
+    use marionette::rig::anim::Clip;
+
+    let puppet = marionette::formats::puppet::embedded_puppet();
+    let skeleton = &puppet.skeleton;
+    let elbow = skeleton.find("l_elbow").unwrap();
+    let rest = skeleton.initial_pose();
+    let mut bent = rest.clone();
+    bent[elbow] = JointRotation::euler_xyz(0.1, -0.7, 0.3);
+    bent[0] = JointRotation::euler_xyz(0.0, 0.5, 0.0);
+    let clip = Clip::empty(skeleton.len()).with_pose_keyed(&[elbow], &rest, 0.0).with_pose_keyed(&[elbow], &bent, 1.5);
+    assert_eq!(clip.range, (0.0, 1.5));
+    let (_, at_end) = clip.pose_at(skeleton, 1.5, &rest);
+    assert_eq!(at_end[elbow].to_euler(marionette::rig::EulerOrder::Xyz), glam::Vec3::new(0.1, -0.7, 0.3));
+    assert_eq!(at_end[0], rest[0], "the root has no keys: it keeps its pose");
+    let (_, halfway) = clip.pose_at(skeleton, 0.75, &rest);
+    let y = halfway[elbow].to_euler(marionette::rig::EulerOrder::Xyz).y;
+    assert!(y < -0.1 && y > -0.6, "between the keys: {y}");
+
+    let mut text = Vec::new();
+    write_anim(&mut text, &clip).unwrap();
+    let back = parse_anim(Cursor::new(&text), Path::new("keys.anim")).unwrap();
+    assert_eq!(back, clip, "the .anim reads back exactly");
+
+    let anim = AnimDoc { keys: Some(clip), time: 0.25, playing: false, ..AnimDoc::default() };
+    let doc = SceneDoc {
+        characters: vec![CharacterDoc {
+            id: None,
+            source: SourceDoc::Embedded("puppet".into()),
+            name: "p".into(),
+            placement: Default::default(),
+            pose: Default::default(),
+            view: Default::default(),
+            smpl: None,
+            binding: None,
+            skinning: Default::default(),
+            anim: Some(anim.clone()),
+        }],
+        ..SceneDoc::default()
+    };
+    let path = crate::common::scratch("keys-scene").join("keys.ron");
+    save_scene(&path, &doc).unwrap();
+    let reread = parse_scene(std::io::BufReader::new(std::fs::File::open(&path).unwrap()), &path).unwrap();
+    assert_eq!(reread.characters[0].anim, Some(anim), "keys survive a save and reload exactly");
+}

@@ -318,3 +318,31 @@ fn a_gizmo_drag_is_one_undo_step_and_a_cancelled_one_none() {
     request(&mut app, HistoryRequest::Undo);
     assert_eq!(pose_of(&app), start, "undo returns to where the drag began");
 }
+
+/// Keying is an edit: the first key puts a clip of the character's own keys on it, undo
+/// takes it off again, redo puts it back.
+#[test]
+fn keying_a_pose_is_undone_and_redone_like_any_edit() {
+    use marionette::scene::keyframes::{ClipPlayer, keyed};
+    let mut app = scene_app();
+    open_puppets(&mut app, &[Some(1)]);
+    let elbow = joint(&app, 1, "l_elbow");
+    edit(
+        &mut app,
+        Edit::Pose { character: CharacterId(1), joints: vec![(elbow, JointRotation::euler_xyz(0.0, -0.5, 0.0))] },
+    );
+    let character = app.world().get::<Character>(entity(&app, 1)).unwrap().clone();
+    let pose: Vec<_> = character.joints.iter().map(|&e| app.world().get::<JointPose>(e).unwrap().0).collect();
+    let anim = keyed(None, pose.len(), &[elbow], &pose);
+    edit(&mut app, Edit::Clip { character: CharacterId(1), anim: Some(anim.clone()) });
+    app.update();
+    let player = |app: &App| app.world().get::<ClipPlayer>(entity(app, 1)).map(|p| p.state.clone());
+    assert_eq!(player(&app), Some(anim.clone()));
+    let clip = anim.keys.as_ref().unwrap();
+    assert_eq!(clip.channels[3 + 3 * elbow + 1].keys()[0].value, -0.5);
+    assert!(clip.channels[3].keys().is_empty(), "only the selected joint is keyed");
+    request(&mut app, HistoryRequest::Undo);
+    assert_eq!(player(&app), None, "undo takes the keys off");
+    request(&mut app, HistoryRequest::Redo);
+    assert_eq!(player(&app), Some(anim));
+}

@@ -33,9 +33,11 @@ pub fn joint_panel(ui: &mut egui::Ui, state: &mut InspectorState, panels: &mut P
         }
         ui.separator();
     }
+    edits.into_iter().for_each(|e| panels.push(e));
+    super::keyframe_panel::keyframe_panel(ui, state, panels, id);
+    ui.separator();
     let additive = ui.input(|i| i.modifiers.shift || i.modifiers.command || i.modifiers.ctrl);
     joint_tree(ui, skeleton, 0, id, &mut panels.selection, additive);
-    edits.into_iter().for_each(|e| panels.push(e));
 }
 
 /// The sliders of joint `j` (a locked axis greyed out) and its reset; returns the joint's

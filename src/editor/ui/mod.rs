@@ -4,6 +4,7 @@
 
 pub mod clip_panel;
 pub mod joint_panel;
+pub mod keyframe_panel;
 pub mod scene_panel;
 pub mod smpl_panel;
 
@@ -29,6 +30,12 @@ pub struct InspectorState {
     pub active_dof: Option<String>,
     /// How many characters "Add crowd" adds.
     pub crowd_size: usize,
+    /// Joint rotations copied to paste as keys.
+    pub copied_keys: Vec<(usize, crate::rig::JointRotation)>,
+    /// The key picked in the curve view.
+    pub picked_key: Option<keyframe_panel::PickedKey>,
+    /// Where "Save .anim" writes.
+    pub anim_path: String,
 }
 
 impl Default for InspectorState {
@@ -38,6 +45,9 @@ impl Default for InspectorState {
             add_path: format!("{cwd}/"),
             recent: Vec::new(),
             scene_path: format!("{cwd}/scene.ron"),
+            copied_keys: Vec::new(),
+            picked_key: None,
+            anim_path: format!("{cwd}/keys.anim"),
             active_dof: None,
             crowd_size: 16,
         }
