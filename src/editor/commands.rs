@@ -9,10 +9,12 @@ use bevy::prelude::*;
 
 use super::document::{AssetLibrary, CharacterIndex, NextCharacterId, SceneCharacter, SceneReader, spawn_from_doc};
 use super::history::History;
+use super::pose_library::PoseLibrary;
 use super::stage::StageSettings;
 use super::state::Messages;
 use crate::formats::scene::{
-    AnimDoc, BindingDoc, CharacterDoc, CharacterId, PlacementDoc, SkinningDoc, SmplDoc, StageDoc, ViewDoc,
+    AnimDoc, BindingDoc, CharacterDoc, CharacterId, LibraryPoseDoc, PlacementDoc, SkinningDoc, SmplDoc, StageDoc,
+    ViewDoc,
 };
 use crate::rig::JointRotation;
 use crate::scene::keyframes::ClipPlayer;
@@ -63,6 +65,11 @@ pub enum Edit {
         character: CharacterId,
         anim: Option<AnimDoc>,
     },
+    /// A pose kept in the scene's library under `name` (none: taken out).
+    Library {
+        name: String,
+        pose: Option<LibraryPoseDoc>,
+    },
     /// Floor, shadows, axes.
     Stage(StageDoc),
     /// A character from its document (a fresh id is given when it has none).
@@ -84,7 +91,7 @@ impl Edit {
             | Edit::Clip { character, .. }
             | Edit::Remove(character) => Some(*character),
             Edit::Add(doc) => doc.id,
-            Edit::Stage(_) => None,
+            Edit::Stage(_) | Edit::Library { .. } => None,
         }
     }
 }
@@ -261,6 +268,10 @@ pub fn inverse_of(world: &mut World, edit: &Edit) -> Result<Option<Edit>, String
             let old = world.get::<ClipPlayer>(entity_of(world, *character)?).map(|p| p.state.clone());
             unless(old == *anim, Edit::Clip { character: *character, anim: old })
         }
+        Edit::Library { name, pose } => {
+            let old = world.resource::<PoseLibrary>().0.get(name).cloned();
+            unless(old == *pose, Edit::Library { name: name.clone(), pose: old })
+        }
         Edit::Stage(stage) => {
             let old = world.resource::<StageSettings>().0;
             unless(old == *stage, Edit::Stage(old))
@@ -305,6 +316,13 @@ fn write(world: &mut World, edit: Edit) -> Result<(), String> {
         Edit::Rebind { character, binding } => rebind_character(world, character, binding)?,
         Edit::Skinning { character, method } => component_mut::<CharacterSkinning>(world, character)?.0 = method,
         Edit::Clip { character, anim } => set_clip(world, character, anim)?,
+        Edit::Library { name, pose } => {
+            let mut library = world.resource_mut::<PoseLibrary>();
+            match pose {
+                Some(pose) => library.0.insert(name, pose),
+                None => library.0.remove(&name),
+            };
+        }
         Edit::Stage(stage) => world.resource_mut::<StageSettings>().0 = stage,
         Edit::Add(doc) => add_character(world, &doc)?,
         Edit::Remove(id) => {

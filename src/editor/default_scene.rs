@@ -82,5 +82,6 @@ pub fn generate() -> SceneDoc {
         ],
         camera: Some(CameraDoc { focus: glam::Vec3::new(0.0, 0.42, -0.3), yaw: 0.0, pitch: -0.32, distance: 2.9 }),
         stage: StageDoc::default(),
+        poses: Default::default(),
     }
 }

@@ -207,9 +207,11 @@ pub struct SceneReader<'w, 's> {
         ),
     >,
     pub poses: Query<'w, 's, &'static JointPose>,
+    pub joint_matrices: Query<'w, 's, &'static crate::scene::CurrentJointToWorld>,
     pub cameras: Query<'w, 's, &'static OrbitCamera>,
     pub stage: Res<'w, StageSettings>,
     pub unloaded: Res<'w, super::state::UnloadedCharacters>,
+    pub pose_library: Res<'w, super::pose_library::PoseLibrary>,
 }
 
 impl SceneReader<'_, '_> {
@@ -224,6 +226,7 @@ impl SceneReader<'_, '_> {
             characters: characters.into_iter().chain(self.unloaded.0.iter().cloned()).collect(),
             camera: self.cameras.iter().next().map(|o| o.0),
             stage: self.stage.0,
+            poses: self.pose_library.0.clone(),
         }
     }
 
@@ -377,7 +380,7 @@ pub fn doc_side_by_side(library: &mut AssetLibrary, sources: Vec<SourceDoc>, mes
             anim: None,
         })
         .collect();
-    SceneDoc { characters, camera: None, stage: Default::default() }
+    SceneDoc { characters, ..SceneDoc::default() }
 }
 
 /// The embedded default scene (`assets/default_scene.ron`).

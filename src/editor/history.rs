@@ -77,8 +77,12 @@ impl History {
                 }
             }
             other => {
-                let same_slot = |e: &Edit| {
-                    std::mem::discriminant(e) == std::mem::discriminant(&other) && e.character() == other.character()
+                let same_slot = |e: &Edit| match (e, &other) {
+                    (Edit::Library { name: a, .. }, Edit::Library { name: b, .. }) => a == b,
+                    _ => {
+                        std::mem::discriminant(e) == std::mem::discriminant(&other)
+                            && e.character() == other.character()
+                    }
                 };
                 if !recent.iter().any(same_slot) {
                     self.gesture.push(other);

@@ -22,6 +22,7 @@ pub mod draw;
 pub mod history;
 pub mod ik_drag;
 pub mod picking;
+pub mod pose_library;
 pub mod readiness;
 pub mod render;
 pub mod rotate_gizmo;

@@ -34,6 +34,7 @@ impl Plugin for ScenePlugin {
             .init_resource::<FramingAspect>()
             .init_resource::<FrameWhenSkinned>()
             .init_resource::<super::arrange::ArrangeWhenSkinned>()
+            .init_resource::<super::pose_library::PoseLibrary>()
             .add_plugins((
                 crate::scene::smpl::SmplPlugin,
                 crate::scene::keyframes::KeyframePlugin,
@@ -201,6 +202,7 @@ pub fn apply_pending_scene(
         }
     }
     stage.0 = doc.stage;
+    reset.pose_library.0 = doc.poses;
     if let Some(c) = doc.camera {
         cameras.iter_mut().for_each(|mut orbit| *orbit = OrbitCamera(c));
     }
@@ -250,6 +252,7 @@ pub struct SceneReset<'w> {
     pins: ResMut<'w, ik_drag::Pins>,
     history: ResMut<'w, history::History>,
     unloaded: ResMut<'w, UnloadedCharacters>,
+    pose_library: ResMut<'w, super::pose_library::PoseLibrary>,
 }
 
 impl SceneReset<'_> {

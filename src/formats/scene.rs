@@ -295,6 +295,19 @@ pub struct SceneDoc {
     pub camera: Option<CameraDoc>,
     #[serde(default)]
     pub stage: StageDoc,
+    /// The scene's pose library, by name.
+    #[serde(default, skip_serializing_if = "BTreeMap::is_empty")]
+    pub poses: BTreeMap<String, LibraryPoseDoc>,
+}
+
+/// A pose kept in the scene's library: rotations by joint name (applied to any character
+/// with those names) and a thumbnail, the posed bones seen from the front as 2D segments
+/// `[x0, y0, x1, y1]` in a unit square.
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+#[serde(default)]
+pub struct LibraryPoseDoc {
+    pub joints: BTreeMap<String, JointRotation>,
+    pub thumbnail: Vec<[f32; 4]>,
 }
 
 impl Default for SmplDoc {

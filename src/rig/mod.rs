@@ -9,6 +9,7 @@ pub mod fk;
 pub mod ik;
 pub mod lbs;
 pub mod matrix_stack;
+pub mod mirror;
 pub mod pose;
 pub mod skeleton;
 pub mod skinning;

@@ -30,6 +30,7 @@ pub fn doc_with(source: SourceDoc, pose: &[(&str, JointRotation)]) -> SceneDoc {
         }],
         camera: None,
         stage: Default::default(),
+        poses: Default::default(),
     }
 }
 

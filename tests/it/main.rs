@@ -14,6 +14,7 @@ mod fuzz;
 mod gizmo;
 mod ik;
 mod kernel;
+mod poses;
 mod rig;
 mod robust;
 mod smpl;

@@ -35,6 +35,7 @@ pub fn joint_panel(ui: &mut egui::Ui, state: &mut InspectorState, panels: &mut P
     }
     edits.into_iter().for_each(|e| panels.push(e));
     super::keyframe_panel::keyframe_panel(ui, state, panels, id);
+    super::pose_panel::pose_panel(ui, state, panels, id);
     ui.separator();
     let additive = ui.input(|i| i.modifiers.shift || i.modifiers.command || i.modifiers.ctrl);
     joint_tree(ui, skeleton, 0, id, &mut panels.selection, additive);

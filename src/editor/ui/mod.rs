@@ -5,6 +5,7 @@
 pub mod clip_panel;
 pub mod joint_panel;
 pub mod keyframe_panel;
+pub mod pose_panel;
 pub mod scene_panel;
 pub mod smpl_panel;
 
@@ -36,6 +37,10 @@ pub struct InspectorState {
     pub picked_key: Option<keyframe_panel::PickedKey>,
     /// Where "Save .anim" writes.
     pub anim_path: String,
+    /// A pose copied by joint name, to paste.
+    pub copied_pose: Vec<(String, crate::rig::JointRotation)>,
+    /// The name "Keep pose" keeps the pose under.
+    pub pose_name: String,
 }
 
 impl Default for InspectorState {
@@ -48,6 +53,8 @@ impl Default for InspectorState {
             copied_keys: Vec::new(),
             picked_key: None,
             anim_path: format!("{cwd}/keys.anim"),
+            copied_pose: Vec::new(),
+            pose_name: "pose 1".into(),
             active_dof: None,
             crowd_size: 16,
         }

@@ -1,0 +1,86 @@
+//! The pose section of the joint panel: copy the selected character's pose (or its
+//! selected joints'), paste it on any character with those joint names, as it was or
+//! mirrored; keep poses in the scene's library with a thumbnail, apply or remove them.
+
+use bevy_egui::egui;
+
+use super::{InspectorState, Panels};
+use crate::editor::commands::Edit;
+use crate::editor::pose_library::{apply_named_pose, library_pose, pose_by_name};
+use crate::formats::scene::{CharacterId, LibraryPoseDoc};
+use crate::rig::JointRotation;
+
+const THUMBNAIL: f32 = 56.0;
+
+pub fn pose_panel(ui: &mut egui::Ui, state: &mut InspectorState, panels: &mut Panels, id: CharacterId) {
+    let Some((_, _, character, ..)) = panels.scene.characters.iter().find(|c| c.1.id == id) else { return };
+    let character = character.clone();
+    let skeleton = &character.asset.skeleton;
+    let pose: Vec<JointRotation> =
+        character.joints.iter().map(|&e| panels.scene.poses.get(e).map_or(Default::default(), |p| p.0)).collect();
+    let positions: Vec<glam::Vec3> = character
+        .joints
+        .iter()
+        .map(|&e| panels.scene.joint_matrices.get(e).map_or(glam::Vec3::ZERO, |m| m.position()))
+        .collect();
+    let selected = panels.selection.joints.clone();
+    let mut edits = Vec::new();
+    egui::CollapsingHeader::new("Poses").default_open(false).show(ui, |ui| {
+        ui.horizontal(|ui| {
+            if ui.button("Copy").on_hover_text("the selected joints' rotations (all when none)").clicked() {
+                state.copied_pose = pose_by_name(skeleton, &pose, &selected);
+            }
+            let any = !state.copied_pose.is_empty();
+            if ui.add_enabled(any, egui::Button::new("Paste")).clicked() {
+                edits.extend(apply_named_pose(id, skeleton, &state.copied_pose, false));
+            }
+            if ui.add_enabled(any, egui::Button::new("Paste mirrored")).clicked() {
+                edits.extend(apply_named_pose(id, skeleton, &state.copied_pose, true));
+            }
+        });
+        ui.horizontal(|ui| {
+            ui.add(egui::TextEdit::singleline(&mut state.pose_name).desired_width(120.0));
+            if ui.button("Keep pose").on_hover_text("in the scene's library under this name").clicked()
+                && !state.pose_name.trim().is_empty()
+            {
+                let kept = library_pose(skeleton, &positions, pose_by_name(skeleton, &pose, &selected));
+                edits.push(Edit::Library { name: state.pose_name.trim().to_string(), pose: Some(kept) });
+            }
+        });
+        for (name, kept) in panels.scene.pose_library.0.iter() {
+            ui.horizontal(|ui| {
+                thumbnail(ui, kept);
+                ui.vertical(|ui| {
+                    ui.label(format!("{name} ({} joints)", kept.joints.len()));
+                    ui.horizontal(|ui| {
+                        let named: Vec<(String, JointRotation)> = kept.joints.clone().into_iter().collect();
+                        if ui.small_button("Apply").clicked() {
+                            edits.extend(apply_named_pose(id, skeleton, &named, false));
+                        }
+                        if ui.small_button("Mirrored").clicked() {
+                            edits.extend(apply_named_pose(id, skeleton, &named, true));
+                        }
+                        if ui.small_button("Remove").clicked() {
+                            edits.push(Edit::Library { name: name.clone(), pose: None });
+                        }
+                    });
+                });
+            });
+        }
+    });
+    edits.into_iter().for_each(|e| panels.push(e));
+}
+
+/// The pose's stick figure.
+fn thumbnail(ui: &mut egui::Ui, pose: &LibraryPoseDoc) {
+    let (response, painter) = ui.allocate_painter(egui::vec2(THUMBNAIL, THUMBNAIL), egui::Sense::hover());
+    let rect = response.rect;
+    painter.rect_filled(rect, 3.0, egui::Color32::from_gray(28));
+    let at = |x: f32, y: f32| egui::pos2(rect.left() + x * rect.width(), rect.bottom() - y * rect.height());
+    for s in &pose.thumbnail {
+        painter.line_segment(
+            [at(s[0], s[1]), at(s[2], s[3])],
+            egui::Stroke::new(1.5, egui::Color32::from_rgb(235, 225, 200)),
+        );
+    }
+}
