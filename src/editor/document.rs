@@ -128,7 +128,12 @@ impl AssetLibrary {
         if let Some(clip) = self.keyframe_clips.get(path) {
             return Ok(clip.clone());
         }
-        let clip = Arc::new(crate::formats::cse169_skin::parse_anim(crate::formats::error::open(path)?, path)?);
+        let input = crate::formats::error::open(path)?;
+        let clip = Arc::new(if path.extension().is_some_and(|e| e.eq_ignore_ascii_case("bvh")) {
+            crate::formats::bvh::parse_bvh(input, path)?.clip
+        } else {
+            crate::formats::cse169_skin::parse_anim(input, path)?
+        });
         self.keyframe_clips.insert(path.to_path_buf(), clip.clone());
         Ok(clip)
     }
@@ -322,6 +327,16 @@ pub fn spawn_from_doc(
     Ok((entity, messages))
 }
 
+/// The motion a source brings with it: a BVH file plays its own clip.
+pub fn own_motion(source: &SourceDoc) -> Option<crate::formats::scene::AnimDoc> {
+    match source {
+        SourceDoc::File(p) if p.extension().is_some_and(|e| e.eq_ignore_ascii_case("bvh")) => {
+            Some(crate::formats::scene::AnimDoc::of(p.clone()))
+        }
+        _ => None,
+    }
+}
+
 /// The player of a character's keyframed clip, and a note when the clip's channels do not
 /// fit the skeleton (3 for the root, then 3 per joint).
 pub fn clip_player(
@@ -335,14 +350,33 @@ pub fn clip_player(
         None => library.keyframe_clip(&anim.file)?,
     };
     let wanted = 3 + 3 * asset.skeleton.len();
-    let note = (clip.channels.len() != wanted).then(|| {
-        format!(
-            "{name}: {} has {} channels; its skeleton takes {wanted} (3 for the root, 3 per joint)",
-            anim.file.display(),
-            clip.channels.len()
-        )
-    });
+    let note = if !clip.joint_names.is_empty() {
+        let matched = asset.skeleton.joints().iter().filter(|j| clip_joint(&clip, anim, &j.name).is_some()).count();
+        (matched < asset.skeleton.len()).then(|| {
+            format!(
+                "{name}: {} moves {matched} of its {} joints (by name; a name map in the scene file's `names` pairs the others)",
+                anim.file.display(),
+                asset.skeleton.len()
+            )
+        })
+    } else {
+        (clip.channels.len() != wanted).then(|| {
+            format!(
+                "{name}: {} has {} channels; its skeleton takes {wanted} (3 for the root, 3 per joint)",
+                anim.file.display(),
+                clip.channels.len()
+            )
+        })
+    };
+    let clip = if clip.joint_names.is_empty() { clip } else { Arc::new(clip.retargeted(&asset.skeleton, &anim.names)) };
     Ok((ClipPlayer { clip, state: anim.clone() }, note))
+}
+
+/// The clip's joint that moves a character's joint `name` (by the name map, or the same
+/// name).
+fn clip_joint(clip: &crate::rig::anim::Clip, anim: &crate::formats::scene::AnimDoc, name: &str) -> Option<usize> {
+    let wanted = anim.names.get(name).map_or(name, String::as_str);
+    clip.joint_names.iter().position(|n| n == wanted)
 }
 
 /// A document of characters placed side by side along x by their bind boxes, each
@@ -370,6 +404,7 @@ pub fn doc_side_by_side(library: &mut AssetLibrary, sources: Vec<SourceDoc>, mes
         .map(|((source, asset), translation)| CharacterDoc {
             id: None,
             name: asset.name.clone(),
+            anim: own_motion(&source),
             source,
             placement: PlacementDoc { translation, yaw: 0.0, scale: 1.0 },
             pose: Default::default(),
@@ -377,7 +412,6 @@ pub fn doc_side_by_side(library: &mut AssetLibrary, sources: Vec<SourceDoc>, mes
             smpl: None,
             binding: None,
             skinning: Default::default(),
-            anim: None,
         })
         .collect();
     SceneDoc { characters, ..SceneDoc::default() }

@@ -152,14 +152,18 @@ fn put_clip_on_fitting_characters(
     };
     let mut fitted = 0;
     for c in &mut doc.characters {
-        if library.load(&c.source).is_ok_and(|a| 3 + 3 * a.skeleton.len() == clip.channels.len()) {
+        let fits = |a: &crate::rig::CharacterAsset| match clip.joint_names.is_empty() {
+            true => 3 + 3 * a.skeleton.len() == clip.channels.len(),
+            false => a.skeleton.joints().iter().any(|j| clip.joint_names.contains(&j.name)),
+        };
+        if library.load(&c.source).is_ok_and(|a| fits(&a)) {
             c.anim = Some(anim.clone());
             fitted += 1;
         }
     }
     if fitted == 0 {
         messages.push(format!(
-            "{}: its {} channels fit no character (3 for the root, then 3 per joint)",
+            "{}: its {} channels fit no character (3 for the root, then 3 per joint, or joints by name)",
             anim.file.display(),
             clip.channels.len()
         ));

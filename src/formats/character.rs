@@ -19,6 +19,8 @@ pub enum CharacterSource {
     Smpl { dir: PathBuf },
     /// Homer's rig JSON (+ an OFF mesh beside it).
     Homer { json: PathBuf },
+    /// A BVH motion capture file: its skeleton as bone boxes.
+    Bvh { path: PathBuf },
 }
 
 impl CharacterSource {
@@ -36,6 +38,7 @@ impl CharacterSource {
                 }
             }
             Some("json") => Ok(Self::Homer { json: path.to_path_buf() }),
+            Some("bvh") => Ok(Self::Bvh { path: path.to_path_buf() }),
             Some("skin") => {
                 let skel = path.with_extension("skel");
                 if !skel.is_file() {
@@ -83,6 +86,7 @@ pub fn load_skeleton(path: &Path) -> Result<Skeleton, FormatError> {
         CharacterSource::Mit6837 { skel, .. } => mit6837::parse_skel(open(&skel)?, &skel),
         CharacterSource::Homer { json } => Ok(super::homer::parse_rig(open(&json)?, &json)?.skeleton),
         CharacterSource::Smpl { dir } => Ok(super::smpl::load_smpl_dir(&dir)?.0.skeleton),
+        CharacterSource::Bvh { path } => Ok(super::bvh::parse_bvh(open(&path)?, &path)?.skeleton),
     }
 }
 
@@ -99,6 +103,10 @@ pub fn load_character(path: &Path) -> Result<CharacterAsset, FormatError> {
             load_cse169_skin(name, skeleton, &skin_path)
         }
         CharacterSource::Homer { json } => super::homer::load_homer(&json),
+        CharacterSource::Bvh { path } => {
+            let skeleton = super::bvh::parse_bvh(open(&path)?, &path)?.skeleton;
+            Ok(CharacterAsset::with_bone_boxes(name, skeleton, Vec::new()))
+        }
         CharacterSource::Smpl { dir } => {
             let (model, warnings) = super::smpl::load_smpl_dir(&dir)?;
             let mut asset = model.asset(&name, &[]).map_err(|e| FormatError::rig(&dir, e))?;

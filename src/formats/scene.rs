@@ -227,11 +227,23 @@ pub struct AnimDoc {
     pub playing: bool,
     pub looping: bool,
     pub speed: f32,
+    /// For a clip of named joints (BVH): the character's joint name → the clip's, where
+    /// they differ (e.g. `L_Knee: "LeftLeg"`).
+    #[serde(skip_serializing_if = "BTreeMap::is_empty")]
+    pub names: BTreeMap<String, String>,
 }
 
 impl Default for AnimDoc {
     fn default() -> Self {
-        Self { file: PathBuf::new(), keys: None, time: 0.0, playing: true, looping: true, speed: 1.0 }
+        Self {
+            file: PathBuf::new(),
+            keys: None,
+            time: 0.0,
+            playing: true,
+            looping: true,
+            speed: 1.0,
+            names: BTreeMap::new(),
+        }
     }
 }
 

@@ -220,6 +220,10 @@ fn slope(keys: &[Key], k: usize, rule: Tangent, incoming: bool) -> f32 {
 pub struct Clip {
     pub range: (f32, f32),
     pub channels: Vec<Channel>,
+    /// The joints the channels are for, by name (motion capture); empty when they follow
+    /// the skeleton's own order.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub joint_names: Vec<String>,
 }
 
 impl Clip {
@@ -230,7 +234,35 @@ impl Clip {
 
     /// An empty clip for `joints` joints: a channel without keys per root axis and DOF.
     pub fn empty(joints: usize) -> Self {
-        Self { range: (0.0, 1.0), channels: vec![Channel::empty(); 3 + 3 * joints] }
+        Self { range: (0.0, 1.0), channels: vec![Channel::empty(); 3 + 3 * joints], joint_names: Vec::new() }
+    }
+
+    /// This clip for `skeleton`: a clip named by joints (motion capture) has its channels
+    /// moved to the skeleton's joints of the same names, or of the names `names` maps them
+    /// to (target name → clip name); joints without one get no keys (they keep their
+    /// pose), and the root moves only when the skeleton's root is the clip's.
+    pub fn retargeted(&self, skeleton: &Skeleton, names: &std::collections::BTreeMap<String, String>) -> Clip {
+        if self.joint_names.is_empty() {
+            return self.clone();
+        }
+        let source = |target: &str| {
+            let wanted = names.get(target).map_or(target, String::as_str);
+            self.joint_names.iter().position(|n| n == wanted)
+        };
+        let mut clip = Clip::empty(skeleton.len());
+        clip.range = self.range;
+        for (j, def) in skeleton.joints().iter().enumerate() {
+            let Some(s) = source(&def.name) else { continue };
+            if j == 0 && s == 0 {
+                clip.channels[..3].clone_from_slice(&self.channels[..3]);
+            }
+            for axis in 0..3 {
+                if let Some(c) = self.channels.get(Self::joint_channel(s, axis)) {
+                    clip.channels[Self::joint_channel(j, axis)] = c.clone();
+                }
+            }
+        }
+        clip
     }
 
     /// The channel of `axis` (0–2) of joint `joint`.

@@ -13,7 +13,7 @@ use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
 use arbitrary::Unstructured;
-use marionette::formats::{FormatError, cse169, cse169_skin, homer, mit6837, obj, off, scene, smpl};
+use marionette::formats::{FormatError, bvh, cse169, cse169_skin, homer, mit6837, obj, off, scene, smpl};
 
 use crate::common::optional_data_dir;
 
@@ -42,6 +42,7 @@ enum Reader {
         vertices: usize,
     },
     Cse169Anim,
+    Bvh,
     Obj,
     Off,
     SmplHierarchy,
@@ -65,6 +66,7 @@ fn read(reader: Reader, bytes: &[u8]) -> Result<(), FormatError> {
         Reader::Cse169Skin => cse169_skin::parse_skin(input, path).map(drop),
         Reader::Cse169Morph { vertices } => cse169_skin::parse_morph(input, path, vertices).map(drop),
         Reader::Cse169Anim => cse169_skin::parse_anim(input, path).map(drop),
+        Reader::Bvh => bvh::parse_bvh(input, path).map(drop),
         Reader::Obj => obj::parse_obj(input, path).map(drop),
         Reader::Off => off::parse_off(input, path).map(drop),
         Reader::SmplHierarchy => smpl::parse_hierarchy(input, path).map(drop),
@@ -189,6 +191,7 @@ fn file_seeds() -> Vec<Seed> {
         seed(Reader::Skel6837, assets.join("puppet.skel")),
         seed(Reader::Obj, assets.join("puppet.obj")),
         seed(Reader::Scene, assets.join("default_scene.ron")),
+        seed(Reader::Bvh, Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/steps.bvh")),
         attach(assets.join("puppet.skel"), assets.join("puppet.attach")),
     ];
     let Some(data) = optional_data_dir() else { return seeds };
@@ -410,6 +413,7 @@ fn regressions_are_rejected_with_a_place() {
             "skel" => Reader::Skel6837,
             "skin" => Reader::Cse169Skin,
             "anim" => Reader::Cse169Anim,
+            "bvh" => Reader::Bvh,
             "off" => Reader::Off,
             "obj" => Reader::Obj,
             "json" if name.contains("character") => Reader::HomerCharacter,

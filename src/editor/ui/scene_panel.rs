@@ -123,6 +123,7 @@ fn add_character(path: &str, state: &mut InspectorState, panels: &mut Panels) {
     let (lo, hi) = asset.bounds();
     let translation = beside(&panels.world_boxes(), lo, hi, 1.0);
     let id = panels.ids.take();
+    let anim = crate::editor::document::own_motion(&source);
     panels.push(Edit::Add(Box::new(CharacterDoc {
         id: Some(id),
         source,
@@ -133,7 +134,7 @@ fn add_character(path: &str, state: &mut InspectorState, panels: &mut Panels) {
         smpl: None,
         binding: None,
         skinning: Default::default(),
-        anim: None,
+        anim,
     })));
     *panels.selection = Selection { character: Some(id), joints: Vec::new() };
     state.recent.retain(|r| r != path);

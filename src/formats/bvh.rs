@@ -1,0 +1,228 @@
+//! BVH motion capture: `HIERARCHY` (`ROOT`/`JOINT name { OFFSET x y z  CHANNELS n …
+//! }`, `End Site { OFFSET … }`) then `MOTION` (`Frames: N`, `Frame Time: dt`, one line of
+//! channel values per frame). Rotations are in degrees; a joint's channels list its
+//! rotation axes outermost first (`Zrotation Xrotation Yrotation` is `Rz · Rx · Ry`).
+//!
+//! Read as a skeleton (end sites become leaf joints named `<parent>_end`, so the last bones
+//! show) and a clip with a key per frame on each root-translation and x/y/z-rotation channel
+//! (linear between frames), named by the BVH's joints so other characters can play it.
+
+use std::io::BufRead;
+use std::path::Path;
+
+use glam::{Quat, Vec3};
+
+use super::cse169::{Tokens, tokenize};
+use super::error::FormatError;
+use crate::rig::anim::{Channel, Clip, Extrapolation, Key, Tangent};
+use crate::rig::{EulerOrder, JointRotation, RawJoint, Skeleton};
+
+/// A BVH file: its skeleton and its motion as a clip.
+#[derive(Debug, Clone)]
+pub struct BvhFile {
+    pub skeleton: Skeleton,
+    pub clip: Clip,
+    pub frame_time: f32,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Dof {
+    Position(usize),
+    Rotation(usize),
+}
+
+/// A joint as read: its channels (into the frame lines) in file order.
+struct Read {
+    raw: RawJoint,
+    dofs: Vec<(Dof, usize)>,
+}
+
+/// Parses a BVH file.
+pub fn parse_bvh(reader: impl BufRead, path: &Path) -> Result<BvhFile, FormatError> {
+    let mut tokens = Tokens::new(tokenize(reader, path)?, path);
+    tokens.expect("HIERARCHY")?;
+    let mut joints: Vec<Read> = Vec::new();
+    let mut open: Vec<usize> = Vec::new();
+    let mut columns = 0usize;
+    let mut first = true;
+    loop {
+        let word = tokens.next_token("`ROOT`, `JOINT`, `End`, `}` or `MOTION`")?;
+        match word.text.as_str() {
+            "ROOT" | "JOINT" => {
+                if (word.text == "ROOT") != first || (word.text == "ROOT" && !open.is_empty()) {
+                    return Err(FormatError::syntax(
+                        path,
+                        word.line,
+                        format!("expected one ROOT first, found `{}`", word.text),
+                    ));
+                }
+                first = false;
+                let name = tokens.next_token("a joint name")?.text;
+                tokens.expect("{")?;
+                tokens.expect("OFFSET")?;
+                let offset = tokens.vec3("the offset")?;
+                tokens.expect("CHANNELS")?;
+                let line = tokens.line();
+                let n = tokens.number("the number of channels")?;
+                if !(0.0..=6.0).contains(&n) || n.fract() != 0.0 {
+                    return Err(FormatError::syntax(path, line, format!("expected 0 to 6 channels, found {n}")));
+                }
+                let mut dofs = Vec::new();
+                for _ in 0..n as usize {
+                    let t = tokens.next_token("a channel name")?;
+                    let dof = match t.text.as_str() {
+                        "Xposition" => Dof::Position(0),
+                        "Yposition" => Dof::Position(1),
+                        "Zposition" => Dof::Position(2),
+                        "Xrotation" => Dof::Rotation(0),
+                        "Yrotation" => Dof::Rotation(1),
+                        "Zrotation" => Dof::Rotation(2),
+                        other => {
+                            return Err(FormatError::syntax(
+                                path,
+                                t.line,
+                                format!("expected a channel (Xposition … Zrotation), found `{other}`"),
+                            ));
+                        }
+                    };
+                    dofs.push((dof, columns));
+                    columns += 1;
+                }
+                let parent = open.last().copied();
+                joints.push(Read { raw: RawJoint::new(name, parent, offset), dofs });
+                open.push(joints.len() - 1);
+            }
+            "End" => {
+                tokens.expect("Site")?;
+                tokens.expect("{")?;
+                tokens.expect("OFFSET")?;
+                let offset = tokens.vec3("the end site's offset")?;
+                tokens.expect("}")?;
+                let parent = *open
+                    .last()
+                    .ok_or_else(|| FormatError::syntax(path, word.line, "expected a joint around the end site"))?;
+                let name = format!("{}_end", joints[parent].raw.name);
+                joints.push(Read { raw: RawJoint::new(name, Some(parent), offset), dofs: Vec::new() });
+            }
+            "}" => {
+                open.pop()
+                    .ok_or_else(|| FormatError::syntax(path, word.line, "expected a joint to close, found `}`"))?;
+            }
+            "MOTION" if open.is_empty() && !first => break,
+            other => {
+                return Err(FormatError::syntax(
+                    path,
+                    word.line,
+                    format!("expected `JOINT`, `End` or `}}`, found `{other}`"),
+                ));
+            }
+        }
+    }
+    let frames = frame_header(&mut tokens, "Frames:")?;
+    tokens.expect("Frame")?;
+    tokens.expect("Time:")?;
+    let frame_time = tokens.number("the frame time")?;
+    if frame_time <= 0.0 {
+        return Err(tokens.error("a positive frame time"));
+    }
+    if (frames as u64) * (columns as u64) > 50_000_000 {
+        return Err(tokens.error("at most 50 million channel values"));
+    }
+    let mut values = Vec::with_capacity(frames * columns);
+    for _ in 0..frames * columns {
+        values.push(tokens.number("a channel value")?);
+    }
+    if !tokens.at_end() {
+        return Err(tokens.error(&format!("the end of the file after {frames} frames of {columns} values")));
+    }
+    let names: Vec<String> = joints.iter().map(|j| j.raw.name.clone()).collect();
+    give_bone_boxes(&mut joints);
+    let dofs: Vec<Vec<(Dof, usize)>> = joints.iter().map(|j| j.dofs.clone()).collect();
+    let skeleton =
+        Skeleton::build(joints.into_iter().map(|j| j.raw).collect()).map_err(|e| FormatError::rig(path, e))?;
+    let clip = motion_clip(&skeleton, &dofs, &values, columns, frame_time, names);
+    Ok(BvhFile { skeleton, clip, frame_time })
+}
+
+/// Each joint a box along the bone to its first child (a small cube at a tip), so the
+/// skeleton shows as boxes whatever the file's units.
+fn give_bone_boxes(joints: &mut [Read]) {
+    let lengths: Vec<f32> = joints.iter().map(|j| j.raw.rest_offset.length()).collect();
+    let typical = lengths.iter().copied().fold(0.0, f32::max).max(1e-3) * 0.08;
+    for j in 0..joints.len() {
+        let bone = joints.iter().find(|c| c.raw.parent == Some(j)).map(|c| c.raw.rest_offset);
+        let thick = bone.map_or(typical, |b| (b.length() * 0.15).min(typical)).max(1e-4);
+        let end = bone.unwrap_or(Vec3::ZERO);
+        joints[j].raw.bone_box = Some(crate::rig::BoneBox {
+            min: end.min(Vec3::ZERO) - Vec3::splat(thick),
+            max: end.max(Vec3::ZERO) + Vec3::splat(thick),
+        });
+    }
+}
+
+/// `Frames:` and a whole count.
+fn frame_header(tokens: &mut Tokens, word: &str) -> Result<usize, FormatError> {
+    tokens.expect(word)?;
+    let n = tokens.number("the number of frames")?;
+    if n < 0.0 || n.fract() != 0.0 || n > 1e7 {
+        return Err(tokens.error("a whole number of frames"));
+    }
+    Ok(n as usize)
+}
+
+/// The motion as a clip: per frame, the root's position and each joint's rotation as x, y,
+/// z angles (unwrapped from frame to frame so the linear keys between them turn the short
+/// way).
+fn motion_clip(
+    skeleton: &Skeleton,
+    dofs: &[Vec<(Dof, usize)>],
+    values: &[f32],
+    columns: usize,
+    frame_time: f32,
+    names: Vec<String>,
+) -> Clip {
+    let frames = if columns == 0 { 0 } else { values.len() / columns };
+    let mut channels: Vec<Vec<Key>> = vec![Vec::new(); 3 + 3 * skeleton.len()];
+    let key = |time, value| Key { time, value, tangent_in: Tangent::Linear, tangent_out: Tangent::Linear };
+    for f in 0..frames {
+        let row = &values[f * columns..(f + 1) * columns];
+        let time = f as f32 * frame_time;
+        for (j, joint) in dofs.iter().enumerate() {
+            if j == 0 {
+                for &(dof, column) in joint {
+                    if let Dof::Position(axis) = dof {
+                        channels[axis].push(key(time, row[column]));
+                    }
+                }
+            }
+            let rotations: Vec<(usize, f32)> = joint
+                .iter()
+                .filter_map(|&(dof, column)| match dof {
+                    Dof::Rotation(axis) => Some((axis, row[column].to_radians())),
+                    Dof::Position(_) => None,
+                })
+                .collect();
+            if rotations.is_empty() {
+                continue;
+            }
+            let angles = rotation_of(&rotations).to_euler(EulerOrder::Xyz);
+            for axis in 0..3 {
+                let c = Clip::joint_channel(j, axis);
+                let previous = channels[c].last().map(|k| k.value);
+                let value = previous.map_or(angles[axis], |p| p + crate::rig::turn::wrap_angle(angles[axis] - p));
+                channels[c].push(key(time, value));
+            }
+        }
+    }
+    let channels =
+        channels.into_iter().map(|keys| Channel::new(keys, Extrapolation::Constant, Extrapolation::Constant)).collect();
+    let end = frames.saturating_sub(1) as f32 * frame_time;
+    Clip { range: (0.0, end.max(frame_time)), channels, joint_names: names }
+}
+
+/// The rotation of channels listed outermost first: `R = R(a₀) · R(a₁) · …`.
+fn rotation_of(rotations: &[(usize, f32)]) -> JointRotation {
+    let q =
+        rotations.iter().fold(Quat::IDENTITY, |q, &(axis, angle)| q * Quat::from_axis_angle(Vec3::AXES[axis], angle));
+    JointRotation::Quat(q)
+}
