@@ -181,7 +181,7 @@ fn motion_clip(
     frame_time: f32,
     names: Vec<String>,
 ) -> Clip {
-    let frames = if columns == 0 { 0 } else { values.len() / columns };
+    let frames = values.len().checked_div(columns).unwrap_or(0);
     let mut channels: Vec<Vec<Key>> = vec![Vec::new(); 3 + 3 * skeleton.len()];
     let key = |time, value| Key { time, value, tangent_in: Tangent::Linear, tangent_out: Tangent::Linear };
     for f in 0..frames {
