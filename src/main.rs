@@ -169,9 +169,10 @@ impl From<Skinning> for marionette::rig::dqs::SkinningMethod {
 /// `--anim FILE --time T`: pose characters from a keyframed clip.
 #[derive(clap::Args, Debug, Clone)]
 struct ClipArgs {
-    /// A CSE169 `.anim` clip: channels 0-2 move the root, then x, y, z rotation per joint
-    /// in the skeleton's order. On every character whose skeleton it fits.
-    #[arg(long, value_name = "FILE.anim")]
+    /// A CSE169 `.anim` clip (channels 0-2 move the root, then x, y, z rotation per joint
+    /// in the skeleton's order) or a `.bvh` (its joints by name), on every character whose
+    /// skeleton it fits.
+    #[arg(long, value_name = "FILE.anim|FILE.bvh")]
     anim: Option<PathBuf>,
     /// The clip's time in seconds (extrapolated outside its keys as the clip says).
     #[arg(long, default_value_t = 0.0, value_parser = finite_seconds, requires = "anim")]
@@ -223,7 +224,7 @@ fn run(cli: Cli) -> Result<()> {
             let mut pose = asset.skeleton.initial_pose();
             let mut origin = Mat4::IDENTITY;
             if let Some(file) = &clip.anim {
-                let anim = marionette::formats::cse169_skin::parse_anim(marionette::formats::error::open(file)?, file)?;
+                let anim = marionette::formats::load_clip(file)?.retargeted(&asset.skeleton, &Default::default());
                 let (root, clip_pose) = anim.pose_at(&asset.skeleton, clip.time, &pose);
                 pose = clip_pose;
                 let root_offset = asset.skeleton.joint(0).rest_offset;

@@ -128,12 +128,7 @@ impl AssetLibrary {
         if let Some(clip) = self.keyframe_clips.get(path) {
             return Ok(clip.clone());
         }
-        let input = crate::formats::error::open(path)?;
-        let clip = Arc::new(if path.extension().is_some_and(|e| e.eq_ignore_ascii_case("bvh")) {
-            crate::formats::bvh::parse_bvh(input, path)?.clip
-        } else {
-            crate::formats::cse169_skin::parse_anim(input, path)?
-        });
+        let clip = Arc::new(crate::formats::load_clip(path)?);
         self.keyframe_clips.insert(path.to_path_buf(), clip.clone());
         Ok(clip)
     }

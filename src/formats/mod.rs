@@ -16,6 +16,16 @@ pub mod scene;
 pub mod smpl;
 
 pub use character::{CharacterSource, load_character};
+
+/// A keyframed clip from a file: a CSE169 `.anim`, or the motion of a `.bvh`.
+pub fn load_clip(path: &std::path::Path) -> Result<crate::rig::anim::Clip, FormatError> {
+    let input = error::open(path)?;
+    if path.extension().is_some_and(|e| e.eq_ignore_ascii_case("bvh")) {
+        Ok(bvh::parse_bvh(input, path)?.clip)
+    } else {
+        cse169_skin::parse_anim(input, path)
+    }
+}
 pub use error::FormatError;
 
 /// Writes a whole file or nothing: the content goes to a new temporary file beside `path`
