@@ -233,6 +233,7 @@ fn editing_frame_3_smpl_playing_1_puppet_dragged(bencher: Bencher, variant: &str
         binding: None,
         skinning: Default::default(),
         anim: None,
+        morphs: Vec::new(),
     };
     let mut characters = vec![character(1, SourceDoc::Embedded("puppet".into()), 0.0, None)];
     if let Some(dir) = std::env::var_os("MARIONETTE_DATA").map(|d| std::path::PathBuf::from(d).join("smpl")) {

@@ -65,6 +65,11 @@ pub enum Edit {
         character: CharacterId,
         anim: Option<AnimDoc>,
     },
+    /// Morph target weights.
+    Morph {
+        character: CharacterId,
+        weights: Vec<f32>,
+    },
     /// A pose kept in the scene's library under `name` (none: taken out).
     Library {
         name: String,
@@ -89,6 +94,7 @@ impl Edit {
             | Edit::Rebind { character, .. }
             | Edit::Skinning { character, .. }
             | Edit::Clip { character, .. }
+            | Edit::Morph { character, .. }
             | Edit::Remove(character) => Some(*character),
             Edit::Add(doc) => doc.id,
             Edit::Stage(_) | Edit::Library { .. } => None,
@@ -268,6 +274,10 @@ pub fn inverse_of(world: &mut World, edit: &Edit) -> Result<Option<Edit>, String
             let old = world.get::<ClipPlayer>(entity_of(world, *character)?).map(|p| p.state.clone());
             unless(old == *anim, Edit::Clip { character: *character, anim: old })
         }
+        Edit::Morph { character, weights } => {
+            let old = component::<crate::scene::morphs::Morphs>(world, *character)?.weights.clone();
+            unless(old == *weights, Edit::Morph { character: *character, weights: old })
+        }
         Edit::Library { name, pose } => {
             let old = world.resource::<PoseLibrary>().0.get(name).cloned();
             unless(old == *pose, Edit::Library { name: name.clone(), pose: old })
@@ -316,6 +326,9 @@ fn write(world: &mut World, edit: Edit) -> Result<(), String> {
         Edit::Rebind { character, binding } => rebind_character(world, character, binding)?,
         Edit::Skinning { character, method } => component_mut::<CharacterSkinning>(world, character)?.0 = method,
         Edit::Clip { character, anim } => set_clip(world, character, anim)?,
+        Edit::Morph { character, weights } => {
+            component_mut::<crate::scene::morphs::Morphs>(world, character)?.weights = weights;
+        }
         Edit::Library { name, pose } => {
             let mut library = world.resource_mut::<PoseLibrary>();
             match pose {

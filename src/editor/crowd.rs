@@ -28,6 +28,7 @@ fn crowd_member(i: usize, n: usize, source: SourceDoc, spacing: f32, lift: f32, 
         binding: None,
         skinning: Default::default(),
         anim: None,
+        morphs: Vec::new(),
     }
 }
 

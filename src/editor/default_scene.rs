@@ -31,6 +31,7 @@ fn puppet(
         binding: None,
         skinning: Default::default(),
         anim: None,
+        morphs: Vec::new(),
     }
 }
 

@@ -204,6 +204,7 @@ pub struct SceneReader<'w, 's> {
             Option<&'static SmplCharacter>,
             &'static CharacterSkinning,
             Option<&'static ClipPlayer>,
+            Option<&'static crate::scene::morphs::Morphs>,
         ),
     >,
     pub poses: Query<'w, 's, &'static JointPose>,
@@ -233,7 +234,7 @@ impl SceneReader<'_, '_> {
     /// The document of one live character: joints listed where they differ from the
     /// source's pose.
     pub fn character_doc(&self, entity: Entity) -> Option<CharacterDoc> {
-        let (_, sc, character, placement, view, smpl, skinning, player) = self.characters.get(entity).ok()?;
+        let (_, sc, character, placement, view, smpl, skinning, player, morphs) = self.characters.get(entity).ok()?;
         let skeleton = &character.asset.skeleton;
         let initial = skeleton.initial_pose();
         let pose = character
@@ -256,6 +257,7 @@ impl SceneReader<'_, '_> {
             binding: sc.binding,
             skinning: skinning.0,
             anim: player.map(|p| p.state.clone()),
+            morphs: morphs.map(|m| m.weights.clone()).unwrap_or_default(),
         })
     }
 }
@@ -305,9 +307,17 @@ pub fn spawn_from_doc(
             None
         }
     });
+    let morphs = (!asset.morphs.is_empty()).then(|| {
+        let mut weights = doc.morphs.clone();
+        weights.resize(asset.morphs.len(), 0.0);
+        crate::scene::morphs::Morphs { base: asset.clone(), weights }
+    });
     let entity = spawn_character_posed(commands, meshes, asset, Placement(doc.placement), &pose);
     if let Some(player) = player {
         commands.entity(entity).insert(player);
+    }
+    if let Some(morphs) = morphs {
+        commands.entity(entity).insert(morphs);
     }
     commands.entity(entity).insert((
         SceneCharacter { id, source: doc.source.clone(), name: doc.name.clone(), binding: doc.binding },
@@ -400,6 +410,7 @@ pub fn doc_side_by_side(library: &mut AssetLibrary, sources: Vec<SourceDoc>, mes
             id: None,
             name: asset.name.clone(),
             anim: own_motion(&source),
+            morphs: Vec::new(),
             source,
             placement: PlacementDoc { translation, yaw: 0.0, scale: 1.0 },
             pose: Default::default(),

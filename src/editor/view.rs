@@ -38,6 +38,7 @@ impl Plugin for ScenePlugin {
             .add_plugins((
                 crate::scene::smpl::SmplPlugin,
                 crate::scene::keyframes::KeyframePlugin,
+                crate::scene::morphs::MorphPlugin,
                 super::commands::CommandsPlugin,
             ))
             .add_systems(

@@ -155,9 +155,37 @@ fn load_cse169_skin(name: String, skeleton: Skeleton, path: &Path) -> Result<Cha
         crate::rig::SkinWeights::from_rows(file.weights, skeleton.len()).map_err(|e| FormatError::rig(path, e))?;
     let warnings = normalised_warnings(path, &normalised);
     let inverse_binds = file.bindings.iter().map(|m| m.inverse()).collect();
+    let morphs = morphs_beside(path, &file.positions)?;
     let skin = Skin { bind_positions: file.positions, triangles: file.triangles, weights };
-    CharacterAsset::with_inverse_binds(name, skeleton, skin, inverse_binds, warnings)
-        .map_err(|e| FormatError::rig(path, e))
+    let asset = CharacterAsset::with_inverse_binds(name, skeleton, skin, inverse_binds, warnings)
+        .map_err(|e| FormatError::rig(path, e))?;
+    Ok(CharacterAsset { morphs, ..asset })
+}
+
+/// The `.morph` files beside a skin whose names start with the skin's (`head1.morph` and
+/// `head2.morph` for `head.skin`), in name order, as moves from the skin's positions (the
+/// files give where the vertices go).
+fn morphs_beside(skin: &Path, positions: &[glam::Vec3]) -> Result<Vec<crate::rig::MorphTarget>, FormatError> {
+    let (Some(dir), Some(stem)) = (skin.parent(), skin.file_stem().and_then(|s| s.to_str())) else {
+        return Ok(Vec::new());
+    };
+    let mut files: Vec<PathBuf> = std::fs::read_dir(dir)
+        .map(|entries| entries.filter_map(|e| Some(e.ok()?.path())).collect())
+        .unwrap_or_default();
+    files.retain(|p| {
+        p.extension().is_some_and(|e| e == "morph")
+            && p.file_stem().and_then(|s| s.to_str()).is_some_and(|s| s.starts_with(stem))
+    });
+    files.sort();
+    files
+        .into_iter()
+        .map(|p| {
+            let morph = super::cse169_skin::parse_morph(open(&p)?, &p, positions.len())?;
+            let deltas = morph.positions.iter().map(|&(v, to)| (v as u32, to - positions[v])).collect();
+            let name = p.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
+            Ok(crate::rig::MorphTarget { name, deltas })
+        })
+        .collect()
 }
 
 fn load_6837_skin(

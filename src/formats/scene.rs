@@ -210,6 +210,9 @@ pub struct CharacterDoc {
     /// A keyframed clip (CSE169 `.anim`) playing on the character.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub anim: Option<AnimDoc>,
+    /// Morph target weights, in the order of the source's targets.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub morphs: Vec<f32>,
 }
 
 /// A keyframed clip on a character: its keys (set in the editor, kept in the scene file)

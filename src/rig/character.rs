@@ -55,6 +55,34 @@ pub struct CharacterAsset {
     pub bind_world_to_joint: Vec<Mat4>,
     /// Things the loader fixed and the user should know (normalised weight rows, ...).
     pub warnings: Vec<String>,
+    /// Shapes the bind mesh can blend towards before skinning (CSE169 `.morph`).
+    pub morphs: Vec<MorphTarget>,
+}
+
+/// A morph target: how far some vertices move (bind space) at full weight.
+#[derive(Debug, Clone, PartialEq)]
+pub struct MorphTarget {
+    pub name: String,
+    pub deltas: Vec<(u32, Vec3)>,
+}
+
+impl CharacterAsset {
+    /// The bind positions with the morph targets blended in by `weights` (one per target;
+    /// missing ones are 0).
+    pub fn morphed_positions(&self, weights: &[f32]) -> Vec<Vec3> {
+        let mut positions = self.skin.bind_positions.clone();
+        for (target, &w) in self.morphs.iter().zip(weights) {
+            if w == 0.0 {
+                continue;
+            }
+            for &(v, d) in &target.deltas {
+                if let Some(p) = positions.get_mut(v as usize) {
+                    *p += d * w;
+                }
+            }
+        }
+        positions
+    }
 }
 
 impl CharacterAsset {
@@ -67,7 +95,15 @@ impl CharacterAsset {
     ) -> Result<Self, RigError> {
         skin.validate()?;
         let bind_world_to_joint = bind_world_to_joint(&skeleton, None);
-        Ok(Self { name: name.into(), skeleton, skin, skin_kind: SkinKind::Mesh, bind_world_to_joint, warnings })
+        Ok(Self {
+            name: name.into(),
+            skeleton,
+            skin,
+            skin_kind: SkinKind::Mesh,
+            bind_world_to_joint,
+            warnings,
+            morphs: Vec::new(),
+        })
     }
 
     /// A skinned character bound by its own inverse bind matrices (one per joint), not
@@ -88,7 +124,15 @@ impl CharacterAsset {
     pub fn with_bone_boxes(name: impl Into<String>, skeleton: Skeleton, warnings: Vec<String>) -> Self {
         let skin = bone_box_skin(&skeleton);
         let bind_world_to_joint = bind_world_to_joint(&skeleton, None);
-        Self { name: name.into(), skeleton, skin, skin_kind: SkinKind::BoneBoxes, bind_world_to_joint, warnings }
+        Self {
+            name: name.into(),
+            skeleton,
+            skin,
+            skin_kind: SkinKind::BoneBoxes,
+            bind_world_to_joint,
+            warnings,
+            morphs: Vec::new(),
+        }
     }
 
     pub fn vertex_count(&self) -> usize {

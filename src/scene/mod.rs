@@ -16,6 +16,7 @@
 
 pub mod components;
 pub mod keyframes;
+pub mod morphs;
 pub mod smpl;
 pub mod spawn;
 pub mod systems;

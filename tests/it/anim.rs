@@ -353,6 +353,7 @@ fn a_scene_plays_a_clip_on_the_wasp_and_keeps_it_in_the_file() {
         binding: None,
         skinning: Default::default(),
         anim: Some(anim.clone()),
+        morphs: Vec::new(),
     };
     let mut app = crate::ecs::app();
     app.add_plugins(ScenePlugin);
@@ -435,6 +436,7 @@ fn keyed_poses_play_back_and_survive_anim_export_and_scene_files() {
             binding: None,
             skinning: Default::default(),
             anim: Some(anim.clone()),
+            morphs: Vec::new(),
         }],
         ..SceneDoc::default()
     };
@@ -442,4 +444,34 @@ fn keyed_poses_play_back_and_survive_anim_export_and_scene_files() {
     save_scene(&path, &doc).unwrap();
     let reread = parse_scene(std::io::BufReader::new(std::fs::File::open(&path).unwrap()), &path).unwrap();
     assert_eq!(reread.characters[0].anim, Some(anim), "keys survive a save and reload exactly");
+}
+
+/// The head's morphs: at full weight the moved vertices are where `head1.morph` puts them
+/// (read here on our own), at zero the skin is as loaded, and halfway is halfway.
+#[test]
+#[cfg_attr(not(marionette_data), ignore = "needs MARIONETTE_DATA (the course data)")]
+fn the_head_blends_its_morph_targets() {
+    let data = data_dir().join("cse169/extras");
+    let head = load_character(&data.join("head.skel")).unwrap();
+    let names: Vec<&str> = head.morphs.iter().map(|m| m.name.as_str()).collect();
+    assert_eq!(names, ["head1", "head2"]);
+    let text = std::fs::read_to_string(data.join("head1.morph")).unwrap();
+    let words: Vec<&str> = text.split(['{', '}', ' ', '\t', '\r', '\n']).filter(|w| !w.is_empty()).collect();
+    let count: usize = words[1].parse().unwrap();
+    let targets: Vec<(usize, Vec3)> = (0..count)
+        .map(|i| {
+            let w = &words[2 + 4 * i..6 + 4 * i];
+            (w[0].parse().unwrap(), Vec3::new(w[1].parse().unwrap(), w[2].parse().unwrap(), w[3].parse().unwrap()))
+        })
+        .collect();
+    let full = head.morphed_positions(&[1.0, 0.0]);
+    let half = head.morphed_positions(&[0.5, 0.0]);
+    let base = &head.skin.bind_positions;
+    for &(v, target) in &targets {
+        assert!((full[v] - target).length() < 1e-5, "vertex {v}");
+        assert!((half[v] - (base[v] + target) / 2.0).length() < 1e-5, "vertex {v} halfway");
+    }
+    assert_eq!(&head.morphed_positions(&[0.0, 0.0]), base);
+    let moved: std::collections::HashSet<usize> = targets.iter().map(|t| t.0).collect();
+    assert!((0..base.len()).filter(|v| !moved.contains(v)).all(|v| full[v] == base[v]), "the others stay");
 }

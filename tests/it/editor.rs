@@ -27,6 +27,7 @@ pub fn doc_with(source: SourceDoc, pose: &[(&str, JointRotation)]) -> SceneDoc {
             binding: None,
             skinning: Default::default(),
             anim: None,
+            morphs: Vec::new(),
         }],
         camera: None,
         stage: Default::default(),

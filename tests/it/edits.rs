@@ -253,6 +253,7 @@ fn smpl_shape_and_clip_edits_undo_and_redo() {
         binding: None,
         skinning: Default::default(),
         anim: None,
+        morphs: Vec::new(),
     };
     *app.world_mut().resource_mut::<PendingScene>() =
         PendingScene { doc: Some(SceneDoc { characters: vec![body], ..SceneDoc::default() }), frame: false };

@@ -167,6 +167,7 @@ fn saving_a_scene_whose_source_path_is_not_utf8_is_an_error_not_a_panic() {
         binding: None,
         skinning: Default::default(),
         anim: None,
+        morphs: Vec::new(),
     });
     let out = dir.join("scene.ron");
     let e = save_scene(&out, &doc).unwrap_err();

@@ -135,6 +135,7 @@ fn add_character(path: &str, state: &mut InspectorState, panels: &mut Panels) {
         binding: None,
         skinning: Default::default(),
         anim,
+        morphs: Vec::new(),
     })));
     *panels.selection = Selection { character: Some(id), joints: Vec::new() };
     state.recent.retain(|r| r != path);
@@ -190,7 +191,8 @@ fn character_row(ui: &mut egui::Ui, panels: &mut Panels, entity: Entity, id: Cha
 /// Name, source, duplicate/remove, placement, display and colours, weights, SMPL state of
 /// the selected character.
 fn selected_character(ui: &mut egui::Ui, panels: &mut Panels, entity: Entity, id: CharacterId) {
-    let Ok((_, sc, character, placement, view, smpl, skinning, player)) = panels.scene.characters.get(entity) else {
+    let Ok((_, sc, character, placement, view, smpl, skinning, player, morphs)) = panels.scene.characters.get(entity)
+    else {
         return;
     };
     let skinning = skinning.0;
@@ -265,6 +267,11 @@ fn selected_character(ui: &mut egui::Ui, panels: &mut Panels, entity: Entity, id
     {
         edits.push(Edit::Clip { character: id, anim });
     }
+    if let Some(morphs) = morphs
+        && let Some(weights) = morph_sliders(ui, morphs)
+    {
+        edits.push(Edit::Morph { character: id, weights });
+    }
     if duplicate && let Some(mut copy) = panels.scene.character_doc(entity) {
         let copy_id = panels.ids.take();
         copy.id = Some(copy_id);
@@ -301,6 +308,17 @@ fn match_heights(panels: &Panels, entity: Entity, height: f32) -> Vec<Edit> {
             Some(Edit::Place { character: sc.id, placement })
         })
         .collect()
+}
+
+/// A slider per morph target; the new weights when one moved.
+fn morph_sliders(ui: &mut egui::Ui, morphs: &crate::scene::morphs::Morphs) -> Option<Vec<f32>> {
+    let mut weights = morphs.weights.clone();
+    egui::CollapsingHeader::new("Morphs").default_open(true).show(ui, |ui| {
+        for (target, w) in morphs.base.morphs.iter().zip(weights.iter_mut()) {
+            ui.add(egui::Slider::new(w, 0.0..=1.0).text(&target.name).clamping(egui::SliderClamping::Edits));
+        }
+    });
+    (weights != morphs.weights).then_some(weights)
 }
 
 /// Position, turn (degrees) and scale.
