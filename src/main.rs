@@ -174,16 +174,17 @@ struct ClipArgs {
     /// skeleton it fits.
     #[arg(long, value_name = "FILE.anim|FILE.bvh")]
     anim: Option<PathBuf>,
-    /// The clip's time in seconds (extrapolated outside its keys as the clip says).
-    #[arg(long, default_value_t = 0.0, value_parser = finite_seconds, requires = "anim")]
-    time: f32,
+    /// The time in seconds at which clips are sampled: `--anim`'s, and a scene's own
+    /// keyframes and SMPL clips (extrapolated outside their keys as each clip says).
+    #[arg(long, value_parser = finite_seconds)]
+    time: Option<f32>,
 }
 
 impl ClipArgs {
     fn anim_doc(&self, playing: bool) -> Option<marionette::formats::scene::AnimDoc> {
         let file = self.anim.clone()?;
         Some(marionette::formats::scene::AnimDoc {
-            time: self.time,
+            time: self.time.unwrap_or(0.0),
             playing,
             ..marionette::formats::scene::AnimDoc::of(file)
         })
@@ -212,7 +213,8 @@ fn run(cli: Cli) -> Result<()> {
     match cli.command {
         None => marionette::editor::run(Vec::new(), Default::default()),
         Some(Command::Edit { paths, clip }) => {
-            let edits = marionette::editor::StartupEdits { anim: clip.anim_doc(true), ..Default::default() };
+            let edits =
+                marionette::editor::StartupEdits { anim: clip.anim_doc(true), time: clip.time, ..Default::default() };
             marionette::editor::run(paths, edits)
         }
         Some(Command::Info { path }) => print!("{}", describe(&load_character(&path)?)),
@@ -225,7 +227,7 @@ fn run(cli: Cli) -> Result<()> {
             let mut origin = Mat4::IDENTITY;
             if let Some(file) = &clip.anim {
                 let anim = marionette::formats::load_clip(file)?.retargeted(&asset.skeleton, &Default::default());
-                let (root, clip_pose) = anim.pose_at(&asset.skeleton, clip.time, &pose);
+                let (root, clip_pose) = anim.pose_at(&asset.skeleton, clip.time.unwrap_or(0.0), &pose);
                 pose = clip_pose;
                 let root_offset = asset.skeleton.joint(0).rest_offset;
                 origin = marionette::scene::keyframes::RootTranslation(Some(root)).origin(root_offset);
@@ -246,6 +248,7 @@ fn run(cli: Cli) -> Result<()> {
                 skinning: skinning.map(Into::into),
                 match_height,
                 anim: clip.anim_doc(false),
+                time: clip.time,
             };
             let notes = marionette::editor::render::render(paths, edits, out.clone(), width, height)
                 .map_err(anyhow::Error::msg)?;

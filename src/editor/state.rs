@@ -24,6 +24,8 @@ pub struct StartupEdits {
     pub match_height: bool,
     /// `--anim` and `--time`: a keyframed clip on every character it fits.
     pub anim: Option<crate::formats::scene::AnimDoc>,
+    /// `--time`: every clip of the scene (keyframes, SMPL) sampled there, paused.
+    pub time: Option<f32>,
 }
 
 /// Messages for the user (load errors, warnings, where files went), newest last.

@@ -118,6 +118,9 @@ fn apply_startup_edits(
     if let Some(anim) = &edits.anim {
         put_clip_on_fitting_characters(doc, anim, library, messages);
     }
+    if let Some(t) = edits.time {
+        pause_clips_at(doc, t);
+    }
     if edits.poses.is_empty() && edits.ik.is_empty() {
         return;
     }
@@ -136,6 +139,20 @@ fn apply_startup_edits(
         let initial = skeleton.initial_pose();
         c.pose =
             (0..skeleton.len()).filter(|&j| pose[j] != initial[j]).map(|j| (pose_key(skeleton, j), pose[j])).collect();
+    }
+}
+
+/// Every clip of the document (keyframes, SMPL) paused at `t` seconds.
+fn pause_clips_at(doc: &mut crate::formats::scene::SceneDoc, t: f32) {
+    for c in &mut doc.characters {
+        if let Some(anim) = &mut c.anim {
+            anim.time = t;
+            anim.playing = false;
+        }
+        if let Some(smpl) = c.smpl.as_mut().filter(|s| s.clip.is_some()) {
+            smpl.time = t * crate::scene::smpl::CLIP_FPS;
+            smpl.playing = false;
+        }
     }
 }
 

@@ -11,7 +11,8 @@
 //! vertex 18 at (0.077, 0.222, −0.595), `head.skin` has it at (0.0772, 0.2225, −0.5949)).
 //!
 //! `.anim`: `animation { range t0 t1  numchannels N  channel [k] { extrapolate IN OUT
-//! keys K { time value tanIn tanOut … } } … }`.
+//! keys K { time value tanIn tanOut … } } … }`. Besides CSE169's tangents (`flat`,
+//! `linear`, `smooth`, a number) ours read and write `step`: hold until the next key.
 
 use std::io::BufRead;
 use std::path::{Path, PathBuf};
@@ -257,6 +258,7 @@ fn extrapolation(tokens: &mut Tokens) -> Result<Extrapolation, FormatError> {
 fn tangent(tokens: &mut Tokens) -> Result<Tangent, FormatError> {
     let rule = match tokens.peek().map(|t| t.text.as_str()) {
         Some("flat") => Tangent::Flat,
+        Some("step") => Tangent::Step,
         Some("linear") => Tangent::Linear,
         Some("smooth") => Tangent::Smooth,
         _ => return Ok(Tangent::Fixed(tokens.number("a tangent (flat, linear, smooth or a number)")?)),
@@ -276,6 +278,7 @@ pub fn write_anim(w: &mut impl std::io::Write, clip: &Clip) -> std::io::Result<(
     };
     let tangent = |t: Tangent| match t {
         Tangent::Flat => "flat".to_string(),
+        Tangent::Step => "step".to_string(),
         Tangent::Linear => "linear".to_string(),
         Tangent::Smooth => "smooth".to_string(),
         Tangent::Fixed(s) => format!("{s:?}"),

@@ -22,6 +22,9 @@ pub enum Tangent {
     Smooth,
     /// This slope.
     Fixed(f32),
+    /// As an out-tangent: hold the key's value until the next key (constant
+    /// interpolation); as an in-tangent, flat.
+    Step,
 }
 
 /// What a channel does before its first key or after its last.
@@ -157,6 +160,9 @@ impl Channel {
         if span <= 0.0 {
             return b.value;
         }
+        if a.tangent_out == Tangent::Step {
+            return a.value;
+        }
         let u = ((t - a.time) / span).clamp(0.0, 1.0);
         hermite(a.value, self.slopes[k].1 * span, b.value, self.slopes[k + 1].0 * span, u)
     }
@@ -199,7 +205,7 @@ fn slope(keys: &[Key], k: usize, rule: Tangent, incoming: bool) -> f32 {
     };
     let (prev, next) = (k.checked_sub(1), Some(k + 1).filter(|&n| n < keys.len()));
     match (rule, prev, next) {
-        (Tangent::Flat, ..) | (_, None, None) => 0.0,
+        (Tangent::Flat | Tangent::Step, ..) | (_, None, None) => 0.0,
         (Tangent::Fixed(s), ..) => s,
         (Tangent::Smooth, Some(p), Some(n)) => secant(p, n),
         (Tangent::Linear, Some(p), Some(n)) => {

@@ -475,3 +475,24 @@ fn the_head_blends_its_morph_targets() {
     let moved: std::collections::HashSet<usize> = targets.iter().map(|t| t.0).collect();
     assert!((0..base.len()).filter(|v| !moved.contains(v)).all(|v| full[v] == base[v]), "the others stay");
 }
+
+/// Constant (step) and linear interpolation between keys.
+#[test]
+fn step_holds_and_linear_tangents_draw_straight_lines() {
+    let text = "animation { range 0 2 numchannels 1 channel { extrapolate constant constant keys 3 {
+        0 0 linear step
+        1 2 linear linear
+        2 0 linear linear } } }";
+    let clip = parse_anim(Cursor::new(text), Path::new("t.anim")).unwrap();
+    let c = &clip.channels[0];
+    for t in [0.0, 0.3, 0.99] {
+        close(c.value_at(t), 0.0, "held until the next key");
+    }
+    close(c.value_at(1.0), 2.0, "the next key");
+    for t in [1.25f32, 1.5, 1.75] {
+        close(c.value_at(t), 2.0 - 2.0 * (t - 1.0), "a straight line between linear keys");
+    }
+    let mut written = Vec::new();
+    marionette::formats::cse169_skin::write_anim(&mut written, &clip).unwrap();
+    assert_eq!(parse_anim(Cursor::new(written), Path::new("t.anim")).unwrap(), clip, "step is written and read back");
+}

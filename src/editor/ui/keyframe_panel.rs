@@ -289,12 +289,13 @@ fn picked_key_rows(ui: &mut egui::Ui, state: &InspectorState, clip: &Clip) -> Op
 fn tangent_choice(ui: &mut egui::Ui, label: &str, tangent: &mut Tangent) {
     let name = |t: &Tangent| match t {
         Tangent::Flat => "flat".to_string(),
+        Tangent::Step => "step (hold)".to_string(),
         Tangent::Linear => "linear".to_string(),
         Tangent::Smooth => "smooth".to_string(),
         Tangent::Fixed(s) => format!("{s:.3}"),
     };
     egui::ComboBox::from_label(format!("tangent {label}")).selected_text(name(tangent)).show_ui(ui, |ui| {
-        for t in [Tangent::Flat, Tangent::Linear, Tangent::Smooth] {
+        for t in [Tangent::Flat, Tangent::Linear, Tangent::Smooth, Tangent::Step] {
             ui.selectable_value(tangent, t, name(&t));
         }
     });
