@@ -23,16 +23,46 @@ impl MaterialExtension for FlatNormals {
 /// The skin material type.
 pub type SkinMaterialAsset = ExtendedMaterial<StandardMaterial, FlatNormals>;
 
-/// One material for every skin.
+/// One material for every skin without a texture.
 #[derive(Resource)]
 pub struct SkinMaterial(pub Handle<SkinMaterialAsset>);
+
+/// The materials of textured skins, by texture file (loaded once).
+#[derive(Resource, Default)]
+pub struct TexturedSkinMaterials(pub std::collections::HashMap<std::path::PathBuf, Handle<SkinMaterialAsset>>);
+
+/// The skin material with `image` as its base colour texture.
+pub fn textured_material(
+    image: &crate::formats::bmp::Rgba,
+    images: &mut Assets<Image>,
+    materials: &mut Assets<SkinMaterialAsset>,
+) -> Handle<SkinMaterialAsset> {
+    let size =
+        bevy::render::render_resource::Extent3d { width: image.width, height: image.height, depth_or_array_layers: 1 };
+    let texture = Image::new(
+        size,
+        bevy::render::render_resource::TextureDimension::D2,
+        image.pixels.clone(),
+        bevy::render::render_resource::TextureFormat::Rgba8UnormSrgb,
+        bevy::asset::RenderAssetUsages::RENDER_WORLD,
+    );
+    let base = StandardMaterial {
+        base_color: Color::WHITE,
+        base_color_texture: Some(images.add(texture)),
+        perceptual_roughness: 0.75,
+        ..default()
+    };
+    materials.add(ExtendedMaterial { base, extension: FlatNormals {} })
+}
 
 pub struct SkinMaterialPlugin;
 
 impl Plugin for SkinMaterialPlugin {
     fn build(&self, app: &mut App) {
         embedded_asset!(app, "flat_normals.wgsl");
-        app.add_plugins(MaterialPlugin::<SkinMaterialAsset>::default()).add_systems(Startup, setup_skin_material);
+        app.init_resource::<TexturedSkinMaterials>()
+            .add_plugins(MaterialPlugin::<SkinMaterialAsset>::default())
+            .add_systems(Startup, setup_skin_material);
     }
 }
 

@@ -302,13 +302,40 @@ pub fn sync_character_views(
 }
 
 /// Gives new skin meshes the shared material (writes `MeshMaterial3d`).
+#[allow(clippy::too_many_arguments)]
 fn attach_skin_material(
     mut commands: Commands,
     material: Res<SkinMaterial>,
-    new_skins: Query<Entity, Added<SkinMesh>>,
+    mut textured: ResMut<super::skin_material::TexturedSkinMaterials>,
+    mut images: ResMut<Assets<Image>>,
+    mut materials: ResMut<Assets<super::skin_material::SkinMaterialAsset>>,
+    mut messages: ResMut<Messages>,
+    characters: Query<&Character>,
+    new_skins: Query<(Entity, &SkinMesh), Added<SkinMesh>>,
 ) {
-    for entity in &new_skins {
-        commands.entity(entity).insert(MeshMaterial3d(material.0.clone()));
+    for (entity, skin) in &new_skins {
+        let texture = characters.get(skin.character).ok().and_then(|c| c.asset.texture.clone());
+        let handle = match texture {
+            Some(path) => match textured.0.get(&path) {
+                Some(handle) => handle.clone(),
+                None => match std::fs::read(&path)
+                    .map_err(|e| crate::formats::FormatError::io(&path, e))
+                    .and_then(|bytes| crate::formats::bmp::decode_bmp(&bytes, &path))
+                {
+                    Ok(image) => {
+                        let handle = super::skin_material::textured_material(&image, &mut images, &mut materials);
+                        textured.0.insert(path, handle.clone());
+                        handle
+                    }
+                    Err(e) => {
+                        messages.push(format!("{e} (the skin is drawn without it)"));
+                        material.0.clone()
+                    }
+                },
+            },
+            None => material.0.clone(),
+        };
+        commands.entity(entity).insert(MeshMaterial3d(handle));
     }
 }
 

@@ -153,13 +153,30 @@ fn load_cse169_skin(name: String, skeleton: Skeleton, path: &Path) -> Result<Cha
     }
     let (weights, normalised) =
         crate::rig::SkinWeights::from_rows(file.weights, skeleton.len()).map_err(|e| FormatError::rig(path, e))?;
-    let warnings = normalised_warnings(path, &normalised);
+    let mut warnings = normalised_warnings(path, &normalised);
     let inverse_binds = file.bindings.iter().map(|m| m.inverse()).collect();
     let morphs = morphs_beside(path, &file.positions)?;
-    let skin = Skin { bind_positions: file.positions, triangles: file.triangles, weights };
+    let textured = file.texcoords.len() == file.positions.len();
+    let texture = file.texture.filter(|t| {
+        let found = t.is_file() && textured;
+        if !found {
+            warnings.push(format!(
+                "{}: its texture {} is not shown (no such file, or no texcoords)",
+                path.display(),
+                t.display()
+            ));
+        }
+        found
+    });
+    // CSE169 counts v from the image's bottom row, as OpenGL does; ours from its top.
+    let texcoords = match texture {
+        Some(_) => file.texcoords.iter().map(|t| glam::Vec2::new(t.x, 1.0 - t.y)).collect(),
+        None => Vec::new(),
+    };
+    let skin = Skin { bind_positions: file.positions, triangles: file.triangles, weights, texcoords };
     let asset = CharacterAsset::with_inverse_binds(name, skeleton, skin, inverse_binds, warnings)
         .map_err(|e| FormatError::rig(path, e))?;
-    Ok(CharacterAsset { morphs, ..asset })
+    Ok(CharacterAsset { morphs, texture, ..asset })
 }
 
 /// The `.morph` files beside a skin whose names start with the skin's (`head1.morph` and
@@ -198,7 +215,7 @@ fn load_6837_skin(
     let (weights, normalised) =
         mit6837::parse_attach(open(attach_path)?, attach_path, skeleton.len(), mesh.positions.len())?;
     let warnings = normalised_warnings(attach_path, &normalised);
-    let skin = Skin { bind_positions: mesh.positions, triangles: mesh.triangles, weights };
+    let skin = Skin { bind_positions: mesh.positions, triangles: mesh.triangles, weights, texcoords: Vec::new() };
     CharacterAsset::new(name, skeleton, skin, warnings).map_err(|e| FormatError::rig(obj_path, e))
 }
 

@@ -2,6 +2,7 @@
 //! fails with `path:line: what was expected, what was found`; `load_*` wrap them for files.
 //! No Bevy here.
 
+pub mod bmp;
 pub mod bvh;
 pub mod character;
 pub mod cse169;

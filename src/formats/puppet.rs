@@ -173,7 +173,12 @@ pub fn embedded_puppet() -> crate::rig::CharacterAsset {
             skeleton.len(),
             mesh.positions.len(),
         )?;
-        let skin = crate::rig::Skin { bind_positions: mesh.positions, triangles: mesh.triangles, weights };
+        let skin = crate::rig::Skin {
+            bind_positions: mesh.positions,
+            triangles: mesh.triangles,
+            weights,
+            texcoords: Vec::new(),
+        };
         crate::rig::CharacterAsset::new("puppet", skeleton, skin, Vec::new())
             .map_err(|e| crate::formats::FormatError::rig(Path::new("assets/puppet.obj"), e))
     };

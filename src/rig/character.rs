@@ -17,6 +17,8 @@ pub struct Skin {
     pub triangles: Vec<[u32; 3]>,
     /// One row of influences per vertex.
     pub weights: SkinWeights,
+    /// Texture coordinates, one per vertex (empty: none).
+    pub texcoords: Vec<glam::Vec2>,
 }
 
 impl Skin {
@@ -57,6 +59,8 @@ pub struct CharacterAsset {
     pub warnings: Vec<String>,
     /// Shapes the bind mesh can blend towards before skinning (CSE169 `.morph`).
     pub morphs: Vec<MorphTarget>,
+    /// The image the skin's texture coordinates index (CSE169 `material { texture }`).
+    pub texture: Option<std::path::PathBuf>,
 }
 
 /// A morph target: how far some vertices move (bind space) at full weight.
@@ -103,6 +107,7 @@ impl CharacterAsset {
             bind_world_to_joint,
             warnings,
             morphs: Vec::new(),
+            texture: None,
         })
     }
 
@@ -132,6 +137,7 @@ impl CharacterAsset {
             bind_world_to_joint,
             warnings,
             morphs: Vec::new(),
+            texture: None,
         }
     }
 

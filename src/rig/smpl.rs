@@ -66,7 +66,12 @@ impl SmplModel {
         skeleton.set_rest_offsets(&self.rest_offsets(&self.shaped_joints(betas)));
         let mut positions = Vec::new();
         self.shaped_positions(betas, &mut positions);
-        let skin = Skin { bind_positions: positions, triangles: self.triangles.clone(), weights: self.weights.clone() };
+        let skin = Skin {
+            bind_positions: positions,
+            triangles: self.triangles.clone(),
+            weights: self.weights.clone(),
+            texcoords: Vec::new(),
+        };
         CharacterAsset::new(name, skeleton, skin, Vec::new())
     }
 }

@@ -55,7 +55,7 @@ pub fn spawn_character_posed(
             .id();
         joints.push(joint);
     }
-    let mesh = meshes.add(empty_skin_mesh(&asset.skin.triangles, asset.vertex_count()));
+    let mesh = meshes.add(empty_skin_mesh(&asset.skin.triangles, asset.vertex_count(), &asset.skin.texcoords));
     let skin_entity = commands
         // The skinning system keeps the bounds right as the mesh deforms (model space).
         .spawn((
@@ -80,13 +80,17 @@ pub fn spawn_character_posed(
 /// A render mesh of the skin's own vertices and triangles: positions and colours, no
 /// normals (the skin material lights each triangle with its own normal, from the
 /// derivatives of the position). Its vertex data is what `upload::pack_vertices` packs.
-pub fn empty_skin_mesh(triangles: &[[u32; 3]], vertex_count: usize) -> Mesh {
+pub fn empty_skin_mesh(triangles: &[[u32; 3]], vertex_count: usize, texcoords: &[Vec2]) -> Mesh {
     // Only the render world keeps it: the skinning system writes vertices straight into its
     // GPU slot (see `upload`), never into this asset.
-    Mesh::new(PrimitiveTopology::TriangleList, RenderAssetUsages::RENDER_WORLD)
+    let mut mesh = Mesh::new(PrimitiveTopology::TriangleList, RenderAssetUsages::RENDER_WORLD)
         .with_inserted_attribute(Mesh::ATTRIBUTE_POSITION, vec![[0.0f32; 3]; vertex_count])
         .with_inserted_attribute(Mesh::ATTRIBUTE_COLOR, vec![[1.0f32; 4]; vertex_count])
-        .with_inserted_indices(Indices::U32(triangles.iter().flatten().copied().collect()))
+        .with_inserted_indices(Indices::U32(triangles.iter().flatten().copied().collect()));
+    if !texcoords.is_empty() {
+        mesh.insert_attribute(Mesh::ATTRIBUTE_UV_0, texcoords.iter().map(|t| t.to_array()).collect::<Vec<_>>());
+    }
+    mesh
 }
 
 /// Despawns a character, its joints leaves first and its skin mesh entity. Bevy's

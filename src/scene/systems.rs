@@ -4,7 +4,7 @@ use bevy::camera::primitives::Aabb;
 use bevy::prelude::*;
 
 use super::components::*;
-use super::upload::{SkinUpload, pack_vertices};
+use super::upload::SkinUpload;
 use crate::rig::JointRotation;
 use crate::rig::fk::forward_kinematics;
 use crate::rig::skinning::{bounds, heat_colors, joint_colors, weight_colors};
@@ -140,7 +140,7 @@ pub fn skin_changed_characters(
         if dirty.colors || scratch.colors.len() != skin.bind_positions.len() {
             vertex_colors(character, view, heat.0, &mut scratch.colors);
         }
-        pack_vertices(&scratch.positions, &scratch.colors, upload.buffer());
+        upload.pack(&scratch.positions, &skin.texcoords, &scratch.colors);
     });
 }
 

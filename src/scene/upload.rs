@@ -1,6 +1,6 @@
 //! Handing skinned vertices to the GPU without Bevy's whole-mesh path: the skinning system
-//! packs each re-skinned character's vertices (position, colour: the skin mesh's own
-//! layout) into its [`SkinUpload`]; the render world takes the changed ones (an `Arc`, no
+//! packs each re-skinned character's vertices (position, texture coordinates where the
+//! skin has them, colour: the skin mesh's own layout) into its [`SkinUpload`]; the render world takes the changed ones (an `Arc`, no
 //! copy) and writes them straight into the mesh's slot of the vertex buffer. The skin mesh
 //! asset itself is never modified after it is made, so Bevy neither clones it into the
 //! render world nor re-packs it each frame, and indices stay as they were uploaded.
@@ -15,28 +15,32 @@ use bevy::render::{Extract, ExtractSchedule, Render, RenderApp, RenderSystems};
 
 use super::components::Character;
 
-/// One skin vertex as the mesh's vertex buffer holds it: position (3 × f32) then colour
-/// (4 × f32), the order in which Bevy packs the mesh's attributes.
-pub type PackedVertex = [f32; 7];
+/// Bytes per skin vertex without texture coordinates: position (3 × f32) then colour
+/// (4 × f32), the order in which Bevy packs the mesh's attributes. Texture coordinates
+/// (2 × f32) go between them where a skin has them.
+pub const SKIN_VERTEX_BYTES: usize = 7 * 4;
 
-/// Bytes per skin vertex.
-pub const SKIN_VERTEX_BYTES: usize = std::mem::size_of::<PackedVertex>();
-
-/// A character's packed vertices, replaced whenever it is re-skinned or recoloured (its
-/// change tick is what the render world looks for).
+/// A character's packed vertices (`floats` per vertex), replaced whenever it is re-skinned
+/// or recoloured (its change tick is what the render world looks for).
 #[derive(Component, Default, Debug)]
 pub struct SkinUpload {
-    pub vertices: Arc<Vec<PackedVertex>>,
+    pub vertices: Arc<Vec<f32>>,
+    pub floats: usize,
 }
 
 impl SkinUpload {
     /// The buffer to pack into: the previous one when nothing else holds it any more (no
     /// allocation per frame), a new one otherwise.
-    pub fn buffer(&mut self) -> &mut Vec<PackedVertex> {
+    pub fn buffer(&mut self) -> &mut Vec<f32> {
         if Arc::get_mut(&mut self.vertices).is_none() {
             self.vertices = Arc::new(Vec::with_capacity(self.vertices.len()));
         }
         Arc::get_mut(&mut self.vertices).expect("the buffer is not shared")
+    }
+
+    /// Packs a skin's vertices into this upload (see [`pack_vertices`]).
+    pub fn pack(&mut self, positions: &[Vec3], texcoords: &[Vec2], colors: &[[f32; 4]]) {
+        self.floats = pack_vertices(positions, texcoords, colors, self.buffer());
     }
 
     /// The vertices as the bytes the GPU takes.
@@ -45,14 +49,27 @@ impl SkinUpload {
     }
 }
 
-/// Packs positions and colours as the skin mesh's vertex buffer holds them.
+/// Packs positions, texture coordinates (none, or one per vertex) and colours as the skin
+/// mesh's vertex buffer holds them; returns the floats per vertex.
 ///
 /// # Panics
 /// When the lengths differ.
-pub fn pack_vertices(positions: &[Vec3], colors: &[[f32; 4]], out: &mut Vec<PackedVertex>) {
+pub fn pack_vertices(positions: &[Vec3], texcoords: &[Vec2], colors: &[[f32; 4]], out: &mut Vec<f32>) -> usize {
     assert_eq!(positions.len(), colors.len(), "one colour per vertex");
     out.clear();
-    out.extend(positions.iter().zip(colors).map(|(p, c)| [p.x, p.y, p.z, c[0], c[1], c[2], c[3]]));
+    if texcoords.is_empty() {
+        out.extend(positions.iter().zip(colors).flat_map(|(p, c)| [p.x, p.y, p.z, c[0], c[1], c[2], c[3]]));
+        return 7;
+    }
+    assert_eq!(positions.len(), texcoords.len(), "texture coordinates for every vertex");
+    out.extend(
+        positions
+            .iter()
+            .zip(texcoords)
+            .zip(colors)
+            .flat_map(|((p, t), c)| [p.x, p.y, p.z, t.x, t.y, c[0], c[1], c[2], c[3]]),
+    );
+    9
 }
 
 /// Bytes of vertex data handed to the GPU in the last frame (the packed uploads that
@@ -67,7 +84,7 @@ fn count_handed_on(changed: Query<&SkinUpload, Changed<SkinUpload>>, mut handed:
 /// Uploads waiting in the render world: by mesh, the newest bytes (kept until the mesh has
 /// its slot on the GPU), with the frames waited.
 #[derive(Resource, Default)]
-struct PendingUploads(HashMap<AssetId<Mesh>, (Arc<Vec<PackedVertex>>, u32)>);
+struct PendingUploads(HashMap<AssetId<Mesh>, (Arc<Vec<f32>>, usize, u32)>);
 
 /// Frames an upload waits for its mesh's slot before it is dropped (the mesh is gone).
 const MAX_WAIT_FRAMES: u32 = 600;
@@ -95,7 +112,7 @@ fn extract_skin_uploads(
 ) {
     for (character, upload) in &skins {
         if !upload.vertices.is_empty() {
-            pending.0.insert(character.mesh.id(), (upload.vertices.clone(), 0));
+            pending.0.insert(character.mesh.id(), (upload.vertices.clone(), upload.floats, 0));
         }
     }
 }
@@ -108,13 +125,13 @@ fn write_skin_uploads(
     queue: Res<RenderQueue>,
 ) {
     let Some(allocator) = allocator else { return };
-    pending.0.retain(|id, (vertices, waited)| {
+    pending.0.retain(|id, (vertices, floats, waited)| {
         let Some(slice) = allocator.mesh_vertex_slice(id) else {
             *waited += 1;
             return *waited < MAX_WAIT_FRAMES;
         };
-        if (slice.range.end - slice.range.start) as usize == vertices.len() {
-            let offset = (slice.range.start as usize * SKIN_VERTEX_BYTES) as u64;
+        if (slice.range.end - slice.range.start) as usize * *floats == vertices.len() {
+            let offset = (slice.range.start as usize * *floats * 4) as u64;
             queue.write_buffer(slice.buffer, offset, bytemuck::cast_slice(vertices));
         }
         false

@@ -496,3 +496,44 @@ fn step_holds_and_linear_tangents_draw_straight_lines() {
     marionette::formats::cse169_skin::write_anim(&mut written, &clip).unwrap();
     assert_eq!(parse_anim(Cursor::new(written), Path::new("t.anim")).unwrap(), clip, "step is written and read back");
 }
+
+/// A 2 × 2 bitmap written here: rows bottom-up, BGR, each row padded to 4 bytes; decoded
+/// top row first as RGBA. Other kinds are refused with what they are.
+#[test]
+fn bitmaps_decode_top_row_first_and_others_are_refused() {
+    use marionette::formats::bmp::decode_bmp;
+    let mut bmp = Vec::new();
+    bmp.extend_from_slice(b"BM");
+    bmp.extend_from_slice(&(54u32 + 16).to_le_bytes());
+    bmp.extend_from_slice(&[0; 4]);
+    bmp.extend_from_slice(&54u32.to_le_bytes());
+    bmp.extend_from_slice(&40u32.to_le_bytes());
+    bmp.extend_from_slice(&2i32.to_le_bytes());
+    bmp.extend_from_slice(&2i32.to_le_bytes());
+    bmp.extend_from_slice(&1u16.to_le_bytes());
+    bmp.extend_from_slice(&24u16.to_le_bytes());
+    bmp.extend_from_slice(&[0; 24]);
+    // Bottom row: blue, green; top row: red, white (BGR, 2 bytes of padding each).
+    bmp.extend_from_slice(&[255, 0, 0, 0, 255, 0, 0, 0]);
+    bmp.extend_from_slice(&[0, 0, 255, 255, 255, 255, 0, 0]);
+    let image = decode_bmp(&bmp, Path::new("t.bmp")).unwrap();
+    assert_eq!((image.width, image.height), (2, 2));
+    assert_eq!(image.pixels, [255, 0, 0, 255, 255, 255, 255, 255, 0, 0, 255, 255, 0, 255, 0, 255]);
+    let mut rle = bmp.clone();
+    rle[30] = 1;
+    let e = decode_bmp(&rle, Path::new("t.bmp")).unwrap_err().to_string();
+    assert!(e.contains("t.bmp") && e.contains("compression 1"), "{e}");
+    assert!(decode_bmp(&bmp[..60], Path::new("t.bmp")).is_err(), "cut short");
+}
+
+#[test]
+#[cfg_attr(not(marionette_data), ignore = "needs MARIONETTE_DATA (the course data)")]
+fn the_head_is_textured_with_its_bitmap() {
+    let data = data_dir().join("cse169/extras");
+    let head = load_character(&data.join("head.skel")).unwrap();
+    assert!(head.texture.as_ref().is_some_and(|t| t.ends_with("head.bmp")));
+    assert_eq!(head.skin.texcoords.len(), head.vertex_count());
+    let bytes = std::fs::read(data.join("head.bmp")).unwrap();
+    let image = marionette::formats::bmp::decode_bmp(&bytes, Path::new("head.bmp")).unwrap();
+    assert_eq!((image.width, image.height), (512, 512));
+}

@@ -34,7 +34,12 @@ pub fn spawn(app: &mut App, asset: Arc<CharacterAsset>, placement: Placement) ->
 /// The positions and colours a character hands to the GPU (decoded from its packed upload).
 fn uploaded_vertices(app: &App, character: Entity) -> (Vec<[f32; 3]>, Vec<[f32; 4]>) {
     let upload = app.world().get::<marionette::scene::upload::SkinUpload>(character).unwrap();
-    upload.vertices.iter().map(|v| ([v[0], v[1], v[2]], [v[3], v[4], v[5], v[6]])).unzip()
+    let color = upload.floats - 4;
+    upload
+        .vertices
+        .chunks(upload.floats)
+        .map(|v| ([v[0], v[1], v[2]], [v[color], v[color + 1], v[color + 2], v[color + 3]]))
+        .unzip()
 }
 
 fn mesh_positions(app: &App, character: Entity) -> Vec<[f32; 3]> {
@@ -195,13 +200,20 @@ fn packed_vertices_match_bevys_vertex_buffer() {
     let triangles = [[0u32, 1, 2], [2, 1, 3]];
     let positions = [Vec3::new(0.0, 1.0, 2.0), Vec3::X, Vec3::new(-1.5, 0.25, 8.0), Vec3::splat(3.0)];
     let colors = [[0.1, 0.2, 0.3, 1.0], [1.0, 0.0, 0.5, 1.0], [0.0; 4], [0.7, 0.7, 0.7, 1.0]];
-    let mut mesh = marionette::scene::spawn::empty_skin_mesh(&triangles, positions.len());
+    let mut mesh = marionette::scene::spawn::empty_skin_mesh(&triangles, positions.len(), &[]);
     mesh.insert_attribute(Mesh::ATTRIBUTE_POSITION, positions.map(|p| p.to_array()).to_vec());
     mesh.insert_attribute(Mesh::ATTRIBUTE_COLOR, colors.to_vec());
     let mut upload = marionette::scene::upload::SkinUpload::default();
-    pack_vertices(&positions, &colors, upload.buffer());
+    assert_eq!(pack_vertices(&positions, &[], &colors, upload.buffer()), 7);
     assert_eq!(upload.bytes(), mesh.create_packed_vertex_buffer_data());
     assert_eq!(upload.bytes().len(), positions.len() * marionette::scene::upload::SKIN_VERTEX_BYTES);
+    // A textured skin: its texture coordinates go where Bevy puts them.
+    let uv = [Vec2::new(0.0, 0.5), Vec2::new(1.0, 0.25), Vec2::ZERO, Vec2::ONE];
+    let mut textured = marionette::scene::spawn::empty_skin_mesh(&triangles, positions.len(), &uv);
+    textured.insert_attribute(Mesh::ATTRIBUTE_POSITION, positions.map(|p| p.to_array()).to_vec());
+    textured.insert_attribute(Mesh::ATTRIBUTE_COLOR, colors.to_vec());
+    assert_eq!(pack_vertices(&positions, &uv, &colors, upload.buffer()), 9);
+    assert_eq!(upload.bytes(), textured.create_packed_vertex_buffer_data());
 }
 
 #[test]

@@ -74,6 +74,7 @@ fn chain_character(n: usize) -> Arc<CharacterAsset> {
         bind_positions: vec![Vec3::new(0.0, tip, 0.0), Vec3::new(0.1, tip, 0.0), Vec3::new(0.0, tip, 0.1)],
         triangles: vec![[0, 1, 2]],
         weights,
+        texcoords: Vec::new(),
     };
     Arc::new(CharacterAsset::new("chain", skeleton, skin, Vec::new()).unwrap())
 }
