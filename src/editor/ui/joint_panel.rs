@@ -22,10 +22,16 @@ pub fn joint_panel(ui: &mut egui::Ui, state: &mut InspectorState, panels: &mut P
     let character = character.clone();
     let skeleton = &character.asset.skeleton;
     let mut edits = Vec::new();
-    if ui.button("Reset the whole pose").clicked() {
-        let joints = skeleton.joints().iter().enumerate().map(|(j, def)| (j, def.initial_rotation)).collect();
-        edits.push(Edit::Pose { character: id, joints });
-    }
+    ui.horizontal(|ui| {
+        if ui.button("Reset the whole pose").on_hover_text("to the pose the file gives").clicked() {
+            let joints = skeleton.joints().iter().enumerate().map(|(j, def)| (j, def.initial_rotation)).collect();
+            edits.push(Edit::Pose { character: id, joints });
+        }
+        if ui.button("Rest").on_hover_text("every joint unturned (within its limits)").clicked() {
+            let joints = (0..skeleton.len()).map(|j| (j, JointRotation::IDENTITY)).collect();
+            edits.push(Edit::Pose { character: id, joints });
+        }
+    });
     ui.separator();
     for &j in &panels.selection.joints {
         if let Some(rotation) = joint_sliders(ui, state, panels, &character, j) {
