@@ -224,16 +224,9 @@ fn editing_frame_3_smpl_playing_1_puppet_dragged(bencher: Bencher, variant: &str
     }
     let character = |id: u64, source: SourceDoc, x: f32, smpl: Option<SmplDoc>| CharacterDoc {
         id: Some(CharacterId(id)),
-        name: format!("c{id}"),
-        source,
         placement: marionette::formats::scene::PlacementDoc { translation: Vec3::X * x, ..Default::default() },
-        pose: Default::default(),
-        view: Default::default(),
         smpl,
-        binding: None,
-        skinning: Default::default(),
-        anim: None,
-        morphs: Vec::new(),
+        ..CharacterDoc::new(source, format!("c{id}"))
     };
     let mut characters = vec![character(1, SourceDoc::Embedded("puppet".into()), 0.0, None)];
     if let Some(dir) = std::env::var_os("MARIONETTE_DATA").map(|d| std::path::PathBuf::from(d).join("smpl")) {

@@ -6,7 +6,7 @@ use std::path::Path;
 
 use bevy::math::Vec3;
 
-use crate::formats::scene::{CharacterDoc, PlacementDoc, SceneDoc, SmplDoc, SourceDoc, ViewDoc};
+use crate::formats::scene::{CharacterDoc, PlacementDoc, SceneDoc, SmplDoc, SourceDoc};
 
 /// Where the `i`-th of `n` characters stands: a square grid `spacing` apart, centred.
 fn grid(i: usize, n: usize, spacing: f32) -> Vec3 {
@@ -18,17 +18,9 @@ fn grid(i: usize, n: usize, spacing: f32) -> Vec3 {
 
 fn crowd_member(i: usize, n: usize, source: SourceDoc, spacing: f32, lift: f32, smpl: Option<SmplDoc>) -> CharacterDoc {
     CharacterDoc {
-        id: None,
-        source,
-        name: format!("crowd {i}"),
         placement: PlacementDoc { translation: grid(i, n, spacing) + Vec3::Y * lift, yaw: 0.0, scale: 1.0 },
-        pose: Default::default(),
-        view: ViewDoc::default(),
         smpl,
-        binding: None,
-        skinning: Default::default(),
-        anim: None,
-        morphs: Vec::new(),
+        ..CharacterDoc::new(source, format!("crowd {i}"))
     }
 }
 

@@ -21,17 +21,10 @@ fn puppet(
     view: ViewDoc,
 ) -> CharacterDoc {
     CharacterDoc {
-        id: None,
-        source: SourceDoc::Embedded("puppet".into()),
-        name: name.into(),
         placement: PlacementDoc { translation, yaw, scale: 1.0 },
         pose,
         view,
-        smpl: None,
-        binding: None,
-        skinning: Default::default(),
-        anim: None,
-        morphs: Vec::new(),
+        ..CharacterDoc::new(SourceDoc::Embedded("puppet".into()), name)
     }
 }
 

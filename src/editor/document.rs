@@ -407,17 +407,9 @@ pub fn doc_side_by_side(library: &mut AssetLibrary, sources: Vec<SourceDoc>, mes
         .into_iter()
         .zip(translations)
         .map(|((source, asset), translation)| CharacterDoc {
-            id: None,
-            name: asset.name.clone(),
             anim: own_motion(&source),
-            morphs: Vec::new(),
-            source,
             placement: PlacementDoc { translation, yaw: 0.0, scale: 1.0 },
-            pose: Default::default(),
-            view: ViewDoc::default(),
-            smpl: None,
-            binding: None,
-            skinning: Default::default(),
+            ..CharacterDoc::new(source, asset.name.clone())
         })
         .collect();
     SceneDoc { characters, ..SceneDoc::default() }

@@ -261,6 +261,26 @@ impl AnimDoc {
     }
 }
 
+impl CharacterDoc {
+    /// A character of `source` named `name`, standing at the origin in its source's pose,
+    /// with nothing else set.
+    pub fn new(source: SourceDoc, name: impl Into<String>) -> Self {
+        Self {
+            id: None,
+            source,
+            name: name.into(),
+            placement: PlacementDoc::default(),
+            pose: BTreeMap::new(),
+            view: ViewDoc::default(),
+            smpl: None,
+            binding: None,
+            skinning: SkinningDoc::default(),
+            anim: None,
+            morphs: Vec::new(),
+        }
+    }
+}
+
 /// How to bind a skin from its skeleton's bones (stored as `Nearest` or `Smooth`).
 pub use crate::rig::bind::Binding as BindingDoc;
 

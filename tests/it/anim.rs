@@ -337,24 +337,13 @@ fn a_scene_plays_a_clip_on_the_wasp_and_keeps_it_in_the_file() {
     use bevy::prelude::*;
     use marionette::editor::ScenePlugin;
     use marionette::editor::document::{PendingScene, SceneReader, read_scene, write_scene};
-    use marionette::formats::scene::{AnimDoc, CharacterDoc, PlacementDoc, SceneDoc, SourceDoc};
+    use marionette::formats::scene::{AnimDoc, CharacterDoc, SceneDoc, SourceDoc};
     use marionette::scene::{Character, CurrentJointToWorld};
 
     let data = data_dir().join("cse169/project3");
     let anim = AnimDoc { time: 2.5, playing: false, ..AnimDoc::of(data.join("wasp_walk.anim")) };
-    let wasp = CharacterDoc {
-        id: None,
-        source: SourceDoc::File(data.join("wasp.skel")),
-        name: "wasp".into(),
-        placement: PlacementDoc::default(),
-        pose: Default::default(),
-        view: Default::default(),
-        smpl: None,
-        binding: None,
-        skinning: Default::default(),
-        anim: Some(anim.clone()),
-        morphs: Vec::new(),
-    };
+    let wasp =
+        CharacterDoc { anim: Some(anim.clone()), ..CharacterDoc::new(SourceDoc::File(data.join("wasp.skel")), "wasp") };
     let mut app = crate::ecs::app();
     app.add_plugins(ScenePlugin);
     let doc = SceneDoc { characters: vec![wasp], ..SceneDoc::default() };
@@ -426,17 +415,8 @@ fn keyed_poses_play_back_and_survive_anim_export_and_scene_files() {
     let anim = AnimDoc { keys: Some(clip), time: 0.25, playing: false, ..AnimDoc::default() };
     let doc = SceneDoc {
         characters: vec![CharacterDoc {
-            id: None,
-            source: SourceDoc::Embedded("puppet".into()),
-            name: "p".into(),
-            placement: Default::default(),
-            pose: Default::default(),
-            view: Default::default(),
-            smpl: None,
-            binding: None,
-            skinning: Default::default(),
             anim: Some(anim.clone()),
-            morphs: Vec::new(),
+            ..CharacterDoc::new(SourceDoc::Embedded("puppet".into()), "p")
         }],
         ..SceneDoc::default()
     };

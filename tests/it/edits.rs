@@ -244,16 +244,8 @@ fn smpl_shape_and_clip_edits_undo_and_redo() {
     let mut app = scene_app();
     let body = CharacterDoc {
         id: Some(CharacterId(1)),
-        source: SourceDoc::File(dir.clone()),
-        name: "body".into(),
-        placement: Default::default(),
-        pose: Default::default(),
-        view: ViewDoc::default(),
         smpl: Some(SmplDoc::default()),
-        binding: None,
-        skinning: Default::default(),
-        anim: None,
-        morphs: Vec::new(),
+        ..CharacterDoc::new(SourceDoc::File(dir.clone()), "body")
     };
     *app.world_mut().resource_mut::<PendingScene>() =
         PendingScene { doc: Some(SceneDoc { characters: vec![body], ..SceneDoc::default() }), frame: false };

@@ -157,19 +157,8 @@ fn saving_a_scene_whose_source_path_is_not_utf8_is_an_error_not_a_panic() {
     let dir = scratch("non-utf8");
     let bad = std::path::PathBuf::from(std::ffi::OsStr::from_bytes(b"/tmp/caf\xe9.skel"));
     let mut doc = SceneDoc::default();
-    doc.characters.push(marionette::formats::scene::CharacterDoc {
-        id: None,
-        source: marionette::formats::scene::SourceDoc::File(bad),
-        name: "c".into(),
-        placement: Default::default(),
-        pose: Default::default(),
-        view: Default::default(),
-        smpl: None,
-        binding: None,
-        skinning: Default::default(),
-        anim: None,
-        morphs: Vec::new(),
-    });
+    doc.characters
+        .push(marionette::formats::scene::CharacterDoc::new(marionette::formats::scene::SourceDoc::File(bad), "c"));
     let out = dir.join("scene.ron");
     let e = save_scene(&out, &doc).unwrap_err();
     assert!(e.to_string().contains("cannot be written"), "{e}");

@@ -126,16 +126,9 @@ fn add_character(path: &str, state: &mut InspectorState, panels: &mut Panels) {
     let anim = crate::editor::document::own_motion(&source);
     panels.push(Edit::Add(Box::new(CharacterDoc {
         id: Some(id),
-        source,
-        name: asset.name.clone(),
         placement: PlacementDoc { translation, yaw: 0.0, scale: 1.0 },
-        pose: Default::default(),
-        view: ViewDoc::default(),
-        smpl: None,
-        binding: None,
-        skinning: Default::default(),
         anim,
-        morphs: Vec::new(),
+        ..CharacterDoc::new(source, asset.name.clone())
     })));
     *panels.selection = Selection { character: Some(id), joints: Vec::new() };
     state.recent.retain(|r| r != path);
