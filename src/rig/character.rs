@@ -71,25 +71,6 @@ pub struct MorphTarget {
 }
 
 impl CharacterAsset {
-    /// The bind positions with the morph targets blended in by `weights` (one per target;
-    /// missing ones are 0).
-    pub fn morphed_positions(&self, weights: &[f32]) -> Vec<Vec3> {
-        let mut positions = self.skin.bind_positions.clone();
-        for (target, &w) in self.morphs.iter().zip(weights) {
-            if w == 0.0 {
-                continue;
-            }
-            for &(v, d) in &target.deltas {
-                if let Some(p) = positions.get_mut(v as usize) {
-                    *p += d * w;
-                }
-            }
-        }
-        positions
-    }
-}
-
-impl CharacterAsset {
     /// A skinned character whose bind pose is the skeleton's rest pose.
     pub fn new(
         name: impl Into<String>,
@@ -139,6 +120,23 @@ impl CharacterAsset {
             morphs: Vec::new(),
             texture: None,
         }
+    }
+
+    /// The bind positions with the morph targets blended in by `weights` (one per target;
+    /// missing ones are 0).
+    pub fn morphed_positions(&self, weights: &[f32]) -> Vec<Vec3> {
+        let mut positions = self.skin.bind_positions.clone();
+        for (target, &w) in self.morphs.iter().zip(weights) {
+            if w == 0.0 {
+                continue;
+            }
+            for &(v, d) in &target.deltas {
+                if let Some(p) = positions.get_mut(v as usize) {
+                    *p += d * w;
+                }
+            }
+        }
+        positions
     }
 
     pub fn vertex_count(&self) -> usize {
