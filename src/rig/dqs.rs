@@ -184,13 +184,8 @@ mod avx2 {
         let sign = _mm_set1_ps(-0.0);
         for (&v, (joints, weights)) in group.vertices.iter().zip(rows) {
             let (joints, weights): (&[u16; K], &[f32; K]) = (joints.try_into().unwrap(), weights.try_into().unwrap());
-            let mut heaviest = 0;
-            for k in 1..K {
-                if weights[k] > weights[heaviest] {
-                    heaviest = k;
-                }
-            }
-            let pivot: __m128 = palette[joints[heaviest] as usize].real.into();
+            // Rows are stored heaviest first (`InfluenceGroups::build`): no search, no branch.
+            let pivot: __m128 = palette[joints[0] as usize].real.into();
             let (mut real, mut dual) = (_mm_setzero_ps(), _mm_setzero_ps());
             for k in 0..K {
                 let q = &palette[joints[k] as usize];

@@ -14,7 +14,8 @@ use super::skinning::{Influence, SkinWeights};
 pub struct FixedGroup {
     /// The vertices of the group, ascending.
     pub vertices: Vec<u32>,
-    /// `k` joints per vertex.
+    /// `k` joints per vertex, heaviest first (a stable sort: among equal weights the row's
+    /// order stays, so the first is also the first of the heaviest in the row).
     pub joints: Vec<u16>,
     /// `k` weights per vertex (summing to 1).
     pub weights: Vec<f32>,
@@ -40,9 +41,12 @@ impl InfluenceGroups {
             match row.len() {
                 k @ 1..=4 => {
                     let group = &mut groups.fixed[k - 1];
+                    let mut sorted = [Influence { joint: 0, weight: 0.0 }; 4];
+                    sorted[..k].copy_from_slice(row);
+                    sorted[..k].sort_by(|a, b| b.weight.total_cmp(&a.weight));
                     group.vertices.push(v as u32);
-                    group.joints.extend(row.iter().map(|i| i.joint));
-                    group.weights.extend(row.iter().map(|i| i.weight));
+                    group.joints.extend(sorted[..k].iter().map(|i| i.joint));
+                    group.weights.extend(sorted[..k].iter().map(|i| i.weight));
                 }
                 _ => groups.wide.push(v as u32),
             }
