@@ -397,6 +397,10 @@ fn rebind_character(world: &mut World, id: CharacterId, binding: Option<BindingD
     let source = component::<SceneCharacter>(world, id)?.source.clone();
     let asset = world.resource_mut::<AssetLibrary>().load_bound(&source, binding).map_err(|e| e.to_string())?;
     let mut character = world.entity_mut(entity);
+    if let Some(mut morphs) = character.get_mut::<crate::scene::morphs::Morphs>() {
+        // The morphs blend from the rebound asset (and put it on the character).
+        morphs.base = asset.clone();
+    }
     if let Some(mut c) = character.get_mut::<Character>() {
         c.asset = asset;
     }
