@@ -339,3 +339,30 @@ fn keying_a_pose_is_undone_and_redone_like_any_edit() {
     request(&mut app, HistoryRequest::Redo);
     assert_eq!(player(&app), Some(anim));
 }
+
+/// Morph weights are an edit, undone like any; a rebind keeps them applied (the morphs
+/// blend from the rebound asset).
+#[test]
+#[cfg_attr(not(marionette_data), ignore = "needs MARIONETTE_DATA (the course data)")]
+fn morph_weights_are_undone_and_survive_a_rebind() {
+    let head = crate::common::data_dir().join("cse169/extras/head.skel");
+    let mut app = scene_app();
+    let doc = CharacterDoc { id: Some(CharacterId(1)), ..CharacterDoc::new(SourceDoc::File(head), "head") };
+    *app.world_mut().resource_mut::<PendingScene>() =
+        PendingScene { doc: Some(SceneDoc { characters: vec![doc], ..SceneDoc::default() }), frame: false };
+    app.update();
+    app.update();
+    let bind = |app: &App| app.world().get::<Character>(entity(app, 1)).unwrap().asset.skin.bind_positions.clone();
+    let base = bind(&app);
+    edit(&mut app, Edit::Morph { character: CharacterId(1), weights: vec![1.0, 0.0] });
+    app.update();
+    let morphed = bind(&app);
+    assert_ne!(morphed, base, "the morph moves vertices");
+    edit(&mut app, Edit::Rebind { character: CharacterId(1), binding: Some(BindingDoc::Nearest) });
+    app.update();
+    assert_eq!(bind(&app), morphed, "still morphed after the rebind");
+    request(&mut app, HistoryRequest::Undo);
+    request(&mut app, HistoryRequest::Undo);
+    app.update();
+    assert_eq!(bind(&app), base, "undoing both puts the skin back");
+}
