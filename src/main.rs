@@ -5,7 +5,10 @@ use std::process::ExitCode;
 
 use anyhow::{Context, Result};
 use clap::{Parser, Subcommand};
-use glam::Mat4;
+use std::io::Write;
+
+use glam::{Mat4, Vec3};
+use marionette::formats::gltf::{GltfCharacter, GltfMesh, write_glb};
 
 use marionette::cli::posing::{
     IkSpec, PoseSpec, apply_ik_specs, apply_pose_specs, describe, describe_ik, posed_positions_by,
@@ -52,6 +55,10 @@ enum Command {
         skinning: Skinning,
         #[command(flatten)]
         clip: ClipArgs,
+        /// With `--out X.glb`: the posed mesh without a skin, instead of a skinned mesh
+        /// with its skeleton.
+        #[arg(long)]
+        bake: bool,
     },
     /// Bind a mesh without weights to a skeleton (each vertex to its nearest bone, or
     /// smoothly to the nearest few) and write 6.837-style weights.
@@ -191,6 +198,50 @@ impl ClipArgs {
     }
 }
 
+fn is_glb(path: &std::path::Path) -> bool {
+    path.extension().is_some_and(|e| e.eq_ignore_ascii_case("glb"))
+}
+
+fn is_scene(path: &std::path::Path) -> bool {
+    path.extension().is_some_and(|e| e.eq_ignore_ascii_case("ron"))
+}
+
+/// Every character of a scene document as glTF: its pose, its clip at its time, its
+/// placement and tint.
+fn scene_glb(doc: &marionette::formats::scene::SceneDoc, mesh: GltfMesh) -> Result<Vec<u8>> {
+    let mut library = marionette::editor::document::AssetLibrary::default();
+    let mut loaded = Vec::new();
+    for c in &doc.characters {
+        let asset = library.load_bound(&c.source, c.binding)?;
+        let (mut pose, notes) = marionette::editor::document::pose_from_doc(&asset, c);
+        notes.iter().for_each(|n| eprintln!("note: {n}"));
+        let mut root = asset.skeleton.joint(0).rest_offset;
+        if let Some(anim) = &c.anim {
+            let clip = match &anim.keys {
+                Some(keys) => keys.clone(),
+                None => marionette::formats::load_clip(&anim.file)?,
+            };
+            let (r, p) = clip.retargeted(&asset.skeleton, &anim.names).pose_at(&asset.skeleton, anim.time, &pose);
+            (root, pose) = (r, p);
+        }
+        loaded.push((c, asset, pose, root));
+    }
+    let characters: Vec<GltfCharacter> = loaded
+        .iter()
+        .map(|(c, asset, pose, root)| GltfCharacter {
+            name: &c.name,
+            asset,
+            pose,
+            root: *root,
+            translation: c.placement.translation,
+            yaw: c.placement.yaw,
+            scale: c.placement.scale,
+            tint: c.view.tint,
+        })
+        .collect();
+    Ok(write_glb(&characters, mesh))
+}
+
 /// A finite number of seconds.
 fn finite_seconds(text: &str) -> Result<f32, String> {
     match text.parse::<f32>() {
@@ -218,7 +269,13 @@ fn run(cli: Cli) -> Result<()> {
             marionette::editor::run(paths, edits)
         }
         Some(Command::Info { path }) => print!("{}", describe(&load_character(&path)?)),
-        Some(Command::Export { path, out, poses, ik, skinning, clip }) => {
+        Some(Command::Export { path, out, bake, .. }) if is_glb(&out) && is_scene(&path) => {
+            let doc = marionette::editor::document::read_scene(&path)?;
+            let glb = scene_glb(&doc, if bake { GltfMesh::Baked } else { GltfMesh::Skinned })?;
+            write_file(&out, |w| w.write_all(&glb))?;
+            println!("wrote {} ({} characters)", out.display(), doc.characters.len());
+        }
+        Some(Command::Export { path, out, poses, ik, skinning, clip, bake }) => {
             let asset = load_character(&path)?;
             for w in &asset.warnings {
                 eprintln!("warning: {w}");
@@ -235,6 +292,29 @@ fn run(cli: Cli) -> Result<()> {
             apply_pose_specs(&asset.skeleton, &mut pose, &poses)?;
             for report in apply_ik_specs(&asset.skeleton, &mut pose, origin, &ik)? {
                 eprintln!("{}", describe_ik(&asset.skeleton, &report));
+            }
+            if is_glb(&out) {
+                let name = asset.name.clone();
+                let root = origin.transform_point3(asset.skeleton.joint(0).rest_offset);
+                let character = GltfCharacter {
+                    name: &name,
+                    asset: &asset,
+                    pose: &pose,
+                    root,
+                    translation: Vec3::ZERO,
+                    yaw: 0.0,
+                    scale: 1.0,
+                    tint: [0.85, 0.75, 0.62],
+                };
+                let glb = write_glb(&[character], if bake { GltfMesh::Baked } else { GltfMesh::Skinned });
+                write_file(&out, |w| w.write_all(&glb))?;
+                println!(
+                    "wrote {} ({} joints, {} vertices)",
+                    out.display(),
+                    asset.skeleton.len(),
+                    asset.vertex_count()
+                );
+                return Ok(());
             }
             let positions = posed_positions_by(&asset, &pose, origin, skinning.into());
             write_file(&out, |w| obj::write_obj(w, &positions, &asset.skin.triangles))?;

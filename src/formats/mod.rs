@@ -8,6 +8,7 @@ pub mod character;
 pub mod cse169;
 pub mod cse169_skin;
 pub mod error;
+pub mod gltf;
 pub mod homer;
 pub mod mit6837;
 pub mod obj;

@@ -13,6 +13,7 @@ mod edits;
 mod formats;
 mod fuzz;
 mod gizmo;
+mod gltf;
 mod ik;
 mod kernel;
 mod poses;

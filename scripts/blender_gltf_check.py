@@ -1,0 +1,79 @@
+"""Marionette's glTF export, opened and deformed by Blender's own glTF importer.
+
+For each case, writes `marionette export PATH --out x.glb` (skinned: the skeleton in its
+pose, bind mesh, weights, inverse binds) and `--out x.obj` (our own skinned vertices),
+imports the .glb with `bpy.ops.import_scene.gltf`, evaluates every mesh object as the
+armature deforms it, and compares the vertices (glTF's y-up turned back from Blender's
+z-up) with the OBJ's: for each OBJ vertex, the nearest deformed vertex.
+
+    python3.11 scripts/blender_gltf_check.py ../shared/data target/debug/marionette
+
+Prints the largest distance per case. Needs `pip install bpy numpy`.
+"""
+import subprocess
+import sys
+import tempfile
+from pathlib import Path
+
+import bpy
+import numpy as np
+from mathutils import kdtree
+
+CASES = {
+    "Model1 posed": ("mit6837/Model1.skel", ["--pose", "3=0.3,0.5,-0.2", "--pose", "8=0,0,0.9", "--pose", "14=0.4,0,0.3"]),
+    "SMPL body posed": ("smpl", ["--pose", "L_Shoulder=0,0,-0.6", "--pose", "R_Knee=0.8,0,0", "--pose", "Spine1=0.2,0.3,0"]),
+    "Homer": ("homer/homer.json", ["--pose", "1=0.2,0.1,0"]),
+    "puppet": (None, ["--pose", "l_elbow=0,-1.1,0.2", "--pose", "r_knee=0.9,0,0"]),
+    "wasp walking": ("cse169/project3/wasp.skel", ["--anim", "{data}/cse169/project3/wasp_walk.anim", "--time", "1.25"]),
+}
+
+
+def read_obj(path):
+    return np.array([list(map(float, l.split()[1:4])) for l in open(path) if l.startswith("v ")])
+
+
+def deformed_vertices(glb):
+    bpy.ops.wm.read_factory_settings(use_empty=True)
+    bpy.ops.import_scene.gltf(filepath=str(glb))
+    depsgraph = bpy.context.evaluated_depsgraph_get()
+    points = []
+    for obj in bpy.context.scene.objects:
+        if obj.type != "MESH":
+            continue
+        evaluated = obj.evaluated_get(depsgraph)
+        mesh = evaluated.to_mesh()
+        m = evaluated.matrix_world
+        points.extend((m @ v.co)[:] for v in mesh.vertices)
+        evaluated.to_mesh_clear()
+    # Blender is z-up: (x, y, z) in glTF is (x, -z, y) here.
+    p = np.array(points)
+    return np.stack([p[:, 0], p[:, 2], -p[:, 1]], axis=1)
+
+
+def main(data: Path, marionette: str):
+    worst_all = 0.0
+    with tempfile.TemporaryDirectory() as tmp:
+        for name, (path, args) in CASES.items():
+            source = str(data / path) if path else None
+            if source is None:
+                # The built-in puppet, from the project's assets.
+                source = str(Path(__file__).resolve().parent.parent / "assets" / "puppet.skel")
+            args = [a.replace("{data}", str(data)) for a in args]
+            glb, obj = Path(tmp) / "x.glb", Path(tmp) / "x.obj"
+            for out in (glb, obj):
+                subprocess.run([marionette, "export", source, "--out", str(out), *args], check=True, capture_output=True)
+            ours = read_obj(obj)
+            theirs = deformed_vertices(glb)
+            tree = kdtree.KDTree(len(theirs))
+            for i, p in enumerate(theirs):
+                tree.insert(p, i)
+            tree.balance()
+            worst = max(tree.find(p)[2] for p in ours)
+            size = float(np.ptp(ours, axis=0).max())
+            print(f"{name}: {len(ours)} vertices, Blender {len(theirs)}; largest distance {worst:.2e} ({worst / size:.1e} of the size {size:.3f})")
+            worst_all = max(worst_all, worst / size)
+    print(f"worst relative distance {worst_all:.1e}")
+
+
+if __name__ == "__main__":
+    main(Path(sys.argv[1]), sys.argv[2])

@@ -1,0 +1,253 @@
+//! glTF 2.0 export (`.glb`): every character as a skinned mesh with its skeleton — joints
+//! as nodes in their hierarchy, the pose as their rotations, inverse bind matrices, all
+//! influences as `JOINTS_n`/`WEIGHTS_n` sets of four — under a node that places it, its tint
+//! as its material. Or, baked, the posed mesh alone. Written with `serde_json`: the format
+//! is plain JSON and one binary buffer.
+
+use glam::{Mat4, Quat, Vec3};
+use serde_json::{Value, json};
+
+use crate::rig::{CharacterAsset, JointRotation};
+
+/// One character to write.
+pub struct GltfCharacter<'a> {
+    pub name: &'a str,
+    pub asset: &'a CharacterAsset,
+    pub pose: &'a [JointRotation],
+    /// The root joint's translation in model space (its offset unless a clip moves it).
+    pub root: Vec3,
+    /// Model space → world: translation, turn about y, uniform scale.
+    pub translation: Vec3,
+    pub yaw: f32,
+    pub scale: f32,
+    pub tint: [f32; 3],
+}
+
+/// How the meshes go out.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum GltfMesh {
+    /// Bind mesh, skin and skeleton: it deforms wherever it is opened.
+    Skinned,
+    /// The skinned, posed vertices and no skin.
+    Baked,
+}
+
+const ARRAY_BUFFER: u32 = 34962;
+const ELEMENT_ARRAY_BUFFER: u32 = 34963;
+const FLOAT: u32 = 5126;
+const UNSIGNED_SHORT: u32 = 5123;
+const UNSIGNED_INT: u32 = 5125;
+
+/// The JSON document and its binary buffer, filled together.
+#[derive(Default)]
+struct Builder {
+    bin: Vec<u8>,
+    views: Vec<Value>,
+    accessors: Vec<Value>,
+    nodes: Vec<Value>,
+}
+
+impl Builder {
+    /// Appends `bytes` as a buffer view (4-byte aligned) and an accessor over it; returns
+    /// the accessor's index.
+    fn accessor(&mut self, bytes: &[u8], target: Option<u32>, mut accessor: Value) -> usize {
+        while !self.bin.len().is_multiple_of(4) {
+            self.bin.push(0);
+        }
+        let mut view = json!({ "buffer": 0, "byteOffset": self.bin.len(), "byteLength": bytes.len() });
+        if let Some(t) = target {
+            view["target"] = json!(t);
+        }
+        self.bin.extend_from_slice(bytes);
+        self.views.push(view);
+        accessor["bufferView"] = json!(self.views.len() - 1);
+        self.accessors.push(accessor);
+        self.accessors.len() - 1
+    }
+
+    fn positions(&mut self, points: &[Vec3]) -> usize {
+        let (lo, hi) = crate::rig::skinning::bounds(points);
+        let bytes: Vec<u8> = points.iter().flat_map(|p| p.to_array()).flat_map(f32::to_le_bytes).collect();
+        let accessor = json!({ "componentType": FLOAT, "count": points.len(), "type": "VEC3",
+            "min": lo.to_array(), "max": hi.to_array() });
+        self.accessor(&bytes, Some(ARRAY_BUFFER), accessor)
+    }
+
+    fn node(&mut self, node: Value) -> usize {
+        self.nodes.push(node);
+        self.nodes.len() - 1
+    }
+}
+
+/// The characters as one binary glTF file.
+pub fn write_glb(characters: &[GltfCharacter], mesh: GltfMesh) -> Vec<u8> {
+    let mut b = Builder::default();
+    let (mut meshes, mut skins, mut materials, mut roots) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
+    for c in characters {
+        let placement = b.node(json!({
+            "name": c.name,
+            "translation": c.translation.to_array(),
+            "rotation": Quat::from_rotation_y(c.yaw).to_array(),
+            "scale": [c.scale, c.scale, c.scale],
+        }));
+        roots.push(placement);
+        materials.push(json!({
+            "name": c.name,
+            "pbrMetallicRoughness": { "baseColorFactor": [c.tint[0], c.tint[1], c.tint[2], 1.0],
+                "metallicFactor": 0.0, "roughnessFactor": 0.75 },
+        }));
+        let skin = &c.asset.skin;
+        let indices: Vec<u8> = skin.triangles.iter().flatten().flat_map(|i| i.to_le_bytes()).collect();
+        let index_accessor = b.accessor(
+            &indices,
+            Some(ELEMENT_ARRAY_BUFFER),
+            json!({ "componentType": UNSIGNED_INT, "count": skin.triangles.len() * 3, "type": "SCALAR" }),
+        );
+        let mut children = Vec::new();
+        let mut attributes = serde_json::Map::new();
+        let mut mesh_node = json!({ "name": format!("{} mesh", c.name), "mesh": meshes.len() });
+        match mesh {
+            GltfMesh::Baked => {
+                let palette = crate::rig::fk::posed_palette(
+                    &c.asset.skeleton,
+                    &c.asset.bind_world_to_joint,
+                    c.pose,
+                    root_origin(c),
+                );
+                let mut posed = vec![Vec3::ZERO; skin.bind_positions.len()];
+                crate::rig::lbs::skin(&skin.bind_positions, &skin.weights, &palette, &mut posed);
+                attributes.insert("POSITION".into(), json!(b.positions(&posed)));
+            }
+            GltfMesh::Skinned => {
+                attributes.insert("POSITION".into(), json!(b.positions(&skin.bind_positions)));
+                for (set, (joints, weights)) in influence_sets(c.asset).into_iter().enumerate() {
+                    let count = skin.bind_positions.len();
+                    let j = b.accessor(
+                        &joints,
+                        Some(ARRAY_BUFFER),
+                        json!({ "componentType": UNSIGNED_SHORT, "count": count, "type": "VEC4" }),
+                    );
+                    let w = b.accessor(
+                        &weights,
+                        Some(ARRAY_BUFFER),
+                        json!({ "componentType": FLOAT, "count": count, "type": "VEC4" }),
+                    );
+                    attributes.insert(format!("JOINTS_{set}"), json!(j));
+                    attributes.insert(format!("WEIGHTS_{set}"), json!(w));
+                }
+                let joints = skeleton_nodes(&mut b, c);
+                children.push(joints[0]);
+                let inverse: Vec<u8> = c
+                    .asset
+                    .bind_world_to_joint
+                    .iter()
+                    .flat_map(Mat4::to_cols_array)
+                    .flat_map(f32::to_le_bytes)
+                    .collect();
+                let ibm = b.accessor(
+                    &inverse,
+                    None,
+                    json!({ "componentType": FLOAT, "count": joints.len(), "type": "MAT4" }),
+                );
+                mesh_node["skin"] = json!(skins.len());
+                skins.push(
+                    json!({ "name": c.name, "joints": joints, "skeleton": joints[0], "inverseBindMatrices": ibm }),
+                );
+            }
+        }
+        meshes.push(json!({
+            "name": c.name,
+            "primitives": [{ "attributes": attributes, "indices": index_accessor, "material": materials.len() - 1 }],
+        }));
+        // A skinned mesh's node sits at the scene's root (its skeleton places it); a baked
+        // one under the placement.
+        let mesh_index = b.node(mesh_node);
+        match mesh {
+            GltfMesh::Skinned => roots.push(mesh_index),
+            GltfMesh::Baked => children.push(mesh_index),
+        }
+        if !children.is_empty() {
+            b.nodes[placement]["children"] = json!(children);
+        }
+    }
+    let mut doc = json!({
+        "asset": { "version": "2.0", "generator": "marionette" },
+        "scene": 0,
+        "scenes": [{ "nodes": roots }],
+        "nodes": b.nodes,
+        "meshes": meshes,
+        "materials": materials,
+        "accessors": b.accessors,
+        "bufferViews": b.views,
+        "buffers": [{ "byteLength": b.bin.len() }],
+    });
+    if !skins.is_empty() {
+        doc["skins"] = json!(skins);
+    }
+    glb(&serde_json::to_vec(&doc).expect("a JSON value serialises"), &b.bin)
+}
+
+/// Where the matrix stack starts for a character: its root moved from its offset to `root`.
+fn root_origin(c: &GltfCharacter) -> Mat4 {
+    Mat4::from_translation(c.root - c.asset.skeleton.joint(0).rest_offset)
+}
+
+/// The joints as nodes (translation: the rest offset, the root's at `root`; rotation: the
+/// pose), linked parent to child; their node indices in joint order.
+fn skeleton_nodes(b: &mut Builder, c: &GltfCharacter) -> Vec<usize> {
+    let skeleton = &c.asset.skeleton;
+    let first = b.nodes.len();
+    for (j, def) in skeleton.joints().iter().enumerate() {
+        let translation = if j == 0 { c.root } else { def.rest_offset };
+        let rotation = c.pose.get(j).map_or(Quat::IDENTITY, JointRotation::to_quat);
+        let mut node =
+            json!({ "name": def.name, "translation": translation.to_array(), "rotation": rotation.to_array() });
+        let children: Vec<usize> = skeleton.children(j).iter().map(|&k| first + k).collect();
+        if !children.is_empty() {
+            node["children"] = json!(children);
+        }
+        b.node(node);
+    }
+    (first..first + skeleton.len()).collect()
+}
+
+/// Every vertex's influences, four to a set, zero-padded: the bytes of `JOINTS_n` (u16)
+/// and `WEIGHTS_n` (f32) for each set.
+fn influence_sets(asset: &CharacterAsset) -> Vec<(Vec<u8>, Vec<u8>)> {
+    let weights = &asset.skin.weights;
+    let sets = weights.max_influences().div_ceil(4).max(1);
+    (0..sets)
+        .map(|s| {
+            let (mut joints, mut values) = (Vec::new(), Vec::new());
+            for v in 0..weights.vertex_count() {
+                let row = weights.of_vertex(v);
+                for k in 4 * s..4 * s + 4 {
+                    let (j, w) = row.get(k).map_or((0, 0.0), |i| (i.joint, i.weight));
+                    joints.extend(j.to_le_bytes());
+                    values.extend(w.to_le_bytes());
+                }
+            }
+            (joints, values)
+        })
+        .collect()
+}
+
+/// The GLB container: header, JSON chunk (space-padded), BIN chunk (zero-padded).
+fn glb(json: &[u8], bin: &[u8]) -> Vec<u8> {
+    let pad = |n: usize| n.div_ceil(4) * 4;
+    let (json_len, bin_len) = (pad(json.len()), pad(bin.len()));
+    let total = 12 + 8 + json_len + 8 + bin_len;
+    let mut out = Vec::with_capacity(total);
+    out.extend(b"glTF");
+    out.extend(2u32.to_le_bytes());
+    out.extend((total as u32).to_le_bytes());
+    out.extend((json_len as u32).to_le_bytes());
+    out.extend(b"JSON");
+    out.extend(json);
+    out.resize(12 + 8 + json_len, b' ');
+    out.extend((bin_len as u32).to_le_bytes());
+    out.extend(b"BIN\0");
+    out.extend(bin);
+    out.resize(total, 0);
+    out
+}

@@ -1,0 +1,158 @@
+//! glTF export: the file read back here on its own (GLB chunks, JSON, the binary buffer)
+//! and skinned as the glTF spec says gives our skinned vertices; names, hierarchy and
+//! weights come back as they went out.
+
+use glam::{Mat4, Quat, Vec3};
+use marionette::formats::gltf::{GltfCharacter, GltfMesh, write_glb};
+use marionette::rig::JointRotation;
+
+/// The JSON and the binary chunk of a GLB.
+fn chunks(glb: &[u8]) -> (serde_json::Value, Vec<u8>) {
+    let u32_at = |at: usize| u32::from_le_bytes(glb[at..at + 4].try_into().unwrap()) as usize;
+    assert_eq!(&glb[0..4], b"glTF");
+    assert_eq!(u32_at(8), glb.len());
+    let json_len = u32_at(12);
+    assert_eq!(&glb[16..20], b"JSON");
+    let json = serde_json::from_slice(&glb[20..20 + json_len]).unwrap();
+    let bin_at = 20 + json_len;
+    assert_eq!(&glb[bin_at + 4..bin_at + 8], b"BIN\0");
+    (json, glb[bin_at + 8..bin_at + 8 + u32_at(bin_at)].to_vec())
+}
+
+/// An accessor's floats (or u16/u32 as floats).
+fn read(json: &serde_json::Value, bin: &[u8], accessor: usize) -> Vec<f32> {
+    let a = &json["accessors"][accessor];
+    let view = &json["bufferViews"][a["bufferView"].as_u64().unwrap() as usize];
+    let start = view["byteOffset"].as_u64().unwrap() as usize;
+    let bytes = &bin[start..start + view["byteLength"].as_u64().unwrap() as usize];
+    match a["componentType"].as_u64().unwrap() {
+        5126 => bytes.chunks(4).map(|b| f32::from_le_bytes(b.try_into().unwrap())).collect(),
+        5123 => bytes.chunks(2).map(|b| f32::from(u16::from_le_bytes(b.try_into().unwrap()))).collect(),
+        5125 => bytes.chunks(4).map(|b| u32::from_le_bytes(b.try_into().unwrap()) as f32).collect(),
+        other => panic!("component type {other}"),
+    }
+}
+
+fn local(node: &serde_json::Value) -> Mat4 {
+    let v = |k: &str, n: usize, d: f32| -> Vec<f32> {
+        node[k].as_array().map_or(vec![d; n], |a| a.iter().map(|x| x.as_f64().unwrap() as f32).collect())
+    };
+    let (t, r, s) =
+        (v("translation", 3, 0.0), node["rotation"].as_array().map(|_| v("rotation", 4, 0.0)), v("scale", 3, 1.0));
+    let r = r.map_or(Quat::IDENTITY, |r| Quat::from_xyzw(r[0], r[1], r[2], r[3]));
+    Mat4::from_scale_rotation_translation(Vec3::new(s[0], s[1], s[2]), r, Vec3::new(t[0], t[1], t[2]))
+}
+
+/// Every node's global matrix, from the scene's roots down.
+fn globals(json: &serde_json::Value) -> Vec<Mat4> {
+    let nodes = json["nodes"].as_array().unwrap();
+    let mut out = vec![Mat4::IDENTITY; nodes.len()];
+    let mut todo: Vec<(usize, Mat4)> = json["scenes"][0]["nodes"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|n| (n.as_u64().unwrap() as usize, Mat4::IDENTITY))
+        .collect();
+    while let Some((n, parent)) = todo.pop() {
+        out[n] = parent * local(&nodes[n]);
+        for c in nodes[n]["children"].as_array().into_iter().flatten() {
+            todo.push((c.as_u64().unwrap() as usize, out[n]));
+        }
+    }
+    out
+}
+
+#[test]
+fn an_exported_character_skins_back_to_our_vertices_with_its_names_and_weights() {
+    let puppet = marionette::formats::puppet::embedded_puppet();
+    let skeleton = &puppet.skeleton;
+    let mut pose = skeleton.initial_pose();
+    pose[skeleton.find("l_elbow").unwrap()] = JointRotation::euler_xyz(0.2, -1.1, 0.3);
+    pose[0] = JointRotation::Quat(Quat::from_rotation_y(0.7));
+    let root = skeleton.joint(0).rest_offset + Vec3::new(0.1, 0.05, -0.2);
+    let character = GltfCharacter {
+        name: "p",
+        asset: &puppet,
+        pose: &pose,
+        root,
+        translation: Vec3::new(1.0, 0.0, -2.0),
+        yaw: 0.6,
+        scale: 1.5,
+        tint: [0.2, 0.4, 0.6],
+    };
+    let (json, bin) = chunks(&write_glb(&[character], GltfMesh::Skinned));
+
+    // Our skinned vertices, placed.
+    let placement =
+        Mat4::from_scale_rotation_translation(Vec3::splat(1.5), Quat::from_rotation_y(0.6), Vec3::new(1.0, 0.0, -2.0));
+    let origin = Mat4::from_translation(root - skeleton.joint(0).rest_offset);
+    let ours: Vec<Vec3> = marionette::cli::posing::posed_positions(&puppet, &pose, origin)
+        .into_iter()
+        .map(|p| placement.transform_point3(p))
+        .collect();
+
+    // The file's, as the spec skins: Σ w · (global(joint) · inverseBind) · position.
+    let skin = &json["skins"][0];
+    let joints: Vec<usize> = skin["joints"].as_array().unwrap().iter().map(|j| j.as_u64().unwrap() as usize).collect();
+    let names: Vec<&str> = joints.iter().map(|&n| json["nodes"][n]["name"].as_str().unwrap()).collect();
+    assert_eq!(names, skeleton.joints().iter().map(|j| j.name.as_str()).collect::<Vec<_>>(), "names in joint order");
+    for (j, &n) in joints.iter().enumerate() {
+        let children: Vec<usize> = json["nodes"][n]["children"].as_array().map_or(Vec::new(), |c| {
+            c.iter().map(|k| joints.iter().position(|&x| x == k.as_u64().unwrap() as usize).unwrap()).collect()
+        });
+        assert_eq!(children, skeleton.children(j), "the hierarchy of joint {j}");
+    }
+    let ibm = read(&json, &bin, skin["inverseBindMatrices"].as_u64().unwrap() as usize);
+    let g = globals(&json);
+    let joint_matrices: Vec<Mat4> =
+        joints.iter().enumerate().map(|(j, &n)| g[n] * Mat4::from_cols_slice(&ibm[16 * j..16 * j + 16])).collect();
+    let primitive = &json["meshes"][0]["primitives"][0];
+    let attribute = |name: &str| read(&json, &bin, primitive["attributes"][name].as_u64().unwrap() as usize);
+    let (positions, joint_ids, weights) = (attribute("POSITION"), attribute("JOINTS_0"), attribute("WEIGHTS_0"));
+    assert_eq!(positions.len(), 3 * ours.len());
+    for (v, want) in ours.iter().enumerate() {
+        let p = Vec3::from_slice(&positions[3 * v..3 * v + 3]);
+        let mut got = Vec3::ZERO;
+        for k in 0..4 {
+            let w = weights[4 * v + k];
+            got += w * joint_matrices[joint_ids[4 * v + k] as usize].transform_point3(p);
+            if w > 0.0 {
+                let joint = joint_ids[4 * v + k] as usize;
+                assert!((puppet.skin.weights.weight(v, joint) - w).abs() < 1e-7, "the weights go out as they are");
+            }
+        }
+        assert!((got - *want).length() < 1e-5, "vertex {v}: {got} vs {want}");
+    }
+    assert_eq!(json["materials"][0]["pbrMetallicRoughness"]["baseColorFactor"][1].as_f64().unwrap() as f32, 0.4);
+}
+
+/// More than four influences (Model1 has up to 13) go out in further sets of four.
+#[test]
+#[cfg_attr(not(marionette_data), ignore = "needs MARIONETTE_DATA (the course data)")]
+fn more_than_four_influences_go_into_further_sets() {
+    let model = marionette::formats::load_character(&crate::common::data_dir().join("mit6837/Model1.skel")).unwrap();
+    let pose = model.skeleton.initial_pose();
+    let character = GltfCharacter {
+        name: "m",
+        asset: &model,
+        pose: &pose,
+        root: model.skeleton.joint(0).rest_offset,
+        translation: Vec3::ZERO,
+        yaw: 0.0,
+        scale: 1.0,
+        tint: [1.0; 3],
+    };
+    let (json, bin) = chunks(&write_glb(&[character], GltfMesh::Skinned));
+    let attributes = &json["meshes"][0]["primitives"][0]["attributes"];
+    let sets = model.skin.weights.max_influences().div_ceil(4);
+    assert!(sets > 1);
+    for s in 0..sets {
+        assert!(attributes.get(format!("WEIGHTS_{s}")).is_some(), "set {s}");
+    }
+    let total: f32 = (0..sets)
+        .map(|s| {
+            read(&json, &bin, attributes[format!("WEIGHTS_{s}")].as_u64().unwrap() as usize)[0..4].iter().sum::<f32>()
+        })
+        .sum();
+    assert!((total - 1.0).abs() < 1e-5, "vertex 0's weights over all sets sum to 1: {total}");
+}
