@@ -366,3 +366,32 @@ fn morph_weights_are_undone_and_survive_a_rebind() {
     app.update();
     assert_eq!(bind(&app), base, "undoing both puts the skin back");
 }
+
+/// Files dropped on the window: a BVH comes in as a character playing its motion, a scene
+/// file opens in place of the scene.
+#[test]
+fn dropped_files_add_characters_and_open_scenes() {
+    use marionette::editor::ui::{InspectorState, open_dropped_files};
+    use marionette::scene::keyframes::ClipPlayer;
+    let mut app = scene_app();
+    app.add_message::<bevy::window::FileDragAndDrop>()
+        .init_resource::<InspectorState>()
+        .add_systems(Update, open_dropped_files);
+    let drop = |app: &mut App, path: std::path::PathBuf| {
+        app.world_mut()
+            .write_message(bevy::window::FileDragAndDrop::DroppedFile { window: Entity::PLACEHOLDER, path_buf: path });
+        app.update();
+        app.update();
+    };
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
+    drop(&mut app, root.join("tests/data/steps.bvh"));
+    let names: Vec<String> =
+        app.world_mut().query::<&SceneCharacter>().iter(app.world()).map(|c| c.name.clone()).collect();
+    assert_eq!(names, ["steps"]);
+    assert_eq!(app.world_mut().query::<&ClipPlayer>().iter(app.world()).count(), 1, "playing its own motion");
+    drop(&mut app, root.join("assets/default_scene.ron"));
+    let mut names: Vec<String> =
+        app.world_mut().query::<&SceneCharacter>().iter(app.world()).map(|c| c.name.clone()).collect();
+    names.sort();
+    assert_eq!(names, ["Ada", "Bo", "Cy"], "the scene replaced the world");
+}

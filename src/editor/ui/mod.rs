@@ -116,7 +116,8 @@ impl Plugin for InspectorPlugin {
         app.init_resource::<InspectorState>()
             .init_resource::<ViewportArea>()
             .add_systems(PostUpdate, fit_camera_viewport)
-            .add_systems(EguiPrimaryContextPass, inspector_ui);
+            .add_systems(EguiPrimaryContextPass, inspector_ui)
+            .add_systems(Update, open_dropped_files);
     }
 }
 
@@ -169,6 +170,20 @@ fn inspector_ui(
         hold.panels = panels;
     }
     Ok(())
+}
+
+/// Files dropped on the window: a `.ron` opens as the scene, a `.anim` plays on the
+/// selected character, others are added as characters (and kept in the recent files).
+pub fn open_dropped_files(
+    mut drops: MessageReader<bevy::window::FileDragAndDrop>,
+    mut state: ResMut<InspectorState>,
+    mut panels: Panels,
+) {
+    for drop in drops.read() {
+        if let bevy::window::FileDragAndDrop::DroppedFile { path_buf, .. } = drop {
+            scene_panel::open_path(&path_buf.to_string_lossy(), &mut state, &mut panels);
+        }
+    }
 }
 
 /// The frame time (ms, smoothed) and frames per second in the viewport's top-right corner.

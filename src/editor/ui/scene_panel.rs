@@ -67,12 +67,12 @@ fn history_row(ui: &mut egui::Ui, panels: &mut Panels) {
 }
 
 fn add_row(ui: &mut egui::Ui, state: &mut InspectorState, panels: &mut Panels) {
-    ui.label("Add a character (.skel, SMPL folder, rig .json):");
+    ui.label("Add a character (.skel, .skin, SMPL folder, rig .json, .bvh), a clip for the selected one (.anim) or open a scene (.ron); or drop files on the window:");
     ui.horizontal(|ui| {
         ui.add(egui::TextEdit::singleline(&mut state.add_path).desired_width(220.0));
         if ui.button("Add").clicked() {
             let path = state.add_path.trim().to_string();
-            add_character(&path, state, panels);
+            open_path(&path, state, panels);
         }
     });
     ui.horizontal(|ui| {
@@ -91,7 +91,7 @@ fn add_row(ui: &mut egui::Ui, state: &mut InspectorState, panels: &mut Panels) {
         for r in state.recent.clone() {
             let label = Path::new(&r).file_name().map_or(r.clone(), |n| n.to_string_lossy().into_owned());
             if ui.small_button(label).on_hover_text(&r).clicked() {
-                add_character(&r, state, panels);
+                open_path(&r, state, panels);
             }
         }
     });
@@ -105,14 +105,25 @@ fn add_clip(path: &str, panels: &mut Panels) {
     }
 }
 
-/// Loads a character file (or a `.anim` clip for the selected one) and adds it right of the others, standing on the floor, and
+/// What a path given to the editor (typed in Add, or dropped on the window) does: a
+/// `.ron` opens as the scene, a `.anim` plays on the selected character, anything else is
+/// added as a character.
+pub fn open_path(path: &str, state: &mut InspectorState, panels: &mut Panels) {
+    if path.ends_with(".ron") {
+        crate::editor::document::open_scene_from(path, &mut panels.pending, &mut panels.messages);
+        state.scene_path = path.to_string();
+    } else if path.ends_with(".anim") {
+        add_clip(path, panels);
+    } else {
+        add_character(path, state, panels);
+    }
+}
+
+/// Loads a character file and adds it right of the others, standing on the floor, and
 /// selects it; errors go to the messages.
 fn add_character(path: &str, state: &mut InspectorState, panels: &mut Panels) {
     if path.is_empty() {
         return;
-    }
-    if path.ends_with(".anim") {
-        return add_clip(path, panels);
     }
     let source = SourceDoc::File(PathBuf::from(path));
     let asset = match panels.library.load(&source) {
