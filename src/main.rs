@@ -206,42 +206,6 @@ fn is_scene(path: &std::path::Path) -> bool {
     path.extension().is_some_and(|e| e.eq_ignore_ascii_case("ron"))
 }
 
-/// Every character of a scene document as glTF: its pose, its clip at its time, its
-/// placement and tint.
-fn scene_glb(doc: &marionette::formats::scene::SceneDoc, mesh: GltfMesh) -> Result<Vec<u8>> {
-    let mut library = marionette::editor::document::AssetLibrary::default();
-    let mut loaded = Vec::new();
-    for c in &doc.characters {
-        let asset = library.load_bound(&c.source, c.binding)?;
-        let (mut pose, notes) = marionette::editor::document::pose_from_doc(&asset, c);
-        notes.iter().for_each(|n| eprintln!("note: {n}"));
-        let mut root = asset.skeleton.joint(0).rest_offset;
-        if let Some(anim) = &c.anim {
-            let clip = match &anim.keys {
-                Some(keys) => keys.clone(),
-                None => marionette::formats::load_clip(&anim.file)?,
-            };
-            let (r, p) = clip.retargeted(&asset.skeleton, &anim.names).pose_at(&asset.skeleton, anim.time, &pose);
-            (root, pose) = (r, p);
-        }
-        loaded.push((c, asset, pose, root));
-    }
-    let characters: Vec<GltfCharacter> = loaded
-        .iter()
-        .map(|(c, asset, pose, root)| GltfCharacter {
-            name: &c.name,
-            asset,
-            pose,
-            root: *root,
-            translation: c.placement.translation,
-            yaw: c.placement.yaw,
-            scale: c.placement.scale,
-            tint: c.view.tint,
-        })
-        .collect();
-    Ok(write_glb(&characters, mesh))
-}
-
 /// A finite number of seconds.
 fn finite_seconds(text: &str) -> Result<f32, String> {
     match text.parse::<f32>() {
@@ -271,7 +235,8 @@ fn run(cli: Cli) -> Result<()> {
         Some(Command::Info { path }) => print!("{}", describe(&load_character(&path)?)),
         Some(Command::Export { path, out, bake, .. }) if is_glb(&out) && is_scene(&path) => {
             let doc = marionette::editor::document::read_scene(&path)?;
-            let glb = scene_glb(&doc, if bake { GltfMesh::Baked } else { GltfMesh::Skinned })?;
+            let glb =
+                marionette::editor::export::scene_glb(&doc, if bake { GltfMesh::Baked } else { GltfMesh::Skinned })?;
             write_file(&out, |w| w.write_all(&glb))?;
             println!("wrote {} ({} characters)", out.display(), doc.characters.len());
         }

@@ -19,6 +19,7 @@ pub mod crowd;
 pub mod default_scene;
 pub mod document;
 pub mod draw;
+pub mod export;
 pub mod history;
 pub mod ik_drag;
 pub mod picking;

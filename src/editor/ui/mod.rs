@@ -3,6 +3,7 @@
 //! writes the scene itself.
 
 pub mod clip_panel;
+pub mod dialogs;
 pub mod joint_panel;
 pub mod keyframe_panel;
 pub mod pose_panel;
@@ -41,6 +42,8 @@ pub struct InspectorState {
     pub copied_pose: Vec<(String, crate::rig::JointRotation)>,
     /// The name "Keep pose" keeps the pose under.
     pub pose_name: String,
+    /// The file dialog.
+    pub dialogs: dialogs::FileDialogs,
 }
 
 impl Default for InspectorState {
@@ -55,6 +58,7 @@ impl Default for InspectorState {
             anim_path: format!("{cwd}/keys.anim"),
             copied_pose: Vec::new(),
             pose_name: "pose 1".into(),
+            dialogs: Default::default(),
             active_dof: None,
             crowd_size: 16,
         }
@@ -153,6 +157,7 @@ fn inspector_ui(
     let central = ui.available_rect_before_wrap();
     let area = ViewportArea(Some(Rect::new(central.min.x, central.min.y, central.max.x, central.max.y)));
     viewport_area.set_if_neq(area);
+    dialogs::show(&ctx, &mut state, &mut panels, &mut shot);
     frame_time_readout(&ctx, central, &overlays.diagnostics);
     hovered_joint_tooltip(&ctx, &panels, &overlays.hovered);
     if let Some(text) = state.active_dof.as_ref().or(overlays.gizmo.readout.as_ref()) {

@@ -7,6 +7,7 @@ use std::path::{Path, PathBuf};
 use bevy::prelude::*;
 use bevy_egui::egui;
 
+use super::dialogs::DialogPurpose;
 use super::{InspectorState, Panels};
 use crate::editor::arrange::{beside, rescaled_keeping_feet};
 use crate::editor::commands::Edit;
@@ -36,7 +37,7 @@ pub fn scene_panel(ui: &mut egui::Ui, state: &mut InspectorState, panels: &mut P
     ui.separator();
     stage_rows(ui, panels);
     ui.separator();
-    screenshot_rows(ui, shot);
+    screenshot_rows(ui, state, shot);
     ui.separator();
     messages(ui, panels);
 }
@@ -49,6 +50,18 @@ fn scene_file_row(ui: &mut egui::Ui, state: &mut InspectorState, panels: &mut Pa
         }
         if ui.button("Open").on_hover_text("Ctrl+O").clicked() {
             open_scene_from(&state.scene_path, &mut panels.pending, &mut panels.messages);
+        }
+    });
+    ui.horizontal(|ui| {
+        let near = state.scene_path.clone();
+        if ui.button("Open…").clicked() {
+            state.dialogs.open(DialogPurpose::OpenScene, &near);
+        }
+        if ui.button("Save as…").clicked() {
+            state.dialogs.open(DialogPurpose::SaveScene, &near);
+        }
+        if ui.button("Export glTF…").clicked() {
+            state.dialogs.open(DialogPurpose::ExportGltf, &near);
         }
     });
 }
@@ -73,6 +86,10 @@ fn add_row(ui: &mut egui::Ui, state: &mut InspectorState, panels: &mut Panels) {
         if ui.button("Add").clicked() {
             let path = state.add_path.trim().to_string();
             open_path(&path, state, panels);
+        }
+        if ui.button("…").on_hover_text("choose a file").clicked() {
+            let near = state.add_path.clone();
+            state.dialogs.open(DialogPurpose::AddFile, &near);
         }
     });
     ui.horizontal(|ui| {
@@ -358,11 +375,15 @@ fn stage_rows(ui: &mut egui::Ui, panels: &mut Panels) {
     ui.label("S cycles mesh / skeleton / both; F frames the selection; click a joint to select it.");
 }
 
-fn screenshot_rows(ui: &mut egui::Ui, shot: &mut ScreenshotRequest) {
+fn screenshot_rows(ui: &mut egui::Ui, state: &mut InspectorState, shot: &mut ScreenshotRequest) {
     ui.heading("Screenshot");
     ui.horizontal(|ui| {
         ui.label("Folder");
-        ui.text_edit_singleline(&mut shot.dir_text);
+        ui.add(egui::TextEdit::singleline(&mut shot.dir_text).desired_width(150.0));
+        if ui.button("…").on_hover_text("choose the folder").clicked() {
+            let near = format!("{}/", shot.dir_text);
+            state.dialogs.open(DialogPurpose::ScreenshotFolder, &near);
+        }
     });
     ui.checkbox(&mut shot.with_panels, "include the panels");
     if ui.button("Save screenshot (F12)").clicked() {

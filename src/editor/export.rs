@@ -1,0 +1,42 @@
+//! Exporting a scene: every character of a document as glTF, posed by its pose and its
+//! clip at its time, placed and tinted.
+
+use crate::formats::FormatError;
+use crate::formats::gltf::{GltfCharacter, GltfMesh, write_glb};
+use crate::formats::scene::SceneDoc;
+
+/// Every character of a scene document as glTF: its pose, its clip at its time, its
+/// placement and tint.
+pub fn scene_glb(doc: &SceneDoc, mesh: GltfMesh) -> Result<Vec<u8>, FormatError> {
+    let mut library = super::document::AssetLibrary::default();
+    let mut loaded = Vec::new();
+    for c in &doc.characters {
+        let asset = library.load_bound(&c.source, c.binding)?;
+        let (mut pose, notes) = super::document::pose_from_doc(&asset, c);
+        notes.iter().for_each(|n| bevy::log::warn!("{n}"));
+        let mut root = asset.skeleton.joint(0).rest_offset;
+        if let Some(anim) = &c.anim {
+            let clip = match &anim.keys {
+                Some(keys) => keys.clone(),
+                None => crate::formats::load_clip(&anim.file)?,
+            };
+            let (r, p) = clip.retargeted(&asset.skeleton, &anim.names).pose_at(&asset.skeleton, anim.time, &pose);
+            (root, pose) = (r, p);
+        }
+        loaded.push((c, asset, pose, root));
+    }
+    let characters: Vec<GltfCharacter> = loaded
+        .iter()
+        .map(|(c, asset, pose, root)| GltfCharacter {
+            name: &c.name,
+            asset,
+            pose,
+            root: *root,
+            translation: c.placement.translation,
+            yaw: c.placement.yaw,
+            scale: c.placement.scale,
+            tint: c.view.tint,
+        })
+        .collect();
+    Ok(write_glb(&characters, mesh))
+}
