@@ -1,17 +1,38 @@
-//! Exporting a scene: every character of a document as glTF, posed by its pose and its
-//! clip at its time, placed and tinted.
+//! Exporting a scene: every character of a document as glTF, shaped (SMPL β, morph
+//! weights), posed by its pose and its keyframed clip at its time, placed and tinted.
 
 use crate::formats::FormatError;
 use crate::formats::gltf::{GltfCharacter, GltfMesh, write_glb};
 use crate::formats::scene::SceneDoc;
 
-/// Every character of a scene document as glTF: its pose, its clip at its time, its
-/// placement and tint.
+/// A character's asset as the document shapes it: an SMPL body by its β, a mesh with morph
+/// targets by their weights.
+fn shaped(
+    library: &mut super::document::AssetLibrary,
+    c: &crate::formats::scene::CharacterDoc,
+) -> Result<std::sync::Arc<crate::rig::CharacterAsset>, FormatError> {
+    let mut asset = library.load_bound(&c.source, c.binding)?;
+    if let (Some(smpl), crate::formats::scene::SourceDoc::File(dir)) = (&c.smpl, &c.source)
+        && !smpl.betas.is_empty()
+    {
+        let set = library.smpl(dir)?;
+        asset = std::sync::Arc::new(set.model.asset(&c.name, &smpl.betas).map_err(|e| FormatError::rig(dir, e))?);
+    }
+    if !c.morphs.is_empty() && !asset.morphs.is_empty() {
+        let mut morphed = (*asset).clone();
+        morphed.skin.bind_positions = asset.morphed_positions(&c.morphs);
+        asset = std::sync::Arc::new(morphed);
+    }
+    Ok(asset)
+}
+
+/// Every character of a scene document as glTF: its shape, its pose, its keyframed clip at
+/// its time, its placement and tint.
 pub fn scene_glb(doc: &SceneDoc, mesh: GltfMesh) -> Result<Vec<u8>, FormatError> {
     let mut library = super::document::AssetLibrary::default();
     let mut loaded = Vec::new();
     for c in &doc.characters {
-        let asset = library.load_bound(&c.source, c.binding)?;
+        let asset = shaped(&mut library, c)?;
         let (mut pose, notes) = super::document::pose_from_doc(&asset, c);
         notes.iter().for_each(|n| bevy::log::warn!("{n}"));
         let mut root = asset.skeleton.joint(0).rest_offset;

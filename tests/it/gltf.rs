@@ -156,3 +156,29 @@ fn more_than_four_influences_go_into_further_sets() {
         .sum();
     assert!((total - 1.0).abs() < 1e-5, "vertex 0's weights over all sets sum to 1: {total}");
 }
+
+/// A scene's SMPL body goes out in its shape (β), not the mean one.
+#[test]
+#[cfg_attr(not(marionette_data), ignore = "needs MARIONETTE_DATA (the course data)")]
+fn a_scene_exports_its_smpl_body_in_its_shape() {
+    use marionette::formats::scene::{CharacterDoc, SceneDoc, SmplDoc, SourceDoc};
+    let dir = crate::common::data_dir().join("smpl");
+    let betas = vec![2.0, -1.0];
+    let body = CharacterDoc {
+        smpl: Some(SmplDoc { betas: betas.clone(), ..SmplDoc::default() }),
+        ..CharacterDoc::new(SourceDoc::File(dir.clone()), "b")
+    };
+    let doc = SceneDoc { characters: vec![body], ..SceneDoc::default() };
+    let (json, bin) = chunks(&marionette::editor::export::scene_glb(&doc, GltfMesh::Skinned).unwrap());
+    let positions =
+        read(&json, &bin, json["meshes"][0]["primitives"][0]["attributes"]["POSITION"].as_u64().unwrap() as usize);
+    let (model, _) = marionette::formats::smpl::load_smpl_dir(&dir).unwrap();
+    let shaped = model.asset("b", &betas).unwrap();
+    let mean = model.asset("b", &[]).unwrap();
+    let at = |v: usize| Vec3::from_slice(&positions[3 * v..3 * v + 3]);
+    assert!((0..shaped.vertex_count()).all(|v| (at(v) - shaped.skin.bind_positions[v]).length() < 1e-6));
+    assert!(
+        (0..mean.vertex_count()).any(|v| (at(v) - mean.skin.bind_positions[v]).length() > 1e-3),
+        "not the mean shape"
+    );
+}
