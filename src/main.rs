@@ -59,6 +59,10 @@ enum Command {
         /// with its skeleton.
         #[arg(long)]
         bake: bool,
+        /// With `--out X.glb`: keyframed clips (a scene's, or `--anim`) go out as glTF
+        /// animations, sampled at 30 frames per second.
+        #[arg(long)]
+        animation: bool,
     },
     /// Bind a mesh without weights to a skeleton (each vertex to its nearest bone, or
     /// smoothly to the nearest few) and write 6.837-style weights.
@@ -233,22 +237,26 @@ fn run(cli: Cli) -> Result<()> {
             marionette::editor::run(paths, edits)
         }
         Some(Command::Info { path }) => print!("{}", describe(&load_character(&path)?)),
-        Some(Command::Export { path, out, bake, .. }) if is_glb(&out) && is_scene(&path) => {
+        Some(Command::Export { path, out, bake, animation, .. }) if is_glb(&out) && is_scene(&path) => {
             let doc = marionette::editor::document::read_scene(&path)?;
-            let glb =
-                marionette::editor::export::scene_glb(&doc, if bake { GltfMesh::Baked } else { GltfMesh::Skinned })?;
+            let mesh = if bake { GltfMesh::Baked } else { GltfMesh::Skinned };
+            let glb = marionette::editor::export::scene_glb(&doc, mesh, animation)?;
             write_file(&out, |w| w.write_all(&glb))?;
             println!("wrote {} ({} characters)", out.display(), doc.characters.len());
         }
-        Some(Command::Export { path, out, poses, ik, skinning, clip, bake }) => {
+        Some(Command::Export { path, out, poses, ik, skinning, clip, bake, animation }) => {
             let asset = load_character(&path)?;
             for w in &asset.warnings {
                 eprintln!("warning: {w}");
             }
             let mut pose = asset.skeleton.initial_pose();
             let mut origin = Mat4::IDENTITY;
+            let mut motion = None;
             if let Some(file) = &clip.anim {
                 let anim = marionette::formats::load_clip(file)?.retargeted(&asset.skeleton, &Default::default());
+                if animation {
+                    motion = Some(marionette::editor::export::sampled(&anim, &asset.skeleton, &pose));
+                }
                 let (root, clip_pose) = anim.pose_at(&asset.skeleton, clip.time.unwrap_or(0.0), &pose);
                 pose = clip_pose;
                 let root_offset = asset.skeleton.joint(0).rest_offset;
@@ -270,6 +278,7 @@ fn run(cli: Cli) -> Result<()> {
                     yaw: 0.0,
                     scale: 1.0,
                     tint: [0.85, 0.75, 0.62],
+                    motion,
                 };
                 let glb = write_glb(&[character], if bake { GltfMesh::Baked } else { GltfMesh::Skinned });
                 write_file(&out, |w| w.write_all(&glb))?;

@@ -21,6 +21,17 @@ pub struct GltfCharacter<'a> {
     pub yaw: f32,
     pub scale: f32,
     pub tint: [f32; 3],
+    /// Poses over time, written as a glTF animation of the joints (skinned meshes only).
+    pub motion: Option<Motion>,
+}
+
+/// A character's motion sampled at `times` (seconds): each time's pose (one rotation per
+/// joint) and root translation.
+#[derive(Debug, Clone, Default)]
+pub struct Motion {
+    pub times: Vec<f32>,
+    pub poses: Vec<Vec<JointRotation>>,
+    pub roots: Vec<Vec3>,
 }
 
 /// How the meshes go out.
@@ -83,6 +94,7 @@ impl Builder {
 pub fn write_glb(characters: &[GltfCharacter], mesh: GltfMesh) -> Vec<u8> {
     let mut b = Builder::default();
     let (mut meshes, mut skins, mut materials, mut roots) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
+    let mut animations = Vec::new();
     for c in characters {
         let placement = b.node(json!({
             "name": c.name,
@@ -149,6 +161,9 @@ pub fn write_glb(characters: &[GltfCharacter], mesh: GltfMesh) -> Vec<u8> {
                     None,
                     json!({ "componentType": FLOAT, "count": joints.len(), "type": "MAT4" }),
                 );
+                if let Some(motion) = c.motion.as_ref().filter(|m| !m.times.is_empty()) {
+                    animations.push(animation(&mut b, c.name, motion, &joints));
+                }
                 mesh_node["skin"] = json!(skins.len());
                 skins.push(
                     json!({ "name": c.name, "joints": joints, "skeleton": joints[0], "inverseBindMatrices": ibm }),
@@ -184,7 +199,43 @@ pub fn write_glb(characters: &[GltfCharacter], mesh: GltfMesh) -> Vec<u8> {
     if !skins.is_empty() {
         doc["skins"] = json!(skins);
     }
+    if !animations.is_empty() {
+        doc["animations"] = json!(animations);
+    }
     glb(&serde_json::to_vec(&doc).expect("a JSON value serialises"), &b.bin)
+}
+
+/// A glTF animation of the joint nodes `joints`: every joint's rotation and the root's
+/// translation at the motion's times, linear between them.
+fn animation(b: &mut Builder, name: &str, motion: &Motion, joints: &[usize]) -> Value {
+    let floats = |v: &mut dyn Iterator<Item = f32>| v.flat_map(f32::to_le_bytes).collect::<Vec<u8>>();
+    let (first, last) = (motion.times[0], motion.times[motion.times.len() - 1]);
+    let input = b.accessor(
+        &floats(&mut motion.times.iter().copied()),
+        None,
+        json!({ "componentType": FLOAT, "count": motion.times.len(), "type": "SCALAR", "min": [first], "max": [last] }),
+    );
+    let mut samplers = Vec::new();
+    let mut channels = Vec::new();
+    let mut add = |b: &mut Builder, node: usize, path: &str, values: Vec<u8>, kind: &str| {
+        let output =
+            b.accessor(&values, None, json!({ "componentType": FLOAT, "count": motion.times.len(), "type": kind }));
+        samplers.push(json!({ "input": input, "output": output, "interpolation": "LINEAR" }));
+        channels.push(json!({ "sampler": samplers.len() - 1, "target": { "node": node, "path": path } }));
+    };
+    add(b, joints[0], "translation", floats(&mut motion.roots.iter().flat_map(|r| r.to_array())), "VEC3");
+    for (j, &node) in joints.iter().enumerate() {
+        // Each quaternion on the side of the previous one: linear blending takes the short way.
+        let mut previous = Quat::IDENTITY;
+        let rotations = motion.poses.iter().map(|pose| {
+            let q = pose.get(j).map_or(Quat::IDENTITY, JointRotation::to_quat);
+            previous = if q.dot(previous) < 0.0 { -q } else { q };
+            previous
+        });
+        let bytes = floats(&mut rotations.flat_map(|q| q.to_array()));
+        add(b, node, "rotation", bytes, "VEC4");
+    }
+    json!({ "name": name, "samplers": samplers, "channels": channels })
 }
 
 /// Where the matrix stack starts for a character: its root moved from its offset to `root`.

@@ -79,6 +79,7 @@ fn an_exported_character_skins_back_to_our_vertices_with_its_names_and_weights()
         yaw: 0.6,
         scale: 1.5,
         tint: [0.2, 0.4, 0.6],
+        motion: None,
     };
     let (json, bin) = chunks(&write_glb(&[character], GltfMesh::Skinned));
 
@@ -141,6 +142,7 @@ fn more_than_four_influences_go_into_further_sets() {
         yaw: 0.0,
         scale: 1.0,
         tint: [1.0; 3],
+        motion: None,
     };
     let (json, bin) = chunks(&write_glb(&[character], GltfMesh::Skinned));
     let attributes = &json["meshes"][0]["primitives"][0]["attributes"];
@@ -169,7 +171,7 @@ fn a_scene_exports_its_smpl_body_in_its_shape() {
         ..CharacterDoc::new(SourceDoc::File(dir.clone()), "b")
     };
     let doc = SceneDoc { characters: vec![body], ..SceneDoc::default() };
-    let (json, bin) = chunks(&marionette::editor::export::scene_glb(&doc, GltfMesh::Skinned).unwrap());
+    let (json, bin) = chunks(&marionette::editor::export::scene_glb(&doc, GltfMesh::Skinned, false).unwrap());
     let positions =
         read(&json, &bin, json["meshes"][0]["primitives"][0]["attributes"]["POSITION"].as_u64().unwrap() as usize);
     let (model, _) = marionette::formats::smpl::load_smpl_dir(&dir).unwrap();
@@ -181,4 +183,50 @@ fn a_scene_exports_its_smpl_body_in_its_shape() {
         (0..mean.vertex_count()).any(|v| (at(v) - mean.skin.bind_positions[v]).length() > 1e-3),
         "not the mean shape"
     );
+}
+
+/// A clip goes out as a glTF animation: at each sampled time the root's translation and
+/// every joint's rotation are the clip's there.
+#[test]
+#[cfg_attr(not(marionette_data), ignore = "needs MARIONETTE_DATA (the course data)")]
+fn a_clip_goes_out_as_an_animation_of_the_joints() {
+    let data = crate::common::data_dir().join("cse169/project3");
+    let wasp = marionette::formats::load_character(&data.join("wasp.skel")).unwrap();
+    let clip = marionette::formats::load_clip(&data.join("wasp_walk.anim")).unwrap();
+    let rest = wasp.skeleton.initial_pose();
+    let motion = marionette::editor::export::sampled(&clip, &wasp.skeleton, &rest);
+    assert_eq!(motion.times.len(), 121, "4 s at 30 frames per second, both ends");
+    let character = GltfCharacter {
+        name: "w",
+        asset: &wasp,
+        pose: &rest,
+        root: wasp.skeleton.joint(0).rest_offset,
+        translation: Vec3::ZERO,
+        yaw: 0.0,
+        scale: 1.0,
+        tint: [1.0; 3],
+        motion: Some(motion),
+    };
+    let (json, bin) = chunks(&write_glb(&[character], GltfMesh::Skinned));
+    let animation = &json["animations"][0];
+    let joints: Vec<u64> = json["skins"][0]["joints"].as_array().unwrap().iter().map(|j| j.as_u64().unwrap()).collect();
+    let sampler = |c: &serde_json::Value| &animation["samplers"][c["sampler"].as_u64().unwrap() as usize];
+    let times = read(&json, &bin, sampler(&animation["channels"][0])["input"].as_u64().unwrap() as usize);
+    for frame in [0usize, 37, 75, 120] {
+        let t = times[frame];
+        let (root, pose) = clip.pose_at(&wasp.skeleton, t, &rest);
+        for channel in animation["channels"].as_array().unwrap() {
+            let node = channel["target"]["node"].as_u64().unwrap();
+            let j = joints.iter().position(|&n| n == node).unwrap();
+            let out = read(&json, &bin, sampler(channel)["output"].as_u64().unwrap() as usize);
+            match channel["target"]["path"].as_str().unwrap() {
+                "translation" => assert!((Vec3::from_slice(&out[3 * frame..3 * frame + 3]) - root).length() < 1e-6),
+                "rotation" => {
+                    let q = Quat::from_slice(&out[4 * frame..4 * frame + 4]);
+                    assert!(q.dot(pose[j].to_quat()).abs() > 1.0 - 1e-6, "joint {j} at {t}");
+                }
+                other => panic!("{other}"),
+            }
+        }
+    }
 }
