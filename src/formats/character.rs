@@ -21,6 +21,8 @@ pub enum CharacterSource {
     Homer { json: PathBuf },
     /// A BVH motion capture file: its skeleton as bone boxes.
     Bvh { path: PathBuf },
+    /// A glTF 2.0 file (`.glb`, `.gltf`): its first skinned mesh.
+    Gltf { path: PathBuf },
 }
 
 impl CharacterSource {
@@ -39,6 +41,7 @@ impl CharacterSource {
             }
             Some("json") => Ok(Self::Homer { json: path.to_path_buf() }),
             Some("bvh") => Ok(Self::Bvh { path: path.to_path_buf() }),
+            Some("glb" | "gltf") => Ok(Self::Gltf { path: path.to_path_buf() }),
             Some("skin") => {
                 let skel = path.with_extension("skel");
                 if !skel.is_file() {
@@ -87,6 +90,7 @@ pub fn load_skeleton(path: &Path) -> Result<Skeleton, FormatError> {
         CharacterSource::Homer { json } => Ok(super::homer::parse_rig(open(&json)?, &json)?.skeleton),
         CharacterSource::Smpl { dir } => Ok(super::smpl::load_smpl_dir(&dir)?.0.skeleton),
         CharacterSource::Bvh { path } => Ok(super::bvh::parse_bvh(open(&path)?, &path)?.skeleton),
+        CharacterSource::Gltf { path } => Ok(super::gltf_import::load_gltf(&path)?.skeleton),
     }
 }
 
@@ -107,6 +111,7 @@ pub fn load_character(path: &Path) -> Result<CharacterAsset, FormatError> {
             let skeleton = super::bvh::parse_bvh(open(&path)?, &path)?.skeleton;
             Ok(CharacterAsset::with_bone_boxes(name, skeleton, Vec::new()))
         }
+        CharacterSource::Gltf { path } => super::gltf_import::load_gltf(&path),
         CharacterSource::Smpl { dir } => {
             let (model, warnings) = super::smpl::load_smpl_dir(&dir)?;
             let mut asset = model.asset(&name, &[]).map_err(|e| FormatError::rig(&dir, e))?;

@@ -9,6 +9,7 @@ pub mod cse169;
 pub mod cse169_skin;
 pub mod error;
 pub mod gltf;
+pub mod gltf_import;
 pub mod homer;
 pub mod mit6837;
 pub mod obj;

@@ -43,6 +43,7 @@ enum Reader {
     },
     Cse169Anim,
     Bvh,
+    Glb,
     Obj,
     Off,
     SmplHierarchy,
@@ -67,6 +68,7 @@ fn read(reader: Reader, bytes: &[u8]) -> Result<(), FormatError> {
         Reader::Cse169Morph { vertices } => cse169_skin::parse_morph(input, path, vertices).map(drop),
         Reader::Cse169Anim => cse169_skin::parse_anim(input, path).map(drop),
         Reader::Bvh => bvh::parse_bvh(input, path).map(drop),
+        Reader::Glb => marionette::formats::gltf_import::parse_gltf(bytes, path).map(drop),
         Reader::Obj => obj::parse_obj(input, path).map(drop),
         Reader::Off => off::parse_off(input, path).map(drop),
         Reader::SmplHierarchy => smpl::parse_hierarchy(input, path).map(drop),
@@ -192,6 +194,11 @@ fn file_seeds() -> Vec<Seed> {
         seed(Reader::Obj, assets.join("puppet.obj")),
         seed(Reader::Scene, assets.join("default_scene.ron")),
         seed(Reader::Bvh, Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/steps.bvh")),
+        Seed {
+            reader: Reader::Glb,
+            bytes: std::fs::read(Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/blender_arm.glb")).unwrap(),
+            whole: true,
+        },
         attach(assets.join("puppet.skel"), assets.join("puppet.attach")),
     ];
     let Some(data) = optional_data_dir() else { return seeds };

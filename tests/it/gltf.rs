@@ -230,3 +230,89 @@ fn a_clip_goes_out_as_an_animation_of_the_joints() {
         }
     }
 }
+
+/// Marionette → glb → Marionette: the same skinned vertices, joint names, hierarchy and
+/// weights.
+#[test]
+fn a_round_trip_through_glb_keeps_vertices_names_hierarchy_and_weights() {
+    let puppet = marionette::formats::puppet::embedded_puppet();
+    let skeleton = &puppet.skeleton;
+    let mut pose = skeleton.initial_pose();
+    pose[skeleton.find("r_shoulder").unwrap()] = JointRotation::euler_xyz(0.4, 0.2, -1.0);
+    pose[skeleton.find("l_knee").unwrap()] = JointRotation::euler_xyz(0.9, 0.0, 0.0);
+    let character = GltfCharacter {
+        name: "p",
+        asset: &puppet,
+        pose: &pose,
+        root: skeleton.joint(0).rest_offset,
+        translation: Vec3::ZERO,
+        yaw: 0.0,
+        scale: 1.0,
+        tint: [1.0; 3],
+        motion: None,
+    };
+    let path = crate::common::scratch("gltf-round-trip").join("p.glb");
+    std::fs::write(&path, write_glb(&[character], GltfMesh::Skinned)).unwrap();
+    let back = marionette::formats::load_character(&path).unwrap();
+    let names =
+        |s: &marionette::rig::Skeleton| s.joints().iter().map(|j| (j.name.clone(), j.parent)).collect::<Vec<_>>();
+    assert_eq!(names(&back.skeleton), names(skeleton), "names and hierarchy");
+    let ours = marionette::cli::posing::posed_positions(&puppet, &pose, Mat4::IDENTITY);
+    let theirs = marionette::cli::posing::posed_positions(&back, &back.skeleton.initial_pose(), Mat4::IDENTITY);
+    let worst = ours.iter().zip(&theirs).map(|(a, b)| a.distance(*b)).fold(0.0f32, f32::max);
+    assert!(worst <= 1e-5, "skinned vertices differ by {worst}");
+    for v in 0..puppet.vertex_count() {
+        for j in 0..skeleton.len() {
+            assert!((puppet.skin.weights.weight(v, j) - back.skin.weights.weight(v, j)).abs() < 1e-6, "weight {v} {j}");
+        }
+    }
+}
+
+/// A rigged arm made and exported by Blender 5 (`scripts/make_gltf_fixture.py`: bones with
+/// rest rotations, automatic weights, a pose): loaded here, it deforms as Blender deforms
+/// it (`tests/data/blender_arm.txt`, vertex by vertex).
+#[test]
+fn a_blender_made_glb_deforms_as_blender_deforms_it() {
+    let data = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data");
+    let arm = marionette::formats::load_character(&data.join("blender_arm.glb")).unwrap();
+    assert_eq!(arm.skeleton.joints().iter().map(|j| j.name.as_str()).collect::<Vec<_>>(), ["upper", "lower"]);
+    let ours = marionette::cli::posing::posed_positions(&arm, &arm.skeleton.initial_pose(), Mat4::IDENTITY);
+    let blender: Vec<Vec3> = std::fs::read_to_string(data.join("blender_arm.txt"))
+        .unwrap()
+        .lines()
+        .map(|l| {
+            let v: Vec<f32> = l.split_whitespace().map(|x| x.parse().unwrap()).collect();
+            Vec3::new(v[0], v[1], v[2])
+        })
+        .collect();
+    assert_eq!(ours.len(), blender.len());
+    let worst = ours.iter().zip(&blender).map(|(a, b)| a.distance(*b)).fold(0.0f32, f32::max);
+    assert!(worst <= 1e-5, "{worst}");
+}
+
+#[test]
+fn bad_gltf_files_say_what_and_where() {
+    let dir = crate::common::scratch("gltf-bad");
+    let not = dir.join("not.glb");
+    std::fs::write(&not, b"glTF nonsense").unwrap();
+    let e = marionette::formats::load_character(&not).unwrap_err().to_string();
+    assert!(e.contains("not.glb") && e.contains("glTF"), "{e}");
+    // A valid file without a skin: the baked export.
+    let puppet = marionette::formats::puppet::embedded_puppet();
+    let pose = puppet.skeleton.initial_pose();
+    let character = GltfCharacter {
+        name: "p",
+        asset: &puppet,
+        pose: &pose,
+        root: puppet.skeleton.joint(0).rest_offset,
+        translation: Vec3::ZERO,
+        yaw: 0.0,
+        scale: 1.0,
+        tint: [1.0; 3],
+        motion: None,
+    };
+    let baked = dir.join("baked.glb");
+    std::fs::write(&baked, write_glb(&[character], GltfMesh::Baked)).unwrap();
+    let e = marionette::formats::load_character(&baked).unwrap_err().to_string();
+    assert!(e.contains("baked.glb") && e.contains("skins[0]"), "{e}");
+}
