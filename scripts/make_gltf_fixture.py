@@ -9,19 +9,29 @@ exported vertex order). The test loads the .glb with Marionette and compares.
 Needs `pip install bpy`.
 """
 import sys
-from math import radians
+from math import cos, pi, radians, sin
 from pathlib import Path
 
 import bpy
 
 out = Path(sys.argv[1])
 bpy.ops.wm.read_factory_settings(use_empty=True)
-bpy.ops.mesh.primitive_cylinder_add(vertices=16, radius=0.15, depth=2.0, location=(0, 0, 1))
-arm_mesh = bpy.context.object
-arm_mesh.name = "arm"
-bpy.ops.object.mode_set(mode="EDIT")
-bpy.ops.mesh.loopcut_slide(MESH_OT_loopcut={"number_cuts": 9, "edge_index": 1})
-bpy.ops.object.mode_set(mode="OBJECT")
+# A tube of 11 rings of 16 vertices from z = 0 to 2, so it bends where the bones meet.
+SEGMENTS, RINGS = 16, 11
+verts = [
+    (0.15 * cos(2 * pi * s / SEGMENTS), 0.15 * sin(2 * pi * s / SEGMENTS), 2.0 * r / (RINGS - 1))
+    for r in range(RINGS)
+    for s in range(SEGMENTS)
+]
+faces = [
+    (r * SEGMENTS + s, r * SEGMENTS + (s + 1) % SEGMENTS, (r + 1) * SEGMENTS + (s + 1) % SEGMENTS, (r + 1) * SEGMENTS + s)
+    for r in range(RINGS - 1)
+    for s in range(SEGMENTS)
+]
+mesh_data = bpy.data.meshes.new("arm")
+mesh_data.from_pydata(verts, [], faces)
+arm_mesh = bpy.data.objects.new("arm", mesh_data)
+bpy.context.scene.collection.objects.link(arm_mesh)
 
 armature = bpy.data.armatures.new("rig")
 rig = bpy.data.objects.new("rig", armature)
@@ -46,7 +56,9 @@ rig.pose.bones["upper"].rotation_euler = (radians(-15), 0, radians(10))
 bpy.context.view_layer.update()
 
 glb = out / "blender_arm.glb"
-bpy.ops.export_scene.gltf(filepath=str(glb), export_format="GLB", export_animations=False, export_apply=False)
+bpy.ops.export_scene.gltf(
+    filepath=str(glb), export_format="GLB", export_animations=False, export_rest_position_armature=False
+)
 
 # Read back what was exported, deformed by Blender, in the exported vertex order.
 bpy.ops.wm.read_factory_settings(use_empty=True)
