@@ -21,8 +21,8 @@ pub fn load_gltf(path: &Path) -> Result<CharacterAsset, FormatError> {
 /// The first skinned mesh of a glTF file's bytes (`.bin` files are looked for beside
 /// `path`).
 pub fn parse_gltf(bytes: &[u8], path: &Path) -> Result<CharacterAsset, FormatError> {
-    let gltf = gltf::Gltf::from_slice(bytes)
-        .map_err(|e| FormatError::other(path, format!("at $: expected glTF 2.0, {e}")))?;
+    let gltf =
+        gltf::Gltf::from_slice(bytes).map_err(|e| FormatError::other(path, format!("at $: expected glTF 2.0, {e}")))?;
     if let Some(ext) = gltf.extensions_required().next() {
         return Err(FormatError::other(path, format!("at $.extensionsRequired: needs `{ext}`, which is not read")));
     }
