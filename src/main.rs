@@ -7,7 +7,7 @@ use anyhow::{Context, Result};
 use clap::{Parser, Subcommand};
 use std::io::Write;
 
-use glam::{Mat4, Vec3};
+use glam::Mat4;
 use marionette::formats::gltf::{GltfCharacter, GltfMesh, write_glb};
 
 use marionette::cli::posing::{
@@ -269,17 +269,7 @@ fn run(cli: Cli) -> Result<()> {
             if is_glb(&out) {
                 let name = asset.name.clone();
                 let root = origin.transform_point3(asset.skeleton.joint(0).rest_offset);
-                let character = GltfCharacter {
-                    name: &name,
-                    asset: &asset,
-                    pose: &pose,
-                    root,
-                    translation: Vec3::ZERO,
-                    yaw: 0.0,
-                    scale: 1.0,
-                    tint: [0.85, 0.75, 0.62],
-                    motion,
-                };
+                let character = GltfCharacter { root, motion, ..GltfCharacter::new(&name, &asset, &pose) };
                 let glb = write_glb(&[character], if bake { GltfMesh::Baked } else { GltfMesh::Skinned });
                 write_file(&out, |w| w.write_all(&glb))?;
                 println!(

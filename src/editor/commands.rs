@@ -102,6 +102,18 @@ impl Edit {
     }
 }
 
+impl Edit {
+    /// Whether `self` and `other` set the same thing (within a gesture, only the first
+    /// value of each thing is kept): the same kind of edit of the same character, or the
+    /// same pose of the library. Poses, adds and removes are judged by the history itself.
+    pub fn same_slot(&self, other: &Edit) -> bool {
+        match (self, other) {
+            (Edit::Library { name: a, .. }, Edit::Library { name: b, .. }) => a == b,
+            _ => std::mem::discriminant(self) == std::mem::discriminant(other) && self.character() == other.character(),
+        }
+    }
+}
+
 /// Edits waiting for this frame's `Animate`.
 #[derive(Resource, Default, Debug)]
 pub struct EditQueue(pub Vec<Edit>);

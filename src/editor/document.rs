@@ -208,7 +208,6 @@ pub struct SceneReader<'w, 's> {
         ),
     >,
     pub poses: Query<'w, 's, &'static JointPose>,
-    pub joint_matrices: Query<'w, 's, &'static crate::scene::CurrentJointToWorld>,
     pub cameras: Query<'w, 's, &'static OrbitCamera>,
     pub stage: Res<'w, StageSettings>,
     pub unloaded: Res<'w, super::state::UnloadedCharacters>,

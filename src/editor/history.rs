@@ -77,14 +77,7 @@ impl History {
                 }
             }
             other => {
-                let same_slot = |e: &Edit| match (e, &other) {
-                    (Edit::Library { name: a, .. }, Edit::Library { name: b, .. }) => a == b,
-                    _ => {
-                        std::mem::discriminant(e) == std::mem::discriminant(&other)
-                            && e.character() == other.character()
-                    }
-                };
-                if !recent.iter().any(same_slot) {
+                if !recent.iter().any(|e| e.same_slot(&other)) {
                     self.gesture.push(other);
                 }
             }

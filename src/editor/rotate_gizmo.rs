@@ -392,13 +392,17 @@ fn type_rotation(
     if wants.is_some_and(|w| w.wants_any_keyboard_input()) {
         return;
     }
+    let starts = !gizmo.is_typing()
+        && keys.just_pressed(KeyCode::KeyR)
+        && gizmo.turn.is_none()
+        && !keys.any_pressed([KeyCode::ControlLeft, KeyCode::ControlRight, KeyCode::SuperLeft, KeyCode::SuperRight]);
+    if !gizmo.is_typing() && !starts {
+        // Nothing typed and no R: no view of the gizmo to work out this frame.
+        return;
+    }
     let view = GizmoView::of_selection(&selection, &picker, &poses);
-    if !gizmo.is_typing() {
-        if keys.just_pressed(KeyCode::KeyR)
-            && gizmo.turn.is_none()
-            && !keys.any_pressed([KeyCode::ControlLeft, KeyCode::ControlRight, KeyCode::SuperLeft, KeyCode::SuperRight])
-            && let Some(view) = &view
-        {
+    if starts {
+        if let Some(view) = &view {
             let grip = Grip::Typed { axis: None, text: String::new() };
             gizmo.turn = Some(Turn {
                 character: view.character,

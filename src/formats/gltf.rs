@@ -25,6 +25,25 @@ pub struct GltfCharacter<'a> {
     pub motion: Option<Motion>,
 }
 
+impl<'a> GltfCharacter<'a> {
+    /// `asset` in `pose` at the origin (unturned, unscaled, its root at its offset), in the
+    /// editor's default skin colour, without motion.
+    pub fn new(name: &'a str, asset: &'a CharacterAsset, pose: &'a [JointRotation]) -> Self {
+        let root = asset.skeleton.joints().first().map_or(Vec3::ZERO, |j| j.rest_offset);
+        Self {
+            name,
+            asset,
+            pose,
+            root,
+            translation: Vec3::ZERO,
+            yaw: 0.0,
+            scale: 1.0,
+            tint: [0.85, 0.75, 0.62],
+            motion: None,
+        }
+    }
+}
+
 /// A character's motion sampled at `times` (seconds): each time's pose (one rotation per
 /// joint) and root translation.
 #[derive(Debug, Clone, Default)]

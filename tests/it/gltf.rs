@@ -71,15 +71,12 @@ fn an_exported_character_skins_back_to_our_vertices_with_its_names_and_weights()
     pose[0] = JointRotation::Quat(Quat::from_rotation_y(0.7));
     let root = skeleton.joint(0).rest_offset + Vec3::new(0.1, 0.05, -0.2);
     let character = GltfCharacter {
-        name: "p",
-        asset: &puppet,
-        pose: &pose,
         root,
         translation: Vec3::new(1.0, 0.0, -2.0),
         yaw: 0.6,
         scale: 1.5,
         tint: [0.2, 0.4, 0.6],
-        motion: None,
+        ..GltfCharacter::new("p", &puppet, &pose)
     };
     let (json, bin) = chunks(&write_glb(&[character], GltfMesh::Skinned));
 
@@ -133,17 +130,7 @@ fn an_exported_character_skins_back_to_our_vertices_with_its_names_and_weights()
 fn more_than_four_influences_go_into_further_sets() {
     let model = marionette::formats::load_character(&crate::common::data_dir().join("mit6837/Model1.skel")).unwrap();
     let pose = model.skeleton.initial_pose();
-    let character = GltfCharacter {
-        name: "m",
-        asset: &model,
-        pose: &pose,
-        root: model.skeleton.joint(0).rest_offset,
-        translation: Vec3::ZERO,
-        yaw: 0.0,
-        scale: 1.0,
-        tint: [1.0; 3],
-        motion: None,
-    };
+    let character = GltfCharacter::new("m", &model, &pose);
     let (json, bin) = chunks(&write_glb(&[character], GltfMesh::Skinned));
     let attributes = &json["meshes"][0]["primitives"][0]["attributes"];
     let sets = model.skin.weights.max_influences().div_ceil(4);
@@ -196,17 +183,7 @@ fn a_clip_goes_out_as_an_animation_of_the_joints() {
     let rest = wasp.skeleton.initial_pose();
     let motion = marionette::editor::export::sampled(&clip, &wasp.skeleton, &rest);
     assert_eq!(motion.times.len(), 121, "4 s at 30 frames per second, both ends");
-    let character = GltfCharacter {
-        name: "w",
-        asset: &wasp,
-        pose: &rest,
-        root: wasp.skeleton.joint(0).rest_offset,
-        translation: Vec3::ZERO,
-        yaw: 0.0,
-        scale: 1.0,
-        tint: [1.0; 3],
-        motion: Some(motion),
-    };
+    let character = GltfCharacter { motion: Some(motion), ..GltfCharacter::new("w", &wasp, &rest) };
     let (json, bin) = chunks(&write_glb(&[character], GltfMesh::Skinned));
     let animation = &json["animations"][0];
     let joints: Vec<u64> = json["skins"][0]["joints"].as_array().unwrap().iter().map(|j| j.as_u64().unwrap()).collect();
@@ -240,17 +217,7 @@ fn a_round_trip_through_glb_keeps_vertices_names_hierarchy_and_weights() {
     let mut pose = skeleton.initial_pose();
     pose[skeleton.find("r_shoulder").unwrap()] = JointRotation::euler_xyz(0.4, 0.2, -1.0);
     pose[skeleton.find("l_knee").unwrap()] = JointRotation::euler_xyz(0.9, 0.0, 0.0);
-    let character = GltfCharacter {
-        name: "p",
-        asset: &puppet,
-        pose: &pose,
-        root: skeleton.joint(0).rest_offset,
-        translation: Vec3::ZERO,
-        yaw: 0.0,
-        scale: 1.0,
-        tint: [1.0; 3],
-        motion: None,
-    };
+    let character = GltfCharacter::new("p", &puppet, &pose);
     let path = crate::common::scratch("gltf-round-trip").join("p.glb");
     std::fs::write(&path, write_glb(&[character], GltfMesh::Skinned)).unwrap();
     let back = marionette::formats::load_character(&path).unwrap();
@@ -300,17 +267,7 @@ fn bad_gltf_files_say_what_and_where() {
     // A valid file without a skin: the baked export.
     let puppet = marionette::formats::puppet::embedded_puppet();
     let pose = puppet.skeleton.initial_pose();
-    let character = GltfCharacter {
-        name: "p",
-        asset: &puppet,
-        pose: &pose,
-        root: puppet.skeleton.joint(0).rest_offset,
-        translation: Vec3::ZERO,
-        yaw: 0.0,
-        scale: 1.0,
-        tint: [1.0; 3],
-        motion: None,
-    };
+    let character = GltfCharacter::new("p", &puppet, &pose);
     let baked = dir.join("baked.glb");
     std::fs::write(&baked, write_glb(&[character], GltfMesh::Baked)).unwrap();
     let e = marionette::formats::load_character(&baked).unwrap_err().to_string();

@@ -71,6 +71,8 @@ pub struct Panels<'w, 's> {
     pub scene: SceneReader<'w, 's>,
     /// Each character's skinned vertices (for heights).
     pub skins: Query<'w, 's, &'static crate::scene::SkinScratch>,
+    /// Joint matrices (for the pose library's thumbnails).
+    pub joint_matrices: Query<'w, 's, &'static crate::scene::CurrentJointToWorld>,
     pub edits: ResMut<'w, EditQueue>,
     pub selection: ResMut<'w, Selection>,
     pub history: ResMut<'w, History>,

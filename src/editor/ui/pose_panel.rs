@@ -21,7 +21,7 @@ pub fn pose_panel(ui: &mut egui::Ui, state: &mut InspectorState, panels: &mut Pa
     let positions: Vec<glam::Vec3> = character
         .joints
         .iter()
-        .map(|&e| panels.scene.joint_matrices.get(e).map_or(glam::Vec3::ZERO, |m| m.position()))
+        .map(|&e| panels.joint_matrices.get(e).map_or(glam::Vec3::ZERO, |m| m.position()))
         .collect();
     let selected = panels.selection.joints.clone();
     let mut edits = Vec::new();
