@@ -13,7 +13,7 @@ use glam::{Mat4, Quat, Vec3};
 use crate::formats::error::open;
 use crate::formats::smpl::{clip_paths, parse_clip};
 use crate::formats::{FormatError, write_atomically};
-use crate::rig::fk::forward_kinematics_with_offsets;
+use crate::rig::fk::{RestOverride, forward_kinematics_with_rest};
 use crate::rig::lbs::skin;
 use crate::rig::smpl::{BlendMode, Clip, SmplModel, blend_rotation};
 use crate::rig::{JointRotation, Skeleton};
@@ -101,7 +101,13 @@ impl<'a> SmplPoser<'a> {
         for (p, q) in self.pose.iter_mut().zip(&frame.rotations) {
             *p = JointRotation::Quat(*q);
         }
-        forward_kinematics_with_offsets(skeleton, &self.pose, Some(&offsets), Mat4::IDENTITY, &mut self.world);
+        forward_kinematics_with_rest(
+            skeleton,
+            &self.pose,
+            RestOverride::offsets(&offsets),
+            Mat4::IDENTITY,
+            &mut self.world,
+        );
         &self.world
     }
 
@@ -381,7 +387,13 @@ pub fn write_frames_naive(
         let pose: Vec<JointRotation> = frame.rotations.iter().map(|&q| JointRotation::Quat(q)).collect();
         let mut world = vec![Mat4::IDENTITY; joints.len()];
         let offsets = model.rest_offsets(&joints);
-        forward_kinematics_with_offsets(&model.skeleton, &pose, Some(&offsets), Mat4::IDENTITY, &mut world);
+        forward_kinematics_with_rest(
+            &model.skeleton,
+            &pose,
+            RestOverride::offsets(&offsets),
+            Mat4::IDENTITY,
+            &mut world,
+        );
         let path = out_dir.join(format!("frame{k:03}.obj"));
         let mut file = std::io::BufWriter::new(std::fs::File::create(&path).map_err(|e| FormatError::io(&path, e))?);
         for (v, x) in shaped.iter().enumerate() {

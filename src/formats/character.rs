@@ -21,7 +21,7 @@ pub enum CharacterSource {
     Homer { json: PathBuf },
     /// A BVH motion capture file: its skeleton as bone boxes.
     Bvh { path: PathBuf },
-    /// A glTF 2.0 file (`.glb`, `.gltf`): its first skinned mesh.
+    /// A glTF 2.0 file (`.glb`, `.gltf`): its skinned characters.
     Gltf { path: PathBuf },
 }
 
@@ -90,11 +90,17 @@ pub fn load_skeleton(path: &Path) -> Result<Skeleton, FormatError> {
         CharacterSource::Homer { json } => Ok(super::homer::parse_rig(open(&json)?, &json)?.skeleton),
         CharacterSource::Smpl { dir } => Ok(super::smpl::load_smpl_dir(&dir)?.0.skeleton),
         CharacterSource::Bvh { path } => Ok(super::bvh::parse_bvh(open(&path)?, &path)?.skeleton),
-        CharacterSource::Gltf { path } => Ok(super::gltf_import::load_gltf(&path)?.skeleton),
+        CharacterSource::Gltf { path } => Ok(first_gltf_character(&path)?.skeleton),
     }
 }
 
-/// Loads whatever character `path` names.
+/// The first character of a glTF file (its first skin that a mesh uses).
+fn first_gltf_character(path: &Path) -> Result<CharacterAsset, FormatError> {
+    let mut characters = super::gltf_import::load_gltf(path)?;
+    Ok(characters.swap_remove(0).asset)
+}
+
+/// Loads whatever character `path` names (the first, where a glTF file holds several).
 pub fn load_character(path: &Path) -> Result<CharacterAsset, FormatError> {
     let name = path.file_stem().and_then(|s| s.to_str()).unwrap_or("character").to_string();
     match CharacterSource::detect(path)? {
@@ -111,7 +117,7 @@ pub fn load_character(path: &Path) -> Result<CharacterAsset, FormatError> {
             let skeleton = super::bvh::parse_bvh(open(&path)?, &path)?.skeleton;
             Ok(CharacterAsset::with_bone_boxes(name, skeleton, Vec::new()))
         }
-        CharacterSource::Gltf { path } => super::gltf_import::load_gltf(&path),
+        CharacterSource::Gltf { path } => first_gltf_character(&path),
         CharacterSource::Smpl { dir } => {
             let (model, warnings) = super::smpl::load_smpl_dir(&dir)?;
             let mut asset = model.asset(&name, &[]).map_err(|e| FormatError::rig(&dir, e))?;

@@ -263,7 +263,7 @@ fn root_origin(c: &GltfCharacter) -> Mat4 {
 }
 
 /// The joints as nodes (translation: the rest offset, the root's at `root`; rotation: the
-/// pose), linked parent to child; their node indices in joint order.
+/// pose; scale: the rest scale), linked parent to child; their node indices in joint order.
 fn skeleton_nodes(b: &mut Builder, c: &GltfCharacter) -> Vec<usize> {
     let skeleton = &c.asset.skeleton;
     let first = b.nodes.len();
@@ -272,6 +272,9 @@ fn skeleton_nodes(b: &mut Builder, c: &GltfCharacter) -> Vec<usize> {
         let rotation = c.pose.get(j).map_or(Quat::IDENTITY, JointRotation::to_quat);
         let mut node =
             json!({ "name": def.name, "translation": translation.to_array(), "rotation": rotation.to_array() });
+        if def.rest_scale != Vec3::ONE {
+            node["scale"] = json!(def.rest_scale.to_array());
+        }
         let children: Vec<usize> = skeleton.children(j).iter().map(|&k| first + k).collect();
         if !children.is_empty() {
             node["children"] = json!(children);

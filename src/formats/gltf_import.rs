@@ -1,112 +1,187 @@
-//! glTF 2.0 import (`.glb`, `.gltf` with its `.bin` files), read with the `gltf` crate: the
-//! first skin becomes a character. Its joints (names, hierarchy, each node's translation as
-//! the rest offset and its rotation as the joint's pose from the file), the file's inverse
-//! bind matrices, and every primitive of the mesh that uses the skin (merged), with all
-//! `JOINTS_n`/`WEIGHTS_n` sets, normalised. Transforms of nodes above the skeleton are folded
-//! into its root. Joint scales are not carried (a warning says where they are not 1).
+//! glTF 2.0 import (`.glb`, `.gltf` with its `.bin` files), read with the `gltf` crate:
+//! every skin with a mesh becomes a character. Its joints (names, hierarchy, each node's
+//! translation as the rest offset, its scale as the rest scale, its rotation as the
+//! joint's pose from the file), the file's inverse bind matrices, every primitive of the
+//! meshes that use the skin (merged, in file order) with all `JOINTS_n`/`WEIGHTS_n` sets,
+//! normalised; morph targets; the base colour factor; and the file's animations of the
+//! skin's joints as clips. Transforms of nodes above the skeleton are folded into its root.
 
 use std::path::Path;
 
 use glam::{Mat4, Quat, Vec3};
 
 use super::error::FormatError;
-use crate::rig::{CharacterAsset, JointRotation, RawJoint, Skeleton, Skin, SkinWeights};
+use crate::rig::node_clip::{Interpolation, JointTracks, NodeClip, Track};
+use crate::rig::{CharacterAsset, JointRotation, MorphTarget, RawJoint, Skeleton, Skin, SkinWeights};
 
-/// Loads the first skinned mesh of a glTF file as a character.
-pub fn load_gltf(path: &Path) -> Result<CharacterAsset, FormatError> {
+/// One character of a glTF file: its asset, the file's animations of its joints, and the
+/// base colour of its first primitive's material (none: the file gives no material).
+#[derive(Debug, Clone)]
+pub struct ImportedCharacter {
+    pub asset: CharacterAsset,
+    pub clips: Vec<NodeClip>,
+    pub base_color: Option<[f32; 4]>,
+}
+
+/// Loads every skinned character of a glTF file, in the order of its skins.
+pub fn load_gltf(path: &Path) -> Result<Vec<ImportedCharacter>, FormatError> {
     let bytes = std::fs::read(path).map_err(|e| FormatError::io(path, e))?;
     parse_gltf(&bytes, path)
 }
 
-/// The first skinned mesh of a glTF file's bytes (`.bin` files are looked for beside
-/// `path`).
-pub fn parse_gltf(bytes: &[u8], path: &Path) -> Result<CharacterAsset, FormatError> {
+/// The skinned characters of a glTF file's bytes (`.bin` files are looked for beside
+/// `path`), one per skin that a mesh uses, in the order of the skins.
+pub fn parse_gltf(bytes: &[u8], path: &Path) -> Result<Vec<ImportedCharacter>, FormatError> {
     let gltf =
         gltf::Gltf::from_slice(bytes).map_err(|e| FormatError::other(path, format!("at $: expected glTF 2.0, {e}")))?;
     if let Some(ext) = gltf.extensions_required().next() {
         return Err(FormatError::other(path, format!("at $.extensionsRequired: needs `{ext}`, which is not read")));
     }
     let buffers = buffers(&gltf, path)?;
-    let data = |b: gltf::Buffer| buffers.get(b.index()).map(Vec::as_slice);
-    let skin = gltf
-        .skins()
-        .next()
-        .ok_or_else(|| FormatError::other(path, "at $.skins[0]: expected a skinned mesh, found none"))?;
-    let mesh = gltf
-        .nodes()
-        .find(|n| n.skin().is_some_and(|s| s.index() == skin.index()) && n.mesh().is_some())
-        .and_then(|n| n.mesh())
-        .ok_or_else(|| {
-            FormatError::other(path, format!("at $.skins[{}]: expected a mesh node using it, found none", skin.index()))
-        })?;
-
-    let mut parent = vec![None; gltf.nodes().len()];
-    for n in gltf.nodes() {
-        for c in n.children() {
-            parent[c.index()] = Some(n.index());
+    let file = File { gltf: &gltf, buffers: &buffers, path, parent: parents(&gltf) };
+    let mut characters = Vec::new();
+    for skin in gltf.skins() {
+        let meshes: Vec<gltf::Mesh> = gltf
+            .nodes()
+            .filter(|n| n.skin().is_some_and(|s| s.index() == skin.index()))
+            .filter_map(|n| n.mesh())
+            .collect();
+        if !meshes.is_empty() {
+            characters.push(file.character(&skin, &meshes, gltf.skins().len())?);
         }
     }
-    let joints: Vec<gltf::Node> = skin.joints().collect();
-    let joint_of = |node: usize| joints.iter().position(|j| j.index() == node);
-    let mut warnings = Vec::new();
-    let mut raw = Vec::with_capacity(joints.len());
-    for (j, node) in joints.iter().enumerate() {
-        let (t, r, s) = node.transform().decomposed();
-        if (Vec3::from(s) - Vec3::ONE).abs().max_element() > 1e-4 {
-            warnings.push(format!(
-                "{}: nodes[{}] scales by {s:?}; joint scales are not carried",
-                path.display(),
-                node.index()
-            ));
-        }
-        let up = parent[node.index()];
-        let mut local = Mat4::from_rotation_translation(Quat::from_array(r), Vec3::from(t));
-        if up.and_then(joint_of).is_none() {
-            // A skeleton root: the nodes above it place it.
-            local = global(&gltf, &parent, up) * local;
-        }
-        let (_, rotation, translation) = local.to_scale_rotation_translation();
-        let name = node.name().map_or_else(|| format!("joint {j}"), str::to_string);
-        let mut joint = RawJoint::new(name, up.and_then(joint_of), translation);
-        joint.initial_rotation = JointRotation::Quat(rotation.normalize());
-        raw.push(joint);
+    if characters.is_empty() {
+        let what = if gltf.skins().len() == 0 {
+            "at $.skins[0]: expected a skinned mesh"
+        } else {
+            "at $.skins: expected a skin that a mesh node uses"
+        };
+        return Err(FormatError::other(path, format!("{what}, found none")));
     }
-    let (skeleton, new_index) = Skeleton::build_reordered(raw)
-        .map_err(|e| FormatError::other(path, format!("at $.skins[{}].joints: {e}", skin.index())))?;
+    Ok(characters)
+}
 
-    let mut inverse = vec![Mat4::IDENTITY; skeleton.len()];
-    if let Some(ibm) = skin.reader(data).read_inverse_bind_matrices() {
-        for (j, m) in ibm.enumerate().take(skeleton.len()) {
-            inverse[new_index[j]] = Mat4::from_cols_array_2d(&m);
-        }
+/// A parsed file: its JSON, its buffers and each node's parent.
+struct File<'a> {
+    gltf: &'a gltf::Gltf,
+    buffers: &'a [Vec<u8>],
+    path: &'a Path,
+    parent: Vec<Option<usize>>,
+}
+
+impl File<'_> {
+    fn error(&self, message: String) -> FormatError {
+        FormatError::other(self.path, message)
     }
 
-    let (mut positions, mut triangles, mut rows) = (Vec::new(), Vec::new(), Vec::new());
-    for (p, primitive) in mesh.primitives().enumerate() {
-        let at = format!("at $.meshes[{}].primitives[{p}]", mesh.index());
-        if primitive.mode() != gltf::mesh::Mode::Triangles {
-            warnings.push(format!("{}: {at} is not triangles and was skipped", path.display()));
-            continue;
+    fn data<'s>(&'s self) -> impl Clone + Fn(gltf::Buffer) -> Option<&'s [u8]> {
+        |b: gltf::Buffer| self.buffers.get(b.index()).map(Vec::as_slice)
+    }
+
+    /// The character of `skin`, drawn by `meshes`.
+    fn character(
+        &self,
+        skin: &gltf::Skin,
+        meshes: &[gltf::Mesh],
+        skin_count: usize,
+    ) -> Result<ImportedCharacter, FormatError> {
+        let mut warnings = Vec::new();
+        let joints: Vec<gltf::Node> = skin.joints().collect();
+        let (skeleton, new_index, root_parent) = self.skeleton(skin, &joints)?;
+        let mut inverse = vec![Mat4::IDENTITY; skeleton.len()];
+        if let Some(ibm) = skin.reader(self.data()).read_inverse_bind_matrices() {
+            for (j, m) in ibm.enumerate().take(skeleton.len()) {
+                inverse[new_index[j]] = Mat4::from_cols_array_2d(&m);
+            }
         }
-        let reader = primitive.reader(data);
-        let first = positions.len() as u32;
+        let mut skin_data = Skin::default();
+        let mut rows = Vec::new();
+        let mut morphs = Vec::new();
+        let mut base_color = None;
+        for mesh in meshes {
+            for (p, primitive) in mesh.primitives().enumerate() {
+                let at = format!("at $.meshes[{}].primitives[{p}]", mesh.index());
+                if primitive.mode() != gltf::mesh::Mode::Triangles {
+                    warnings.push(format!("{}: {at} is not triangles and was skipped", self.path.display()));
+                    continue;
+                }
+                base_color.get_or_insert(primitive.material().pbr_metallic_roughness().base_color_factor());
+                let first = skin_data.bind_positions.len();
+                self.primitive(&primitive, &at, &new_index, &mut skin_data, &mut rows)?;
+                self.morph_targets(mesh, &primitive, first, &mut morphs);
+            }
+        }
+        let (weights, normalised) = SkinWeights::from_rows(rows, skeleton.len())
+            .map_err(|e| self.error(format!("at $.skins[{}] meshes (JOINTS_n, WEIGHTS_n): {e}", skin.index())))?;
+        warnings.extend(super::character::normalised_warnings(self.path, &normalised));
+        skin_data.weights = weights;
+        let clips = self.clips(&joints, &new_index, root_parent, &mut warnings)?;
+        let stem = self.path.file_stem().and_then(|s| s.to_str()).unwrap_or("gltf");
+        let name = match (skin_count, meshes[0].name()) {
+            (1, _) => stem.to_string(),
+            (_, Some(mesh)) => mesh.to_string(),
+            _ => format!("{stem} {}", skin.index()),
+        };
+        let mut asset = CharacterAsset::with_inverse_binds(name, skeleton, skin_data, inverse, warnings)
+            .map_err(|e| FormatError::rig(self.path, e))?;
+        asset.morphs = morphs;
+        Ok(ImportedCharacter { asset, clips, base_color })
+    }
+
+    /// The skin's joints as a skeleton (reordered parents first: `new_index[file joint]`)
+    /// and the transform of the nodes above its root.
+    fn skeleton(&self, skin: &gltf::Skin, joints: &[gltf::Node]) -> Result<(Skeleton, Vec<usize>, Mat4), FormatError> {
+        let joint_of = |node: usize| joints.iter().position(|j| j.index() == node);
+        let mut raw = Vec::with_capacity(joints.len());
+        let mut root_parent = Mat4::IDENTITY;
+        for (j, node) in joints.iter().enumerate() {
+            let up = self.parent[node.index()];
+            let mut local = Mat4::from_cols_array_2d(&node.transform().matrix());
+            if up.and_then(joint_of).is_none() {
+                // A skeleton root: the nodes above it place it.
+                root_parent = self.global(up);
+                local = root_parent * local;
+            }
+            let (scale, rotation, translation) = local.to_scale_rotation_translation();
+            let name = node.name().map_or_else(|| format!("joint {j}"), str::to_string);
+            let mut joint = RawJoint::new(name, up.and_then(joint_of), translation);
+            joint.initial_rotation = JointRotation::Quat(rotation.normalize());
+            if (scale - Vec3::ONE).abs().max_element() > 1e-6 {
+                joint.rest_scale = scale;
+            }
+            raw.push(joint);
+        }
+        let (skeleton, new_index) = Skeleton::build_reordered(raw)
+            .map_err(|e| self.error(format!("at $.skins[{}].joints: {e}", skin.index())))?;
+        Ok((skeleton, new_index, root_parent))
+    }
+
+    /// Appends one triangle primitive: its positions, triangles and influence rows.
+    fn primitive(
+        &self,
+        primitive: &gltf::Primitive,
+        at: &str,
+        new_index: &[usize],
+        skin: &mut Skin,
+        rows: &mut Vec<Vec<(usize, f32)>>,
+    ) -> Result<(), FormatError> {
+        let reader = primitive.reader(self.data());
+        let first = skin.bind_positions.len() as u32;
         let points: Vec<Vec3> = reader
             .read_positions()
-            .ok_or_else(|| {
-                FormatError::other(path, format!("{at}.attributes.POSITION: expected positions, found none"))
-            })?
+            .ok_or_else(|| self.error(format!("{at}.attributes.POSITION: expected positions, found none")))?
             .map(Vec3::from)
             .collect();
         let count = points.len();
-        positions.extend(points);
+        skin.bind_positions.extend(points);
         let indices: Vec<u32> = match reader.read_indices() {
             Some(i) => i.into_u32().collect(),
             None => (0..count as u32).collect(),
         };
         if let Some(bad) = indices.iter().find(|&&i| i as usize >= count) {
-            return Err(FormatError::other(path, format!("{at}.indices: index {bad} is beyond its {count} vertices")));
+            return Err(self.error(format!("{at}.indices: index {bad} is beyond its {count} vertices")));
         }
-        triangles.extend(indices.chunks_exact(3).map(|t| [first + t[0], first + t[1], first + t[2]]));
+        skin.triangles.extend(indices.chunks_exact(3).map(|t| [first + t[0], first + t[1], first + t[2]]));
         let mut influences: Vec<Vec<(usize, f32)>> = vec![Vec::new(); count];
         let mut set = 0;
         while let (Some(js), Some(ws)) = (reader.read_joints(set), reader.read_weights(set)) {
@@ -114,14 +189,11 @@ pub fn parse_gltf(bytes: &[u8], path: &Path) -> Result<CharacterAsset, FormatErr
                 for k in 0..4 {
                     if w[k] > 0.0 {
                         let joint = *new_index.get(j[k] as usize).ok_or_else(|| {
-                            FormatError::other(
-                                path,
-                                format!(
-                                    "{at}.attributes.JOINTS_{set}: vertex {v} names joint {} of {}",
-                                    j[k],
-                                    skeleton.len()
-                                ),
-                            )
+                            self.error(format!(
+                                "{at}.attributes.JOINTS_{set}: vertex {v} names joint {} of {}",
+                                j[k],
+                                new_index.len()
+                            ))
                         })?;
                         influences[v].push((joint, w[k]));
                     }
@@ -130,19 +202,132 @@ pub fn parse_gltf(bytes: &[u8], path: &Path) -> Result<CharacterAsset, FormatErr
             set += 1;
         }
         if set == 0 {
-            return Err(FormatError::other(
-                path,
-                format!("{at}.attributes: expected JOINTS_0 and WEIGHTS_0, found none"),
-            ));
+            return Err(self.error(format!("{at}.attributes: expected JOINTS_0 and WEIGHTS_0, found none")));
         }
         rows.extend(influences);
+        Ok(())
     }
-    let (weights, normalised) = SkinWeights::from_rows(rows, skeleton.len())
-        .map_err(|e| FormatError::other(path, format!("at $.meshes[{}] (JOINTS_n, WEIGHTS_n): {e}", mesh.index())))?;
-    warnings.extend(super::character::normalised_warnings(path, &normalised));
-    let name = path.file_stem().and_then(|s| s.to_str()).unwrap_or("gltf").to_string();
-    let skin = Skin { bind_positions: positions, triangles, weights, texcoords: Vec::new() };
-    CharacterAsset::with_inverse_binds(name, skeleton, skin, inverse, warnings).map_err(|e| FormatError::rig(path, e))
+
+    /// Adds the primitive's morph targets (position deltas of its vertices, which start
+    /// at `first`) to `morphs`, target k of every primitive of a mesh into one morph.
+    fn morph_targets(
+        &self,
+        mesh: &gltf::Mesh,
+        primitive: &gltf::Primitive,
+        first: usize,
+        morphs: &mut Vec<MorphTarget>,
+    ) {
+        let names = target_names(mesh);
+        let reader = primitive.reader(self.data());
+        for (k, (positions, _, _)) in reader.read_morph_targets().enumerate() {
+            let name = names.get(k).cloned().unwrap_or_else(|| format!("{} target {k}", mesh.name().unwrap_or("mesh")));
+            let at = match morphs.iter().position(|m| m.name == name) {
+                Some(at) => at,
+                None => {
+                    morphs.push(MorphTarget { name, deltas: Vec::new() });
+                    morphs.len() - 1
+                }
+            };
+            let deltas = positions.into_iter().flatten().enumerate().filter(|(_, d)| *d != [0.0; 3]);
+            morphs[at].deltas.extend(deltas.map(|(v, d)| ((first + v) as u32, Vec3::from(d))));
+        }
+    }
+
+    /// The file's animations that move the skin's joints, as clips by joint index.
+    fn clips(
+        &self,
+        joints: &[gltf::Node],
+        new_index: &[usize],
+        root_parent: Mat4,
+        warnings: &mut Vec<String>,
+    ) -> Result<Vec<NodeClip>, FormatError> {
+        let mut clips = Vec::new();
+        for animation in self.gltf.animations() {
+            let mut tracks = vec![JointTracks::default(); joints.len()];
+            let mut moved = false;
+            for (c, channel) in animation.channels().enumerate() {
+                let node = channel.target().node().index();
+                let Some(j) = joints.iter().position(|n| n.index() == node) else { continue };
+                let at = format!("at $.animations[{}].channels[{c}]", animation.index());
+                let sampler = format!("at $.animations[{}].samplers[{}]", animation.index(), channel.sampler().index());
+                let reader = channel.reader(self.data());
+                let times: Vec<f32> = reader
+                    .read_inputs()
+                    .ok_or_else(|| self.error(format!("{sampler}.input: expected key times, found none")))?
+                    .collect();
+                if let Some(k) = times.windows(2).position(|w| !(w[0] <= w[1])) {
+                    return Err(self.error(format!(
+                        "{sampler}.input: key time {} comes before {}",
+                        times[k + 1],
+                        times[k]
+                    )));
+                }
+                let interpolation = match channel.sampler().interpolation() {
+                    gltf::animation::Interpolation::Step => Interpolation::Step,
+                    gltf::animation::Interpolation::Linear => Interpolation::Linear,
+                    gltf::animation::Interpolation::CubicSpline => Interpolation::CubicSpline,
+                };
+                let outputs = reader
+                    .read_outputs()
+                    .ok_or_else(|| self.error(format!("{sampler}.output: expected key values, found none")))?;
+                let joint = &mut tracks[new_index[j]];
+                let incomplete = || {
+                    self.error(format!("{sampler}: expected a value per key time (three for CUBICSPLINE) and a key, found {} key times", times.len()))
+                };
+                use gltf::animation::util::ReadOutputs;
+                match outputs {
+                    ReadOutputs::Translations(v) => {
+                        let track = Track { times: times.clone(), values: v.map(Vec3::from).collect(), interpolation };
+                        joint.translation = Some(track).filter(Track::is_complete).ok_or_else(incomplete).map(Some)?;
+                    }
+                    ReadOutputs::Rotations(v) => {
+                        let values = v.into_f32().map(Quat::from_array).collect();
+                        let track = Track { times: times.clone(), values, interpolation };
+                        joint.rotation = Some(track).filter(Track::is_complete).ok_or_else(incomplete).map(Some)?;
+                    }
+                    ReadOutputs::Scales(v) => {
+                        let track = Track { times: times.clone(), values: v.map(Vec3::from).collect(), interpolation };
+                        joint.scale = Some(track).filter(Track::is_complete).ok_or_else(incomplete).map(Some)?;
+                    }
+                    ReadOutputs::MorphTargetWeights(_) => {
+                        warnings.push(format!("{}: {at} keys morph weights, which do not play", self.path.display()));
+                        continue;
+                    }
+                }
+                moved = true;
+            }
+            if moved {
+                let name = animation.name().map_or_else(|| format!("animation {}", animation.index()), str::to_string);
+                clips.push(NodeClip { name, tracks, root_parent });
+            }
+        }
+        Ok(clips)
+    }
+
+    /// The global transform of `node` (identity for none), from its parents.
+    fn global(&self, node: Option<usize>) -> Mat4 {
+        global(self.gltf, &self.parent, node)
+    }
+}
+
+/// Each node's parent (none for a scene root).
+fn parents(gltf: &gltf::Gltf) -> Vec<Option<usize>> {
+    let mut parent = vec![None; gltf.nodes().len()];
+    for n in gltf.nodes() {
+        for c in n.children() {
+            parent[c.index()] = Some(n.index());
+        }
+    }
+    parent
+}
+
+/// A mesh's morph target names (`extras.targetNames`, as Blender writes them).
+fn target_names(mesh: &gltf::Mesh) -> Vec<String> {
+    mesh.extras()
+        .as_ref()
+        .and_then(|raw| serde_json::from_str::<serde_json::Value>(raw.get()).ok())
+        .and_then(|v| serde_json::from_value(v.get("targetNames")?.clone()).ok())
+        .unwrap_or_default()
 }
 
 /// The global transform of `node` (identity for none), from its parents.

@@ -7,38 +7,62 @@ use super::pose::JointRotation;
 use super::skeleton::Skeleton;
 
 /// Fills `joint_to_world[j]` for every joint: a depth-first walk from the root that
-/// pushes each joint's local transform (`T(offset) · R(pose)`), writes the top, recurses
+/// pushes each joint's local transform (`T(offset) · R(pose) · S(rest scale)`), writes the top, recurses
 /// into the children and pops. `placement` (model → world) starts the stack.
 ///
 /// # Panics
 /// When `pose` or `joint_to_world` is not one entry per joint.
 pub fn forward_kinematics(skeleton: &Skeleton, pose: &[JointRotation], placement: Mat4, joint_to_world: &mut [Mat4]) {
-    forward_kinematics_with_offsets(skeleton, pose, None, placement, joint_to_world)
+    forward_kinematics_with_rest(skeleton, pose, RestOverride::default(), placement, joint_to_world)
 }
 
-/// As [`forward_kinematics`], with optional per-joint rest offsets replacing the
-/// skeleton's (a reshaped or translated skeleton).
-pub fn forward_kinematics_with_offsets(
+/// Per-joint rest offsets and scales that replace the skeleton's (a reshaped skeleton, or
+/// a clip that keys them); none keeps the skeleton's.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct RestOverride<'a> {
+    pub offsets: Option<&'a [Vec3]>,
+    pub scales: Option<&'a [Vec3]>,
+}
+
+impl<'a> RestOverride<'a> {
+    /// Only the offsets replaced.
+    pub fn offsets(offsets: &'a [Vec3]) -> Self {
+        Self { offsets: Some(offsets), scales: None }
+    }
+}
+
+/// As [`forward_kinematics`], with the rest offsets and scales `rest` replaces.
+///
+/// # Panics
+/// When `pose`, `joint_to_world` or a replacement is not one entry per joint.
+pub fn forward_kinematics_with_rest(
     skeleton: &Skeleton,
     pose: &[JointRotation],
-    offsets: Option<&[Vec3]>,
+    rest: RestOverride,
     placement: Mat4,
     joint_to_world: &mut [Mat4],
 ) {
     let n = skeleton.len();
     assert_eq!(pose.len(), n, "one pose entry per joint");
     assert_eq!(joint_to_world.len(), n, "one output matrix per joint");
-    if let Some(o) = offsets {
-        assert_eq!(o.len(), n, "one offset per joint");
+    for replaced in [rest.offsets, rest.scales].into_iter().flatten() {
+        assert_eq!(replaced.len(), n, "one offset or scale per joint");
     }
     let mut stack = MatrixStack::with_capacity(n + 1);
     stack.push(placement);
-    let offset = |j: usize| offsets.map_or(skeleton.joint(j).rest_offset, |o| o[j]);
+    let local = |j: usize| {
+        let joint = skeleton.joint(j);
+        let offset = rest.offsets.map_or(joint.rest_offset, |o| o[j]);
+        match rest.scales {
+            Some(s) => pose[j].local_transform(offset) * Mat4::from_scale(s[j]),
+            None => joint.local_transform(&pose[j], offset),
+        }
+    };
     // Explicit DFS: (joint, entering?) so each push is matched by one pop.
     let mut todo = vec![(0usize, true)];
     while let Some((j, entering)) = todo.pop() {
         if entering {
-            joint_to_world[j] = stack.push(pose[j].local_transform(offset(j)));
+            joint_to_world[j] = stack.push(local(j));
             todo.push((j, false));
             todo.extend(skeleton.children(j).iter().rev().map(|&c| (c, true)));
         } else {
@@ -62,7 +86,8 @@ pub fn forward_kinematics_along(
 ) {
     for &j in path {
         let parent = skeleton.parent(j).map_or(placement, |p| joint_to_world[p]);
-        joint_to_world[j] = parent * pose[j].local_transform(skeleton.joint(j).rest_offset);
+        let joint = skeleton.joint(j);
+        joint_to_world[j] = parent * joint.local_transform(&pose[j], joint.rest_offset);
     }
 }
 
@@ -70,7 +95,8 @@ pub fn forward_kinematics_along(
 /// joint-to-world), in model space (identity placement).
 pub fn bind_world_to_joint(skeleton: &Skeleton, offsets: Option<&[Vec3]>) -> Vec<Mat4> {
     let mut rest = vec![Mat4::IDENTITY; skeleton.len()];
-    forward_kinematics_with_offsets(skeleton, &skeleton.rest_pose(), offsets, Mat4::IDENTITY, &mut rest);
+    let replaced = RestOverride { offsets, scales: None };
+    forward_kinematics_with_rest(skeleton, &skeleton.rest_pose(), replaced, Mat4::IDENTITY, &mut rest);
     rest.iter().map(Mat4::inverse).collect()
 }
 

@@ -10,6 +10,7 @@ pub mod ik;
 pub mod lbs;
 pub mod matrix_stack;
 pub mod mirror;
+pub mod node_clip;
 pub mod pose;
 pub mod skeleton;
 pub mod skinning;

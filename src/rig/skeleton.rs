@@ -28,6 +28,9 @@ pub struct RawJoint {
     pub bone_box: Option<BoneBox>,
     /// The pose the file gives (already clamped to `limits` by [`Skeleton::build`]).
     pub initial_rotation: JointRotation,
+    /// Scale of the joint's frame after its rotation (glTF node scale; 1 for the course
+    /// rigs).
+    pub rest_scale: Vec3,
 }
 
 impl RawJoint {
@@ -40,6 +43,7 @@ impl RawJoint {
             limits: DofLimits::UNLIMITED,
             bone_box: None,
             initial_rotation: JointRotation::IDENTITY,
+            rest_scale: Vec3::ONE,
         }
     }
 }
@@ -56,6 +60,17 @@ pub struct JointDef {
     pub bone_box: Option<BoneBox>,
     /// The file's pose, clamped to `limits`.
     pub initial_rotation: JointRotation,
+    /// Scale of the joint's frame after its rotation (1 for the course rigs).
+    pub rest_scale: Vec3,
+}
+
+impl JointDef {
+    /// The joint's transform in its parent's frame at `pose` with rest offset `offset`:
+    /// `T(offset) · R(pose) · S(rest_scale)`, glTF's order.
+    pub fn local_transform(&self, pose: &JointRotation, offset: Vec3) -> glam::Mat4 {
+        let m = pose.local_transform(offset);
+        if self.rest_scale == Vec3::ONE { m } else { m * glam::Mat4::from_scale(self.rest_scale) }
+    }
 }
 
 /// A validated joint tree: exactly one root (index 0), parents before children.
@@ -170,6 +185,7 @@ fn joint_def(j: RawJoint, parent_index: impl Fn(usize) -> usize) -> JointDef {
         rest_offset: j.rest_offset,
         limits: j.limits,
         bone_box: j.bone_box,
+        rest_scale: j.rest_scale,
     }
 }
 
