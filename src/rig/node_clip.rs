@@ -161,6 +161,15 @@ impl NodePose {
         self.rotations.iter().map(|&q| JointRotation::Quat(q)).collect()
     }
 
+    /// Every joint's model-space transform in this pose, from `placement` (the matrix
+    /// stack with the pose's offsets and scales).
+    pub fn joint_to_world(&self, skeleton: &Skeleton, placement: Mat4) -> Vec<Mat4> {
+        let mut out = vec![Mat4::IDENTITY; skeleton.len()];
+        let rest = super::fk::RestOverride { offsets: Some(&self.offsets), scales: Some(&self.scales) };
+        super::fk::forward_kinematics_with_rest(skeleton, &self.pose(), rest, placement, &mut out);
+        out
+    }
+
     /// `self` blended towards `other` by `alpha`: rotations along the shorter arc
     /// (normalised linear interpolation), offsets and scales linearly.
     pub fn blended(&self, other: &NodePose, alpha: f32) -> NodePose {
