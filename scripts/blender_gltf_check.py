@@ -28,7 +28,12 @@ CASES = {
     "Homer": ("homer/homer.json", ["--pose", "1=0.2,0.1,0"]),
     "puppet": (None, ["--pose", "l_elbow=0,-1.1,0.2", "--pose", "r_knee=0.9,0,0"]),
     "wasp walking": ("cse169/project3/wasp.skel", ["--anim", "{data}/cse169/project3/wasp_walk.anim", "--time", "1.25"]),
+    # A Blender-made file of two characters, one playing its STEP rotation and LINEAR scale
+    # animation (re-exported by Marionette with the keyed scale as node scale).
+    "Blender pair, waver's clip at 0.5 s": ("{repo}/tests/data/blender_pair.glb", ["--clip", "waver_rig_action", "--time", "0.5"]),
+    "Blender pair, walker's clip at 0.3 s": ("{repo}/tests/data/blender_pair.glb", ["--clip", "0", "--time", "0.3"]),
 }
+REPO = Path(__file__).resolve().parent.parent
 
 
 def read_obj(path):
@@ -80,11 +85,28 @@ def check_animation(data: Path, marionette: str, tmp: str):
     return worst
 
 
+def check_gltf_clip_animation(marionette: str, tmp: str):
+    """The Blender pair's walker clip (CUBICSPLINE in the file) re-exported with
+    --animation (sampled at 30 fps, LINEAR), played by Blender at key frames of ours."""
+    pair = str(REPO / "tests/data/blender_pair.glb")
+    glb = Path(tmp) / "pair.glb"
+    subprocess.run([marionette, "export", pair, "--clip", "0", "--animation", "--out", str(glb)], check=True, capture_output=True)
+    worst = 0.0
+    for seconds in (0.5, 1.0):
+        obj = Path(tmp) / "pair.obj"
+        subprocess.run([marionette, "export", pair, "--clip", "0", "--time", str(seconds), "--out", str(obj)], check=True, capture_output=True)
+        ours = read_obj(obj)
+        d = largest_distance(ours, deformed_vertices(glb, seconds))
+        print(f"Blender pair, walker's clip as a glTF animation at {seconds} s: largest distance {d:.2e}")
+        worst = max(worst, d / float(np.ptp(ours, axis=0).max()))
+    return worst
+
+
 def main(data: Path, marionette: str):
     worst_all = 0.0
     with tempfile.TemporaryDirectory() as tmp:
         for name, (path, args) in CASES.items():
-            source = str(data / path) if path else None
+            source = (path.replace("{repo}", str(REPO)) if path.startswith("{repo}") else str(data / path)) if path else None
             if source is None:
                 # The built-in puppet, from the project's assets.
                 source = str(Path(__file__).resolve().parent.parent / "assets" / "puppet.skel")
@@ -99,6 +121,7 @@ def main(data: Path, marionette: str):
             print(f"{name}: {len(ours)} vertices, Blender {len(theirs)}; largest distance {worst:.2e} ({worst / size:.1e} of the size {size:.3f})")
             worst_all = max(worst_all, worst / size)
         worst_all = max(worst_all, check_animation(data, marionette, tmp))
+        worst_all = max(worst_all, check_gltf_clip_animation(marionette, tmp))
     print(f"worst relative distance {worst_all:.1e}")
 
 

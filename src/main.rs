@@ -185,10 +185,15 @@ struct ClipArgs {
     /// skeleton it fits.
     #[arg(long, value_name = "FILE.anim|FILE.bvh")]
     anim: Option<PathBuf>,
-    /// The time in seconds at which clips are sampled: `--anim`'s, and a scene's own
-    /// keyframes and SMPL clips (extrapolated outside their keys as each clip says).
+    /// The time in seconds at which clips are sampled: `--anim`'s, `--clip`'s, and a
+    /// scene's own keyframes, SMPL and glTF clips (extrapolated outside their keys as each
+    /// clip says).
     #[arg(long, value_parser = finite_seconds)]
     time: Option<f32>,
+    /// A glTF file's animation, by name or by index among the file's animations, on every
+    /// character of the file it moves (without it the file's node transforms are the pose).
+    #[arg(long, value_name = "NAME|INDEX")]
+    clip: Option<String>,
 }
 
 impl ClipArgs {
@@ -200,6 +205,56 @@ impl ClipArgs {
             ..marionette::formats::scene::AnimDoc::of(file)
         })
     }
+}
+
+fn is_gltf(path: &std::path::Path) -> bool {
+    marionette::formats::gltf_import::is_gltf(path)
+}
+
+/// `export FILE.glb|FILE.gltf`: every character of the file, posed by `--clip` at `--time`
+/// (or the file's node transforms) and `--pose`, as one OBJ of all their vertices in file
+/// order, or as a glb scene.
+fn export_gltf_file(
+    path: &std::path::Path,
+    out: &std::path::Path,
+    poses: &[PoseSpec],
+    method: marionette::rig::dqs::SkinningMethod,
+    clip: &ClipArgs,
+    bake: bool,
+    animation: bool,
+) -> Result<()> {
+    let time = clip.time.unwrap_or(0.0);
+    if is_glb(out) {
+        let mut library = marionette::editor::document::AssetLibrary::default();
+        let mut doc = marionette::formats::scene::SceneDoc::default();
+        for source in library.sources_of(path) {
+            let asset = library.load(&source)?;
+            let mut c = library.new_character_doc(source.clone(), &asset);
+            let part = library.gltf_source(&source);
+            let found = clip.clip.as_deref().and_then(|spec| marionette::cli::posing::find_clip(&part?.clips, spec).cloned());
+            c.playback = found.map(|k| marionette::formats::scene::PlaybackDoc { clip: Some(k.name), time, ..Default::default() });
+            doc.characters.push(c);
+        }
+        let mesh = if bake { GltfMesh::Baked } else { GltfMesh::Skinned };
+        let glb = marionette::editor::export::scene_glb(&doc, mesh, animation)?;
+        write_file(out, |w| w.write_all(&glb))?;
+        println!("wrote {} ({} characters)", out.display(), doc.characters.len());
+        return Ok(());
+    }
+    let characters = marionette::formats::gltf_import::load_gltf(path)?;
+    characters.iter().flat_map(|c| &c.asset.warnings).for_each(|w| eprintln!("warning: {w}"));
+    let (positions, triangles) =
+        marionette::cli::posing::posed_gltf(&characters, clip.clip.as_deref(), time, poses, method)
+            .map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
+    write_file(out, |w| obj::write_obj(w, &positions, &triangles))?;
+    println!(
+        "wrote {} ({} characters, {} vertices, {} triangles)",
+        out.display(),
+        characters.len(),
+        positions.len(),
+        triangles.len()
+    );
+    Ok(())
 }
 
 fn is_glb(path: &std::path::Path) -> bool {
@@ -232,11 +287,26 @@ fn run(cli: Cli) -> Result<()> {
     match cli.command {
         None => marionette::editor::run(Vec::new(), Default::default()),
         Some(Command::Edit { paths, clip }) => {
-            let edits =
-                marionette::editor::StartupEdits { anim: clip.anim_doc(true), time: clip.time, ..Default::default() };
+            let edits = marionette::editor::StartupEdits {
+                anim: clip.anim_doc(true),
+                time: clip.time,
+                clip: clip.clip.clone(),
+                ..Default::default()
+            };
             marionette::editor::run(paths, edits)
         }
+        Some(Command::Info { path }) if is_gltf(&path) => {
+            for c in marionette::formats::gltf_import::load_gltf(&path)? {
+                print!("{}", describe(&c.asset));
+                for clip in &c.clips {
+                    println!("animation {} `{}`: {:.3} s", clip.index, clip.name, clip.duration());
+                }
+            }
+        }
         Some(Command::Info { path }) => print!("{}", describe(&load_character(&path)?)),
+        Some(Command::Export { path, out, poses, skinning, clip, bake, animation, .. }) if is_gltf(&path) => {
+            export_gltf_file(&path, &out, &poses, skinning.into(), &clip, bake, animation)?
+        }
         Some(Command::Export { path, out, bake, animation, .. }) if is_glb(&out) && is_scene(&path) => {
             let doc = marionette::editor::document::read_scene(&path)?;
             let mesh = if bake { GltfMesh::Baked } else { GltfMesh::Skinned };
@@ -293,6 +363,7 @@ fn run(cli: Cli) -> Result<()> {
                 match_height,
                 anim: clip.anim_doc(false),
                 time: clip.time,
+                clip: clip.clip.clone(),
             };
             let notes = marionette::editor::render::render(paths, edits, out.clone(), width, height)
                 .map_err(anyhow::Error::msg)?;

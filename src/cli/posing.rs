@@ -4,7 +4,8 @@
 use glam::{Mat4, Vec3};
 
 use crate::rig::dqs::SkinningMethod;
-use crate::rig::fk::posed_palette;
+use crate::rig::fk::{RestOverride, forward_kinematics_with_rest, skinning_palette};
+use crate::rig::node_clip::NodeClip;
 use crate::rig::lbs::skin;
 use crate::rig::{CharacterAsset, JointRotation, Skeleton};
 
@@ -81,7 +82,21 @@ pub fn posed_positions_by(
     placement: Mat4,
     method: SkinningMethod,
 ) -> Vec<Vec3> {
-    let palette = posed_palette(&asset.skeleton, &asset.bind_world_to_joint, pose, placement);
+    posed_positions_with_rest(asset, pose, RestOverride::default(), placement, method)
+}
+
+/// As [`posed_positions_by`], with the rest offsets and scales a clip keys.
+pub fn posed_positions_with_rest(
+    asset: &CharacterAsset,
+    pose: &[JointRotation],
+    rest: RestOverride,
+    placement: Mat4,
+    method: SkinningMethod,
+) -> Vec<Vec3> {
+    let mut world = vec![Mat4::IDENTITY; asset.skeleton.len()];
+    forward_kinematics_with_rest(&asset.skeleton, pose, rest, placement, &mut world);
+    let mut palette = vec![Mat4::IDENTITY; world.len()];
+    skinning_palette(&world, &asset.bind_world_to_joint, &mut palette);
     let mut out = vec![Vec3::ZERO; asset.vertex_count()];
     match method {
         SkinningMethod::Linear => skin(&asset.skin.bind_positions, &asset.skin.weights, &palette, &mut out),
@@ -92,6 +107,49 @@ pub fn posed_positions_by(
         }
     }
     out
+}
+
+/// The animation `spec` names among a character's clips: by name, or by its index among
+/// the file's animations.
+pub fn find_clip<'a>(clips: &'a [NodeClip], spec: &str) -> Option<&'a NodeClip> {
+    clips.iter().find(|c| c.name == spec).or_else(|| {
+        let index: usize = spec.parse().ok()?;
+        clips.iter().find(|c| c.index == index)
+    })
+}
+
+/// Every character of a glTF file, each posed by its clip `clip` at `time` seconds (by
+/// its file's node transforms without one) and then by `poses` where it has the joints:
+/// the vertices and triangles of all of them, in file order. Fails when no character has
+/// the clip.
+pub fn posed_gltf(
+    characters: &[crate::formats::gltf_import::ImportedCharacter],
+    clip: Option<&str>,
+    time: f32,
+    poses: &[PoseSpec],
+    method: SkinningMethod,
+) -> Result<(Vec<Vec3>, Vec<[u32; 3]>), String> {
+    if let Some(spec) = clip
+        && !characters.iter().any(|c| find_clip(&c.clips, spec).is_some())
+    {
+        let names: Vec<String> =
+            characters.iter().flat_map(|c| &c.clips).map(|c| format!("{} `{}`", c.index, c.name)).collect();
+        return Err(format!("no animation `{spec}` in the file (it has: {})", if names.is_empty() { "none".to_string() } else { names.join(", ") }));
+    }
+    let (mut positions, mut triangles) = (Vec::new(), Vec::new());
+    for c in characters {
+        let skeleton = &c.asset.skeleton;
+        let sampled = clip.and_then(|spec| find_clip(&c.clips, spec)).map(|clip| clip.sample(skeleton, time));
+        let node_pose = sampled.unwrap_or_else(|| crate::rig::node_clip::NodePose::of(skeleton));
+        let mut pose = node_pose.pose();
+        let mine: Vec<PoseSpec> = poses.iter().filter(|p| skeleton.resolve(&p.joint).is_some()).cloned().collect();
+        apply_pose_specs(skeleton, &mut pose, &mine).map_err(|e| e.to_string())?;
+        let rest = RestOverride { offsets: Some(&node_pose.offsets), scales: Some(&node_pose.scales) };
+        let first = positions.len() as u32;
+        positions.extend(posed_positions_with_rest(&c.asset, &pose, rest, Mat4::IDENTITY, method));
+        triangles.extend(c.asset.skin.triangles.iter().map(|t| t.map(|i| i + first)));
+    }
+    Ok((positions, triangles))
 }
 
 /// A human-readable summary of what was loaded.

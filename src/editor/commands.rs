@@ -13,11 +13,12 @@ use super::pose_library::PoseLibrary;
 use super::stage::StageSettings;
 use super::state::Messages;
 use crate::formats::scene::{
-    AnimDoc, BindingDoc, CharacterDoc, CharacterId, LibraryPoseDoc, PlacementDoc, SkinningDoc, SmplDoc, StageDoc,
+    AnimDoc, BindingDoc, CharacterDoc, CharacterId, LibraryPoseDoc, PlacementDoc, PlaybackDoc, SkinningDoc, SmplDoc, StageDoc,
     ViewDoc,
 };
 use crate::rig::JointRotation;
 use crate::scene::keyframes::ClipPlayer;
+use crate::scene::node_clips::NodeClipPlayer;
 use crate::scene::smpl::SmplCharacter;
 use crate::scene::{
     Character, CharacterSkinning, CharacterView, JointLimits, JointPose, MarionetteSystems, Placement, PoseDirty,
@@ -65,6 +66,11 @@ pub enum Edit {
         character: CharacterId,
         anim: Option<AnimDoc>,
     },
+    /// Clip, time, playback and blend of a source's own clips (glTF animations).
+    Playback {
+        character: CharacterId,
+        state: PlaybackDoc,
+    },
     /// Morph target weights.
     Morph {
         character: CharacterId,
@@ -95,6 +101,7 @@ impl Edit {
             | Edit::Skinning { character, .. }
             | Edit::Clip { character, .. }
             | Edit::Morph { character, .. }
+            | Edit::Playback { character, .. }
             | Edit::Remove(character) => Some(*character),
             Edit::Add(doc) => doc.id,
             Edit::Stage(_) | Edit::Library { .. } => None,
@@ -225,7 +232,7 @@ pub fn apply(world: &mut World, mut edit: Edit) -> Result<Vec<Edit>, String> {
     }
     let Some(inverse) = inverse_of(world, &edit)? else { return Ok(Vec::new()) };
     let mut undo = Vec::with_capacity(2);
-    if let Edit::Smpl { character, .. } = &edit {
+    if let Edit::Smpl { character, .. } | Edit::Playback { character, .. } = &edit {
         // Playback poses the joints from the clip; without a clip to return to, undo must
         // give the joints back their rotations.
         undo.push(current_pose(world, *character)?);
@@ -286,6 +293,10 @@ pub fn inverse_of(world: &mut World, edit: &Edit) -> Result<Option<Edit>, String
             let old = world.get::<ClipPlayer>(entity_of(world, *character)?).map(|p| p.state.clone());
             unless(old == *anim, Edit::Clip { character: *character, anim: old })
         }
+        Edit::Playback { character, state } => {
+            let old = component::<NodeClipPlayer>(world, *character)?.state.clone();
+            unless(old == *state, Edit::Playback { character: *character, state: old })
+        }
         Edit::Morph { character, weights } => {
             let old = component::<crate::scene::morphs::Morphs>(world, *character)?.weights.clone();
             unless(old == *weights, Edit::Morph { character: *character, weights: old })
@@ -335,6 +346,7 @@ fn write(world: &mut World, edit: Edit) -> Result<(), String> {
             component_mut::<SceneCharacter>(world, character)?.name = name;
         }
         Edit::Smpl { character, state } => component_mut::<SmplCharacter>(world, character)?.state = state,
+        Edit::Playback { character, state } => component_mut::<NodeClipPlayer>(world, character)?.state = state,
         Edit::Rebind { character, binding } => rebind_character(world, character, binding)?,
         Edit::Skinning { character, method } => component_mut::<CharacterSkinning>(world, character)?.0 = method,
         Edit::Clip { character, anim } => set_clip(world, character, anim)?,

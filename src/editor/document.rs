@@ -76,6 +76,15 @@ pub struct AssetLibrary {
     smpl: HashMap<PathBuf, SmplSet>,
     bound: HashMap<(SourceDoc, BindingDoc), Arc<CharacterAsset>>,
     keyframe_clips: HashMap<PathBuf, Arc<crate::rig::anim::Clip>>,
+    gltf: HashMap<PathBuf, Vec<GltfPart>>,
+}
+
+/// One character of a glTF file, loaded: its asset, its clips and its base colour.
+#[derive(Clone)]
+pub struct GltfPart {
+    pub asset: Arc<CharacterAsset>,
+    pub clips: Arc<[crate::rig::node_clip::NodeClip]>,
+    pub base_color: Option<[f32; 4]>,
 }
 
 /// A copy of `asset` whose weights come from the distance to its bones at rest.
@@ -117,10 +126,64 @@ impl AssetLibrary {
                 asset.warnings = set.warnings;
                 asset
             }
+            SourceDoc::File(path) if crate::formats::gltf_import::is_gltf(path) => {
+                return Ok(self.gltf_part(path, 0)?.asset);
+            }
+            SourceDoc::Part(path, n) => return Ok(self.gltf_part(path, *n)?.asset),
             SourceDoc::File(path) => load_character(path)?,
         });
         self.cache.insert(source.clone(), asset.clone());
         Ok(asset)
+    }
+
+    /// Character `n` of the glTF file at `path` (the file read once).
+    pub fn gltf_part(&mut self, path: &Path, n: usize) -> Result<GltfPart, FormatError> {
+        let parts = self.gltf_parts(path)?;
+        parts.get(n).cloned().ok_or_else(|| {
+            FormatError::other(path, format!("expected character {} of the file, found {} characters", n + 1, parts.len()))
+        })
+    }
+
+    /// Every character of the glTF file at `path` (the file read once).
+    pub fn gltf_parts(&mut self, path: &Path) -> Result<&[GltfPart], FormatError> {
+        if !self.gltf.contains_key(path) {
+            let parts = crate::formats::gltf_import::load_gltf(path)?
+                .into_iter()
+                .map(|c| GltfPart { asset: Arc::new(c.asset), clips: c.clips.into(), base_color: c.base_color })
+                .collect();
+            self.gltf.insert(path.to_path_buf(), parts);
+        }
+        Ok(&self.gltf[path])
+    }
+
+    /// The sources of a path: one per character of a glTF file (its first as `File`, the
+    /// others as `Part`), or the path itself.
+    pub fn sources_of(&mut self, path: &Path) -> Vec<SourceDoc> {
+        let file = SourceDoc::File(path.to_path_buf());
+        if !crate::formats::gltf_import::is_gltf(path) {
+            return vec![file];
+        }
+        let count = self.gltf_parts(path).map_or(1, <[GltfPart]>::len);
+        std::iter::once(file).chain((1..count).map(|n| SourceDoc::Part(path.to_path_buf(), n))).collect()
+    }
+
+    /// A new character's document for `source`: its name, the motion a BVH brings, the
+    /// base colour a glTF material gives as its tint.
+    pub fn new_character_doc(&mut self, source: SourceDoc, asset: &CharacterAsset) -> CharacterDoc {
+        let mut doc = CharacterDoc { anim: own_motion(&source), ..CharacterDoc::new(source, asset.name.clone()) };
+        if let Some([r, g, b, _]) = self.gltf_source(&doc.source).and_then(|part| part.base_color) {
+            doc.view.tint = [r, g, b];
+        }
+        doc
+    }
+
+    /// The glTF character a source names, if it is one.
+    pub fn gltf_source(&mut self, source: &SourceDoc) -> Option<GltfPart> {
+        match source {
+            SourceDoc::File(p) if crate::formats::gltf_import::is_gltf(p) => self.gltf_part(p, 0).ok(),
+            SourceDoc::Part(p, n) => self.gltf_part(p, *n).ok(),
+            _ => None,
+        }
     }
 
     /// The keyframed clip (`.anim`) at `path`, read once.
@@ -205,6 +268,7 @@ pub struct SceneReader<'w, 's> {
             &'static CharacterSkinning,
             Option<&'static ClipPlayer>,
             Option<&'static crate::scene::morphs::Morphs>,
+            Option<&'static crate::scene::node_clips::NodeClipPlayer>,
         ),
     >,
     pub poses: Query<'w, 's, &'static JointPose>,
@@ -233,7 +297,8 @@ impl SceneReader<'_, '_> {
     /// The document of one live character: joints listed where they differ from the
     /// source's pose.
     pub fn character_doc(&self, entity: Entity) -> Option<CharacterDoc> {
-        let (_, sc, character, placement, view, smpl, skinning, player, morphs) = self.characters.get(entity).ok()?;
+        let (_, sc, character, placement, view, smpl, skinning, player, morphs, node_clips) =
+            self.characters.get(entity).ok()?;
         let skeleton = &character.asset.skeleton;
         let initial = skeleton.initial_pose();
         let pose = character
@@ -257,6 +322,7 @@ impl SceneReader<'_, '_> {
             skinning: skinning.0,
             anim: player.map(|p| p.state.clone()),
             morphs: morphs.map(|m| m.weights.clone()).unwrap_or_default(),
+            playback: node_clips.map(|p| p.state.clone()),
         })
     }
 }
@@ -306,6 +372,7 @@ pub fn spawn_from_doc(
             None
         }
     });
+    let node_clips = library.gltf_source(&doc.source).map(|part| part.clips).filter(|c| !c.is_empty());
     let morphs = (!asset.morphs.is_empty()).then(|| {
         let mut weights = doc.morphs.clone();
         weights.resize(asset.morphs.len(), 0.0);
@@ -317,6 +384,10 @@ pub fn spawn_from_doc(
     }
     if let Some(morphs) = morphs {
         commands.entity(entity).insert(morphs);
+    }
+    if let Some(clips) = node_clips {
+        let state = doc.playback.clone().unwrap_or_default();
+        commands.entity(entity).insert(crate::scene::node_clips::NodeClipPlayer { clips, state });
     }
     commands.entity(entity).insert((
         SceneCharacter { id, source: doc.source.clone(), name: doc.name.clone(), binding: doc.binding },
@@ -406,9 +477,8 @@ pub fn doc_side_by_side(library: &mut AssetLibrary, sources: Vec<SourceDoc>, mes
         .into_iter()
         .zip(translations)
         .map(|((source, asset), translation)| CharacterDoc {
-            anim: own_motion(&source),
             placement: PlacementDoc { translation, yaw: 0.0, scale: 1.0 },
-            ..CharacterDoc::new(source, asset.name.clone())
+            ..library.new_character_doc(source, &asset)
         })
         .collect();
     SceneDoc { characters, ..SceneDoc::default() }
@@ -438,7 +508,8 @@ pub fn startup_doc(paths: &[PathBuf], library: &mut AssetLibrary, messages: &mut
             }
         };
     }
-    Some(doc_side_by_side(library, paths.iter().map(|p| SourceDoc::File(p.clone())).collect(), messages))
+    let sources = paths.iter().flat_map(|p| library.sources_of(p)).collect();
+    Some(doc_side_by_side(library, sources, messages))
 }
 
 /// The scene file among startup paths: a single `.ron`.

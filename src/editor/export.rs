@@ -1,9 +1,12 @@
 //! Exporting a scene: every character of a document as glTF, shaped (SMPL β, morph
-//! weights), posed by its pose and its keyframed clip at its time, placed and tinted.
+//! weights), posed by its pose and its clip at its time (keyframes, a glTF file's own
+//! animation, SMPL playback), placed and tinted; clips as glTF animations.
 
 use crate::formats::FormatError;
 use crate::formats::gltf::{GltfCharacter, GltfMesh, Motion, write_glb};
 use crate::formats::scene::SceneDoc;
+use crate::rig::fk::RestOverride;
+use crate::rig::node_clip::{NodePose, sample_mix};
 
 /// Frames per second at which clips are sampled for glTF.
 pub const EXPORT_FPS: f32 = 30.0;
@@ -49,43 +52,138 @@ fn shaped(
     Ok(asset)
 }
 
-/// Every character of a scene document as glTF: its shape, its pose, its keyframed clip at
-/// its time, its placement and tint.
+/// A character's pose, motion and keyed rest for export.
+struct Posed {
+    pose: Vec<crate::rig::JointRotation>,
+    root: glam::Vec3,
+    /// Rest offsets and scales a clip keys (the root's offset is `root`).
+    rest: Option<(Vec<glam::Vec3>, Vec<glam::Vec3>)>,
+    motion: Option<Motion>,
+}
+
+/// Every character of a scene document as glTF: its shape, its pose, its clip (keyframes,
+/// its source's own animation, SMPL playback) at its time, its placement and tint; with
+/// `animated`, the clips as glTF animations.
 pub fn scene_glb(doc: &SceneDoc, mesh: GltfMesh, animated: bool) -> Result<Vec<u8>, FormatError> {
     let mut library = super::document::AssetLibrary::default();
     let mut loaded = Vec::new();
     for c in &doc.characters {
         let asset = shaped(&mut library, c)?;
-        let (mut pose, notes) = super::document::pose_from_doc(&asset, c);
-        notes.iter().for_each(|n| bevy::log::warn!("{n}"));
-        let mut root = asset.skeleton.joint(0).rest_offset;
-        let mut motion = None;
-        if let Some(anim) = &c.anim {
-            let clip = match &anim.keys {
-                Some(keys) => keys.clone(),
-                None => crate::formats::load_clip(&anim.file)?,
-            };
-            let clip = clip.retargeted(&asset.skeleton, &anim.names);
-            if animated {
-                motion = Some(sampled(&clip, &asset.skeleton, &pose));
-            }
-            (root, pose) = clip.pose_at(&asset.skeleton, anim.time, &pose);
-        }
-        loaded.push((c, asset, pose, root, motion));
+        let posed = posed(&mut library, c, &asset, animated)?;
+        loaded.push((c, asset, posed));
     }
     let characters: Vec<GltfCharacter> = loaded
         .iter()
-        .map(|(c, asset, pose, root, motion)| GltfCharacter {
+        .map(|(c, asset, posed)| GltfCharacter {
             name: &c.name,
             asset,
-            pose,
-            root: *root,
+            pose: &posed.pose,
+            root: posed.root,
+            rest: posed.rest.as_ref().map_or_else(Default::default, |(o, s)| RestOverride { offsets: Some(o), scales: Some(s) }),
             translation: c.placement.translation,
             yaw: c.placement.yaw,
             scale: c.placement.scale,
             tint: c.view.tint,
-            motion: motion.clone(),
+            motion: posed.motion.clone(),
         })
         .collect();
     Ok(write_glb(&characters, mesh))
+}
+
+/// A character's pose from its document and clips at their times, and (with `animated`)
+/// its clip sampled over its length.
+fn posed(
+    library: &mut super::document::AssetLibrary,
+    c: &crate::formats::scene::CharacterDoc,
+    asset: &crate::rig::CharacterAsset,
+    animated: bool,
+) -> Result<Posed, FormatError> {
+    let skeleton = &asset.skeleton;
+    let (pose, notes) = super::document::pose_from_doc(asset, c);
+    notes.iter().for_each(|n| bevy::log::warn!("{n}"));
+    let mut posed = Posed { pose, root: skeleton.joint(0).rest_offset, rest: None, motion: None };
+    if let Some(anim) = &c.anim {
+        let clip = match &anim.keys {
+            Some(keys) => keys.clone(),
+            None => crate::formats::load_clip(&anim.file)?,
+        };
+        let clip = clip.retargeted(skeleton, &anim.names);
+        if animated {
+            posed.motion = Some(sampled(&clip, skeleton, &posed.pose));
+        }
+        (posed.root, posed.pose) = clip.pose_at(skeleton, anim.time, &posed.pose);
+    }
+    if let Some(playback) = &c.playback
+        && let Some(part) = library.gltf_source(&c.source)
+    {
+        let find = |name: &Option<String>| part.clips.iter().find(|k| Some(&k.name) == name.as_ref());
+        if let Some(clip) = find(&playback.clip) {
+            let blend = find(&playback.blend_clip).map(|k| (k, playback.blend));
+            let at = |t: f32| sample_mix(skeleton, clip, blend, t);
+            let keyed = |pose: &mut Vec<crate::rig::JointRotation>, sample: &NodePose| {
+                for (j, q) in sample.rotations.iter().enumerate() {
+                    if clip.turns(j) || blend.is_some_and(|(k, _)| k.turns(j)) {
+                        pose[j] = crate::rig::JointRotation::Quat(*q);
+                    }
+                }
+            };
+            let moves_rest = clip.moves_rest() || blend.is_some_and(|(k, _)| k.moves_rest());
+            let now = at(playback.time);
+            keyed(&mut posed.pose, &now);
+            posed.root = now.offsets[0];
+            if moves_rest {
+                posed.rest = Some(rest_of(skeleton, &now));
+            }
+            if animated {
+                let frames = (clip.duration() * EXPORT_FPS).ceil() as usize;
+                let mut motion = Motion::default();
+                for f in 0..=frames {
+                    let t = (f as f32 / EXPORT_FPS).min(clip.duration());
+                    let sample = at(t);
+                    let mut pose = posed.pose.clone();
+                    keyed(&mut pose, &sample);
+                    motion.times.push(t);
+                    motion.poses.push(pose);
+                    motion.roots.push(sample.offsets[0]);
+                    if moves_rest {
+                        motion.rests.push(rest_of(skeleton, &sample));
+                    }
+                }
+                posed.motion = Some(motion);
+            }
+        }
+    }
+    if animated && let Some(motion) = smpl_motion(library, c, asset)? {
+        posed.motion = Some(motion);
+    }
+    Ok(posed)
+}
+
+/// A sampled pose's offsets (the root's left at the skeleton's, as `root` carries it) and
+/// scales.
+fn rest_of(skeleton: &crate::rig::Skeleton, sample: &NodePose) -> (Vec<glam::Vec3>, Vec<glam::Vec3>) {
+    let mut offsets = sample.offsets.clone();
+    offsets[0] = skeleton.joint(0).rest_offset;
+    (offsets, sample.scales.clone())
+}
+
+/// An SMPL body's playing clip, every frame (at its 30 frames per second), with the body's
+/// own root and the clip's rotations.
+fn smpl_motion(
+    library: &mut super::document::AssetLibrary,
+    c: &crate::formats::scene::CharacterDoc,
+    asset: &crate::rig::CharacterAsset,
+) -> Result<Option<Motion>, FormatError> {
+    let (Some(smpl), crate::formats::scene::SourceDoc::File(dir)) = (&c.smpl, &c.source) else { return Ok(None) };
+    let Some(name) = &smpl.clip else { return Ok(None) };
+    let set = library.smpl(dir)?;
+    let Some((_, clip)) = set.clips.iter().find(|(n, _)| n == name) else { return Ok(None) };
+    let mut motion = Motion::default();
+    let root = asset.skeleton.joint(0).rest_offset;
+    for f in 0..clip.frame_count() {
+        motion.times.push(f as f32 / crate::scene::smpl::CLIP_FPS);
+        motion.poses.push(clip.frame(f).iter().map(|&q| crate::rig::JointRotation::Quat(q)).collect());
+        motion.roots.push(root);
+    }
+    Ok(Some(motion))
 }

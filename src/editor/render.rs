@@ -104,6 +104,7 @@ pub fn render(
 /// file, an unparsable scene or a character that fails to load is an error (and no picture
 /// is written). Returns the loaded assets for the app to reuse.
 fn preload(paths: &[PathBuf]) -> Result<AssetLibrary, String> {
+    let mut library = AssetLibrary::default();
     // Each source, with what names it in a scene file (for the message).
     let sources: Vec<(SourceDoc, Option<BindingDoc>, String)> = match scene_path(paths) {
         Some(scene) => read_scene(scene)
@@ -112,9 +113,8 @@ fn preload(paths: &[PathBuf]) -> Result<AssetLibrary, String> {
             .into_iter()
             .map(|c| (c.source, c.binding, format!(" (character `{}` of {})", c.name, scene.display())))
             .collect(),
-        None => paths.iter().map(|p| (SourceDoc::File(p.clone()), None, String::new())).collect(),
+        None => paths.iter().flat_map(|p| library.sources_of(p)).map(|s| (s, None, String::new())).collect(),
     };
-    let mut library = AssetLibrary::default();
     let errors: Vec<String> = sources
         .iter()
         .filter_map(|(source, binding, named_in)| {

@@ -61,7 +61,7 @@ pub fn scene_shortcuts(
     }
     if keys.just_pressed(KeyCode::KeyK)
         && let Some(id) = selection.character
-        && let Some((_, _, character, .., player, _)) = scene.characters.iter().find(|c| c.1.id == id)
+        && let Some((_, _, character, .., player, _, _)) = scene.characters.iter().find(|c| c.1.id == id)
     {
         let pose: Vec<_> =
             character.joints.iter().map(|&e| scene.poses.get(e).map_or(Default::default(), |p| p.0)).collect();

@@ -24,8 +24,10 @@ pub struct StartupEdits {
     pub match_height: bool,
     /// `--anim` and `--time`: a keyframed clip on every character it fits.
     pub anim: Option<crate::formats::scene::AnimDoc>,
-    /// `--time`: every clip of the scene (keyframes, SMPL) sampled there, paused.
+    /// `--time`: every clip of the scene (keyframes, SMPL, glTF) sampled there, paused.
     pub time: Option<f32>,
+    /// `--clip`: a glTF file's animation (name or index) on the characters it moves.
+    pub clip: Option<String>,
 }
 
 /// Messages for the user (load errors, warnings, where files went), newest last.

@@ -38,6 +38,7 @@ impl Plugin for ScenePlugin {
             .add_plugins((
                 crate::scene::smpl::SmplPlugin,
                 crate::scene::keyframes::KeyframePlugin,
+                crate::scene::node_clips::NodeClipPlugin,
                 crate::scene::morphs::MorphPlugin,
                 super::commands::CommandsPlugin,
             ))
@@ -118,6 +119,9 @@ fn apply_startup_edits(
     if let Some(anim) = &edits.anim {
         put_clip_on_fitting_characters(doc, anim, library, messages);
     }
+    if let Some(spec) = &edits.clip {
+        play_gltf_clip(doc, spec, library, messages);
+    }
     if let Some(t) = edits.time {
         pause_clips_at(doc, t);
     }
@@ -153,6 +157,32 @@ fn pause_clips_at(doc: &mut crate::formats::scene::SceneDoc, t: f32) {
             smpl.time = t * crate::scene::smpl::CLIP_FPS;
             smpl.playing = false;
         }
+        if let Some(playback) = c.playback.as_mut().filter(|p| p.clip.is_some()) {
+            playback.time = t;
+            playback.playing = false;
+        }
+    }
+}
+
+/// Plays the glTF animation `spec` (name or index) on every character of the document that
+/// it moves; says when it moves none.
+fn play_gltf_clip(
+    doc: &mut crate::formats::scene::SceneDoc,
+    spec: &str,
+    library: &mut AssetLibrary,
+    messages: &mut Messages,
+) {
+    let mut played = 0;
+    for c in &mut doc.characters {
+        let Some(part) = library.gltf_source(&c.source) else { continue };
+        if let Some(clip) = crate::cli::posing::find_clip(&part.clips, spec) {
+            let state = c.playback.take().unwrap_or(crate::formats::scene::PlaybackDoc { playing: true, ..Default::default() });
+            c.playback = Some(crate::formats::scene::PlaybackDoc { clip: Some(clip.name.clone()), ..state });
+            played += 1;
+        }
+    }
+    if played == 0 {
+        messages.push(format!("no character has an animation `{spec}` (--clip takes a glTF animation's name or index)"));
     }
 }
 

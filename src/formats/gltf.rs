@@ -16,6 +16,9 @@ pub struct GltfCharacter<'a> {
     pub pose: &'a [JointRotation],
     /// The root joint's translation in model space (its offset unless a clip moves it).
     pub root: Vec3,
+    /// Rest offsets and scales a clip keys, in place of the skeleton's (the root's offset
+    /// is `root`).
+    pub rest: crate::rig::fk::RestOverride<'a>,
     /// Model space → world: translation, turn about y, uniform scale.
     pub translation: Vec3,
     pub yaw: f32,
@@ -35,6 +38,7 @@ impl<'a> GltfCharacter<'a> {
             asset,
             pose,
             root,
+            rest: Default::default(),
             translation: Vec3::ZERO,
             yaw: 0.0,
             scale: 1.0,
@@ -51,6 +55,9 @@ pub struct Motion {
     pub times: Vec<f32>,
     pub poses: Vec<Vec<JointRotation>>,
     pub roots: Vec<Vec3>,
+    /// Each time's rest offsets and scales of every joint, where the clip keys them (empty:
+    /// the skeleton's; the root's offset is `roots`).
+    pub rests: Vec<(Vec<Vec3>, Vec<Vec3>)>,
 }
 
 /// How the meshes go out.
@@ -139,12 +146,10 @@ pub fn write_glb(characters: &[GltfCharacter], mesh: GltfMesh) -> Vec<u8> {
         let mut mesh_node = json!({ "name": format!("{} mesh", c.name), "mesh": meshes.len() });
         match mesh {
             GltfMesh::Baked => {
-                let palette = crate::rig::fk::posed_palette(
-                    &c.asset.skeleton,
-                    &c.asset.bind_world_to_joint,
-                    c.pose,
-                    root_origin(c),
-                );
+                let mut world = vec![Mat4::IDENTITY; c.asset.skeleton.len()];
+                crate::rig::fk::forward_kinematics_with_rest(&c.asset.skeleton, c.pose, c.rest, root_origin(c), &mut world);
+                let mut palette = vec![Mat4::IDENTITY; world.len()];
+                crate::rig::fk::skinning_palette(&world, &c.asset.bind_world_to_joint, &mut palette);
                 let mut posed = vec![Vec3::ZERO; skin.bind_positions.len()];
                 crate::rig::lbs::skin(&skin.bind_positions, &skin.weights, &palette, &mut posed);
                 attributes.insert("POSITION".into(), json!(b.positions(&posed)));
@@ -253,6 +258,14 @@ fn animation(b: &mut Builder, name: &str, motion: &Motion, joints: &[usize]) -> 
         });
         let bytes = floats(&mut rotations.flat_map(|q| q.to_array()));
         add(b, node, "rotation", bytes, "VEC4");
+        if !motion.rests.is_empty() {
+            if j > 0 {
+                let offsets = motion.rests.iter().flat_map(|(o, _)| o[j].to_array());
+                add(b, node, "translation", floats(&mut offsets.into_iter()), "VEC3");
+            }
+            let scales = motion.rests.iter().flat_map(|(_, s)| s[j].to_array());
+            add(b, node, "scale", floats(&mut scales.into_iter()), "VEC3");
+        }
     }
     json!({ "name": name, "samplers": samplers, "channels": channels })
 }
@@ -263,17 +276,18 @@ fn root_origin(c: &GltfCharacter) -> Mat4 {
 }
 
 /// The joints as nodes (translation: the rest offset, the root's at `root`; rotation: the
-/// pose; scale: the rest scale), linked parent to child; their node indices in joint order.
+/// pose; scale: the rest scale; a clip's keyed rest in their place), linked parent to child; their node indices in joint order.
 fn skeleton_nodes(b: &mut Builder, c: &GltfCharacter) -> Vec<usize> {
     let skeleton = &c.asset.skeleton;
     let first = b.nodes.len();
     for (j, def) in skeleton.joints().iter().enumerate() {
-        let translation = if j == 0 { c.root } else { def.rest_offset };
+        let translation = if j == 0 { c.root } else { c.rest.offsets.map_or(def.rest_offset, |o| o[j]) };
+        let scale = c.rest.scales.map_or(def.rest_scale, |s| s[j]);
         let rotation = c.pose.get(j).map_or(Quat::IDENTITY, JointRotation::to_quat);
         let mut node =
             json!({ "name": def.name, "translation": translation.to_array(), "rotation": rotation.to_array() });
-        if def.rest_scale != Vec3::ONE {
-            node["scale"] = json!(def.rest_scale.to_array());
+        if scale != Vec3::ONE {
+            node["scale"] = json!(scale.to_array());
         }
         let children: Vec<usize> = skeleton.children(j).iter().map(|&k| first + k).collect();
         if !children.is_empty() {

@@ -23,6 +23,11 @@ pub struct ImportedCharacter {
     pub base_color: Option<[f32; 4]>,
 }
 
+/// Whether `path` names a glTF file (`.glb`, `.gltf`).
+pub fn is_gltf(path: &Path) -> bool {
+    path.extension().and_then(|e| e.to_str()).is_some_and(|e| e.eq_ignore_ascii_case("glb") || e.eq_ignore_ascii_case("gltf"))
+}
+
 /// Loads every skinned character of a glTF file, in the order of its skins.
 pub fn load_gltf(path: &Path) -> Result<Vec<ImportedCharacter>, FormatError> {
     let bytes = std::fs::read(path).map_err(|e| FormatError::io(path, e))?;
@@ -298,7 +303,7 @@ impl File<'_> {
             }
             if moved {
                 let name = animation.name().map_or_else(|| format!("animation {}", animation.index()), str::to_string);
-                clips.push(NodeClip { name, tracks, root_parent });
+                clips.push(NodeClip { name, index: animation.index(), tracks, root_parent });
             }
         }
         Ok(clips)

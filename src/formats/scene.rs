@@ -17,6 +17,9 @@ pub enum SourceDoc {
     Embedded(String),
     /// A file or folder; relative to the scene file's folder when written in a scene.
     File(PathBuf),
+    /// Character `n` (from 0) of a file that holds several (a glTF file with several
+    /// skins); `File` is its first.
+    Part(PathBuf, usize),
 }
 
 impl SourceDoc {
@@ -24,6 +27,7 @@ impl SourceDoc {
     pub fn resolved(&self, dir: &Path) -> Self {
         match self {
             SourceDoc::File(p) if p.is_relative() => SourceDoc::File(dir.join(p)),
+            SourceDoc::Part(p, n) if p.is_relative() => SourceDoc::Part(dir.join(p), *n),
             other => other.clone(),
         }
     }
@@ -33,6 +37,7 @@ impl SourceDoc {
     pub fn relative_to(&self, dir: &Path) -> Self {
         match self {
             SourceDoc::File(p) => SourceDoc::File(relative_path(p, dir)),
+            SourceDoc::Part(p, n) => SourceDoc::Part(relative_path(p, dir), *n),
             other => other.clone(),
         }
     }
@@ -41,6 +46,15 @@ impl SourceDoc {
         match self {
             SourceDoc::Embedded(name) => format!("{name} (built in)"),
             SourceDoc::File(p) => p.display().to_string(),
+            SourceDoc::Part(p, n) => format!("{} (character {})", p.display(), n + 1),
+        }
+    }
+
+    /// The file or folder it is read from (none: built in).
+    pub fn path(&self) -> Option<&Path> {
+        match self {
+            SourceDoc::Embedded(_) => None,
+            SourceDoc::File(p) | SourceDoc::Part(p, _) => Some(p),
         }
     }
 }
@@ -213,6 +227,31 @@ pub struct CharacterDoc {
     /// Morph target weights, in the order of the source's targets.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub morphs: Vec<f32>,
+    /// Playback of the source's own clips (a glTF file's animations).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub playback: Option<PlaybackDoc>,
+}
+
+/// Playback of a source's own clips (a glTF file's animations): which clip by name, the
+/// time in seconds, and a second clip blended in on the same clock.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default)]
+pub struct PlaybackDoc {
+    pub clip: Option<String>,
+    /// Playback time in seconds.
+    pub time: f32,
+    pub playing: bool,
+    pub speed: f32,
+    pub looping: bool,
+    /// A second clip blended in with `blend` (0 = first clip only).
+    pub blend_clip: Option<String>,
+    pub blend: f32,
+}
+
+impl Default for PlaybackDoc {
+    fn default() -> Self {
+        Self { clip: None, time: 0.0, playing: false, speed: 1.0, looping: true, blend_clip: None, blend: 0.0 }
+    }
 }
 
 /// A keyframed clip on a character: its keys (set in the editor, kept in the scene file)
@@ -277,6 +316,7 @@ impl CharacterDoc {
             skinning: SkinningDoc::default(),
             anim: None,
             morphs: Vec::new(),
+            playback: None,
         }
     }
 }

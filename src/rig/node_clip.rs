@@ -132,6 +132,8 @@ pub struct JointTracks {
 #[derive(Debug, Clone, PartialEq)]
 pub struct NodeClip {
     pub name: String,
+    /// Its index among the file's animations.
+    pub index: usize,
     /// `tracks[j]` moves joint j (one entry per joint of the skeleton).
     pub tracks: Vec<JointTracks>,
     pub root_parent: Mat4,
@@ -234,5 +236,31 @@ impl NodeClip {
             }
         }
         pose
+    }
+}
+
+/// The pose of `clip` at `t` seconds, blended with `blend`'s clip by its weight (which runs
+/// on the same clock, wrapped to its own length).
+pub fn sample_mix(skeleton: &Skeleton, clip: &NodeClip, blend: Option<(&NodeClip, f32)>, t: f32) -> NodePose {
+    let pose = clip.sample(skeleton, t);
+    match blend {
+        Some((other, weight)) if weight > 0.0 => {
+            let length = other.duration();
+            let wrapped = if length > 0.0 { t.rem_euclid(length) } else { t };
+            pose.blended(&other.sample(skeleton, wrapped), weight)
+        }
+        _ => pose,
+    }
+}
+
+impl NodeClip {
+    /// Whether it keys joint `j`'s rotation.
+    pub fn turns(&self, j: usize) -> bool {
+        self.tracks.get(j).is_some_and(|t| t.rotation.is_some())
+    }
+
+    /// Whether it keys any joint's translation or scale.
+    pub fn moves_rest(&self) -> bool {
+        self.tracks.iter().any(|t| t.translation.is_some() || t.scale.is_some())
     }
 }

@@ -18,6 +18,7 @@ use crate::rig::{CharacterAsset, DofLimits, JointRotation};
     PoseDirty,
     Transform,
     Visibility,
+    RestOverrides,
     super::upload::SkinUpload
 )]
 pub struct Character {
@@ -81,6 +82,25 @@ pub struct PoseDirty {
 
 impl PoseDirty {
     pub const ALL: Self = Self { matrices: true, bind: true, colors: true };
+}
+
+/// Rest offsets and scales of a character's joints where a clip keys them, by joint index
+/// (empty: the skeleton's own), on the character entity.
+#[derive(Component, Clone, Debug, Default, PartialEq)]
+pub struct RestOverrides {
+    pub offsets: Vec<Vec3>,
+    pub scales: Vec<Vec3>,
+}
+
+impl RestOverrides {
+    /// What the matrix stack takes in place of the skeleton's rest (only lists with one
+    /// entry per joint).
+    pub fn for_joints(&self, joints: usize) -> crate::rig::fk::RestOverride<'_> {
+        fn fits(v: &[Vec3], joints: usize) -> Option<&[Vec3]> {
+            (v.len() == joints).then_some(v)
+        }
+        crate::rig::fk::RestOverride { offsets: fits(&self.offsets, joints), scales: fits(&self.scales, joints) }
+    }
 }
 
 /// A joint of a character.

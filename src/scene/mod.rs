@@ -17,6 +17,7 @@
 pub mod components;
 pub mod keyframes;
 pub mod morphs;
+pub mod node_clips;
 pub mod smpl;
 pub mod spawn;
 pub mod systems;

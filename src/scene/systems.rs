@@ -6,7 +6,7 @@ use bevy::prelude::*;
 use super::components::*;
 use super::upload::SkinUpload;
 use crate::rig::JointRotation;
-use crate::rig::fk::forward_kinematics;
+use crate::rig::fk::forward_kinematics_with_rest;
 use crate::rig::skinning::{bounds, heat_colors, joint_colors, weight_colors};
 use crate::rig::{dqs, lbs};
 
@@ -31,6 +31,7 @@ pub fn mark_changed_characters(
         &SkinScratch,
         Ref<CharacterSkinning>,
         Ref<super::keyframes::RootTranslation>,
+        Ref<RestOverrides>,
         &mut PoseDirty,
     )>,
 ) {
@@ -39,11 +40,11 @@ pub fn mark_changed_characters(
             dirty.matrices = true;
         }
     }
-    for (view, heat, scratch, method, root, mut dirty) in &mut characters {
+    for (view, heat, scratch, method, root, rest, mut dirty) in &mut characters {
         if scratch.colored_with != Some(Coloring::of(view, heat)) {
             dirty.colors = true;
         }
-        if method.is_changed() || root.is_changed() {
+        if method.is_changed() || root.is_changed() || rest.is_changed() {
             dirty.matrices = true;
         }
     }
@@ -75,14 +76,21 @@ pub fn bind_rest_pose(characters: Query<(&Character, &PoseDirty)>, mut binds: Qu
 
 /// The matrix-stack pass: for characters marked dirty, gathers the joints' poses by joint
 /// index and runs the one forward kinematics of `rig` over the asset's skeleton (the
-/// matrix stack: push `T(offset) · R(pose)`, write the top, descend, pop) from the
-/// model-space origin (reads `JointPose`, `Character`; writes `CurrentJointToWorld`).
+/// matrix stack: push `T(offset) · R(pose) · S(scale)`, write the top, descend, pop) from
+/// the model-space origin, with the rest a clip keys (reads `JointPose`, `Character`,
+/// `RestOverrides`; writes `CurrentJointToWorld`).
 pub fn compute_joint_to_world(
-    mut characters: Query<(&Character, &PoseDirty, &super::keyframes::RootTranslation, &mut JointScratch)>,
+    mut characters: Query<(
+        &Character,
+        &PoseDirty,
+        &super::keyframes::RootTranslation,
+        &RestOverrides,
+        &mut JointScratch,
+    )>,
     poses: Query<&JointPose>,
     mut currents: Query<&mut CurrentJointToWorld>,
 ) {
-    for (character, dirty, root, mut scratch) in &mut characters {
+    for (character, dirty, root, rest, mut scratch) in &mut characters {
         if !dirty.matrices && !dirty.bind {
             continue;
         }
@@ -92,7 +100,7 @@ pub fn compute_joint_to_world(
         matrices.resize(character.joints.len(), Mat4::IDENTITY);
         let skeleton = &character.asset.skeleton;
         let origin = root.origin(skeleton.joints().first().map_or(Vec3::ZERO, |j| j.rest_offset));
-        forward_kinematics(skeleton, pose, origin, matrices);
+        forward_kinematics_with_rest(skeleton, pose, rest.for_joints(skeleton.len()), origin, matrices);
         for (&entity, &m) in character.joints.iter().zip(matrices.iter()) {
             if let Ok(mut current) = currents.get_mut(entity) {
                 current.0 = m;

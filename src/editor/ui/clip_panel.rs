@@ -1,10 +1,13 @@
-//! A keyframed clip's panel: play, pause, loop, the timeline and speed, and taking it off.
+//! Clip panels: a keyframed clip's (play, pause, loop, the timeline and speed, taking it
+//! off) and a source's own clips' (which clip, the same controls, a second clip blended
+//! in).
 
 use bevy_egui::egui;
 
 use super::smpl_panel::slider;
-use crate::formats::scene::AnimDoc;
+use crate::formats::scene::{AnimDoc, PlaybackDoc};
 use crate::scene::keyframes::ClipPlayer;
+use crate::scene::node_clips::NodeClipPlayer;
 
 /// Draws the clip's controls; returns the new state (none: the clip taken off) when one
 /// was changed.
@@ -33,4 +36,40 @@ pub fn clip_panel(ui: &mut egui::Ui, player: &ClipPlayer) -> Option<Option<AnimD
         return Some(None);
     }
     (state != player.state).then_some(Some(state))
+}
+
+/// Draws the controls of a source's own clips; returns the new state when one was changed.
+pub fn playback_panel(ui: &mut egui::Ui, player: &NodeClipPlayer) -> Option<PlaybackDoc> {
+    let mut state = player.state.clone();
+    let names: Vec<&str> = player.clips.iter().map(|c| c.name.as_str()).collect();
+    egui::CollapsingHeader::new(format!("Animations ({})", names.len())).default_open(true).show(ui, |ui| {
+        clip_choice(ui, "clip", &names, &mut state.clip);
+        let Some(clip) = player.clip() else { return };
+        if state.clip != player.state.clip {
+            state.time = 0.0;
+        }
+        ui.horizontal(|ui| {
+            if ui.button(if state.playing { "Pause" } else { "Play" }).clicked() {
+                state.playing = !state.playing;
+            }
+            ui.checkbox(&mut state.looping, "loop");
+        });
+        ui.add(slider(&mut state.time, 0.0..=clip.duration()).text("time (s)").max_decimals(2));
+        ui.add(slider(&mut state.speed, 0.1..=3.0).text("speed"));
+        clip_choice(ui, "blend with", &names, &mut state.blend_clip);
+        if state.blend_clip.is_some() {
+            ui.add(slider(&mut state.blend, 0.0..=1.0).text("blend"));
+        }
+    });
+    (state != player.state).then_some(state)
+}
+
+/// A drop-down of clip names (or none).
+fn clip_choice(ui: &mut egui::Ui, label: &str, names: &[&str], choice: &mut Option<String>) {
+    egui::ComboBox::from_label(label).selected_text(choice.as_deref().unwrap_or("(none)")).show_ui(ui, |ui| {
+        ui.selectable_value(choice, None, "(none)");
+        for &n in names {
+            ui.selectable_value(choice, Some(n.to_string()), n);
+        }
+    });
 }

@@ -32,7 +32,7 @@ pub struct PickedKey {
 
 /// The keyframe section of the joint panel for character `id`.
 pub fn keyframe_panel(ui: &mut egui::Ui, state: &mut InspectorState, panels: &mut Panels, id: CharacterId) {
-    let Some((_, _, character, _, _, _, _, player, _)) = panels.scene.characters.iter().find(|c| c.1.id == id) else {
+    let Some((_, _, character, _, _, _, _, player, ..)) = panels.scene.characters.iter().find(|c| c.1.id == id) else {
         return;
     };
     let joint_count = character.asset.skeleton.len();

@@ -16,7 +16,7 @@ use crate::editor::history::HistoryRequest;
 use crate::editor::screenshot::ScreenshotRequest;
 use crate::editor::state::Selection;
 use crate::formats::scene::{
-    AnimDoc, BindingDoc, CharacterDoc, CharacterId, DisplayDoc, PlacementDoc, SkinningDoc, SourceDoc, ViewDoc,
+    AnimDoc, BindingDoc, CharacterDoc, CharacterId, DisplayDoc, PlacementDoc, SkinningDoc, ViewDoc,
 };
 
 pub fn scene_panel(ui: &mut egui::Ui, state: &mut InspectorState, panels: &mut Panels, shot: &mut ScreenshotRequest) {
@@ -136,29 +136,31 @@ pub fn open_path(path: &str, state: &mut InspectorState, panels: &mut Panels) {
     }
 }
 
-/// Loads a character file and adds it right of the others, standing on the floor, and
-/// selects it; errors go to the messages.
+/// Loads a character file (every character of a glTF file) and adds it right of the
+/// others, standing on the floor, and selects it; errors go to the messages.
 fn add_character(path: &str, state: &mut InspectorState, panels: &mut Panels) {
     if path.is_empty() {
         return;
     }
-    let source = SourceDoc::File(PathBuf::from(path));
-    let asset = match panels.library.load(&source) {
-        Ok(a) => a,
-        Err(e) => return panels.messages.push(e.to_string()),
-    };
-    panels.messages.0.extend(asset.warnings.iter().cloned());
-    let (lo, hi) = asset.bounds();
-    let translation = beside(&panels.world_boxes(), lo, hi, 1.0);
-    let id = panels.ids.take();
-    let anim = crate::editor::document::own_motion(&source);
-    panels.push(Edit::Add(Box::new(CharacterDoc {
-        id: Some(id),
-        placement: PlacementDoc { translation, yaw: 0.0, scale: 1.0 },
-        anim,
-        ..CharacterDoc::new(source, asset.name.clone())
-    })));
-    *panels.selection = Selection { character: Some(id), joints: Vec::new() };
+    let mut boxes = panels.world_boxes();
+    for source in panels.library.sources_of(Path::new(path)) {
+        let asset = match panels.library.load(&source) {
+            Ok(a) => a,
+            Err(e) => return panels.messages.push(e.to_string()),
+        };
+        panels.messages.0.extend(asset.warnings.iter().cloned());
+        let (lo, hi) = asset.bounds();
+        let translation = beside(&boxes, lo, hi, 1.0);
+        boxes.push((lo + translation, hi + translation));
+        let id = panels.ids.take();
+        let doc = panels.library.new_character_doc(source, &asset);
+        panels.push(Edit::Add(Box::new(CharacterDoc {
+            id: Some(id),
+            placement: PlacementDoc { translation, yaw: 0.0, scale: 1.0 },
+            ..doc
+        })));
+        *panels.selection = Selection { character: Some(id), joints: Vec::new() };
+    }
     state.recent.retain(|r| r != path);
     state.recent.insert(0, path.to_string());
     state.recent.truncate(8);
@@ -212,7 +214,8 @@ fn character_row(ui: &mut egui::Ui, panels: &mut Panels, entity: Entity, id: Cha
 /// Name, source, duplicate/remove, placement, display and colours, weights, SMPL state of
 /// the selected character.
 fn selected_character(ui: &mut egui::Ui, panels: &mut Panels, entity: Entity, id: CharacterId) {
-    let Ok((_, sc, character, placement, view, smpl, skinning, player, morphs)) = panels.scene.characters.get(entity)
+    let Ok((_, sc, character, placement, view, smpl, skinning, player, morphs, node_clips)) =
+        panels.scene.characters.get(entity)
     else {
         return;
     };
@@ -287,6 +290,11 @@ fn selected_character(ui: &mut egui::Ui, panels: &mut Panels, entity: Entity, id
         && let Some(anim) = super::clip_panel::clip_panel(ui, player)
     {
         edits.push(Edit::Clip { character: id, anim });
+    }
+    if let Some(player) = node_clips
+        && let Some(state) = super::clip_panel::playback_panel(ui, player)
+    {
+        edits.push(Edit::Playback { character: id, state });
     }
     if let Some(morphs) = morphs
         && let Some(weights) = morph_sliders(ui, morphs)
