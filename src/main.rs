@@ -231,8 +231,13 @@ fn export_gltf_file(
             let asset = library.load(&source)?;
             let mut c = library.new_character_doc(source.clone(), &asset);
             let part = library.gltf_source(&source);
-            let found = clip.clip.as_deref().and_then(|spec| marionette::cli::posing::find_clip(&part?.clips, spec).cloned());
-            c.playback = found.map(|k| marionette::formats::scene::PlaybackDoc { clip: Some(k.name), time, ..Default::default() });
+            let found =
+                clip.clip.as_deref().and_then(|spec| marionette::cli::posing::find_clip(&part?.clips, spec).cloned());
+            c.playback = found.map(|k| marionette::formats::scene::PlaybackDoc {
+                clip: Some(k.name),
+                time,
+                ..Default::default()
+            });
             doc.characters.push(c);
         }
         let mesh = if bake { GltfMesh::Baked } else { GltfMesh::Skinned };

@@ -5,8 +5,8 @@ use glam::{Mat4, Vec3};
 
 use crate::rig::dqs::SkinningMethod;
 use crate::rig::fk::{RestOverride, forward_kinematics_with_rest, skinning_palette};
-use crate::rig::node_clip::NodeClip;
 use crate::rig::lbs::skin;
+use crate::rig::node_clip::NodeClip;
 use crate::rig::{CharacterAsset, JointRotation, Skeleton};
 
 /// What is wrong with a `JOINT=rx,ry,rz` spec.
@@ -134,7 +134,10 @@ pub fn posed_gltf(
     {
         let names: Vec<String> =
             characters.iter().flat_map(|c| &c.clips).map(|c| format!("{} `{}`", c.index, c.name)).collect();
-        return Err(format!("no animation `{spec}` in the file (it has: {})", if names.is_empty() { "none".to_string() } else { names.join(", ") }));
+        return Err(format!(
+            "no animation `{spec}` in the file (it has: {})",
+            if names.is_empty() { "none".to_string() } else { names.join(", ") }
+        ));
     }
     let (mut positions, mut triangles) = (Vec::new(), Vec::new());
     for c in characters {

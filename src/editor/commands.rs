@@ -13,8 +13,8 @@ use super::pose_library::PoseLibrary;
 use super::stage::StageSettings;
 use super::state::Messages;
 use crate::formats::scene::{
-    AnimDoc, BindingDoc, CharacterDoc, CharacterId, LibraryPoseDoc, PlacementDoc, PlaybackDoc, SkinningDoc, SmplDoc, StageDoc,
-    ViewDoc,
+    AnimDoc, BindingDoc, CharacterDoc, CharacterId, LibraryPoseDoc, PlacementDoc, PlaybackDoc, SkinningDoc, SmplDoc,
+    StageDoc, ViewDoc,
 };
 use crate::rig::JointRotation;
 use crate::scene::keyframes::ClipPlayer;

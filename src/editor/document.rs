@@ -140,7 +140,10 @@ impl AssetLibrary {
     pub fn gltf_part(&mut self, path: &Path, n: usize) -> Result<GltfPart, FormatError> {
         let parts = self.gltf_parts(path)?;
         parts.get(n).cloned().ok_or_else(|| {
-            FormatError::other(path, format!("expected character {} of the file, found {} characters", n + 1, parts.len()))
+            FormatError::other(
+                path,
+                format!("expected character {} of the file, found {} characters", n + 1, parts.len()),
+            )
         })
     }
 

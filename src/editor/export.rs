@@ -79,7 +79,10 @@ pub fn scene_glb(doc: &SceneDoc, mesh: GltfMesh, animated: bool) -> Result<Vec<u
             asset,
             pose: &posed.pose,
             root: posed.root,
-            rest: posed.rest.as_ref().map_or_else(Default::default, |(o, s)| RestOverride { offsets: Some(o), scales: Some(s) }),
+            rest: posed
+                .rest
+                .as_ref()
+                .map_or_else(Default::default, |(o, s)| RestOverride { offsets: Some(o), scales: Some(s) }),
             translation: c.placement.translation,
             yaw: c.placement.yaw,
             scale: c.placement.scale,

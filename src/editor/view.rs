@@ -176,13 +176,15 @@ fn play_gltf_clip(
     for c in &mut doc.characters {
         let Some(part) = library.gltf_source(&c.source) else { continue };
         if let Some(clip) = crate::cli::posing::find_clip(&part.clips, spec) {
-            let state = c.playback.take().unwrap_or(crate::formats::scene::PlaybackDoc { playing: true, ..Default::default() });
+            let state =
+                c.playback.take().unwrap_or(crate::formats::scene::PlaybackDoc { playing: true, ..Default::default() });
             c.playback = Some(crate::formats::scene::PlaybackDoc { clip: Some(clip.name.clone()), ..state });
             played += 1;
         }
     }
     if played == 0 {
-        messages.push(format!("no character has an animation `{spec}` (--clip takes a glTF animation's name or index)"));
+        messages
+            .push(format!("no character has an animation `{spec}` (--clip takes a glTF animation's name or index)"));
     }
 }
 

@@ -147,7 +147,13 @@ pub fn write_glb(characters: &[GltfCharacter], mesh: GltfMesh) -> Vec<u8> {
         match mesh {
             GltfMesh::Baked => {
                 let mut world = vec![Mat4::IDENTITY; c.asset.skeleton.len()];
-                crate::rig::fk::forward_kinematics_with_rest(&c.asset.skeleton, c.pose, c.rest, root_origin(c), &mut world);
+                crate::rig::fk::forward_kinematics_with_rest(
+                    &c.asset.skeleton,
+                    c.pose,
+                    c.rest,
+                    root_origin(c),
+                    &mut world,
+                );
                 let mut palette = vec![Mat4::IDENTITY; world.len()];
                 crate::rig::fk::skinning_palette(&world, &c.asset.bind_world_to_joint, &mut palette);
                 let mut posed = vec![Vec3::ZERO; skin.bind_positions.len()];

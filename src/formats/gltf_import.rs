@@ -25,7 +25,9 @@ pub struct ImportedCharacter {
 
 /// Whether `path` names a glTF file (`.glb`, `.gltf`).
 pub fn is_gltf(path: &Path) -> bool {
-    path.extension().and_then(|e| e.to_str()).is_some_and(|e| e.eq_ignore_ascii_case("glb") || e.eq_ignore_ascii_case("gltf"))
+    path.extension()
+        .and_then(|e| e.to_str())
+        .is_some_and(|e| e.eq_ignore_ascii_case("glb") || e.eq_ignore_ascii_case("gltf"))
 }
 
 /// Loads every skinned character of a glTF file, in the order of its skins.

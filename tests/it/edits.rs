@@ -395,3 +395,83 @@ fn dropped_files_add_characters_and_open_scenes() {
     names.sort();
     assert_eq!(names, ["Ada", "Bo", "Cy"], "the scene replaced the world");
 }
+
+/// A glTF file of two characters (made by Blender) dropped on the window: both load, each
+/// with its own clip; playing one through an edit poses the ECS joints exactly as the rig
+/// samples the clip (rotations, keyed scale); undo gives the file's pose back; the scene
+/// file keeps the second character as `Part` and its playback, and reopens it posed the
+/// same.
+#[test]
+fn a_glb_of_two_characters_plays_its_clips_in_the_ecs_as_the_rig_samples_them() {
+    use marionette::editor::ui::{InspectorState, open_dropped_files};
+    use marionette::formats::scene::PlaybackDoc;
+    use marionette::rig::node_clip::NodePose;
+    use marionette::scene::CurrentJointToWorld;
+    use marionette::scene::node_clips::NodeClipPlayer;
+    let mut app = scene_app();
+    app.add_message::<bevy::window::FileDragAndDrop>()
+        .init_resource::<InspectorState>()
+        .add_systems(Update, open_dropped_files);
+    let glb = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/blender_pair.glb");
+    app.world_mut().write_message(bevy::window::FileDragAndDrop::DroppedFile {
+        window: Entity::PLACEHOLDER,
+        path_buf: glb.clone(),
+    });
+    app.update();
+    app.update();
+    let mut found: Vec<(String, SourceDoc, CharacterId)> = app
+        .world_mut()
+        .query::<&SceneCharacter>()
+        .iter(app.world())
+        .map(|c| (c.name.clone(), c.source.clone(), c.id))
+        .collect();
+    found.sort();
+    assert_eq!(found.len(), 2);
+    assert_eq!((found[0].0.as_str(), &found[0].1), ("walker", &SourceDoc::File(glb.clone())));
+    assert_eq!((found[1].0.as_str(), &found[1].1), ("waver", &SourceDoc::Part(glb.clone(), 1)));
+    let waver = found[1].2;
+    let e = entity(&app, waver.0);
+    assert_eq!(app.world_mut().query::<&NodeClipPlayer>().iter(app.world()).count(), 2);
+    let matrices = |app: &App| -> Vec<Mat4> {
+        let c = app.world().get::<Character>(e).unwrap();
+        c.joints.iter().map(|&j| app.world().get::<CurrentJointToWorld>(j).unwrap().0).collect()
+    };
+    let character = app.world().get::<Character>(e).unwrap().clone();
+    let skeleton = &character.asset.skeleton;
+    let file_pose = NodePose::of(skeleton).joint_to_world(skeleton, Mat4::IDENTITY);
+    let start = matrices(&app);
+    start.iter().zip(&file_pose).for_each(|(a, b)| crate::common::assert_mat_close(*a, *b, 1e-6));
+
+    let clip = app.world().get::<NodeClipPlayer>(e).unwrap().clips[0].clone();
+    let playing = PlaybackDoc { clip: Some(clip.name.clone()), time: 0.5, ..PlaybackDoc::default() };
+    edit(&mut app, Edit::Playback { character: waver, state: playing.clone() });
+    let expected = clip.sample(skeleton, 0.5).joint_to_world(skeleton, Mat4::IDENTITY);
+    let posed = matrices(&app);
+    posed.iter().zip(&expected).for_each(|(a, b)| crate::common::assert_mat_close(*a, *b, 1e-6));
+    assert!(posed[1].x_axis.length() > 1.05, "the keyed scale of `lower` is played: {}", posed[1].x_axis.length());
+
+    let doc = app.world().resource::<Captured>().0.clone();
+    let saved = doc.characters.iter().find(|c| c.id == Some(waver)).unwrap();
+    assert_eq!(saved.playback.as_ref(), Some(&playing));
+    let file = crate::common::scratch("glb-scene").join("pair.ron");
+    marionette::editor::document::write_scene(&file, &doc).unwrap();
+
+    request(&mut app, HistoryRequest::Undo);
+    matrices(&app).iter().zip(&file_pose).for_each(|(a, b)| crate::common::assert_mat_close(*a, *b, 1e-6));
+
+    let mut reopened = scene_app();
+    let doc = marionette::editor::document::read_scene(&file).unwrap();
+    let part = doc.characters.iter().find_map(|c| match &c.source {
+        SourceDoc::Part(p, 1) => Some(p.canonicalize().unwrap()),
+        _ => None,
+    });
+    assert_eq!(part, Some(glb.canonicalize().unwrap()));
+    *reopened.world_mut().resource_mut::<PendingScene>() = PendingScene { doc: Some(doc), frame: false };
+    reopened.update();
+    reopened.update();
+    let e = entity(&reopened, waver.0);
+    let c = reopened.world().get::<Character>(e).unwrap();
+    let again: Vec<Mat4> =
+        c.joints.iter().map(|&j| reopened.world().get::<CurrentJointToWorld>(j).unwrap().0).collect();
+    again.iter().zip(&expected).for_each(|(a, b)| crate::common::assert_mat_close(*a, *b, 1e-6));
+}

@@ -374,3 +374,45 @@ fn bad_gltf_files_say_what_and_where() {
     let e = marionette::formats::load_character(&baked).unwrap_err().to_string();
     assert!(e.contains("baked.glb") && e.contains("skins[0]"), "{e}");
 }
+
+/// `export FILE.glb --clip 0 --time 1 --out x.obj` writes both characters of the Blender
+/// pair, in file order: the walker as Blender plays its clip at 1 s, the waver (which the
+/// clip does not move) in the file's pose. An animation the file lacks is an error naming
+/// the file and what it has, and nothing is written.
+#[test]
+fn exporting_a_glb_to_obj_writes_every_character_as_blender_poses_it() {
+    use std::process::Command;
+    let data = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data");
+    let blender = blender_pair(&data.join("blender_pair.txt"));
+    let at = |mesh: usize, t: f32| &blender.meshes[mesh].1.frames.iter().find(|f| f.0 == t).unwrap().1;
+    let expected: Vec<Vec3> = at(0, 1.0).iter().chain(at(1, 0.0)).copied().collect();
+    let dir = crate::common::scratch("gltf-obj");
+    let obj = dir.join("pair.obj");
+    let glb = data.join("blender_pair.glb");
+    let run = |args: &[&str]| {
+        Command::new(env!("CARGO_BIN_EXE_marionette")).arg("export").arg(&glb).args(args).output().unwrap()
+    };
+    let out = run(&["--clip", "0", "--time", "1", "--out", obj.to_str().unwrap()]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let ours: Vec<Vec3> = std::fs::read_to_string(&obj)
+        .unwrap()
+        .lines()
+        .filter_map(|l| l.strip_prefix("v "))
+        .map(|l| {
+            let v: Vec<f32> = l.split_whitespace().map(|x| x.parse().unwrap()).collect();
+            Vec3::new(v[0], v[1], v[2])
+        })
+        .collect();
+    assert_eq!(ours.len(), expected.len());
+    let worst = ours.iter().zip(&expected).map(|(a, b)| a.distance(*b)).fold(0.0f32, f32::max);
+    assert!(worst <= 1e-5, "{worst}");
+
+    let missing = dir.join("missing.obj");
+    let out = run(&["--clip", "dance", "--out", missing.to_str().unwrap()]);
+    let message = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success() && !missing.exists());
+    assert!(
+        message.contains("blender_pair.glb") && message.contains("`dance`") && message.contains("waver_rig_action"),
+        "{message}"
+    );
+}
