@@ -39,8 +39,7 @@ pub fn load_gltf(path: &Path) -> Result<Vec<ImportedCharacter>, FormatError> {
 /// The skinned characters of a glTF file's bytes (`.bin` files are looked for beside
 /// `path`), one per skin that a mesh uses, in the order of the skins.
 pub fn parse_gltf(bytes: &[u8], path: &Path) -> Result<Vec<ImportedCharacter>, FormatError> {
-    let gltf =
-        gltf::Gltf::from_slice(bytes).map_err(|e| FormatError::other(path, format!("at $: expected glTF 2.0, {e}")))?;
+    let gltf = validated(bytes).map_err(|e| FormatError::other(path, format!("at $: expected glTF 2.0, {e}")))?;
     if let Some(ext) = gltf.extensions_required().next() {
         return Err(FormatError::other(path, format!("at $.extensionsRequired: needs `{ext}`, which is not read")));
     }
@@ -315,6 +314,27 @@ impl File<'_> {
     fn global(&self, node: Option<usize>) -> Mat4 {
         global(self.gltf, &self.parent, node)
     }
+}
+
+/// The file parsed and validated by the `gltf` crate, after the checks its validation
+/// takes for granted: its hook for primitives indexes `accessors` by every `POSITION`
+/// without a bounds check (a panic on a bad index), so those indices are checked first.
+fn validated(bytes: &[u8]) -> Result<gltf::Gltf, String> {
+    let unchecked = gltf::Gltf::from_slice_without_validation(bytes).map_err(|e| e.to_string())?;
+    let json = unchecked.document.into_json();
+    for (m, mesh) in json.meshes.iter().enumerate() {
+        for (p, primitive) in mesh.primitives.iter().enumerate() {
+            if let Some(bad) = primitive.attributes.values().find(|a| a.value() >= json.accessors.len()) {
+                return Err(format!(
+                    "$.meshes[{m}].primitives[{p}].attributes: accessor {} is beyond the file's {}",
+                    bad.value(),
+                    json.accessors.len()
+                ));
+            }
+        }
+    }
+    let document = gltf::Document::from_json(json).map_err(|e| e.to_string())?;
+    Ok(gltf::Gltf { document, blob: unchecked.blob })
 }
 
 /// Each node's parent (none for a scene root).

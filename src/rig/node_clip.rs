@@ -79,7 +79,8 @@ impl<T: Keyed> Track<T> {
     /// last the last (glTF's clamping).
     pub fn sample(&self, t: f32) -> T {
         let n = self.times.len();
-        if n == 1 || t <= self.times[0] {
+        // Not after the first key (or not a number): the first value.
+        if n == 1 || !(t > self.times[0]) {
             return self.key(0);
         }
         if t >= self.times[n - 1] {

@@ -68,7 +68,16 @@ fn read(reader: Reader, bytes: &[u8]) -> Result<(), FormatError> {
         Reader::Cse169Morph { vertices } => cse169_skin::parse_morph(input, path, vertices).map(drop),
         Reader::Cse169Anim => cse169_skin::parse_anim(input, path).map(drop),
         Reader::Bvh => bvh::parse_bvh(input, path).map(drop),
-        Reader::Glb => marionette::formats::gltf_import::parse_gltf(bytes, path).map(drop),
+        Reader::Glb => marionette::formats::gltf_import::parse_gltf(bytes, path).map(|characters| {
+            // Sampling whatever clips were read must not panic either.
+            for c in &characters {
+                for clip in &c.clips {
+                    for t in [-1.0, 0.0, 0.3, 1e9, f32::NAN] {
+                        clip.sample(&c.asset.skeleton, t);
+                    }
+                }
+            }
+        }),
         Reader::Obj => obj::parse_obj(input, path).map(drop),
         Reader::Off => off::parse_off(input, path).map(drop),
         Reader::SmplHierarchy => smpl::parse_hierarchy(input, path).map(drop),
@@ -197,6 +206,11 @@ fn file_seeds() -> Vec<Seed> {
         Seed {
             reader: Reader::Glb,
             bytes: std::fs::read(Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/blender_arm.glb")).unwrap(),
+            whole: true,
+        },
+        Seed {
+            reader: Reader::Glb,
+            bytes: std::fs::read(Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/blender_pair.glb")).unwrap(),
             whole: true,
         },
         attach(assets.join("puppet.skel"), assets.join("puppet.attach")),
