@@ -5,7 +5,8 @@ back (tests/data/blender_pair.txt).
 
 - `walker`: three bones; the root bone moves (translation keys) and the middle one bends
   (rotation keys) with Bezier curves, exported without resampling, so the file holds
-  CUBICSPLINE samplers; its mesh has a shape key `bulge` (a glTF morph target).
+  CUBICSPLINE samplers; its mesh has a shape key `bulge` (a glTF morph target) and a base
+  colour texture (an 8 x 8 red and blue checker, a PNG inside the .glb).
 - `waver`: two bones under an armature object that is moved, turned and scaled (nodes
   above the skeleton); its upper bone turns with constant keys (STEP) and its lower bone
   scales with linear keys (LINEAR).
@@ -24,7 +25,7 @@ Needs `pip install bpy`.
 import json
 import struct
 import sys
-from math import cos, pi, radians, sin
+from math import atan2, cos, pi, radians, sin
 from pathlib import Path
 
 import bpy
@@ -92,6 +93,22 @@ for i, v in enumerate(walker.data.vertices):
     if 1.2 < v.co.z < 1.8:
         bulge.data[i].co = (v.co.x * 1.5, v.co.y * 1.5, v.co.z)
 bulge.value = 0.0
+
+# The walker wears a base colour texture: an 8 x 8 checker of red and blue (written into
+# the .glb as a PNG), on texture coordinates around the tube.
+checker = bpy.data.images.new("checker", 8, 8)
+checker.pixels = [c for i in range(64) for c in ((1, 0, 0, 1) if (i % 8 + i // 8) % 2 else (0, 0, 1, 1))]
+material = bpy.data.materials.new("walker_skin")
+material.use_nodes = True
+image_node = material.node_tree.nodes.new("ShaderNodeTexImage")
+image_node.image = checker
+bsdf = material.node_tree.nodes["Principled BSDF"]
+material.node_tree.links.new(image_node.outputs["Color"], bsdf.inputs["Base Color"])
+walker.data.materials.append(material)
+uv = walker.data.uv_layers.new(name="UVMap")
+for loop in walker.data.loops:
+    co = walker.data.vertices[loop.vertex_index].co
+    uv.data[loop.index].uv = ((atan2(co.y, co.x) / (2 * pi)) % 1.0, co.z / 3.0)
 
 # waver: two bones, its armature object moved, turned and scaled.
 waver = tube("waver", 9, 2.0, 0.25)

@@ -27,9 +27,10 @@ pub type SkinMaterialAsset = ExtendedMaterial<StandardMaterial, FlatNormals>;
 #[derive(Resource)]
 pub struct SkinMaterial(pub Handle<SkinMaterialAsset>);
 
-/// The materials of textured skins, by texture file (loaded once).
+/// The materials of textured skins, by texture (a file's path, or the key of an image a
+/// character's file holds; loaded once).
 #[derive(Resource, Default)]
-pub struct TexturedSkinMaterials(pub std::collections::HashMap<std::path::PathBuf, Handle<SkinMaterialAsset>>);
+pub struct TexturedSkinMaterials(pub std::collections::HashMap<String, Handle<SkinMaterialAsset>>);
 
 /// The skin material with `image` as its base colour texture.
 pub fn textured_material(

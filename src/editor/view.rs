@@ -15,6 +15,7 @@ use super::stage::{
 use super::state::{Messages, Selection, StartupEdits, StartupPaths, UnloadedCharacters};
 use super::{draw, history, ik_drag};
 use crate::formats::scene::{CharacterId, DisplayDoc};
+use crate::rig::SkinTexture;
 use crate::scene::{Character, CharacterView, HeatJoint, MarionetteSystems, SkinMesh};
 
 /// The live scene without drawing: opening documents, edits and their history, SMPL
@@ -348,26 +349,40 @@ fn attach_skin_material(
     for (entity, skin) in &new_skins {
         let texture = characters.get(skin.character).ok().and_then(|c| c.asset.texture.clone());
         let handle = match texture {
-            Some(path) => match textured.0.get(&path) {
-                Some(handle) => handle.clone(),
-                None => match std::fs::read(&path)
-                    .map_err(|e| crate::formats::FormatError::io(&path, e))
-                    .and_then(|bytes| crate::formats::bmp::decode_bmp(&bytes, &path))
-                {
-                    Ok(image) => {
-                        let handle = super::skin_material::textured_material(&image, &mut images, &mut materials);
-                        textured.0.insert(path, handle.clone());
-                        handle
-                    }
-                    Err(e) => {
-                        messages.push(format!("{e} (the skin is drawn without it)"));
-                        material.0.clone()
-                    }
-                },
-            },
+            Some(texture) => {
+                let key = match &texture {
+                    SkinTexture::File(path) => path.display().to_string(),
+                    SkinTexture::Picture { key, .. } => key.clone(),
+                };
+                match textured.0.get(&key) {
+                    Some(handle) => handle.clone(),
+                    None => match picture_of(&texture) {
+                        Ok(image) => {
+                            let handle = super::skin_material::textured_material(&image, &mut images, &mut materials);
+                            textured.0.insert(key, handle.clone());
+                            handle
+                        }
+                        Err(e) => {
+                            messages.push(format!("{e} (the skin is drawn without it)"));
+                            material.0.clone()
+                        }
+                    },
+                }
+            }
             None => material.0.clone(),
         };
         commands.entity(entity).insert(MeshMaterial3d(handle));
+    }
+}
+
+/// A skin texture's pixels: a BMP file read now, or the image its character's file held.
+fn picture_of(texture: &SkinTexture) -> Result<std::sync::Arc<crate::rig::Picture>, crate::formats::FormatError> {
+    match texture {
+        SkinTexture::File(path) => std::fs::read(path)
+            .map_err(|e| crate::formats::FormatError::io(path, e))
+            .and_then(|bytes| crate::formats::bmp::decode_bmp(&bytes, path))
+            .map(std::sync::Arc::new),
+        SkinTexture::Picture { picture, .. } => Ok(picture.clone()),
     }
 }
 

@@ -6,12 +6,7 @@ use std::path::Path;
 use super::error::FormatError;
 
 /// An image as RGBA8 rows, top row first.
-#[derive(Debug, Clone, PartialEq)]
-pub struct Rgba {
-    pub width: u32,
-    pub height: u32,
-    pub pixels: Vec<u8>,
-}
+pub use crate::rig::Picture as Rgba;
 
 fn u16_at(b: &[u8], at: usize) -> Option<u16> {
     Some(u16::from_le_bytes(b.get(at..at + 2)?.try_into().ok()?))

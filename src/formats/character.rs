@@ -187,7 +187,7 @@ fn load_cse169_skin(name: String, skeleton: Skeleton, path: &Path) -> Result<Cha
     let skin = Skin { bind_positions: file.positions, triangles: file.triangles, weights, texcoords };
     let asset = CharacterAsset::with_inverse_binds(name, skeleton, skin, inverse_binds, warnings)
         .map_err(|e| FormatError::rig(path, e))?;
-    Ok(CharacterAsset { morphs, texture, ..asset })
+    Ok(CharacterAsset { morphs, texture: texture.map(crate::rig::SkinTexture::File), ..asset })
 }
 
 /// The `.morph` files beside a skin whose names start with the skin's (`head1.morph` and

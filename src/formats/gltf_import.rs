@@ -3,16 +3,18 @@
 //! translation as the rest offset, its scale as the rest scale, its rotation as the
 //! joint's pose from the file), the file's inverse bind matrices, every primitive of the
 //! meshes that use the skin (merged, in file order) with all `JOINTS_n`/`WEIGHTS_n` sets,
-//! normalised; morph targets; the base colour factor; and the file's animations of the
+//! normalised; morph targets; the base colour factor and texture; and the file's animations of the
 //! skin's joints as clips. Transforms of nodes above the skeleton are folded into its root.
 
 use std::path::Path;
 
-use glam::{Mat4, Quat, Vec3};
+use glam::{Mat4, Quat, Vec2, Vec3};
 
 use super::error::FormatError;
 use crate::rig::node_clip::{Interpolation, JointTracks, NodeClip, Track};
-use crate::rig::{CharacterAsset, JointRotation, MorphTarget, RawJoint, Skeleton, Skin, SkinWeights};
+use crate::rig::{
+    CharacterAsset, JointRotation, MorphTarget, Picture, RawJoint, Skeleton, Skin, SkinTexture, SkinWeights,
+};
 
 /// One character of a glTF file: its asset, the file's animations of its joints, and the
 /// base colour of its first primitive's material (none: the file gives no material).
@@ -104,6 +106,7 @@ impl File<'_> {
         let mut rows = Vec::new();
         let mut morphs = Vec::new();
         let mut base_color = None;
+        let (mut texture, mut texcoords) = (None, Vec::new());
         for mesh in meshes {
             for (p, primitive) in mesh.primitives().enumerate() {
                 let at = format!("at $.meshes[{}].primitives[{p}]", mesh.index());
@@ -111,9 +114,16 @@ impl File<'_> {
                     warnings.push(format!("{}: {at} is not triangles and was skipped", self.path.display()));
                     continue;
                 }
-                base_color.get_or_insert(primitive.material().pbr_metallic_roughness().base_color_factor());
+                let pbr = primitive.material().pbr_metallic_roughness();
+                base_color.get_or_insert(pbr.base_color_factor());
                 let first = skin_data.bind_positions.len();
                 self.primitive(&primitive, &at, &new_index, &mut skin_data, &mut rows)?;
+                if let Some(info) = pbr.base_color_texture() {
+                    texture = texture.or_else(|| self.texture(&info.texture(), &mut warnings));
+                    let uv = primitive.reader(self.data()).read_tex_coords(info.tex_coord());
+                    texcoords.resize(first, Vec2::ZERO);
+                    texcoords.extend(uv.into_iter().flat_map(|t| t.into_f32()).map(Vec2::from));
+                }
                 self.morph_targets(mesh, &primitive, first, &mut morphs);
             }
         }
@@ -121,6 +131,10 @@ impl File<'_> {
             .map_err(|e| self.error(format!("at $.skins[{}] meshes (JOINTS_n, WEIGHTS_n): {e}", skin.index())))?;
         warnings.extend(super::character::normalised_warnings(self.path, &normalised));
         skin_data.weights = weights;
+        if texture.is_some() {
+            texcoords.resize(skin_data.bind_positions.len(), Vec2::ZERO);
+            skin_data.texcoords = texcoords;
+        }
         let clips = self.clips(&joints, &new_index, root_parent, &mut warnings)?;
         let stem = self.path.file_stem().and_then(|s| s.to_str()).unwrap_or("gltf");
         let name = match (skin_count, meshes[0].name()) {
@@ -131,6 +145,7 @@ impl File<'_> {
         let mut asset = CharacterAsset::with_inverse_binds(name, skeleton, skin_data, inverse, warnings)
             .map_err(|e| FormatError::rig(self.path, e))?;
         asset.morphs = morphs;
+        asset.texture = texture;
         Ok(ImportedCharacter { asset, clips, base_color })
     }
 
@@ -236,6 +251,37 @@ impl File<'_> {
             };
             let deltas = positions.into_iter().flatten().enumerate().filter(|(_, d)| *d != [0.0; 3]);
             morphs[at].deltas.extend(deltas.map(|(v, d)| ((first + v) as u32, Vec3::from(d))));
+        }
+    }
+
+    /// A texture's image, decoded (PNG or JPEG, from the file's buffers or a file beside
+    /// it); a warning and none when it cannot be read.
+    fn texture(&self, texture: &gltf::Texture, warnings: &mut Vec<String>) -> Option<SkinTexture> {
+        let image = texture.source();
+        let at = format!("{}: at $.images[{}]", self.path.display(), image.index());
+        let bytes = match image.source() {
+            gltf::image::Source::View { view, .. } => {
+                let buffer = self.buffers.get(view.buffer().index())?;
+                buffer.get(view.offset()..view.offset() + view.length()).map(<[u8]>::to_vec)
+            }
+            gltf::image::Source::Uri { uri, .. } if !uri.starts_with("data:") => {
+                std::fs::read(self.path.parent().unwrap_or(Path::new(".")).join(uri)).ok()
+            }
+            gltf::image::Source::Uri { .. } => None,
+        };
+        let decoded = bytes
+            .ok_or_else(|| "its bytes cannot be read".to_string())
+            .and_then(|b| image::load_from_memory(&b).map_err(|e| e.to_string()));
+        match decoded {
+            Ok(decoded) => {
+                let rgba = decoded.to_rgba8();
+                let picture = Picture { width: rgba.width(), height: rgba.height(), pixels: rgba.into_raw() };
+                Some(SkinTexture::Picture { key: at, picture: std::sync::Arc::new(picture) })
+            }
+            Err(e) => {
+                warnings.push(format!("{at}: the base colour texture is not shown ({e})"));
+                None
+            }
         }
     }
 

@@ -59,8 +59,26 @@ pub struct CharacterAsset {
     pub warnings: Vec<String>,
     /// Shapes the bind mesh can blend towards before skinning (CSE169 `.morph`).
     pub morphs: Vec<MorphTarget>,
-    /// The image the skin's texture coordinates index (CSE169 `material { texture }`).
-    pub texture: Option<std::path::PathBuf>,
+    /// The image the skin's texture coordinates index (CSE169 `material { texture }`, a
+    /// glTF base colour texture).
+    pub texture: Option<SkinTexture>,
+}
+
+/// A skin's base colour image.
+#[derive(Debug, Clone, PartialEq)]
+pub enum SkinTexture {
+    /// A file beside the character's (read when it is shown).
+    File(std::path::PathBuf),
+    /// An image the character's file holds, decoded; `key` names it (file and image index).
+    Picture { key: String, picture: std::sync::Arc<Picture> },
+}
+
+/// An image as RGBA8 (sRGB) rows, top row first.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Picture {
+    pub width: u32,
+    pub height: u32,
+    pub pixels: Vec<u8>,
 }
 
 /// A morph target: how far some vertices move (bind space) at full weight.

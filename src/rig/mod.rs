@@ -17,7 +17,7 @@ pub mod skinning;
 pub mod smpl;
 pub mod turn;
 
-pub use character::{CharacterAsset, MorphTarget, Skin};
+pub use character::{CharacterAsset, MorphTarget, Picture, Skin, SkinTexture};
 pub use fk::{bind_world_to_joint, forward_kinematics, skinning_palette};
 pub use matrix_stack::MatrixStack;
 pub use pose::{DofLimits, EulerOrder, JointRotation};
