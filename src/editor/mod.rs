@@ -25,6 +25,7 @@ pub mod ik_drag;
 pub mod picking;
 pub mod pose_library;
 pub mod readiness;
+pub mod recent;
 pub mod render;
 pub mod rotate_gizmo;
 pub mod screenshot;
@@ -117,6 +118,7 @@ pub fn run(paths: Vec<PathBuf>, edits: StartupEdits) {
             ViewPlugin,
             InteractionPlugin,
             ui::InspectorPlugin,
+            recent::RecentFilesPlugin,
             screenshot::ScreenshotPlugin,
         ))
         // The inspector's edits (bevy_egui's pass) land before the chain that animates,

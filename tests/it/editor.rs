@@ -280,3 +280,23 @@ fn the_stage_grows_with_the_scene() {
         assert!([1.0, 2.0, 5.0].iter().any(|m| (mantissa - m).abs() < 1e-3), "{e:?}");
     }
 }
+
+/// Recent files: the newest first, once each, at most eight, kept whole in a file (its
+/// folder made) and read back; a missing file is an empty list.
+#[test]
+fn recent_files_are_kept_newest_first_and_read_back() {
+    use marionette::editor::recent::{KEPT, read_recent, remember, write_recent};
+    let file = crate::common::scratch("recent").join("config/marionette/recent.txt");
+    assert!(read_recent(&file).is_empty());
+    let mut recent = Vec::new();
+    for i in 0..10 {
+        remember(&mut recent, &format!("/data/model{i}.skel"));
+    }
+    remember(&mut recent, "/data/model5.skel");
+    assert_eq!(recent.len(), KEPT);
+    assert_eq!(recent[0], "/data/model5.skel");
+    assert_eq!(recent.iter().filter(|r| *r == "/data/model5.skel").count(), 1);
+    assert_eq!(recent[1], "/data/model9.skel");
+    write_recent(&file, &recent).unwrap();
+    assert_eq!(read_recent(&file), recent);
+}

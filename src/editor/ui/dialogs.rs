@@ -75,6 +75,7 @@ pub fn show(ctx: &egui::Context, state: &mut InspectorState, panels: &mut Panels
     match purpose {
         DialogPurpose::OpenScene => {
             state.scene_path = text.clone();
+            crate::editor::recent::remember(&mut state.recent, &text);
             crate::editor::document::open_scene_from(&text, &mut panels.pending, &mut panels.messages);
         }
         DialogPurpose::SaveScene => {

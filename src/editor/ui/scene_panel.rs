@@ -126,6 +126,9 @@ fn add_clip(path: &str, panels: &mut Panels) {
 /// `.ron` opens as the scene, a `.anim` plays on the selected character, anything else is
 /// added as a character.
 pub fn open_path(path: &str, state: &mut InspectorState, panels: &mut Panels) {
+    if !path.is_empty() {
+        crate::editor::recent::remember(&mut state.recent, path);
+    }
     if path.ends_with(".ron") {
         crate::editor::document::open_scene_from(path, &mut panels.pending, &mut panels.messages);
         state.scene_path = path.to_string();
@@ -161,9 +164,6 @@ fn add_character(path: &str, state: &mut InspectorState, panels: &mut Panels) {
         })));
         *panels.selection = Selection { character: Some(id), joints: Vec::new() };
     }
-    state.recent.retain(|r| r != path);
-    state.recent.insert(0, path.to_string());
-    state.recent.truncate(8);
     if let Some(dir) = Path::new(path).parent() {
         state.add_path = format!("{}/", dir.display());
     }
