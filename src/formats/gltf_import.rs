@@ -115,7 +115,10 @@ impl File<'_> {
                     continue;
                 }
                 let pbr = primitive.material().pbr_metallic_roughness();
-                base_color.get_or_insert(pbr.base_color_factor());
+                if primitive.material().index().is_some() {
+                    // A primitive without a material has glTF's default (white): no tint.
+                    base_color.get_or_insert(pbr.base_color_factor());
+                }
                 let first = skin_data.bind_positions.len();
                 self.primitive(&primitive, &at, &new_index, &mut skin_data, &mut rows)?;
                 if let Some(info) = pbr.base_color_texture() {
@@ -307,9 +310,9 @@ impl File<'_> {
                     .read_inputs()
                     .ok_or_else(|| self.error(format!("{sampler}.input: expected key times, found none")))?
                     .collect();
-                if let Some(k) = times.windows(2).position(|w| !(w[0] <= w[1])) {
+                if let Some(k) = times.windows(2).position(|w| w[0].partial_cmp(&w[1]).is_none_or(|o| o.is_gt())) {
                     return Err(self.error(format!(
-                        "{sampler}.input: key time {} comes before {}",
+                        "{sampler}.input: key time {} follows {} (times must increase and be numbers)",
                         times[k + 1],
                         times[k]
                     )));

@@ -80,7 +80,7 @@ impl<T: Keyed> Track<T> {
     pub fn sample(&self, t: f32) -> T {
         let n = self.times.len();
         // Not after the first key (or not a number): the first value.
-        if n == 1 || !(t > self.times[0]) {
+        if n == 1 || t.partial_cmp(&self.times[0]).is_none_or(|o| o.is_le()) {
             return self.key(0);
         }
         if t >= self.times[n - 1] {

@@ -172,6 +172,51 @@ fn a_scene_exports_its_smpl_body_in_its_shape() {
     );
 }
 
+/// An SMPL body playing a clip goes out with `--animation` as a glTF animation of every
+/// frame (30 per second): at frame f each joint's rotation is the clip's frame f.
+#[test]
+#[cfg_attr(not(marionette_data), ignore = "needs MARIONETTE_DATA (the course data)")]
+fn an_smpl_body_playing_a_clip_goes_out_as_an_animation_of_its_frames() {
+    use marionette::formats::scene::{CharacterDoc, SceneDoc, SmplDoc, SourceDoc};
+    let dir = crate::common::data_dir().join("smpl");
+    let clip_path = marionette::formats::smpl::clip_paths(&dir)[0].clone();
+    let name = clip_path.file_name().unwrap().to_string_lossy().into_owned();
+    let body = CharacterDoc {
+        smpl: Some(SmplDoc { clip: Some(name), ..SmplDoc::default() }),
+        ..CharacterDoc::new(SourceDoc::File(dir.clone()), "b")
+    };
+    let doc = SceneDoc { characters: vec![body], ..SceneDoc::default() };
+    let (json, bin) = chunks(&marionette::editor::export::scene_glb(&doc, GltfMesh::Skinned, true).unwrap());
+    let (model, _) = marionette::formats::smpl::load_smpl_dir(&dir).unwrap();
+    let clip = marionette::formats::smpl::parse_clip(
+        std::io::BufReader::new(std::fs::File::open(&clip_path).unwrap()),
+        &clip_path,
+        model.skeleton.len(),
+    )
+    .unwrap();
+    let animation = &json["animations"][0];
+    let joint_nodes: Vec<u64> =
+        json["skins"][0]["joints"].as_array().unwrap().iter().map(|j| j.as_u64().unwrap()).collect();
+    let mut checked = 0;
+    for channel in animation["channels"].as_array().unwrap() {
+        if channel["target"]["path"] != "rotation" {
+            continue;
+        }
+        let j = joint_nodes.iter().position(|&n| n == channel["target"]["node"].as_u64().unwrap()).unwrap();
+        let sampler = &animation["samplers"][channel["sampler"].as_u64().unwrap() as usize];
+        let times = read(&json, &bin, sampler["input"].as_u64().unwrap() as usize);
+        let values = read(&json, &bin, sampler["output"].as_u64().unwrap() as usize);
+        assert_eq!(times.len(), clip.frame_count());
+        for f in [0, 1, clip.frame_count() / 2, clip.frame_count() - 1] {
+            assert!((times[f] - f as f32 / 30.0).abs() < 1e-6);
+            let q = Quat::from_slice(&values[4 * f..4 * f + 4]);
+            assert!(q.dot(clip.frame(f)[j]).abs() > 1.0 - 1e-6, "joint {j} frame {f}");
+        }
+        checked += 1;
+    }
+    assert_eq!(checked, model.skeleton.len());
+}
+
 /// A clip goes out as a glTF animation: at each sampled time the root's translation and
 /// every joint's rotation are the clip's there.
 #[test]
