@@ -64,8 +64,9 @@ enum Command {
         #[arg(long)]
         animation: bool,
     },
-    /// Bind a mesh without weights to a skeleton (each vertex to its nearest bone, or
-    /// smoothly to the nearest few) and write 6.837-style weights.
+    /// Bind a mesh without weights to a skeleton and write 6.837-style weights: by bone heat
+    /// (weights diffused over the mesh from the bones each vertex sees), to the nearest
+    /// bone, or smoothly to the nearest few.
     Bind {
         /// The mesh (.obj or .off).
         mesh: PathBuf,
@@ -73,9 +74,15 @@ enum Command {
         skeleton: PathBuf,
         #[arg(long)]
         out: PathBuf,
-        /// Blend the nearest bones' weights (falling off with distance) instead of one bone.
-        #[arg(long)]
+        #[arg(long, value_enum, default_value_t = BindMethod::Heat)]
+        method: BindMethod,
+        /// The same as `--method smooth` (kept for older scripts).
+        #[arg(long, conflicts_with = "method")]
         smooth: bool,
+        /// Weights to compare with (a 6.837 `.attach` for the same mesh and skeleton):
+        /// prints how often the heaviest joint agrees and the mean L1 distance of the rows.
+        #[arg(long, value_name = "F.attach")]
+        against: Option<PathBuf>,
     },
     /// Render a scene (.ron) or characters offscreen to a PNG, without a window.
     Render {
@@ -173,6 +180,27 @@ impl From<Skinning> for marionette::rig::dqs::SkinningMethod {
         match s {
             Skinning::Lbs => Self::Linear,
             Skinning::Dq => Self::DualQuaternion,
+        }
+    }
+}
+
+/// How `bind` computes weights.
+#[derive(clap::ValueEnum, Clone, Copy, Debug)]
+enum BindMethod {
+    /// Bone heat (Baran and Popović 2007).
+    Heat,
+    /// Each vertex rigidly to its nearest bone.
+    Nearest,
+    /// The nearest few bones, falling off with distance.
+    Smooth,
+}
+
+impl From<BindMethod> for marionette::rig::bind::Binding {
+    fn from(m: BindMethod) -> Self {
+        match m {
+            BindMethod::Heat => Self::Heat,
+            BindMethod::Nearest => Self::Nearest,
+            BindMethod::Smooth => Self::Smooth,
         }
     }
 }
@@ -377,7 +405,10 @@ fn run(cli: Cli) -> Result<()> {
             }
             println!("wrote {} ({width}x{height}) in {:.2} s", out.display(), started.elapsed().as_secs_f64());
         }
-        Some(Command::Bind { mesh, skeleton, out, smooth }) => bind(&mesh, &skeleton, &out, smooth)?,
+        Some(Command::Bind { mesh, skeleton, out, method, smooth, against }) => {
+            let method = if smooth { BindMethod::Smooth } else { method };
+            bind(&mesh, &skeleton, &out, method.into(), against.as_deref())?
+        }
         Some(Command::Smpl { data, task, sequence, transition, slerp, out, naive }) => {
             smpl(&data, task, sequence, transition, slerp, &out, naive)?
         }
@@ -409,24 +440,36 @@ fn bind(
     mesh_path: &std::path::Path,
     skeleton_path: &std::path::Path,
     out: &std::path::Path,
-    smooth: bool,
+    binding: marionette::rig::bind::Binding,
+    against: Option<&std::path::Path>,
 ) -> Result<()> {
     use marionette::formats::{error::open, mit6837, off};
-    use marionette::rig::bind::{Binding, bind_to_skeleton};
+    use marionette::rig::bind::bind_to_skeleton;
     let mesh = match mesh_path.extension().and_then(|e| e.to_str()) {
         Some("off") => off::parse_off(open(mesh_path)?, mesh_path)?,
         _ => obj::parse_obj(open(mesh_path)?, mesh_path)?,
     };
     let skeleton = marionette::formats::character::load_skeleton(skeleton_path)?;
-    let weights = bind_to_skeleton(&skeleton, &mesh.positions, if smooth { Binding::Smooth } else { Binding::Nearest });
+    let started = std::time::Instant::now();
+    let weights = bind_to_skeleton(&skeleton, &mesh.positions, &mesh.triangles, binding)
+        .map_err(|e| anyhow::anyhow!("{}: {e}", mesh_path.display()))?;
+    let seconds = started.elapsed().as_secs_f64();
     write_file(out, |w| mit6837::write_attach(w, &weights, skeleton.len()))?;
     println!(
-        "wrote {} ({} vertices, {} joints, {} binding)",
+        "wrote {} ({} vertices, {} joints, {binding:?} binding in {seconds:.3} s)",
         out.display(),
         mesh.positions.len(),
-        skeleton.len(),
-        if smooth { "smooth" } else { "nearest-bone" }
+        skeleton.len()
     );
+    if let Some(reference) = against {
+        let (theirs, _) = mit6837::parse_attach(open(reference)?, reference, skeleton.len(), mesh.positions.len())?;
+        let (agree, l1) = marionette::rig::skinning::agreement(&weights, &theirs);
+        println!(
+            "against {}: heaviest joint agrees on {:.1} % of the vertices; mean L1 {l1:.3}",
+            reference.display(),
+            100.0 * agree
+        );
+    }
     Ok(())
 }
 

@@ -87,10 +87,20 @@ pub struct GltfPart {
     pub base_color: Option<[f32; 4]>,
 }
 
-/// A copy of `asset` whose weights come from the distance to its bones at rest.
+/// A copy of `asset` whose weights come from its bones at rest (by `binding`); when heat
+/// binding fails, smooth weights and a warning that says so.
 pub fn rebind(asset: &CharacterAsset, binding: BindingDoc) -> CharacterAsset {
+    use crate::rig::bind::{Binding, bind_to_skeleton};
     let mut out = asset.clone();
-    out.skin.weights = crate::rig::bind::bind_to_skeleton(&asset.skeleton, &asset.skin.bind_positions, binding);
+    let (skeleton, skin) = (&asset.skeleton, &asset.skin);
+    out.skin.weights = match bind_to_skeleton(skeleton, &skin.bind_positions, &skin.triangles, binding) {
+        Ok(weights) => weights,
+        Err(e) => {
+            out.warnings.push(format!("{}: {e}; smooth weights instead", asset.name));
+            bind_to_skeleton(skeleton, &skin.bind_positions, &skin.triangles, Binding::Smooth)
+                .expect("smooth binding cannot fail")
+        }
+    };
     out.warnings.push(format!("weights computed ({binding:?}) from the bones"));
     out
 }

@@ -118,17 +118,31 @@ pub enum Binding {
     Nearest,
     /// The nearest few bones, falling off with distance.
     Smooth,
+    /// Bone heat (Baran and Popović 2007; see [`super::heat`]): weights diffused over the
+    /// mesh from the bones each vertex sees.
+    Heat,
 }
 
 /// Bones blended by the smooth binding, and how much farther than the nearest a bone may be.
 pub const SMOOTH_MAX_BONES: usize = 3;
 pub const SMOOTH_FALLOFF: f32 = 1.6;
 
-/// Weights for `vertices` (model space) from the bones of `skeleton` at its rest pose.
-pub fn bind_to_skeleton(skeleton: &Skeleton, vertices: &[Vec3], binding: Binding) -> SkinWeights {
+/// Weights for a mesh (`vertices` in model space, `triangles`) from the bones of
+/// `skeleton` at its rest pose. Only heat binding uses the triangles, and only it can fail
+/// (a system that cannot be factored).
+pub fn bind_to_skeleton(
+    skeleton: &Skeleton,
+    vertices: &[Vec3],
+    triangles: &[[u32; 3]],
+    binding: Binding,
+) -> Result<SkinWeights, super::heat::HeatError> {
     let mut world = vec![Mat4::IDENTITY; skeleton.len()];
     super::fk::forward_kinematics(skeleton, &skeleton.rest_pose(), Mat4::IDENTITY, &mut world);
-    bind_to_bones(vertices, &bones(skeleton, &super::fk::joint_positions(&world)), skeleton.len(), binding)
+    let joints = super::fk::joint_positions(&world);
+    match binding {
+        Binding::Heat => super::heat::heat_weights(skeleton, &joints, vertices, triangles),
+        _ => Ok(bind_to_bones(vertices, &bones(skeleton, &joints), skeleton.len(), binding)),
+    }
 }
 
 /// Weights for `vertices` from given bones (when the joint positions are known exactly).
@@ -140,6 +154,9 @@ pub fn bind_to_bones(vertices: &[Vec3], bones: &[Bone], joint_count: usize, bind
     }
     match binding {
         Binding::Nearest => nearest_bone_weights(vertices, bones),
-        Binding::Smooth => smooth_bone_weights(vertices, bones, joint_count, SMOOTH_MAX_BONES, SMOOTH_FALLOFF),
+        // Without the mesh's triangles heat has nothing to diffuse over: smooth is closest.
+        Binding::Smooth | Binding::Heat => {
+            smooth_bone_weights(vertices, bones, joint_count, SMOOTH_MAX_BONES, SMOOTH_FALLOFF)
+        }
     }
 }

@@ -6,6 +6,7 @@ pub mod bind;
 pub mod character;
 pub mod dqs;
 pub mod fk;
+pub mod heat;
 pub mod ik;
 pub mod lbs;
 pub mod matrix_stack;
@@ -15,6 +16,7 @@ pub mod pose;
 pub mod skeleton;
 pub mod skinning;
 pub mod smpl;
+pub mod triangle_tree;
 pub mod turn;
 
 pub use character::{CharacterAsset, MorphTarget, Picture, Skin, SkinTexture};

@@ -115,6 +115,29 @@ impl SkinWeights {
     }
 }
 
+/// How two bindings of the same mesh agree: the share of vertices whose heaviest joint is
+/// the same (0–1), and the mean over vertices of the L1 distance of their rows (0–2).
+/// Vertices beyond the shorter binding are not counted.
+pub fn agreement(ours: &SkinWeights, theirs: &SkinWeights) -> (f64, f64) {
+    let n = ours.vertex_count().min(theirs.vertex_count());
+    if n == 0 {
+        return (1.0, 0.0);
+    }
+    let heaviest =
+        |w: &SkinWeights, v: usize| w.of_vertex(v).iter().max_by(|a, b| a.weight.total_cmp(&b.weight)).map(|i| i.joint);
+    let agreeing = (0..n).filter(|&v| heaviest(ours, v) == heaviest(theirs, v)).count();
+    let l1: f64 = (0..n)
+        .map(|v| {
+            let joints = ours.of_vertex(v).iter().chain(theirs.of_vertex(v)).map(|i| i.joint as usize);
+            let mut joints: Vec<usize> = joints.collect();
+            joints.sort_unstable();
+            joints.dedup();
+            joints.iter().map(|&j| f64::from((ours.weight(v, j) - theirs.weight(v, j)).abs())).sum::<f64>()
+        })
+        .sum();
+    (agreeing as f64 / n as f64, l1 / n as f64)
+}
+
 /// Skins bind-pose vertices: `out[v] = Σ w · palette[j] · bind[v]` over v's influences.
 /// The plain loop, kept as the oracle of the fast kernel [`super::lbs::skin`].
 ///

@@ -265,9 +265,12 @@ fn selected_character(ui: &mut egui::Ui, panels: &mut Panels, entity: Entity, id
     }
     ui.horizontal(|ui| {
         ui.label("Weights:");
-        for (label, b) in
-            [("from the file", None), ("nearest bone", Some(BindingDoc::Nearest)), ("smooth", Some(BindingDoc::Smooth))]
-        {
+        for (label, b) in [
+            ("from the file", None),
+            ("bone heat", Some(BindingDoc::Heat)),
+            ("nearest bone", Some(BindingDoc::Nearest)),
+            ("smooth", Some(BindingDoc::Smooth)),
+        ] {
             if ui.selectable_label(binding == b, label).clicked() && binding != b {
                 edits.push(Edit::Rebind { character: id, binding: b });
             }
