@@ -87,7 +87,8 @@ const LEAF_DIRECTIONS: usize = 512;
 /// A leaf's bone end. Its direction is the one in which a segment of length `limit` from
 /// `start` brings the mesh nearest to the skeleton (the least sum over `vertices`, each
 /// with its distance to the known bones, of the nearer of that and the segment): the segment that
-/// runs into the part of the mesh no other bone explains (a head, a hand, a foot). The bone
+/// runs into the part of the mesh no other bone explains (a head, a hand, a foot), then
+/// turned to the mean direction of the vertices it explains better. The bone
 /// reaches [`LEAF_REACH`] of the way to the farthest vertex that its ray explains better
 /// than the known bones. None when it explains none.
 fn leaf_tip(start: Vec3, limit: f32, vertices: &[(Vec3, f32)]) -> Option<Vec3> {
@@ -106,6 +107,9 @@ fn leaf_tip(start: Vec3, limit: f32, vertices: &[(Vec3, f32)]) -> Option<Vec3> {
             Vec3::new(r * a.cos(), y, r * a.sin())
         })
         .min_by(|a, b| score(*a).total_cmp(&score(*b)))?;
+    // Refined off the sphere's grid: the mean direction of the vertices it explains.
+    let explained = |u: Vec3| vertices.iter().filter(move |&&(v, k)| along(v, u, limit) < k).map(|&(v, _)| v - start);
+    let direction = explained(direction).sum::<Vec3>().try_normalize().unwrap_or(direction);
     let reach = vertices
         .iter()
         .filter(|&&(v, k)| along(v, direction, f32::INFINITY) < k)

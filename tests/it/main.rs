@@ -14,6 +14,7 @@ mod formats;
 mod fuzz;
 mod gizmo;
 mod gltf;
+mod heat;
 mod ik;
 mod kernel;
 mod poses;
