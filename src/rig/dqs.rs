@@ -157,6 +157,16 @@ mod avx2 {
     use crate::rig::lbs::FixedGroup;
 
     /// `a × b` of the xyz lanes (w: 0).
+    /// `a · b` in every lane, by shuffles and adds (`dpps` is microcoded and slow on
+    /// some CPUs, AMD's Zen among them).
+    #[inline]
+    #[target_feature(enable = "avx2,fma")]
+    fn dot(a: __m128, b: __m128) -> __m128 {
+        let m = _mm_mul_ps(a, b);
+        let pairs = _mm_add_ps(m, _mm_shuffle_ps::<0b10_11_00_01>(m, m));
+        _mm_add_ps(pairs, _mm_shuffle_ps::<0b01_00_11_10>(pairs, pairs))
+    }
+
     #[inline]
     #[target_feature(enable = "avx2,fma")]
     fn cross(a: __m128, b: __m128) -> __m128 {
@@ -191,14 +201,14 @@ mod avx2 {
                 let q = &palette[joints[k] as usize];
                 let (qr, qd): (__m128, __m128) = (q.real.into(), q.dual.into());
                 // The weight takes the sign of dot(q.real, pivot): q and -q are one rotation.
-                let dot = _mm_dp_ps::<0xFF>(qr, pivot);
+                let dot = dot(qr, pivot);
                 let w = _mm_xor_ps(_mm_set1_ps(weights[k]), _mm_and_ps(dot, sign));
                 real = _mm_fmadd_ps(w, qr, real);
                 dual = _mm_fmadd_ps(w, qd, dual);
             }
             // 1/|real| by the reciprocal square root estimate and one Newton step (about
             // 23 bits, the same as the division it replaces; a shorter chain of latency).
-            let n2 = _mm_dp_ps::<0xFF>(real, real);
+            let n2 = dot(real, real);
             let y = _mm_rsqrt_ps(n2);
             let inv =
                 _mm_mul_ps(_mm_mul_ps(_mm_set1_ps(0.5), y), _mm_fnmadd_ps(_mm_mul_ps(n2, y), y, _mm_set1_ps(3.0)));
