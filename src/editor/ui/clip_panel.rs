@@ -64,12 +64,7 @@ pub fn playback_panel(ui: &mut egui::Ui, player: &NodeClipPlayer) -> Option<Play
     (state != player.state).then_some(state)
 }
 
-/// A drop-down of clip names (or none).
+/// A drop-down of the clips by name (or none).
 fn clip_choice(ui: &mut egui::Ui, label: &str, names: &[&str], choice: &mut Option<String>) {
-    egui::ComboBox::from_label(label).selected_text(choice.as_deref().unwrap_or("(none)")).show_ui(ui, |ui| {
-        ui.selectable_value(choice, None, "(none)");
-        for &n in names {
-            ui.selectable_value(choice, Some(n.to_string()), n);
-        }
-    });
+    super::smpl_panel::named_choice(ui, label, names, choice, str::to_string);
 }

@@ -61,11 +61,22 @@ fn playback_rows(ui: &mut egui::Ui, body: &SmplCharacter, names: &[&str], state:
 /// A drop-down of the folder's clips (or none), shown without the file name's decoration.
 fn clip_choice(ui: &mut egui::Ui, label: &str, names: &[&str], choice: &mut Option<String>) {
     let short = |n: &str| n.trim_start_matches("smpl_quaternions_").trim_end_matches(".txt").to_string();
-    let shown = choice.as_deref().map_or("(none)".to_string(), short);
-    egui::ComboBox::from_label(label).selected_text(shown).show_ui(ui, |ui| {
+    named_choice(ui, label, names, choice, short);
+}
+
+/// A drop-down of named things (or none), each shown as `shown` writes its name.
+pub fn named_choice(
+    ui: &mut egui::Ui,
+    label: &str,
+    names: &[&str],
+    choice: &mut Option<String>,
+    shown: impl Fn(&str) -> String,
+) {
+    let selected = choice.as_deref().map_or("(none)".to_string(), &shown);
+    egui::ComboBox::from_label(label).selected_text(selected).show_ui(ui, |ui| {
         ui.selectable_value(choice, None, "(none)");
         for &n in names {
-            ui.selectable_value(choice, Some(n.to_string()), short(n));
+            ui.selectable_value(choice, Some(n.to_string()), shown(n));
         }
     });
 }
