@@ -50,6 +50,30 @@ pub fn side_by_side(boxes: &[(Vec3, Vec3)], scales: &[f32]) -> Vec<Vec3> {
         .collect()
 }
 
+/// Characters that stand as one: the characters of one glTF file keep the layout the file
+/// gives them (each `Some(file)`), every other character stands alone. Returns groups of
+/// indices, in order of their first member.
+pub fn one_file_groups(files: &[Option<&std::path::Path>]) -> Vec<Vec<usize>> {
+    let mut groups: Vec<Vec<usize>> = Vec::new();
+    for (i, file) in files.iter().enumerate() {
+        match file.and_then(|f| groups.iter_mut().find(|g| files[g[0]] == Some(f))) {
+            Some(group) => group.push(i),
+            None => groups.push(vec![i]),
+        }
+    }
+    groups
+}
+
+/// The box around boxes.
+pub fn union(boxes: impl IntoIterator<Item = (Vec3, Vec3)>) -> (Vec3, Vec3) {
+    boxes.into_iter().fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(a, b), (lo, hi)| (a.min(lo), b.max(hi)))
+}
+
+/// The glTF file a source is one character of (none for any other source).
+pub fn gltf_file(source: &crate::formats::scene::SourceDoc) -> Option<&std::path::Path> {
+    source.path().filter(|p| crate::formats::gltf_import::is_gltf(p))
+}
+
 /// The translation that puts a model box's left side at x = `left`, on the floor,
 /// centred in z.
 fn stand_left_at(lo: Vec3, hi: Vec3, scale: f32, left: f32) -> Vec3 {
@@ -98,9 +122,10 @@ pub fn arrange_when_skinned(
         return;
     }
     *arrange = ArrangeWhenSkinned::default();
-    let mut characters: Vec<_> = characters.iter_mut().map(|(sc, p, s, _)| (sc.id, p, s.bounds)).collect();
+    let mut characters: Vec<_> =
+        characters.iter_mut().map(|(sc, p, s, _)| ((sc.id, sc.source.clone()), p, s.bounds)).collect();
     // Ids follow the document's order.
-    characters.sort_by_key(|c| c.0);
+    characters.sort_by_key(|c| c.0.0);
     let height = |(lo, hi): (Vec3, Vec3)| hi.y - lo.y;
     let target = characters.first().map(|c| height(c.2) * c.1.scale);
     let scales: Vec<f32> = characters
@@ -110,8 +135,18 @@ pub fn arrange_when_skinned(
             _ => placement.scale,
         })
         .collect();
-    let boxes: Vec<(Vec3, Vec3)> = characters.iter().map(|c| c.2).collect();
-    let translations = side_by_side(&boxes, &scales);
+    // The characters of one glTF file move together, keeping the file's layout.
+    let files: Vec<Option<&std::path::Path>> = characters.iter().map(|c| gltf_file(&c.0.1)).collect();
+    let groups = one_file_groups(&files);
+    let boxes: Vec<(Vec3, Vec3)> = groups.iter().map(|g| union(g.iter().map(|&i| characters[i].2))).collect();
+    let group_scales: Vec<f32> = groups.iter().map(|g| scales[g[0]]).collect();
+    let mut translations = vec![Vec3::ZERO; characters.len()];
+    for (group, t) in groups.iter().zip(side_by_side(&boxes, &group_scales)) {
+        group.iter().for_each(|&i| translations[i] = t);
+    }
+    let scales: Vec<f32> = (0..characters.len())
+        .map(|i| groups.iter().find(|g| g.contains(&i)).map_or(scales[i], |g| scales[g[0]]))
+        .collect();
     for (((_, placement, bounds), scale), translation) in characters.iter_mut().zip(scales).zip(translations) {
         placement.0 = if in_a_row {
             PlacementDoc { translation, scale, yaw: 0.0 }

@@ -484,8 +484,14 @@ pub fn doc_side_by_side(library: &mut AssetLibrary, sources: Vec<SourceDoc>, mes
             }
         })
         .collect();
-    let boxes: Vec<(Vec3, Vec3)> = loaded.iter().map(|(_, a)| a.bounds()).collect();
-    let translations = super::arrange::side_by_side(&boxes, &vec![1.0; boxes.len()]);
+    // The characters of one glTF file stand as the file places them.
+    use super::arrange::{gltf_file, one_file_groups, side_by_side, union};
+    let groups = one_file_groups(&loaded.iter().map(|(s, _)| gltf_file(s)).collect::<Vec<_>>());
+    let boxes: Vec<(Vec3, Vec3)> = groups.iter().map(|g| union(g.iter().map(|&i| loaded[i].1.bounds()))).collect();
+    let mut translations = vec![Vec3::ZERO; loaded.len()];
+    for (group, t) in groups.iter().zip(side_by_side(&boxes, &vec![1.0; boxes.len()])) {
+        group.iter().for_each(|&i| translations[i] = t);
+    }
     let characters = loaded
         .into_iter()
         .zip(translations)

@@ -152,3 +152,22 @@ fn framing_sees_every_corner_and_fills_most_of_the_picture() {
         }
     }
 }
+
+/// The characters of one glTF file stand as one (keeping the file's layout); every other
+/// character stands alone, even one from the same non-glTF file.
+#[test]
+fn characters_of_one_gltf_file_are_placed_together() {
+    use marionette::editor::arrange::{gltf_file, one_file_groups};
+    use marionette::formats::scene::SourceDoc;
+    let glb = std::path::PathBuf::from("pair.glb");
+    let sources = [
+        SourceDoc::File(glb.clone()),
+        SourceDoc::Embedded("puppet".into()),
+        SourceDoc::Part(glb.clone(), 1),
+        SourceDoc::File("Model1.skel".into()),
+        SourceDoc::File("Model1.skel".into()),
+        SourceDoc::Part(glb, 2),
+    ];
+    let files: Vec<_> = sources.iter().map(gltf_file).collect();
+    assert_eq!(one_file_groups(&files), vec![vec![0, 2, 5], vec![1], vec![3], vec![4]]);
+}

@@ -431,6 +431,9 @@ fn a_glb_of_two_characters_plays_its_clips_in_the_ecs_as_the_rig_samples_them() 
     assert_eq!((found[1].0.as_str(), &found[1].1), ("waver", &SourceDoc::Part(glb.clone(), 1)));
     let waver = found[1].2;
     let e = entity(&app, waver.0);
+    // Added together, they keep the layout the file gives them: one placement for both.
+    let placement = |id: CharacterId| app.world().get::<Placement>(entity(&app, id.0)).unwrap().0;
+    assert_eq!(placement(found[0].2), placement(waver));
     assert_eq!(app.world_mut().query::<&NodeClipPlayer>().iter(app.world()).count(), 2);
     let matrices = |app: &App| -> Vec<Mat4> {
         let c = app.world().get::<Character>(e).unwrap();

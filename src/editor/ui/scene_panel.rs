@@ -145,16 +145,18 @@ fn add_character(path: &str, state: &mut InspectorState, panels: &mut Panels) {
     if path.is_empty() {
         return;
     }
-    let mut boxes = panels.world_boxes();
+    let mut loaded = Vec::new();
     for source in panels.library.sources_of(Path::new(path)) {
-        let asset = match panels.library.load(&source) {
-            Ok(a) => a,
+        match panels.library.load(&source) {
+            Ok(asset) => loaded.push((source, asset)),
             Err(e) => return panels.messages.push(e.to_string()),
-        };
+        }
+    }
+    // The characters of one file move together: they keep the layout the file gives them.
+    let (lo, hi) = crate::editor::arrange::union(loaded.iter().map(|(_, a)| a.bounds()));
+    let translation = beside(&panels.world_boxes(), lo, hi, 1.0);
+    for (source, asset) in loaded {
         panels.messages.0.extend(asset.warnings.iter().cloned());
-        let (lo, hi) = asset.bounds();
-        let translation = beside(&boxes, lo, hi, 1.0);
-        boxes.push((lo + translation, hi + translation));
         let id = panels.ids.take();
         let doc = panels.library.new_character_doc(source, &asset);
         panels.push(Edit::Add(Box::new(CharacterDoc {
