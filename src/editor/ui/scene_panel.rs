@@ -265,7 +265,7 @@ fn selected_character(ui: &mut egui::Ui, panels: &mut Panels, entity: Entity, id
     if v != view.0 {
         edits.push(Edit::View { character: id, view: v });
     }
-    ui.horizontal(|ui| {
+    ui.horizontal_wrapped(|ui| {
         ui.label("Weights:");
         for (label, b) in [
             ("from the file", None),
