@@ -5,7 +5,8 @@ back (tests/data/blender_pair.txt).
 
 - `walker`: three bones; the root bone moves (translation keys) and the middle one bends
   (rotation keys) with Bezier curves, exported without resampling, so the file holds
-  CUBICSPLINE samplers; its mesh has a shape key `bulge` (a glTF morph target) and a base
+  CUBICSPLINE samplers; its mesh has a shape key `bulge` (a glTF morph target, at weight
+  0.25 in the file, which Blender's deformation includes) and a base
   colour texture (an 8 x 8 red and blue checker, a PNG inside the .glb).
 - `waver`: two bones under an armature object that is moved, turned and scaled (nodes
   above the skeleton); its upper bone turns with constant keys (STEP) and its lower bone
@@ -92,7 +93,7 @@ bulge = walker.shape_key_add(name="bulge")
 for i, v in enumerate(walker.data.vertices):
     if 1.2 < v.co.z < 1.8:
         bulge.data[i].co = (v.co.x * 1.5, v.co.y * 1.5, v.co.z)
-bulge.value = 0.0
+bulge.value = 0.25  # the mesh's weight in the file (glTF mesh.weights)
 
 # The walker wears a base colour texture: an 8 x 8 checker of red and blue (written into
 # the .glb as a PNG), on texture coordinates around the tube.

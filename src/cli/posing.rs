@@ -118,8 +118,9 @@ pub fn find_clip<'a>(clips: &'a [NodeClip], spec: &str) -> Option<&'a NodeClip> 
     })
 }
 
-/// Every character of a glTF file, each posed by its clip `clip` at `time` seconds (by
-/// its file's node transforms without one) and then by `poses` where it has the joints:
+/// Every character of a glTF file, shaped by the morph weights the file sets, each posed
+/// by its clip `clip` at `time` seconds (by its file's node transforms without one) and
+/// then by `poses` where it has the joints:
 /// the vertices and triangles of all of them, in file order. Fails when no character has
 /// the clip.
 pub fn posed_gltf(
@@ -149,7 +150,12 @@ pub fn posed_gltf(
         apply_pose_specs(skeleton, &mut pose, &mine).map_err(|e| e.to_string())?;
         let rest = RestOverride { offsets: Some(&node_pose.offsets), scales: Some(&node_pose.scales) };
         let first = positions.len() as u32;
-        positions.extend(posed_positions_with_rest(&c.asset, &pose, rest, Mat4::IDENTITY, method));
+        // The morph weights the file sets are part of its pose.
+        let mut shaped = std::borrow::Cow::Borrowed(&c.asset);
+        if c.morph_weights.iter().any(|&w| w != 0.0) {
+            shaped.to_mut().skin.bind_positions = c.asset.morphed_positions(&c.morph_weights);
+        }
+        positions.extend(posed_positions_with_rest(&shaped, &pose, rest, Mat4::IDENTITY, method));
         triangles.extend(c.asset.skin.triangles.iter().map(|t| t.map(|i| i + first)));
     }
     Ok((positions, triangles))

@@ -85,6 +85,7 @@ pub struct GltfPart {
     pub asset: Arc<CharacterAsset>,
     pub clips: Arc<[crate::rig::node_clip::NodeClip]>,
     pub base_color: Option<[f32; 4]>,
+    pub morph_weights: Vec<f32>,
 }
 
 /// A copy of `asset` whose weights come from its bones at rest (by `binding`); when heat
@@ -162,7 +163,12 @@ impl AssetLibrary {
         if !self.gltf.contains_key(path) {
             let parts = crate::formats::gltf_import::load_gltf(path)?
                 .into_iter()
-                .map(|c| GltfPart { asset: Arc::new(c.asset), clips: c.clips.into(), base_color: c.base_color })
+                .map(|c| GltfPart {
+                    asset: Arc::new(c.asset),
+                    clips: c.clips.into(),
+                    base_color: c.base_color,
+                    morph_weights: c.morph_weights,
+                })
                 .collect();
             self.gltf.insert(path.to_path_buf(), parts);
         }
@@ -181,11 +187,16 @@ impl AssetLibrary {
     }
 
     /// A new character's document for `source`: its name, the motion a BVH brings, the
-    /// base colour a glTF material gives as its tint.
+    /// base colour a glTF material gives as its tint and the morph weights its mesh sets.
     pub fn new_character_doc(&mut self, source: SourceDoc, asset: &CharacterAsset) -> CharacterDoc {
         let mut doc = CharacterDoc { anim: own_motion(&source), ..CharacterDoc::new(source, asset.name.clone()) };
-        if let Some([r, g, b, _]) = self.gltf_source(&doc.source).and_then(|part| part.base_color) {
-            doc.view.tint = [r, g, b];
+        if let Some(part) = self.gltf_source(&doc.source) {
+            if let Some([r, g, b, _]) = part.base_color {
+                doc.view.tint = [r, g, b];
+            }
+            if part.morph_weights.iter().any(|&w| w != 0.0) {
+                doc.morphs = part.morph_weights;
+            }
         }
         doc
     }

@@ -23,6 +23,8 @@ pub struct ImportedCharacter {
     pub asset: CharacterAsset,
     pub clips: Vec<NodeClip>,
     pub base_color: Option<[f32; 4]>,
+    /// The morph targets' weights as the file sets them (`mesh.weights`; 0 where unset).
+    pub morph_weights: Vec<f32>,
 }
 
 /// Whether `path` names a glTF file (`.glb`, `.gltf`).
@@ -147,9 +149,20 @@ impl File<'_> {
         };
         let mut asset = CharacterAsset::with_inverse_binds(name, skeleton, skin_data, inverse, warnings)
             .map_err(|e| FormatError::rig(self.path, e))?;
+        // Each morph's weight from the first mesh that names it.
+        let morph_weights = morphs
+            .iter()
+            .map(|m| {
+                meshes.iter().find_map(|mesh| {
+                    let k = target_names(mesh).iter().position(|n| *n == m.name)?;
+                    mesh.weights()?.get(k).copied()
+                })
+            })
+            .map(|w| w.filter(|w| w.is_finite()).unwrap_or(0.0))
+            .collect();
         asset.morphs = morphs;
         asset.texture = texture;
-        Ok(ImportedCharacter { asset, clips, base_color })
+        Ok(ImportedCharacter { asset, clips, base_color, morph_weights })
     }
 
     /// The skin's joints as a skeleton (reordered parents first: `new_index[file joint]`)

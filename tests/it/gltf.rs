@@ -352,8 +352,8 @@ fn blender_pair(path: &std::path::Path) -> BlenderPair {
 /// (STEP rotation and LINEAR scale of a skeleton under a moved, turned and scaled node;
 /// CUBICSPLINE root translation and rotation) deform them as Blender deforms them when it
 /// reads the file back (at six times; at the key times for CUBICSPLINE, whose tangents
-/// Blender's importer drops), CUBICSPLINE follows the spec's formula between keys, and the
-/// morph target is Blender's shape key.
+/// Blender's importer drops; with the morph weight the file sets), CUBICSPLINE follows the
+/// spec's formula between keys, and the morph target is Blender's shape key.
 #[test]
 fn two_blender_characters_play_their_clips_as_blender_plays_them() {
     let data = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data");
@@ -362,6 +362,7 @@ fn two_blender_characters_play_their_clips_as_blender_plays_them() {
     let names: Vec<&str> = characters.iter().map(|c| c.asset.name.as_str()).collect();
     assert_eq!(names, ["walker", "waver"]);
     let walker = &characters[0];
+    assert_eq!(walker.morph_weights, [0.25], "the shape key's value in the file");
     assert_eq!(blender.splines.len(), 2);
     for (node, property, samples) in &blender.splines {
         let j = walker.asset.skeleton.find(node).unwrap();
@@ -385,7 +386,9 @@ fn two_blender_characters_play_their_clips_as_blender_plays_them() {
             let world = pose.joint_to_world(&asset.skeleton, Mat4::IDENTITY);
             let palette: Vec<Mat4> = world.iter().zip(&asset.bind_world_to_joint).map(|(w, b)| *w * *b).collect();
             let mut ours = vec![Vec3::ZERO; asset.vertex_count()];
-            marionette::rig::lbs::skin(&asset.skin.bind_positions, &asset.skin.weights, &palette, &mut ours);
+            // The morph weights the file sets are part of its pose.
+            let shaped = asset.morphed_positions(&character.morph_weights);
+            marionette::rig::lbs::skin(&shaped, &asset.skin.weights, &palette, &mut ours);
             assert_eq!(ours.len(), vertices.len());
             let off = ours.iter().zip(vertices).map(|(a, b)| a.distance(*b)).fold(0.0f32, f32::max);
             assert!(off <= 1e-4, "{mesh} at {t} s: {off}");
