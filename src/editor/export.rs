@@ -119,47 +119,59 @@ fn posed(
     if let Some(playback) = &c.playback
         && let Some(part) = library.gltf_source(&c.source)
     {
-        let find = |name: &Option<String>| part.clips.iter().find(|k| Some(&k.name) == name.as_ref());
-        if let Some(clip) = find(&playback.clip) {
-            let blend = find(&playback.blend_clip).map(|k| (k, playback.blend));
-            let at = |t: f32| sample_mix(skeleton, clip, blend, t);
-            let keyed = |pose: &mut Vec<crate::rig::JointRotation>, sample: &NodePose| {
-                for (j, q) in sample.rotations.iter().enumerate() {
-                    if clip.turns(j) || blend.is_some_and(|(k, _)| k.turns(j)) {
-                        pose[j] = crate::rig::JointRotation::Quat(*q);
-                    }
-                }
-            };
-            let moves_rest = clip.moves_rest() || blend.is_some_and(|(k, _)| k.moves_rest());
-            let now = at(playback.time);
-            keyed(&mut posed.pose, &now);
-            posed.root = now.offsets[0];
-            if moves_rest {
-                posed.rest = Some(rest_of(skeleton, &now));
-            }
-            if animated {
-                let frames = (clip.duration() * EXPORT_FPS).ceil() as usize;
-                let mut motion = Motion::default();
-                for f in 0..=frames {
-                    let t = (f as f32 / EXPORT_FPS).min(clip.duration());
-                    let sample = at(t);
-                    let mut pose = posed.pose.clone();
-                    keyed(&mut pose, &sample);
-                    motion.times.push(t);
-                    motion.poses.push(pose);
-                    motion.roots.push(sample.offsets[0]);
-                    if moves_rest {
-                        motion.rests.push(rest_of(skeleton, &sample));
-                    }
-                }
-                posed.motion = Some(motion);
-            }
-        }
+        play_node_clip(&mut posed, skeleton, &part.clips, playback, animated);
     }
     if animated && let Some(motion) = smpl_motion(library, c, asset)? {
         posed.motion = Some(motion);
     }
     Ok(posed)
+}
+
+/// A glTF clip's pose at the playback's time on `posed` (its keyed joints, root and rest),
+/// and with `animated` the clip sampled at [`EXPORT_FPS`] over its length.
+fn play_node_clip(
+    posed: &mut Posed,
+    skeleton: &crate::rig::Skeleton,
+    clips: &[crate::rig::node_clip::NodeClip],
+    playback: &crate::formats::scene::PlaybackDoc,
+    animated: bool,
+) {
+    let find = |name: &Option<String>| clips.iter().find(|k| Some(&k.name) == name.as_ref());
+    let Some(clip) = find(&playback.clip) else { return };
+    let blend = find(&playback.blend_clip).map(|k| (k, playback.blend));
+    let at = |t: f32| sample_mix(skeleton, clip, blend, t);
+    let keyed = |pose: &mut Vec<crate::rig::JointRotation>, sample: &NodePose| {
+        for (j, q) in sample.rotations.iter().enumerate() {
+            if clip.turns(j) || blend.is_some_and(|(k, _)| k.turns(j)) {
+                pose[j] = crate::rig::JointRotation::Quat(*q);
+            }
+        }
+    };
+    let moves_rest = clip.moves_rest() || blend.is_some_and(|(k, _)| k.moves_rest());
+    let now = at(playback.time);
+    keyed(&mut posed.pose, &now);
+    posed.root = now.offsets[0];
+    if moves_rest {
+        posed.rest = Some(rest_of(skeleton, &now));
+    }
+    if !animated {
+        return;
+    }
+    let frames = (clip.duration() * EXPORT_FPS).ceil() as usize;
+    let mut motion = Motion::default();
+    for f in 0..=frames {
+        let t = (f as f32 / EXPORT_FPS).min(clip.duration());
+        let sample = at(t);
+        let mut pose = posed.pose.clone();
+        keyed(&mut pose, &sample);
+        motion.times.push(t);
+        motion.poses.push(pose);
+        motion.roots.push(sample.offsets[0]);
+        if moves_rest {
+            motion.rests.push(rest_of(skeleton, &sample));
+        }
+    }
+    posed.motion = Some(motion);
 }
 
 /// A sampled pose's offsets (the root's left at the skeleton's, as `root` carries it) and
