@@ -4,7 +4,7 @@
 use glam::{Mat4, Vec3};
 
 use crate::rig::dqs::SkinningMethod;
-use crate::rig::fk::{RestOverride, forward_kinematics_with_rest, skinning_palette};
+use crate::rig::fk::{RestOverride, posed_palette_with_rest};
 use crate::rig::lbs::skin;
 use crate::rig::node_clip::NodeClip;
 use crate::rig::{CharacterAsset, JointRotation, Skeleton};
@@ -93,10 +93,7 @@ pub fn posed_positions_with_rest(
     placement: Mat4,
     method: SkinningMethod,
 ) -> Vec<Vec3> {
-    let mut world = vec![Mat4::IDENTITY; asset.skeleton.len()];
-    forward_kinematics_with_rest(&asset.skeleton, pose, rest, placement, &mut world);
-    let mut palette = vec![Mat4::IDENTITY; world.len()];
-    skinning_palette(&world, &asset.bind_world_to_joint, &mut palette);
+    let palette = posed_palette_with_rest(&asset.skeleton, &asset.bind_world_to_joint, pose, rest, placement);
     let mut out = vec![Vec3::ZERO; asset.vertex_count()];
     match method {
         SkinningMethod::Linear => skin(&asset.skin.bind_positions, &asset.skin.weights, &palette, &mut out),

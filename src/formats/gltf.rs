@@ -146,16 +146,8 @@ pub fn write_glb(characters: &[GltfCharacter], mesh: GltfMesh) -> Vec<u8> {
         let mut mesh_node = json!({ "name": format!("{} mesh", c.name), "mesh": meshes.len() });
         match mesh {
             GltfMesh::Baked => {
-                let mut world = vec![Mat4::IDENTITY; c.asset.skeleton.len()];
-                crate::rig::fk::forward_kinematics_with_rest(
-                    &c.asset.skeleton,
-                    c.pose,
-                    c.rest,
-                    root_origin(c),
-                    &mut world,
-                );
-                let mut palette = vec![Mat4::IDENTITY; world.len()];
-                crate::rig::fk::skinning_palette(&world, &c.asset.bind_world_to_joint, &mut palette);
+                let (skeleton, binds) = (&c.asset.skeleton, &c.asset.bind_world_to_joint);
+                let palette = crate::rig::fk::posed_palette_with_rest(skeleton, binds, c.pose, c.rest, root_origin(c));
                 let mut posed = vec![Vec3::ZERO; skin.bind_positions.len()];
                 crate::rig::lbs::skin(&skin.bind_positions, &skin.weights, &palette, &mut posed);
                 attributes.insert("POSITION".into(), json!(b.positions(&posed)));

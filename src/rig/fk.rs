@@ -113,9 +113,21 @@ pub fn posed_palette(
     pose: &[JointRotation],
     placement: Mat4,
 ) -> Vec<Mat4> {
+    posed_palette_with_rest(skeleton, bind_world_to_joint, pose, RestOverride::default(), placement)
+}
+
+/// As [`posed_palette`], with the rest offsets and scales `rest` replaces (a clip keys
+/// them).
+pub fn posed_palette_with_rest(
+    skeleton: &Skeleton,
+    bind_world_to_joint: &[Mat4],
+    pose: &[JointRotation],
+    rest: RestOverride,
+    placement: Mat4,
+) -> Vec<Mat4> {
     let n = skeleton.len();
     let mut current = vec![Mat4::IDENTITY; n];
-    forward_kinematics(skeleton, pose, placement, &mut current);
+    forward_kinematics_with_rest(skeleton, pose, rest, placement, &mut current);
     let mut palette = vec![Mat4::IDENTITY; n];
     skinning_palette(&current, bind_world_to_joint, &mut palette);
     palette

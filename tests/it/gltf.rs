@@ -62,6 +62,16 @@ fn globals(json: &serde_json::Value) -> Vec<Mat4> {
     out
 }
 
+/// The largest distance between corresponding points.
+fn largest_distance(a: &[Vec3], b: &[Vec3]) -> f32 {
+    a.iter().zip(b).map(|(p, q)| p.distance(*q)).fold(0.0f32, f32::max)
+}
+
+/// A line of numbers, `x y z ...`.
+fn numbers(line: &str) -> Vec<f32> {
+    line.split_whitespace().map(|x| x.parse().unwrap()).collect()
+}
+
 #[test]
 fn an_exported_character_skins_back_to_our_vertices_with_its_names_and_weights() {
     let puppet = marionette::formats::puppet::embedded_puppet();
@@ -271,7 +281,7 @@ fn a_round_trip_through_glb_keeps_vertices_names_hierarchy_and_weights() {
     assert_eq!(names(&back.skeleton), names(skeleton), "names and hierarchy");
     let ours = marionette::cli::posing::posed_positions(&puppet, &pose, Mat4::IDENTITY);
     let theirs = marionette::cli::posing::posed_positions(&back, &back.skeleton.initial_pose(), Mat4::IDENTITY);
-    let worst = ours.iter().zip(&theirs).map(|(a, b)| a.distance(*b)).fold(0.0f32, f32::max);
+    let worst = largest_distance(&ours, &theirs);
     assert!(worst <= 1e-5, "skinned vertices differ by {worst}");
     for v in 0..puppet.vertex_count() {
         for j in 0..skeleton.len() {
@@ -289,16 +299,10 @@ fn a_blender_made_glb_deforms_as_blender_deforms_it() {
     let arm = marionette::formats::load_character(&data.join("blender_arm.glb")).unwrap();
     assert_eq!(arm.skeleton.joints().iter().map(|j| j.name.as_str()).collect::<Vec<_>>(), ["upper", "lower"]);
     let ours = marionette::cli::posing::posed_positions(&arm, &arm.skeleton.initial_pose(), Mat4::IDENTITY);
-    let blender: Vec<Vec3> = std::fs::read_to_string(data.join("blender_arm.txt"))
-        .unwrap()
-        .lines()
-        .map(|l| {
-            let v: Vec<f32> = l.split_whitespace().map(|x| x.parse().unwrap()).collect();
-            Vec3::new(v[0], v[1], v[2])
-        })
-        .collect();
+    let text = std::fs::read_to_string(data.join("blender_arm.txt")).unwrap();
+    let blender: Vec<Vec3> = text.lines().map(|l| Vec3::from_slice(&numbers(l))).collect();
     assert_eq!(ours.len(), blender.len());
-    let worst = ours.iter().zip(&blender).map(|(a, b)| a.distance(*b)).fold(0.0f32, f32::max);
+    let worst = largest_distance(&ours, &blender);
     assert!(worst <= 1e-5, "{worst}");
 }
 
@@ -331,7 +335,7 @@ fn blender_pair(path: &std::path::Path) -> BlenderPair {
             "morph" => pair.meshes.last_mut().unwrap().1.morphs.push((rest.to_string(), Vec::new())),
             "time" => pair.meshes.last_mut().unwrap().1.frames.push((rest.parse().unwrap(), Vec::new())),
             _ => {
-                let v: Vec<f32> = line.split_whitespace().map(|x| x.parse().unwrap()).collect();
+                let v = numbers(line);
                 let Some((_, mesh)) = pair.meshes.last_mut() else {
                     pair.splines.last_mut().unwrap().2.push(v);
                     continue;
@@ -340,7 +344,7 @@ fn blender_pair(path: &std::path::Path) -> BlenderPair {
                     Some(frame) => &mut frame.1,
                     None => &mut mesh.morphs.last_mut().unwrap().1,
                 };
-                target.push(Vec3::new(v[0], v[1], v[2]));
+                target.push(Vec3::from_slice(&v));
             }
         }
     }
@@ -390,7 +394,7 @@ fn two_blender_characters_play_their_clips_as_blender_plays_them() {
             let shaped = asset.morphed_positions(&character.morph_weights);
             marionette::rig::lbs::skin(&shaped, &asset.skin.weights, &palette, &mut ours);
             assert_eq!(ours.len(), vertices.len());
-            let off = ours.iter().zip(vertices).map(|(a, b)| a.distance(*b)).fold(0.0f32, f32::max);
+            let off = largest_distance(&ours, vertices);
             assert!(off <= 1e-4, "{mesh} at {t} s: {off}");
             worst = worst.max(off);
         }
@@ -399,7 +403,7 @@ fn two_blender_characters_play_their_clips_as_blender_plays_them() {
             assert_eq!(&morph.name, name);
             let mut dense = vec![Vec3::ZERO; asset.vertex_count()];
             morph.deltas.iter().for_each(|&(v, d)| dense[v as usize] = d);
-            let off = dense.iter().zip(deltas).map(|(a, b)| a.distance(*b)).fold(0.0f32, f32::max);
+            let off = largest_distance(&dense, deltas);
             assert!(off <= 1e-5 && morph.deltas.len() > 10, "{name}: {off}");
         }
     }
@@ -442,17 +446,10 @@ fn exporting_a_glb_to_obj_writes_every_character_as_blender_poses_it() {
     };
     let out = run(&["--clip", "0", "--time", "1", "--out", obj.to_str().unwrap()]);
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
-    let ours: Vec<Vec3> = std::fs::read_to_string(&obj)
-        .unwrap()
-        .lines()
-        .filter_map(|l| l.strip_prefix("v "))
-        .map(|l| {
-            let v: Vec<f32> = l.split_whitespace().map(|x| x.parse().unwrap()).collect();
-            Vec3::new(v[0], v[1], v[2])
-        })
-        .collect();
+    let ours =
+        marionette::formats::obj::parse_obj(marionette::formats::error::open(&obj).unwrap(), &obj).unwrap().positions;
     assert_eq!(ours.len(), expected.len());
-    let worst = ours.iter().zip(&expected).map(|(a, b)| a.distance(*b)).fold(0.0f32, f32::max);
+    let worst = largest_distance(&ours, &expected);
     assert!(worst <= 1e-5, "{worst}");
 
     let missing = dir.join("missing.obj");
