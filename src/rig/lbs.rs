@@ -166,8 +166,10 @@ mod avx2 {
 
     use super::FixedGroup;
 
-    /// One fixed group with FMA on 128-bit columns (glam's `Vec4` is an `__m128`, so the
-    /// palette's columns load as they are, with no copy).
+    /// One fixed group with FMA on 256-bit registers: a palette matrix is two of them
+    /// (columns 0 and 1, columns 2 and 3), so a blend of `K` matrices is `2K` multiply-adds,
+    /// and the blended matrix transforms the bind position with one more multiply-add and
+    /// one add of the register's halves.
     ///
     /// # Safety
     /// The CPU must have AVX2 and FMA. (Indices are checked: a joint beyond the palette or a
@@ -182,27 +184,27 @@ mod avx2 {
     ) {
         let (vertices, joints, weights) = super::rows_in::<K>(group, first, out.len());
         let rows = joints.chunks_exact(K).zip(weights.chunks_exact(K));
+        let one = _mm_set1_ps(1.0);
         for (&v, (joints, weights)) in vertices.iter().zip(rows) {
             let (joints, weights): (&[u16; K], &[f32; K]) = (joints.try_into().unwrap(), weights.try_into().unwrap());
-            // Two accumulators (even and odd influences) halve the chain of dependent
-            // multiply-adds each column waits on.
-            let mut c = [[_mm_setzero_ps(); 4]; 2];
+            // Two accumulators per half (even and odd influences) halve the chain of
+            // dependent multiply-adds.
+            let mut c = [[_mm256_setzero_ps(); 2]; 2];
             for k in 0..K {
                 let m = &palette[joints[k] as usize];
-                let w = _mm_set1_ps(weights[k]);
+                let w = _mm256_set1_ps(weights[k]);
                 let acc = &mut c[k % 2];
-                acc[0] = _mm_fmadd_ps(w, m.x_axis.into(), acc[0]);
-                acc[1] = _mm_fmadd_ps(w, m.y_axis.into(), acc[1]);
-                acc[2] = _mm_fmadd_ps(w, m.z_axis.into(), acc[2]);
-                acc[3] = _mm_fmadd_ps(w, m.w_axis.into(), acc[3]);
+                let c01 = _mm256_set_m128(m.y_axis.into(), m.x_axis.into());
+                let c23 = _mm256_set_m128(m.w_axis.into(), m.z_axis.into());
+                acc[0] = _mm256_fmadd_ps(w, c01, acc[0]);
+                acc[1] = _mm256_fmadd_ps(w, c23, acc[1]);
             }
-            let c: [__m128; 4] = std::array::from_fn(|i| _mm_add_ps(c[0][i], c[1][i]));
+            let (c01, c23) = (_mm256_add_ps(c[0][0], c[1][0]), _mm256_add_ps(c[0][1], c[1][1]));
             let b = bind[v as usize];
-            let p = _mm_fmadd_ps(
-                c[0],
-                _mm_set1_ps(b.x),
-                _mm_fmadd_ps(c[1], _mm_set1_ps(b.y), _mm_fmadd_ps(c[2], _mm_set1_ps(b.z), c[3])),
-            );
+            let xy = _mm256_set_m128(_mm_set1_ps(b.y), _mm_set1_ps(b.x));
+            let z1 = _mm256_set_m128(one, _mm_set1_ps(b.z));
+            let p = _mm256_fmadd_ps(c01, xy, _mm256_mul_ps(c23, z1));
+            let p = _mm_add_ps(_mm256_castps256_ps128(p), _mm256_extractf128_ps::<1>(p));
             out[v as usize - first] = Vec4::from(p).truncate();
         }
     }
