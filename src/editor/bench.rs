@@ -48,6 +48,10 @@ pub struct BenchReport {
     pub kernel_mvps: f64,
     /// The plain loop it replaced (kept as the oracle), same character, same run.
     pub baseline_kernel_mvps: f64,
+    /// Dual quaternion skinning, same character, same run.
+    pub dual_quaternion_kernel_mvps: f64,
+    /// The kernel followed by flat normals into unshared buffers (per vertex of the mesh).
+    pub kernel_with_flat_normals_mvps: f64,
 }
 
 /// Instants at the phase boundaries of the main world's frame.
@@ -81,7 +85,7 @@ pub fn run(characters: usize, frames: usize, data: Option<&Path>) -> Result<Benc
         samples.push(timed_frame(&mut app));
         bytes += app.world().resource::<HandedOn>().0;
     }
-    let (kernel_mvps, baseline_kernel_mvps) = kernel_speeds(&asset);
+    let kernels = kernel_speeds(&asset);
     let phase = |k: usize| median(samples.iter().map(|s| s[k]).collect());
     let frame: Vec<f64> = samples.iter().map(|s| s[1] + s[2] + s[3] + s[4] + s[5]).collect();
     Ok(BenchReport {
@@ -98,8 +102,10 @@ pub fn run(characters: usize, frames: usize, data: Option<&Path>) -> Result<Benc
         upload_ms_p50: phase(5),
         render_world_ms_p50: phase(6),
         upload_bytes_per_frame: bytes / frames.max(1),
-        kernel_mvps,
-        baseline_kernel_mvps,
+        kernel_mvps: kernels.lbs,
+        baseline_kernel_mvps: kernels.oracle,
+        dual_quaternion_kernel_mvps: kernels.dual_quaternion,
+        kernel_with_flat_normals_mvps: kernels.lbs_and_flat_normals,
     })
 }
 
@@ -111,7 +117,8 @@ pub fn table(r: &BenchReport) -> String {
          \x20 sampling {:.2} ms | FK {:.2} ms | skin {:.2} ms | extract {:.2} ms | upload {:.2} ms   (medians)\n\
          \x20 render world besides the upload (drawing; CPU on llvmpipe) {:.2} ms\n\
          mesh data handed on per frame: {} bytes\n\
-         kernel: {:.1} M vertices/s per core (the plain loop it replaced: {:.1}, ×{:.2})",
+         kernel: {:.1} M vertices/s per core (the plain loop it replaced: {:.1}, ×{:.2})\n\
+         \x20 with flat normals {:.1} M vertices/s | dual quaternions {:.1} M vertices/s (LBS is ×{:.2} as fast)",
         r.characters,
         r.kind,
         r.vertices_per_character,
@@ -128,6 +135,9 @@ pub fn table(r: &BenchReport) -> String {
         r.kernel_mvps,
         r.baseline_kernel_mvps,
         r.kernel_mvps / r.baseline_kernel_mvps,
+        r.kernel_with_flat_normals_mvps,
+        r.dual_quaternion_kernel_mvps,
+        r.kernel_mvps / r.dual_quaternion_kernel_mvps,
     )
 }
 
@@ -264,24 +274,52 @@ fn wait_for_the_gpu(app: &App) {
     }
 }
 
-/// Vertices per second of the kernel and of the plain loop on `asset` in a posed pose.
-fn kernel_speeds(asset: &CharacterAsset) -> (f64, f64) {
+/// The kernels on one posed character, in M vertices per second. They run interleaved
+/// (one call of each in turn, the median call of each kept), so a change of the machine's
+/// speed during the run touches all alike and their ratios hold.
+#[derive(Debug, Clone, Copy)]
+struct KernelSpeeds {
+    lbs: f64,
+    oracle: f64,
+    dual_quaternion: f64,
+    lbs_and_flat_normals: f64,
+}
+
+fn kernel_speeds(asset: &CharacterAsset) -> KernelSpeeds {
     let n = asset.skeleton.len();
     let pose: Vec<JointRotation> = (0..n).map(|i| JointRotation::euler_xyz(0.1 * i as f32, 0.05, -0.02)).collect();
     let palette = crate::rig::fk::posed_palette(&asset.skeleton, &asset.bind_world_to_joint, &pose, Mat4::IDENTITY);
-    let mut out = vec![Vec3::ZERO; asset.vertex_count()];
+    let mut dual_quaternions = Vec::new();
+    crate::rig::dqs::dual_quaternion_palette(&palette, &mut dual_quaternions);
     let skin = &asset.skin;
-    let mut speed = |run: &mut dyn FnMut(&mut [Vec3])| {
-        let (mut runs, started) = (0usize, Instant::now());
-        while started.elapsed() < Duration::from_millis(300) {
-            run(&mut out);
-            runs += 1;
+    let corners = skin.triangles.len() * 3;
+    let (mut flat_positions, mut flat_normals) = (vec![[0.0; 3]; corners], vec![[0.0; 3]; corners]);
+    let mut out = vec![Vec3::ZERO; asset.vertex_count()];
+    let mut kernels: [&mut dyn FnMut(&mut [Vec3]); 4] = [
+        &mut |o| crate::rig::lbs::skin(&skin.bind_positions, &skin.weights, &palette, o),
+        &mut |o| crate::rig::skinning::skin_positions(&skin.bind_positions, &skin.weights, &palette, o),
+        &mut |o| crate::rig::dqs::skin_dq(&skin.bind_positions, &skin.weights, &dual_quaternions, o),
+        &mut |o| {
+            crate::rig::lbs::skin(&skin.bind_positions, &skin.weights, &palette, o);
+            crate::rig::skinning::flat_shade(o, &skin.triangles, &mut flat_positions, &mut flat_normals);
+        },
+    ];
+    let mut seconds: [Vec<f64>; 4] = Default::default();
+    let started = Instant::now();
+    while started.elapsed() < Duration::from_millis(600) {
+        for (kernel, times) in kernels.iter_mut().zip(&mut seconds) {
+            let t = Instant::now();
+            kernel(&mut out);
+            times.push(t.elapsed().as_secs_f64());
         }
-        (runs * skin.bind_positions.len()) as f64 / started.elapsed().as_secs_f64() / 1e6
-    };
-    let fast = speed(&mut |o| crate::rig::lbs::skin(&skin.bind_positions, &skin.weights, &palette, o));
-    let plain = speed(&mut |o| crate::rig::skinning::skin_positions(&skin.bind_positions, &skin.weights, &palette, o));
-    (fast, plain)
+    }
+    let mvps = |times: &Vec<f64>| skin.bind_positions.len() as f64 / median(times.clone()) / 1e6;
+    KernelSpeeds {
+        lbs: mvps(&seconds[0]),
+        oracle: mvps(&seconds[1]),
+        dual_quaternion: mvps(&seconds[2]),
+        lbs_and_flat_normals: mvps(&seconds[3]),
+    }
 }
 
 fn median(v: Vec<f64>) -> f64 {

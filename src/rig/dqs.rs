@@ -74,9 +74,10 @@ pub fn dual_quaternion_palette(palette: &[Mat4], out: &mut Vec<DualQuat>) {
 pub fn skin_dq(bind_positions: &[Vec3], weights: &SkinWeights, palette: &[DualQuat], out: &mut [Vec3]) {
     assert_eq!(bind_positions.len(), weights.vertex_count(), "one weight row per vertex");
     assert_eq!(out.len(), bind_positions.len(), "one output per vertex");
+    let groups = weights.groups();
+    assert!(groups.joint_bound <= palette.len(), "an influence names a joint beyond the palette");
     #[cfg(target_arch = "x86_64")]
     if std::arch::is_x86_feature_detected!("avx2") && std::arch::is_x86_feature_detected!("fma") {
-        let groups = weights.groups();
         // SAFETY: the CPU has AVX2 and FMA (checked above).
         unsafe {
             avx2::fixed_rows::<1>(bind_positions, &groups.fixed[0], palette, out);
@@ -176,10 +177,10 @@ mod avx2 {
         _mm_shuffle_ps::<0b11_00_10_01>(c, c)
     }
 
-    /// One fixed group, each vertex's blend and its application in 128-bit registers:
-    /// hemisphere test by a broadcast dot product, the sign flipped into the weight,
-    /// one reciprocal square root, rotation `v + 2w (r × v) + 2 r × (r × v)` and
-    /// translation `2 (w_r d - w_d r + r × d)`.
+    /// One fixed group: batches of eight vertices with one vertex per lane of 256-bit
+    /// registers (the dual quaternions transposed into eight registers of eight lanes, so
+    /// the hemisphere tests, the blend, the normalisation and the application are plain
+    /// multiply-adds), then the rows left over one at a time.
     ///
     /// # Safety
     /// The CPU must have AVX2 and FMA. (Indices are checked.)
@@ -190,9 +191,168 @@ mod avx2 {
         palette: &[DualQuat],
         out: &mut [Vec3],
     ) {
-        let rows = group.joints.chunks_exact(K).zip(group.weights.chunks_exact(K));
+        let batches = group.vertices.len() / 8 * 8;
+        let rows = group.joints[..batches * K].chunks_exact(8 * K).zip(group.weights[..batches * K].chunks_exact(8 * K));
+        for (vertices, (joints, weights)) in group.vertices[..batches].chunks_exact(8).zip(rows) {
+            let vertices: &[u32; 8] = vertices.try_into().unwrap();
+            batch_of_eight::<K>(bind, vertices, joints, weights, palette, out);
+        }
+        let rest = (&group.vertices[batches..], &group.joints[batches * K..], &group.weights[batches * K..]);
+        // SAFETY: as this function's.
+        unsafe { rows_one_by_one::<K>(bind, rest, palette, out) };
+    }
+
+    /// Four quaternions, one per lane of each 128-bit half (`a`, `b`, `c`, `d` hold
+    /// vertices 0..3 of the low half and 4..7 of the high one), as x, y, z, w registers.
+    #[inline]
+    #[target_feature(enable = "avx2,fma")]
+    fn transpose(a: __m256, b: __m256, c: __m256, d: __m256) -> [__m256; 4] {
+        let (ab_lo, ab_hi) = (_mm256_unpacklo_ps(a, b), _mm256_unpackhi_ps(a, b));
+        let (cd_lo, cd_hi) = (_mm256_unpacklo_ps(c, d), _mm256_unpackhi_ps(c, d));
+        [
+            _mm256_shuffle_ps::<0x44>(ab_lo, cd_lo),
+            _mm256_shuffle_ps::<0xEE>(ab_lo, cd_lo),
+            _mm256_shuffle_ps::<0x44>(ab_hi, cd_hi),
+            _mm256_shuffle_ps::<0xEE>(ab_hi, cd_hi),
+        ]
+    }
+
+    /// Eight quaternions (`real` or `dual` parts) as four registers of eight lanes: x, y,
+    /// z, w; lane i holds quaternion i.
+    #[inline]
+    #[target_feature(enable = "avx2,fma")]
+    fn lanes(q: [&Vec4; 8]) -> [__m256; 4] {
+        let pair = |i: usize| (<__m128>::from(*q[i + 4]), <__m128>::from(*q[i]));
+        let [(a1, a0), (b1, b0), (c1, c0), (d1, d0)] = [pair(0), pair(1), pair(2), pair(3)];
+        transpose(_mm256_set_m128(a1, a0), _mm256_set_m128(b1, b0), _mm256_set_m128(c1, c0), _mm256_set_m128(d1, d0))
+    }
+
+    /// The weights of eight rows of `K`, one register per influence (lane i: row i).
+    #[inline]
+    #[target_feature(enable = "avx2,fma")]
+    fn lane_weights<const K: usize>(weights: &[f32]) -> [__m256; K] {
+        if K == 4 {
+            // Four rows of four: each half of a register is one row; transposed, as the
+            // quaternions are.
+            let row = |i: usize| Vec4::from_slice(&weights[i * 4..]);
+            let rows: [Vec4; 8] = std::array::from_fn(row);
+            let transposed = lanes(std::array::from_fn(|i| &rows[i]));
+            let mut lanes = [_mm256_setzero_ps(); K];
+            lanes.copy_from_slice(&transposed[..K]);
+            return lanes;
+        }
+        let mut lanes = [_mm256_setzero_ps(); K];
+        for (k, lane) in lanes.iter_mut().enumerate() {
+            let w: [f32; 8] = std::array::from_fn(|i| weights[i * K + k]);
+            *lane = _mm256_setr_ps(w[0], w[1], w[2], w[3], w[4], w[5], w[6], w[7]);
+        }
+        lanes
+    }
+
+    #[inline]
+    #[target_feature(enable = "avx2,fma")]
+    fn cross8([ax, ay, az]: [__m256; 3], [bx, by, bz]: [__m256; 3]) -> [__m256; 3] {
+        [
+            _mm256_fmsub_ps(ay, bz, _mm256_mul_ps(az, by)),
+            _mm256_fmsub_ps(az, bx, _mm256_mul_ps(ax, bz)),
+            _mm256_fmsub_ps(ax, by, _mm256_mul_ps(ay, bx)),
+        ]
+    }
+
+    /// `a · b` of four-lane-register quaternions.
+    #[inline]
+    #[target_feature(enable = "avx2,fma")]
+    fn dot8(a: &[__m256; 4], b: &[__m256; 4]) -> __m256 {
+        _mm256_fmadd_ps(a[3], b[3], _mm256_fmadd_ps(a[2], b[2], _mm256_fmadd_ps(a[1], b[1], _mm256_mul_ps(a[0], b[0]))))
+    }
+
+    #[inline]
+    #[target_feature(enable = "avx2,fma")]
+    fn batch_of_eight<const K: usize>(
+        bind: &[Vec3],
+        vertices: &[u32; 8],
+        joints: &[u16],
+        weights: &[f32],
+        palette: &[DualQuat],
+        out: &mut [Vec3],
+    ) {
+        // SAFETY: `skin_dq` checked that every joint lies inside the palette.
+        let quaternions = |k: usize| -> [&DualQuat; 8] {
+            std::array::from_fn(|i| unsafe { palette.get_unchecked(joints[i * K + k] as usize) })
+        };
+        // Influence 0 is the heaviest (rows are sorted): its real parts are the pivots.
+        // The real parts are blended first and the dual parts after, with the signed
+        // weights kept: fewer registers live at once.
+        let mut w = lane_weights::<K>(weights);
+        let pivot = lanes(quaternions(0).map(|q| &q.real));
+        let mut real = [_mm256_setzero_ps(); 4];
+        for c in 0..4 {
+            real[c] = _mm256_mul_ps(w[0], pivot[c]);
+        }
+        let sign = _mm256_set1_ps(-0.0);
+        for k in 1..K {
+            let r = lanes(quaternions(k).map(|q| &q.real));
+            // q and -q are one rotation: the weight takes the sign of dot(q.real, pivot).
+            w[k] = _mm256_xor_ps(w[k], _mm256_and_ps(dot8(&r, &pivot), sign));
+            for c in 0..4 {
+                real[c] = _mm256_fmadd_ps(w[k], r[c], real[c]);
+            }
+        }
+        let mut dual = [_mm256_setzero_ps(); 4];
+        for k in 0..K {
+            let d = lanes(quaternions(k).map(|q| &q.dual));
+            for c in 0..4 {
+                dual[c] = _mm256_fmadd_ps(w[k], d[c], dual[c]);
+            }
+        }
+        // 1/|real| by the reciprocal square root estimate and one Newton step.
+        let n2 = dot8(&real, &real);
+        let y = _mm256_rsqrt_ps(n2);
+        let inv =
+            _mm256_mul_ps(_mm256_mul_ps(_mm256_set1_ps(0.5), y), _mm256_fnmadd_ps(_mm256_mul_ps(n2, y), y, _mm256_set1_ps(3.0)));
+        for c in 0..4 {
+            real[c] = _mm256_mul_ps(real[c], inv);
+            dual[c] = _mm256_mul_ps(dual[c], inv);
+        }
+        let points: [Vec4; 8] = std::array::from_fn(|i| bind[vertices[i] as usize].extend(0.0));
+        let [px, py, pz, _] = lanes(std::array::from_fn(|i| &points[i]));
+        let (r, wr, d, wd, p) = ([real[0], real[1], real[2]], real[3], [dual[0], dual[1], dual[2]], dual[3], [px, py, pz]);
+        // t = r × p + w p; p' = p + 2 (r × t + w_r d - w_d r + r × d).
+        let rxp = cross8(r, p);
+        let mut t = [_mm256_setzero_ps(); 3];
+        for c in 0..3 {
+            t[c] = _mm256_fmadd_ps(wr, p[c], rxp[c]);
+        }
+        let (rxt, rxd) = (cross8(r, t), cross8(r, d));
+        let mut moved = [_mm256_setzero_ps(); 4];
+        for c in 0..3 {
+            let translation = _mm256_add_ps(_mm256_fmsub_ps(wr, d[c], _mm256_mul_ps(wd, r[c])), rxd[c]);
+            moved[c] = _mm256_fmadd_ps(_mm256_set1_ps(2.0), _mm256_add_ps(rxt[c], translation), p[c]);
+        }
+        let moved = transpose(moved[0], moved[1], moved[2], moved[3]);
+        for i in 0..4 {
+            out[vertices[i] as usize] = Vec4::from(_mm256_castps256_ps128(moved[i])).truncate();
+            out[vertices[i + 4] as usize] = Vec4::from(_mm256_extractf128_ps::<1>(moved[i])).truncate();
+        }
+    }
+
+    /// Rows one vertex at a time (the rows left over from the batches of eight): each vertex's blend and its application in 128-bit registers:
+    /// hemisphere test by a broadcast dot product, the sign flipped into the weight,
+    /// one reciprocal square root, rotation `v + 2w (r × v) + 2 r × (r × v)` and
+    /// translation `2 (w_r d - w_d r + r × d)`.
+    ///
+    /// # Safety
+    /// The CPU must have AVX2 and FMA. (Indices are checked.)
+    #[target_feature(enable = "avx2,fma")]
+    unsafe fn rows_one_by_one<const K: usize>(
+        bind: &[Vec3],
+        (vertices, joints, weights): (&[u32], &[u16], &[f32]),
+        palette: &[DualQuat],
+        out: &mut [Vec3],
+    ) {
+        let rows = joints.chunks_exact(K).zip(weights.chunks_exact(K));
         let sign = _mm_set1_ps(-0.0);
-        for (&v, (joints, weights)) in group.vertices.iter().zip(rows) {
+        for (&v, (joints, weights)) in vertices.iter().zip(rows) {
             let (joints, weights): (&[u16; K], &[f32; K]) = (joints.try_into().unwrap(), weights.try_into().unwrap());
             // Rows are stored heaviest first (`InfluenceGroups::build`): no search, no branch.
             let pivot: __m128 = palette[joints[0] as usize].real.into();
