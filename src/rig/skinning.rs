@@ -87,6 +87,17 @@ impl SkinWeights {
         Self { offsets, influences, groups }
     }
 
+    /// Where each vertex's row starts in [`influences`](Self::influences) (one more entry
+    /// than vertices: the last is the end).
+    pub fn offsets(&self) -> &[u32] {
+        &self.offsets
+    }
+
+    /// Every vertex's influences, row after row.
+    pub fn influences(&self) -> &[Influence] {
+        &self.influences
+    }
+
     /// The rows partitioned by influence count (see [`super::lbs`]).
     pub fn groups(&self) -> &InfluenceGroups {
         &self.groups
@@ -167,6 +178,34 @@ pub fn bounds(points: &[Vec3]) -> (Vec3, Vec3) {
         .iter()
         .fold((Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)), |(lo, hi), p| (lo.min(*p), hi.max(*p)));
     if lo.x > hi.x { (Vec3::ZERO, Vec3::ZERO) } else { (lo, hi) }
+}
+
+/// For each joint, the box of the bind positions of the vertices it influences (an empty
+/// box, min above max, for a joint that influences none).
+pub fn influence_boxes(bind_positions: &[Vec3], weights: &SkinWeights, joint_count: usize) -> Vec<(Vec3, Vec3)> {
+    let mut boxes = vec![(Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)); joint_count];
+    for (v, &p) in bind_positions.iter().enumerate() {
+        for inf in weights.of_vertex(v) {
+            let (lo, hi) = &mut boxes[inf.joint as usize];
+            (*lo, *hi) = (lo.min(p), hi.max(p));
+        }
+    }
+    boxes
+}
+
+/// A box that holds every linear-blend-skinned vertex without skinning one: a skinned
+/// vertex is a weighted mean of `palette[j] · p` over its joints j, and each of those
+/// lies in joint j's influence box moved by `palette[j]`, so the union of the moved boxes
+/// holds it. (Both zero when no joint influences a vertex.)
+pub fn influence_hull_bounds(boxes: &[(Vec3, Vec3)], palette: &[Mat4]) -> (Vec3, Vec3) {
+    let corners = boxes.iter().zip(palette).filter(|((lo, hi), _)| lo.x <= hi.x).flat_map(|(&(lo, hi), m)| {
+        (0..8).map(move |k| {
+            let pick = |bit: usize, a: f32, b: f32| if k & bit == 0 { a } else { b };
+            m.transform_point3(Vec3::new(pick(1, lo.x, hi.x), pick(2, lo.y, hi.y), pick(4, lo.z, hi.z)))
+        })
+    });
+    let corners: Vec<Vec3> = corners.collect();
+    bounds(&corners)
 }
 
 /// Unshares the vertices of every triangle and gives each the triangle's unit normal:

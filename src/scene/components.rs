@@ -19,7 +19,9 @@ use crate::rig::{CharacterAsset, DofLimits, JointRotation};
     Transform,
     Visibility,
     RestOverrides,
-    super::upload::SkinUpload
+    super::upload::SkinUpload,
+    SkinOnGpu,
+    super::gpu_skinning::GpuSkinJob
 )]
 pub struct Character {
     pub asset: Arc<CharacterAsset>,
@@ -63,6 +65,11 @@ pub struct CharacterView(pub ViewDoc);
 /// character entity.
 #[derive(Component, Clone, Copy, Debug, Default, PartialEq, Eq, Deref, DerefMut)]
 pub struct CharacterSkinning(pub crate::rig::dqs::SkinningMethod);
+
+/// Whether the character is skinned by the GPU skinning compute shader instead of on the
+/// CPU (the default); on the character entity.
+#[derive(Component, Clone, Copy, Debug, Default, PartialEq, Eq, Deref, DerefMut)]
+pub struct SkinOnGpu(pub bool);
 
 /// The joint whose weights the skin shows as a heat map (overrides weight colours); set
 /// from the selection where the view asks for it.
@@ -187,6 +194,8 @@ pub struct SkinScratch {
     pub dual_quaternions: Vec<crate::rig::dqs::DualQuat>,
     /// What the mesh's colours were last written from.
     pub colored_with: Option<Coloring>,
+    /// Each joint's box of the bind vertices it moves (GPU-skinned characters' bounds).
+    pub influence_boxes: Vec<(Vec3, Vec3)>,
 }
 
 /// What a skin's colours depend on: a view change that leaves this alone (display mode,

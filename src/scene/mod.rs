@@ -15,6 +15,7 @@
 //! skin material lights each triangle with its own).
 
 pub mod components;
+pub mod gpu_skinning;
 pub mod keyframes;
 pub mod morphs;
 pub mod node_clips;
@@ -76,13 +77,13 @@ impl Plugin for RigCorePlugin {
     }
 }
 
-/// CPU skinning of changed characters (in parallel), handed straight to their meshes' GPU
-/// slots.
+/// Skinning of changed characters: on the CPU (in parallel), handed straight to their
+/// meshes' GPU slots, or by the GPU skinning compute shader where a character asks for it.
 pub struct SkinningPlugin;
 
 impl Plugin for SkinningPlugin {
     fn build(&self, app: &mut App) {
-        app.add_plugins(upload::SkinUploadPlugin).add_systems(
+        app.add_plugins((upload::SkinUploadPlugin, gpu_skinning::GpuSkinningPlugin)).add_systems(
             PostUpdate,
             (systems::skin_changed_characters, systems::finish_skinned_characters)
                 .chain()

@@ -7,7 +7,8 @@ use super::components::*;
 use super::upload::SkinUpload;
 use crate::rig::JointRotation;
 use crate::rig::fk::forward_kinematics_with_rest;
-use crate::rig::skinning::{bounds, heat_colors, joint_colors, weight_colors};
+use super::gpu_skinning::GpuSkinJob;
+use crate::rig::skinning::{bounds, heat_colors, influence_boxes, influence_hull_bounds, joint_colors, weight_colors};
 use crate::rig::{dqs, lbs};
 
 /// Clamps changed joint poses to their limits (reads `JointLimits`, writes `JointPose`).
@@ -30,6 +31,7 @@ pub fn mark_changed_characters(
         &HeatJoint,
         &SkinScratch,
         Ref<CharacterSkinning>,
+        Ref<SkinOnGpu>,
         Ref<super::keyframes::RootTranslation>,
         Ref<RestOverrides>,
         &mut PoseDirty,
@@ -40,11 +42,11 @@ pub fn mark_changed_characters(
             dirty.matrices = true;
         }
     }
-    for (view, heat, scratch, method, root, rest, mut dirty) in &mut characters {
+    for (view, heat, scratch, method, on_gpu, root, rest, mut dirty) in &mut characters {
         if scratch.colored_with != Some(Coloring::of(view, heat)) {
             dirty.colors = true;
         }
-        if method.is_changed() || root.is_changed() || rest.is_changed() {
+        if method.is_changed() || on_gpu.is_changed() || root.is_changed() || rest.is_changed() {
             dirty.matrices = true;
         }
     }
@@ -110,46 +112,76 @@ pub fn compute_joint_to_world(
 }
 
 /// Skins characters marked dirty, in model space and in parallel on Bevy's compute task
-/// pool: palette `CurrentJointToWorld · BindWorldToJoint`, the LBS kernel of the bind
+/// pool: palette `CurrentJointToWorld · BindWorldToJoint`, the LBS or DQ kernel of the bind
 /// vertices and their bounds; the colours when they changed; then packs the vertices for
-/// the GPU (reads joint matrices; writes `SkinScratch`, `SkinUpload`).
+/// the GPU. Characters skinned on the GPU hand over the palette instead (reads joint
+/// matrices; writes `SkinScratch`, `SkinUpload`, `GpuSkinJob`).
 pub fn skin_changed_characters(
     mut characters: Query<(
         &Character,
         &CharacterView,
         &CharacterSkinning,
+        &SkinOnGpu,
         &HeatJoint,
         &PoseDirty,
         &mut SkinScratch,
         &mut SkinUpload,
+        &mut GpuSkinJob,
     )>,
     joints: Query<(&CurrentJointToWorld, &BindWorldToJoint)>,
 ) {
-    characters.par_iter_mut().for_each(|(character, view, method, heat, dirty, mut scratch, mut upload)| {
-        if *dirty == PoseDirty::default() {
-            return;
-        }
-        let skin = &character.asset.skin;
-        let scratch = &mut *scratch;
-        if dirty.matrices || dirty.bind || scratch.positions.len() != skin.bind_positions.len() {
-            scratch.palette.clear();
-            scratch
-                .palette
-                .extend(character.joints.iter().map(|&e| joints.get(e).map_or(Mat4::IDENTITY, |(c, b)| c.0 * b.0)));
-            scratch.positions.resize(skin.bind_positions.len(), Vec3::ZERO);
-            if method.is_linear() {
-                skin_in_chunks(skin, &scratch.palette, &mut scratch.positions);
-            } else {
-                dqs::dual_quaternion_palette(&scratch.palette, &mut scratch.dual_quaternions);
-                dqs::skin_dq(&skin.bind_positions, &skin.weights, &scratch.dual_quaternions, &mut scratch.positions);
+    characters.par_iter_mut().for_each(
+        |(character, view, method, on_gpu, heat, dirty, mut scratch, mut upload, mut job)| {
+            if *dirty == PoseDirty::default() {
+                return;
             }
-            scratch.bounds = bounds(&scratch.positions);
-        }
-        if dirty.colors || scratch.colors.len() != skin.bind_positions.len() {
-            vertex_colors(character, view, heat.0, &mut scratch.colors);
-        }
-        upload.pack(&scratch.positions, &skin.texcoords, &scratch.colors);
-    });
+            let skin = &character.asset.skin;
+            let scratch = &mut *scratch;
+            let never_skinned = scratch.positions.len() != skin.bind_positions.len();
+            let moved = dirty.matrices || dirty.bind || never_skinned;
+            if moved {
+                scratch.palette.clear();
+                scratch.palette.extend(
+                    character.joints.iter().map(|&e| joints.get(e).map_or(Mat4::IDENTITY, |(c, b)| c.0 * b.0)),
+                );
+            }
+            let recolored = dirty.colors || scratch.colors.len() != skin.bind_positions.len();
+            if recolored {
+                vertex_colors(character, view, heat.0, &mut scratch.colors);
+            }
+            if on_gpu.0 {
+                // The first skin is done here as well: its positions frame the scene and
+                // stand the characters on the floor when it opens.
+                if never_skinned || dirty.bind {
+                    skin_on_cpu(skin, method.0, scratch);
+                    scratch.influence_boxes = influence_boxes(&skin.bind_positions, &skin.weights, character.joints.len());
+                } else if moved {
+                    scratch.bounds = influence_hull_bounds(&scratch.influence_boxes, &scratch.palette);
+                }
+                job.hand_over(character, method.0, scratch, recolored);
+                return;
+            }
+            if job.0.is_some() {
+                job.0 = None;
+            }
+            if moved {
+                skin_on_cpu(skin, method.0, scratch);
+            }
+            upload.pack(&scratch.positions, &skin.texcoords, &scratch.colors);
+        },
+    );
+}
+
+/// The LBS or DQ kernel of the skin into `scratch.positions`, and their bounds.
+fn skin_on_cpu(skin: &crate::rig::Skin, method: dqs::SkinningMethod, scratch: &mut SkinScratch) {
+    scratch.positions.resize(skin.bind_positions.len(), Vec3::ZERO);
+    if method.is_linear() {
+        skin_in_chunks(skin, &scratch.palette, &mut scratch.positions);
+    } else {
+        dqs::dual_quaternion_palette(&scratch.palette, &mut scratch.dual_quaternions);
+        dqs::skin_dq(&skin.bind_positions, &skin.weights, &scratch.dual_quaternions, &mut scratch.positions);
+    }
+    scratch.bounds = bounds(&scratch.positions);
 }
 
 /// Vertices per task when one mesh is skinned on several threads.

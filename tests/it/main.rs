@@ -11,6 +11,7 @@ mod ecs;
 mod editor;
 mod edits;
 mod formats;
+mod gpu;
 mod fuzz;
 mod gizmo;
 mod gltf;

@@ -1,0 +1,320 @@
+//! GPU skinning (the 6.837 assignment's "accelerate SSD using shaders"): a compute shader
+//! (`gpu_skinning.wgsl`) takes the same palette and bind data as the CPU kernels and writes
+//! the skinned positions into the packed vertices, which are copied into the mesh's slot of
+//! the vertex buffer. Chosen per character ([`SkinOnGpu`](super::SkinOnGpu), the inspector,
+//! the scene file); the CPU path stays the default.
+//!
+//! The main world hands over each re-posed character's palette ([`GpuSkinJob`]); the render
+//! world keeps, per character, the bind positions and influences on the GPU (uploaded once
+//! per asset), the packed vertices as a template (texture coordinates and colours; written
+//! again only when they change), and dispatches one invocation per vertex.
+//!
+//! Flat normals need no pass: the skin material lights each triangle with its own normal.
+//! Culling is off for these skins ([`NoFrustumCulling`]): the main world has no skinned
+//! vertices to bound them by (its bounds are the influence boxes' hull, see
+//! [`influence_hull_bounds`](crate::rig::skinning::influence_hull_bounds), which holds every
+//! linear-blend vertex but not every dual-quaternion one).
+
+use std::collections::HashMap;
+use std::sync::Arc;
+
+use bevy::camera::visibility::NoFrustumCulling;
+use bevy::prelude::*;
+use bevy::render::mesh::allocator::MeshAllocator;
+use bevy::render::render_resource::{
+    BindGroup, BindGroupEntry, BindGroupLayout, BindGroupLayoutEntry, BindingType, Buffer, BufferBindingType,
+    BufferDescriptor, BufferUsages, CommandEncoderDescriptor, ComputePassDescriptor, ComputePipeline, MapMode,
+    PipelineCompilationOptions, PipelineLayoutDescriptor, PollType, RawComputePipelineDescriptor,
+    ShaderModuleDescriptor, ShaderSource, ShaderStages,
+};
+use bevy::render::renderer::{RenderDevice, RenderQueue};
+use bevy::render::{Extract, ExtractSchedule, Render, RenderApp, RenderSystems};
+
+use super::components::{Character, SkinOnGpu, SkinScratch};
+use super::upload::pack_vertices;
+use crate::rig::CharacterAsset;
+use crate::rig::dqs::{self, SkinningMethod};
+
+/// What the render world needs to skin a character on the GPU (`None`: it is skinned on
+/// the CPU). Replaced whenever the character is re-posed or recoloured.
+#[derive(Component, Default)]
+pub struct GpuSkinJob(pub Option<GpuSkinInput>);
+
+/// One character's input to the compute shader.
+#[derive(Clone)]
+pub struct GpuSkinInput {
+    /// The asset whose bind positions and influences are skinned.
+    pub asset: Arc<CharacterAsset>,
+    /// Linear blend: the palette matrices. Dual quaternion: columns (real, dual, 0, 0).
+    pub palette: Arc<Vec<Mat4>>,
+    pub method: SkinningMethod,
+    /// The packed vertices at the bind pose (positions, texture coordinates, colours);
+    /// the shader overwrites the positions.
+    pub template: Arc<Vec<f32>>,
+    /// Floats per packed vertex.
+    pub floats: usize,
+}
+
+impl GpuSkinJob {
+    /// Hands over the character's palette (from `scratch`, as `method` takes it), and a
+    /// new template when the colours changed or there was none.
+    pub fn hand_over(&mut self, character: &Character, method: SkinningMethod, scratch: &mut SkinScratch, recolored: bool) {
+        let skin = &character.asset.skin;
+        let kept = self.0.as_ref().filter(|job| !recolored && Arc::ptr_eq(&job.asset, &character.asset));
+        let (template, floats) = match kept {
+            Some(job) => (job.template.clone(), job.floats),
+            None => {
+                let mut template = Vec::new();
+                let floats = pack_vertices(&skin.bind_positions, &skin.texcoords, &scratch.colors, &mut template);
+                (Arc::new(template), floats)
+            }
+        };
+        let palette = if method.is_linear() {
+            scratch.palette.clone()
+        } else {
+            dqs::dual_quaternion_palette(&scratch.palette, &mut scratch.dual_quaternions);
+            scratch.dual_quaternions.iter().map(|q| Mat4::from_cols(q.real, q.dual, Vec4::ZERO, Vec4::ZERO)).collect()
+        };
+        self.0 = Some(GpuSkinInput { asset: character.asset.clone(), palette: Arc::new(palette), method, template, floats });
+    }
+}
+
+/// The compute path: culling off for GPU-skinned skins, extraction of the jobs, the
+/// dispatches.
+pub struct GpuSkinningPlugin;
+
+impl Plugin for GpuSkinningPlugin {
+    fn build(&self, app: &mut App) {
+        app.add_systems(PostUpdate, cull_only_cpu_skins.in_set(super::MarionetteSystems::Skin));
+        let Some(render_app) = app.get_sub_app_mut(RenderApp) else {
+            return;
+        };
+        render_app
+            .init_resource::<GpuSkins>()
+            .add_systems(ExtractSchedule, extract_gpu_skin_jobs)
+            .add_systems(Render, dispatch_gpu_skinning.in_set(RenderSystems::PrepareMeshes));
+    }
+}
+
+/// Turns frustum culling off for skins skinned on the GPU and back on for the others
+/// (reads `SkinOnGpu`; writes `NoFrustumCulling` on skin entities).
+fn cull_only_cpu_skins(mut commands: Commands, characters: Query<(&Character, &SkinOnGpu), Changed<SkinOnGpu>>) {
+    for (character, on_gpu) in &characters {
+        let Ok(mut skin) = commands.get_entity(character.skin_entity) else { continue };
+        if on_gpu.0 {
+            skin.insert(NoFrustumCulling);
+        } else {
+            skin.remove::<NoFrustumCulling>();
+        }
+    }
+}
+
+/// The render world's GPU skinning state.
+#[derive(Resource, Default)]
+struct GpuSkins {
+    pipeline: Option<SkinningPipeline>,
+    /// By character entity (main world).
+    skins: HashMap<Entity, SkinBuffers>,
+    /// Jobs waiting for their dispatch (their mesh's slot), by character entity.
+    pending: HashMap<Entity, (AssetId<Mesh>, GpuSkinInput, u32)>,
+}
+
+struct SkinningPipeline {
+    layout: BindGroupLayout,
+    pipeline: ComputePipeline,
+}
+
+/// One character's buffers on the GPU.
+struct SkinBuffers {
+    /// The asset they were made from, and the template last written into `vertices`.
+    asset: Arc<CharacterAsset>,
+    template: Arc<Vec<f32>>,
+    params: Buffer,
+    palette: Buffer,
+    vertices: Buffer,
+    bind_group: BindGroup,
+}
+
+/// Frames a job waits for its mesh's slot before it is dropped (the mesh is gone).
+const MAX_WAIT_FRAMES: u32 = 600;
+
+/// Takes the jobs that changed; forgets characters that are gone or went back to the CPU
+/// (reads `GpuSkinJob`; writes `GpuSkins`).
+fn extract_gpu_skin_jobs(jobs: Extract<Query<(Entity, &Character, Ref<GpuSkinJob>)>>, mut gpu: ResMut<GpuSkins>) {
+    let gpu = &mut *gpu;
+    gpu.skins.retain(|e, _| jobs.get(*e).is_ok_and(|(_, _, job)| job.0.is_some()));
+    gpu.pending.retain(|e, _| jobs.get(*e).is_ok_and(|(_, _, job)| job.0.is_some()));
+    for (entity, character, job) in &jobs {
+        if let Some(input) = job.0.as_ref().filter(|_| job.is_changed()) {
+            gpu.pending.insert(entity, (character.mesh.id(), input.clone(), 0));
+        }
+    }
+}
+
+/// Skins each pending character on the GPU into its mesh's slot of the vertex buffer, after
+/// Bevy has allocated the slots of new meshes (reads `MeshAllocator`; writes GPU buffers).
+fn dispatch_gpu_skinning(
+    mut gpu: ResMut<GpuSkins>,
+    allocator: Option<Res<MeshAllocator>>,
+    device: Res<RenderDevice>,
+    queue: Res<RenderQueue>,
+) {
+    let Some(allocator) = allocator else { return };
+    if gpu.pending.is_empty() {
+        return;
+    }
+    let gpu = &mut *gpu;
+    let pipeline = gpu.pipeline.get_or_insert_with(|| SkinningPipeline::new(&device));
+    let mut encoder = device.create_command_encoder(&CommandEncoderDescriptor { label: Some("marionette gpu skinning") });
+    gpu.pending.retain(|entity, (mesh, input, waited)| {
+        let Some(slice) = allocator.mesh_vertex_slice(mesh) else {
+            *waited += 1;
+            return *waited < MAX_WAIT_FRAMES;
+        };
+        let vertex_count = input.asset.vertex_count();
+        let bytes = (input.template.len() * 4) as u64;
+        if (slice.range.end - slice.range.start) as usize != vertex_count || input.template.len() != vertex_count * input.floats {
+            return false;
+        }
+        let skin = match gpu.skins.get_mut(entity) {
+            Some(skin) if Arc::ptr_eq(&skin.asset, &input.asset) => skin,
+            _ => gpu.skins.entry(*entity).insert_entry(SkinBuffers::new(&device, pipeline, input)).into_mut(),
+        };
+        if !Arc::ptr_eq(&skin.template, &input.template) {
+            queue.write_buffer(&skin.vertices, 0, bytemuck::cast_slice(&input.template));
+            skin.template = input.template.clone();
+        }
+        let method = u32::from(!input.method.is_linear());
+        queue.write_buffer(&skin.params, 0, bytemuck::cast_slice(&[vertex_count as u32, input.floats as u32, method, 0]));
+        queue.write_buffer(&skin.palette, 0, bytemuck::cast_slice(input.palette.as_slice()));
+        {
+            let mut pass = encoder.begin_compute_pass(&ComputePassDescriptor { label: Some("skin"), timestamp_writes: None });
+            pass.set_pipeline(&pipeline.pipeline);
+            pass.set_bind_group(0, &*skin.bind_group, &[]);
+            let (x, y) = workgroups(vertex_count);
+            pass.dispatch_workgroups(x, y, 1);
+        }
+        let offset = u64::from(slice.range.start) * input.floats as u64 * 4;
+        encoder.copy_buffer_to_buffer(&skin.vertices, 0, slice.buffer, offset, bytes);
+        false
+    });
+    queue.submit([encoder.finish()]);
+}
+
+/// Vertices per workgroup (the shader's `@workgroup_size`).
+const WORKGROUP: usize = 64;
+
+/// Workgroups in x and y for `vertex_count` vertices (x at most 65,535, the least limit).
+fn workgroups(vertex_count: usize) -> (u32, u32) {
+    let groups = vertex_count.div_ceil(WORKGROUP).max(1);
+    let x = groups.min(65_535);
+    (x as u32, groups.div_ceil(x) as u32)
+}
+
+impl SkinningPipeline {
+    fn new(device: &RenderDevice) -> Self {
+        let storage = |binding: u32, read_only: bool| BindGroupLayoutEntry {
+            binding,
+            visibility: ShaderStages::COMPUTE,
+            ty: BindingType::Buffer {
+                ty: BufferBindingType::Storage { read_only },
+                has_dynamic_offset: false,
+                min_binding_size: None,
+            },
+            count: None,
+        };
+        let params = BindGroupLayoutEntry {
+            binding: 0,
+            visibility: ShaderStages::COMPUTE,
+            ty: BindingType::Buffer { ty: BufferBindingType::Uniform, has_dynamic_offset: false, min_binding_size: None },
+            count: None,
+        };
+        let entries = [params, storage(1, true), storage(2, true), storage(3, true), storage(4, true), storage(5, false)];
+        let layout = device.create_bind_group_layout("marionette gpu skinning", &entries);
+        let module = device.create_and_validate_shader_module(ShaderModuleDescriptor {
+            label: Some("gpu_skinning.wgsl"),
+            source: ShaderSource::Wgsl(include_str!("gpu_skinning.wgsl").into()),
+        });
+        let pipeline_layout = device.create_pipeline_layout(&PipelineLayoutDescriptor {
+            label: Some("marionette gpu skinning"),
+            bind_group_layouts: &[Some(&*layout)],
+            immediate_size: 0,
+        });
+        let pipeline = device.create_compute_pipeline(&RawComputePipelineDescriptor {
+            label: Some("marionette gpu skinning"),
+            layout: Some(&pipeline_layout),
+            module: &module,
+            entry_point: Some("skin"),
+            compilation_options: PipelineCompilationOptions::default(),
+            cache: None,
+        });
+        Self { layout, pipeline }
+    }
+}
+
+impl SkinBuffers {
+    /// The asset's bind positions and influences on the GPU, and room for the palette and
+    /// the packed vertices.
+    fn new(device: &RenderDevice, pipeline: &SkinningPipeline, input: &GpuSkinInput) -> Self {
+        let skin = &input.asset.skin;
+        let with_data = |label: &str, contents: &[u8]| {
+            device.create_buffer_with_data(&bevy::render::render_resource::BufferInitDescriptor {
+                label: Some(label),
+                contents,
+                usage: BufferUsages::STORAGE,
+            })
+        };
+        let empty = |label: &str, size: usize, usage: BufferUsages| {
+            device.create_buffer(&BufferDescriptor {
+                label: Some(label),
+                size: size.max(16) as u64,
+                usage: usage | BufferUsages::COPY_DST,
+                mapped_at_creation: false,
+            })
+        };
+        let positions: Vec<f32> = skin.bind_positions.iter().flat_map(|p| p.to_array()).collect();
+        let influences: Vec<[u32; 2]> =
+            skin.weights.influences().iter().map(|i| [u32::from(i.joint), i.weight.to_bits()]).collect();
+        let bind = with_data("bind positions", bytemuck::cast_slice(&positions));
+        let offsets = with_data("influence offsets", bytemuck::cast_slice(skin.weights.offsets()));
+        let influences = with_data("influences", bytemuck::cast_slice(&influences));
+        let params = empty("skinning params", 16, BufferUsages::UNIFORM);
+        let palette = empty("palette", input.palette.len() * 64, BufferUsages::STORAGE);
+        let vertices =
+            empty("skinned vertices", input.template.len() * 4, BufferUsages::STORAGE | BufferUsages::COPY_SRC);
+        let entries = [&params, &palette, &bind, &offsets, &influences, &vertices]
+            .into_iter()
+            .enumerate()
+            .map(|(binding, buffer)| BindGroupEntry { binding: binding as u32, resource: buffer.as_entire_binding() })
+            .collect::<Vec<_>>();
+        let bind_group = device.create_bind_group("marionette gpu skinning", &pipeline.layout, &entries);
+        Self { asset: input.asset.clone(), template: Arc::new(Vec::new()), params, palette, vertices, bind_group }
+    }
+}
+
+/// Reads back a mesh's packed vertices from its slot of the vertex buffer (render world;
+/// blocks until the GPU has finished). For tests that compare the GPU path with the CPU.
+pub fn read_back_mesh_vertices(render_world: &World, mesh: AssetId<Mesh>, floats: usize) -> Option<Vec<f32>> {
+    let allocator = render_world.get_resource::<MeshAllocator>()?;
+    let device = render_world.get_resource::<RenderDevice>()?;
+    let queue = render_world.get_resource::<RenderQueue>()?;
+    let slice = allocator.mesh_vertex_slice(&mesh)?;
+    let bytes = u64::from(slice.range.end - slice.range.start) * floats as u64 * 4;
+    let staging = device.create_buffer(&BufferDescriptor {
+        label: Some("read back"),
+        size: bytes,
+        usage: BufferUsages::MAP_READ | BufferUsages::COPY_DST,
+        mapped_at_creation: false,
+    });
+    let mut encoder = device.create_command_encoder(&CommandEncoderDescriptor { label: Some("read back") });
+    encoder.copy_buffer_to_buffer(slice.buffer, u64::from(slice.range.start) * floats as u64 * 4, &staging, 0, bytes);
+    queue.submit([encoder.finish()]);
+    let (sender, receiver) = std::sync::mpsc::channel();
+    staging.slice(..).map_async(MapMode::Read, move |result| {
+        let _ = sender.send(result);
+    });
+    device.poll(PollType::wait_indefinitely()).ok()?;
+    receiver.recv().ok()?.ok()?;
+    let floats = bytemuck::cast_slice::<u8, f32>(&staging.slice(..).get_mapped_range()).to_vec();
+    Some(floats)
+}

@@ -1,0 +1,114 @@
+//! GPU skinning against the CPU kernels, through the app and the render world: the compute
+//! shader's output is read back from the meshes' slots of the vertex buffer (on llvmpipe
+//! here: wgpu compute runs there).
+
+use std::sync::Arc;
+
+use bevy::prelude::*;
+use bevy::render::RenderApp;
+use bevy::render::pipelined_rendering::PipelinedRenderingPlugin;
+use bevy::window::ExitCondition;
+use bevy::winit::WinitPlugin;
+use marionette::cli::posing::posed_positions_by;
+use marionette::rig::dqs::SkinningMethod;
+use marionette::rig::{CharacterAsset, JointRotation};
+use marionette::scene::gpu_skinning::{GpuSkinJob, read_back_mesh_vertices};
+use marionette::scene::*;
+
+/// Our plugins with Bevy's renderer and no window (no pipelining: a frame's GPU work is
+/// submitted within its `update`).
+fn render_app() -> App {
+    let mut app = App::new();
+    app.add_plugins(
+        DefaultPlugins
+            .set(WindowPlugin {
+                primary_window: None,
+                exit_condition: ExitCondition::DontExit,
+                close_when_requested: false,
+                ..default()
+            })
+            .disable::<WinitPlugin>()
+            .disable::<PipelinedRenderingPlugin>(),
+    )
+    .add_plugins((RigCorePlugin, SkinningPlugin));
+    app.finish();
+    app.cleanup();
+    app
+}
+
+fn pose_of(asset: &CharacterAsset) -> Vec<JointRotation> {
+    (0..asset.skeleton.len()).map(|i| JointRotation::euler_xyz(0.3 + 0.05 * i as f32, -0.2, 0.25)).collect()
+}
+
+/// The puppet and, with the data, Model1 (up to 13 influences a vertex) and an SMPL body,
+/// each posed, skinned on the GPU by linear blend and by dual quaternions: every vertex
+/// within 1e-4 (relative to the model's size) of the CPU kernels, texture coordinates and
+/// colours as the template holds them. Then one goes back to the CPU and uploads from there.
+#[test]
+fn gpu_skinning_matches_the_cpu_kernels() {
+    let mut assets = vec![Arc::new(marionette::formats::puppet::embedded_puppet())];
+    if let Some(data) = crate::common::optional_data_dir() {
+        assets.push(Arc::new(marionette::formats::load_character(&data.join("mit6837/Model1.skel")).unwrap()));
+        let (model, _) = marionette::formats::smpl::load_smpl_dir(&data.join("smpl")).unwrap();
+        assets.push(Arc::new(model.asset("smpl", &[0.8, -0.4]).unwrap()));
+    }
+    let mut app = render_app();
+    let mut characters = Vec::new();
+    for asset in &assets {
+        for method in [SkinningMethod::Linear, SkinningMethod::DualQuaternion] {
+            let entity = spawn_posed(&mut app, asset.clone(), &pose_of(asset));
+            app.world_mut().entity_mut(entity).insert((SkinOnGpu(true), CharacterSkinning(method)));
+            let expected = posed_positions_by(asset, &pose_of(asset), Mat4::IDENTITY, method);
+            characters.push((entity, asset.clone(), method, expected));
+        }
+    }
+    let mut worst = Vec::new();
+    for _ in 0..600 {
+        app.update();
+        worst = characters.iter().map(|c| largest_error(&app, c.0, &c.1, &c.3)).collect();
+        if worst.iter().all(|w| w.is_some_and(|w| w <= 1e-4)) {
+            break;
+        }
+    }
+    for ((_, asset, method, _), worst) in characters.iter().zip(&worst) {
+        let worst = worst.unwrap_or_else(|| panic!("{} ({method:?}) was never skinned on the GPU", asset.name));
+        eprintln!("GPU skinning, {} ({method:?}): largest relative difference {worst:e}", asset.name);
+        assert!(worst <= 1e-4, "{} ({method:?}): largest relative difference {worst:e}", asset.name);
+    }
+    // Back to the CPU: the job is withdrawn and the CPU's packed vertices are uploaded.
+    let (entity, ..) = characters[0].clone();
+    app.world_mut().entity_mut(entity).insert(SkinOnGpu(false));
+    app.update();
+    assert!(app.world().get::<GpuSkinJob>(entity).unwrap().0.is_none());
+    let upload = app.world().get::<marionette::scene::upload::SkinUpload>(entity).unwrap();
+    assert_eq!(upload.vertices.len(), assets[0].vertex_count() * upload.floats);
+}
+
+fn spawn_posed(app: &mut App, asset: Arc<CharacterAsset>, pose: &[JointRotation]) -> Entity {
+    let world = app.world_mut();
+    let mut meshes = world.remove_resource::<Assets<Mesh>>().unwrap();
+    let mut queue = bevy::ecs::world::CommandQueue::default();
+    let entity = spawn_character_posed(&mut Commands::new(&mut queue, world), &mut meshes, asset, default(), pose);
+    queue.apply(world);
+    world.insert_resource(meshes);
+    entity
+}
+
+/// The largest distance between the GPU's positions and `expected`, relative to the
+/// model's size (`None` until the GPU has skinned it); the other floats must be the
+/// template's.
+fn largest_error(app: &App, entity: Entity, asset: &CharacterAsset, expected: &[Vec3]) -> Option<f32> {
+    let job = app.world().get::<GpuSkinJob>(entity)?.0.as_ref()?;
+    let mesh = app.world().get::<Character>(entity)?.mesh.id();
+    let vertices = read_back_mesh_vertices(app.sub_app(RenderApp).world(), mesh, job.floats)?;
+    assert_eq!(vertices.len(), job.template.len(), "{}: the mesh's slot holds its vertices", asset.name);
+    let size = expected.iter().fold(1.0f32, |m, p| m.max(p.abs().max_element()));
+    let mut worst = 0.0f32;
+    for ((gpu, template), want) in vertices.chunks(job.floats).zip(job.template.chunks(job.floats)).zip(expected) {
+        if gpu[3..] != template[3..] {
+            return None;
+        }
+        worst = worst.max(Vec3::new(gpu[0], gpu[1], gpu[2]).distance(*want) / size);
+    }
+    Some(worst)
+}
