@@ -158,6 +158,9 @@ enum Command {
         /// Print one JSON object instead of the table.
         #[arg(long)]
         json: bool,
+        /// Skin the crowd with the GPU skinning compute shader instead of on the CPU.
+        #[arg(long)]
+        gpu: bool,
     },
     /// Rebuild the project's own characters into a folder (normally `assets`).
     GenAssets {
@@ -412,11 +415,11 @@ fn run(cli: Cli) -> Result<()> {
         Some(Command::Smpl { data, task, sequence, transition, slerp, out, naive }) => {
             smpl(&data, task, sequence, transition, slerp, &out, naive)?
         }
-        Some(Command::Bench { characters, frames, data, json }) => {
+        Some(Command::Bench { characters, frames, data, json, gpu }) => {
             use marionette::editor::bench;
             let data = bench::data_folder(data);
             let report =
-                bench::run(characters as usize, frames as usize, data.as_deref()).map_err(anyhow::Error::msg)?;
+                bench::run(characters as usize, frames as usize, data.as_deref(), gpu).map_err(anyhow::Error::msg)?;
             if json {
                 println!("{}", serde_json::to_string(&report)?);
             } else {

@@ -29,10 +29,12 @@ use crate::scene::{Character, JointPose, MarionetteSystems, RigCorePlugin, Skinn
 pub struct BenchReport {
     pub characters: usize,
     pub kind: String,
+    /// Skinned by the GPU skinning compute shader (else on the CPU).
+    pub gpu_skinning: bool,
     pub vertices_per_character: usize,
     pub frames: usize,
     /// CPU work of a frame: main-world schedule, extraction, and the render world's asset
-    /// preparation (the upload).
+    /// and mesh preparation (the upload, or the GPU skinning's dispatch).
     pub frame_ms_p50: f64,
     pub frame_ms_p95: f64,
     /// Medians of the phases.
@@ -63,8 +65,9 @@ struct MainClock([Option<Instant>; 4]);
 struct RenderClock([Option<Instant>; 2]);
 
 /// Runs the crowd bench: `characters` SMPL bodies from `data` (clips and β varied, all
-/// playing), or puppets swaying when there is no SMPL folder.
-pub fn run(characters: usize, frames: usize, data: Option<&Path>) -> Result<BenchReport, String> {
+/// playing), or puppets swaying when there is no SMPL folder; skinned on the CPU, or by the
+/// GPU skinning compute shader with `gpu`.
+pub fn run(characters: usize, frames: usize, data: Option<&Path>, gpu: bool) -> Result<BenchReport, String> {
     let smpl_dir = data.map(|d| d.join("smpl")).filter(|d| crate::formats::smpl::is_smpl_dir(d));
     let (mut doc, kind) = match &smpl_dir {
         Some(dir) => (smpl_crowd(dir, characters)?, "SMPL body"),
@@ -72,6 +75,7 @@ pub fn run(characters: usize, frames: usize, data: Option<&Path>) -> Result<Benc
     };
     // No shadows: the drawing (not what is measured) stays affordable on llvmpipe.
     doc.stage.shadows = false;
+    doc.characters.iter_mut().for_each(|c| c.gpu_skinning = gpu);
     let mut app = crowd_app(smpl_dir.is_none());
     app.finish();
     app.cleanup();
@@ -91,6 +95,7 @@ pub fn run(characters: usize, frames: usize, data: Option<&Path>) -> Result<Benc
     Ok(BenchReport {
         characters,
         kind: kind.to_string(),
+        gpu_skinning: gpu,
         vertices_per_character: asset.vertex_count(),
         frames,
         frame_ms_p50: percentile(frame.clone(), 0.5),
@@ -112,7 +117,7 @@ pub fn run(characters: usize, frames: usize, data: Option<&Path>) -> Result<Benc
 /// The report as a table.
 pub fn table(r: &BenchReport) -> String {
     format!(
-        "{} × {} ({} vertices each), {} frames\n\
+        "{} × {} ({} vertices each), {} frames, skinned {}\n\
          frame (CPU: main world + extraction + upload)  p50 {:.2} ms  p95 {:.2} ms\n\
          \x20 sampling {:.2} ms | FK {:.2} ms | skin {:.2} ms | extract {:.2} ms | upload {:.2} ms   (medians)\n\
          \x20 render world besides the upload (drawing; CPU on llvmpipe) {:.2} ms\n\
@@ -123,6 +128,7 @@ pub fn table(r: &BenchReport) -> String {
         r.kind,
         r.vertices_per_character,
         r.frames,
+        if r.gpu_skinning { "by the GPU compute shader" } else { "on the CPU" },
         r.frame_ms_p50,
         r.frame_ms_p95,
         r.sampling_ms_p50,
@@ -171,7 +177,7 @@ fn crowd_app(sway: bool) -> App {
     let render = app.sub_app_mut(RenderApp);
     render.init_resource::<RenderClock>();
     render.add_systems(Render, render_stamp::<0>.before(RenderSystems::PrepareAssets));
-    render.add_systems(Render, render_stamp::<1>.after(RenderSystems::PrepareAssets));
+    render.add_systems(Render, render_stamp::<1>.after(RenderSystems::PrepareMeshes).before(RenderSystems::Prepare));
     app
 }
 

@@ -22,6 +22,7 @@ use crate::scene::node_clips::NodeClipPlayer;
 use crate::scene::smpl::SmplCharacter;
 use crate::scene::{
     Character, CharacterSkinning, CharacterView, JointLimits, JointPose, MarionetteSystems, Placement, PoseDirty,
+    SkinOnGpu,
 };
 
 /// One user action on the scene.
@@ -61,6 +62,11 @@ pub enum Edit {
         character: CharacterId,
         method: SkinningDoc,
     },
+    /// Skinning by the GPU compute shader (`true`) or on the CPU.
+    SkinOnGpu {
+        character: CharacterId,
+        on: bool,
+    },
     /// A keyframed clip on a character, its time and playback (none: no clip).
     Clip {
         character: CharacterId,
@@ -99,6 +105,7 @@ impl Edit {
             | Edit::Smpl { character, .. }
             | Edit::Rebind { character, .. }
             | Edit::Skinning { character, .. }
+            | Edit::SkinOnGpu { character, .. }
             | Edit::Clip { character, .. }
             | Edit::Morph { character, .. }
             | Edit::Playback { character, .. }
@@ -289,6 +296,10 @@ pub fn inverse_of(world: &mut World, edit: &Edit) -> Result<Option<Edit>, String
             let old = component::<CharacterSkinning>(world, *character)?.0;
             unless(old == *method, Edit::Skinning { character: *character, method: old })
         }
+        Edit::SkinOnGpu { character, on } => {
+            let old = component::<SkinOnGpu>(world, *character)?.0;
+            unless(old == *on, Edit::SkinOnGpu { character: *character, on: old })
+        }
         Edit::Clip { character, anim } => {
             let old = world.get::<ClipPlayer>(entity_of(world, *character)?).map(|p| p.state.clone());
             unless(old == *anim, Edit::Clip { character: *character, anim: old })
@@ -349,6 +360,7 @@ fn write(world: &mut World, edit: Edit) -> Result<(), String> {
         Edit::Playback { character, state } => component_mut::<NodeClipPlayer>(world, character)?.state = state,
         Edit::Rebind { character, binding } => rebind_character(world, character, binding)?,
         Edit::Skinning { character, method } => component_mut::<CharacterSkinning>(world, character)?.0 = method,
+        Edit::SkinOnGpu { character, on } => component_mut::<SkinOnGpu>(world, character)?.0 = on,
         Edit::Clip { character, anim } => set_clip(world, character, anim)?,
         Edit::Morph { character, weights } => {
             component_mut::<crate::scene::morphs::Morphs>(world, character)?.weights = weights;

@@ -21,7 +21,9 @@ use crate::rig::smpl::{Clip, SmplModel};
 use crate::rig::{CharacterAsset, JointRotation};
 use crate::scene::keyframes::ClipPlayer;
 use crate::scene::smpl::SmplCharacter;
-use crate::scene::{Character, CharacterSkinning, CharacterView, JointPose, Placement, spawn_character_posed};
+use crate::scene::{
+    Character, CharacterSkinning, CharacterView, JointPose, Placement, SkinOnGpu, spawn_character_posed,
+};
 
 /// A character as the scene knows it: its stable id, where it comes from, its name and
 /// whether its weights were computed from the bones. The rest of its document lives in
@@ -289,7 +291,7 @@ pub struct SceneReader<'w, 's> {
             &'static Placement,
             &'static CharacterView,
             Option<&'static SmplCharacter>,
-            &'static CharacterSkinning,
+            (&'static CharacterSkinning, &'static SkinOnGpu),
             Option<&'static ClipPlayer>,
             Option<&'static crate::scene::morphs::Morphs>,
             Option<&'static crate::scene::node_clips::NodeClipPlayer>,
@@ -343,7 +345,8 @@ impl SceneReader<'_, '_> {
             view: view.0.clone(),
             smpl: smpl.map(|body| body.state.clone()),
             binding: sc.binding,
-            skinning: skinning.0,
+            skinning: skinning.0.0,
+            gpu_skinning: skinning.1.0,
             anim: player.map(|p| p.state.clone()),
             morphs: morphs.map(|m| m.weights.clone()).unwrap_or_default(),
             playback: node_clips.map(|p| p.state.clone()),
@@ -417,6 +420,7 @@ pub fn spawn_from_doc(
         SceneCharacter { id, source: doc.source.clone(), name: doc.name.clone(), binding: doc.binding },
         CharacterView(doc.view.clone()),
         CharacterSkinning(doc.skinning),
+        SkinOnGpu(doc.gpu_skinning),
         visibility_of(&doc.view),
     ));
     if let Some((dir, set)) = smpl {

@@ -221,6 +221,10 @@ pub struct CharacterDoc {
     /// Linear blend or dual quaternion skinning (files without it: linear).
     #[serde(default, skip_serializing_if = "SkinningDoc::is_linear")]
     pub skinning: SkinningDoc,
+    /// Skinned by the GPU skinning compute shader instead of on the CPU (files without
+    /// it: the CPU).
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub gpu_skinning: bool,
     /// A keyframed clip (CSE169 `.anim`) playing on the character.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub anim: Option<AnimDoc>,
@@ -314,6 +318,7 @@ impl CharacterDoc {
             smpl: None,
             binding: None,
             skinning: SkinningDoc::default(),
+            gpu_skinning: false,
             anim: None,
             morphs: Vec::new(),
             playback: None,

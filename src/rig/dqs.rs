@@ -192,7 +192,8 @@ mod avx2 {
         out: &mut [Vec3],
     ) {
         let batches = group.vertices.len() / 8 * 8;
-        let rows = group.joints[..batches * K].chunks_exact(8 * K).zip(group.weights[..batches * K].chunks_exact(8 * K));
+        let rows =
+            group.joints[..batches * K].chunks_exact(8 * K).zip(group.weights[..batches * K].chunks_exact(8 * K));
         for (vertices, (joints, weights)) in group.vertices[..batches].chunks_exact(8).zip(rows) {
             let vertices: &[u32; 8] = vertices.try_into().unwrap();
             batch_of_eight::<K>(bind, vertices, joints, weights, palette, out);
@@ -290,33 +291,36 @@ mod avx2 {
             real[c] = _mm256_mul_ps(w[0], pivot[c]);
         }
         let sign = _mm256_set1_ps(-0.0);
-        for k in 1..K {
+        for (k, w) in w.iter_mut().enumerate().skip(1) {
             let r = lanes(quaternions(k).map(|q| &q.real));
             // q and -q are one rotation: the weight takes the sign of dot(q.real, pivot).
-            w[k] = _mm256_xor_ps(w[k], _mm256_and_ps(dot8(&r, &pivot), sign));
+            *w = _mm256_xor_ps(*w, _mm256_and_ps(dot8(&r, &pivot), sign));
             for c in 0..4 {
-                real[c] = _mm256_fmadd_ps(w[k], r[c], real[c]);
+                real[c] = _mm256_fmadd_ps(*w, r[c], real[c]);
             }
         }
         let mut dual = [_mm256_setzero_ps(); 4];
-        for k in 0..K {
+        for (k, &w) in w.iter().enumerate() {
             let d = lanes(quaternions(k).map(|q| &q.dual));
             for c in 0..4 {
-                dual[c] = _mm256_fmadd_ps(w[k], d[c], dual[c]);
+                dual[c] = _mm256_fmadd_ps(w, d[c], dual[c]);
             }
         }
         // 1/|real| by the reciprocal square root estimate and one Newton step.
         let n2 = dot8(&real, &real);
         let y = _mm256_rsqrt_ps(n2);
-        let inv =
-            _mm256_mul_ps(_mm256_mul_ps(_mm256_set1_ps(0.5), y), _mm256_fnmadd_ps(_mm256_mul_ps(n2, y), y, _mm256_set1_ps(3.0)));
+        let inv = _mm256_mul_ps(
+            _mm256_mul_ps(_mm256_set1_ps(0.5), y),
+            _mm256_fnmadd_ps(_mm256_mul_ps(n2, y), y, _mm256_set1_ps(3.0)),
+        );
         for c in 0..4 {
             real[c] = _mm256_mul_ps(real[c], inv);
             dual[c] = _mm256_mul_ps(dual[c], inv);
         }
         let points: [Vec4; 8] = std::array::from_fn(|i| bind[vertices[i] as usize].extend(0.0));
         let [px, py, pz, _] = lanes(std::array::from_fn(|i| &points[i]));
-        let (r, wr, d, wd, p) = ([real[0], real[1], real[2]], real[3], [dual[0], dual[1], dual[2]], dual[3], [px, py, pz]);
+        let (r, wr, d, wd, p) =
+            ([real[0], real[1], real[2]], real[3], [dual[0], dual[1], dual[2]], dual[3], [px, py, pz]);
         // t = r × p + w p; p' = p + 2 (r × t + w_r d - w_d r + r × d).
         let rxp = cross8(r, p);
         let mut t = [_mm256_setzero_ps(); 3];

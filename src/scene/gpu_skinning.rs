@@ -58,7 +58,13 @@ pub struct GpuSkinInput {
 impl GpuSkinJob {
     /// Hands over the character's palette (from `scratch`, as `method` takes it), and a
     /// new template when the colours changed or there was none.
-    pub fn hand_over(&mut self, character: &Character, method: SkinningMethod, scratch: &mut SkinScratch, recolored: bool) {
+    pub fn hand_over(
+        &mut self,
+        character: &Character,
+        method: SkinningMethod,
+        scratch: &mut SkinScratch,
+        recolored: bool,
+    ) {
         let skin = &character.asset.skin;
         let kept = self.0.as_ref().filter(|job| !recolored && Arc::ptr_eq(&job.asset, &character.asset));
         let (template, floats) = match kept {
@@ -75,7 +81,8 @@ impl GpuSkinJob {
             dqs::dual_quaternion_palette(&scratch.palette, &mut scratch.dual_quaternions);
             scratch.dual_quaternions.iter().map(|q| Mat4::from_cols(q.real, q.dual, Vec4::ZERO, Vec4::ZERO)).collect()
         };
-        self.0 = Some(GpuSkinInput { asset: character.asset.clone(), palette: Arc::new(palette), method, template, floats });
+        self.0 =
+            Some(GpuSkinInput { asset: character.asset.clone(), palette: Arc::new(palette), method, template, floats });
     }
 }
 
@@ -165,7 +172,8 @@ fn dispatch_gpu_skinning(
     }
     let gpu = &mut *gpu;
     let pipeline = gpu.pipeline.get_or_insert_with(|| SkinningPipeline::new(&device));
-    let mut encoder = device.create_command_encoder(&CommandEncoderDescriptor { label: Some("marionette gpu skinning") });
+    let mut encoder =
+        device.create_command_encoder(&CommandEncoderDescriptor { label: Some("marionette gpu skinning") });
     gpu.pending.retain(|entity, (mesh, input, waited)| {
         let Some(slice) = allocator.mesh_vertex_slice(mesh) else {
             *waited += 1;
@@ -173,7 +181,9 @@ fn dispatch_gpu_skinning(
         };
         let vertex_count = input.asset.vertex_count();
         let bytes = (input.template.len() * 4) as u64;
-        if (slice.range.end - slice.range.start) as usize != vertex_count || input.template.len() != vertex_count * input.floats {
+        if (slice.range.end - slice.range.start) as usize != vertex_count
+            || input.template.len() != vertex_count * input.floats
+        {
             return false;
         }
         let skin = match gpu.skins.get_mut(entity) {
@@ -185,10 +195,15 @@ fn dispatch_gpu_skinning(
             skin.template = input.template.clone();
         }
         let method = u32::from(!input.method.is_linear());
-        queue.write_buffer(&skin.params, 0, bytemuck::cast_slice(&[vertex_count as u32, input.floats as u32, method, 0]));
+        queue.write_buffer(
+            &skin.params,
+            0,
+            bytemuck::cast_slice(&[vertex_count as u32, input.floats as u32, method, 0]),
+        );
         queue.write_buffer(&skin.palette, 0, bytemuck::cast_slice(input.palette.as_slice()));
         {
-            let mut pass = encoder.begin_compute_pass(&ComputePassDescriptor { label: Some("skin"), timestamp_writes: None });
+            let mut pass =
+                encoder.begin_compute_pass(&ComputePassDescriptor { label: Some("skin"), timestamp_writes: None });
             pass.set_pipeline(&pipeline.pipeline);
             pass.set_bind_group(0, &*skin.bind_group, &[]);
             let (x, y) = workgroups(vertex_count);
@@ -226,10 +241,15 @@ impl SkinningPipeline {
         let params = BindGroupLayoutEntry {
             binding: 0,
             visibility: ShaderStages::COMPUTE,
-            ty: BindingType::Buffer { ty: BufferBindingType::Uniform, has_dynamic_offset: false, min_binding_size: None },
+            ty: BindingType::Buffer {
+                ty: BufferBindingType::Uniform,
+                has_dynamic_offset: false,
+                min_binding_size: None,
+            },
             count: None,
         };
-        let entries = [params, storage(1, true), storage(2, true), storage(3, true), storage(4, true), storage(5, false)];
+        let entries =
+            [params, storage(1, true), storage(2, true), storage(3, true), storage(4, true), storage(5, false)];
         let layout = device.create_bind_group_layout("marionette gpu skinning", &entries);
         let module = device.create_and_validate_shader_module(ShaderModuleDescriptor {
             label: Some("gpu_skinning.wgsl"),

@@ -4,10 +4,10 @@ use bevy::camera::primitives::Aabb;
 use bevy::prelude::*;
 
 use super::components::*;
+use super::gpu_skinning::GpuSkinJob;
 use super::upload::SkinUpload;
 use crate::rig::JointRotation;
 use crate::rig::fk::forward_kinematics_with_rest;
-use super::gpu_skinning::GpuSkinJob;
 use crate::rig::skinning::{bounds, heat_colors, influence_boxes, influence_hull_bounds, joint_colors, weight_colors};
 use crate::rig::{dqs, lbs};
 
@@ -141,9 +141,9 @@ pub fn skin_changed_characters(
             let moved = dirty.matrices || dirty.bind || never_skinned;
             if moved {
                 scratch.palette.clear();
-                scratch.palette.extend(
-                    character.joints.iter().map(|&e| joints.get(e).map_or(Mat4::IDENTITY, |(c, b)| c.0 * b.0)),
-                );
+                scratch
+                    .palette
+                    .extend(character.joints.iter().map(|&e| joints.get(e).map_or(Mat4::IDENTITY, |(c, b)| c.0 * b.0)));
             }
             let recolored = dirty.colors || scratch.colors.len() != skin.bind_positions.len();
             if recolored {
@@ -154,7 +154,8 @@ pub fn skin_changed_characters(
                 // stand the characters on the floor when it opens.
                 if never_skinned || dirty.bind {
                     skin_on_cpu(skin, method.0, scratch);
-                    scratch.influence_boxes = influence_boxes(&skin.bind_positions, &skin.weights, character.joints.len());
+                    scratch.influence_boxes =
+                        influence_boxes(&skin.bind_positions, &skin.weights, character.joints.len());
                 } else if moved {
                     scratch.bounds = influence_hull_bounds(&scratch.influence_boxes, &scratch.palette);
                 }

@@ -72,13 +72,21 @@ pub fn pack_vertices(positions: &[Vec3], texcoords: &[Vec2], colors: &[[f32; 4]]
     9
 }
 
-/// Bytes of vertex data handed to the GPU in the last frame (the packed uploads that
-/// changed), for benchmarks and readouts.
+/// Bytes handed to the GPU in the last frame (the packed uploads that changed, and the
+/// palettes of characters skinned on the GPU), for benchmarks and readouts.
 #[derive(Resource, Default, Debug)]
 pub struct HandedOn(pub usize);
 
-fn count_handed_on(changed: Query<&SkinUpload, Changed<SkinUpload>>, mut handed: ResMut<HandedOn>) {
-    handed.0 = changed.iter().map(|u| u.bytes().len()).sum();
+/// Counts the packed vertices that changed and, for characters skinned on the GPU, their
+/// palettes (reads `SkinUpload`, `GpuSkinJob`; writes `HandedOn`).
+fn count_handed_on(
+    changed: Query<&SkinUpload, Changed<SkinUpload>>,
+    gpu_jobs: Query<&super::gpu_skinning::GpuSkinJob, Changed<super::gpu_skinning::GpuSkinJob>>,
+    mut handed: ResMut<HandedOn>,
+) {
+    let palettes: usize =
+        gpu_jobs.iter().filter_map(|j| j.0.as_ref()).map(|j| std::mem::size_of_val(j.palette.as_slice())).sum();
+    handed.0 = changed.iter().map(|u| u.bytes().len()).sum::<usize>() + palettes;
 }
 
 /// Uploads waiting in the render world: by mesh, the newest bytes (kept until the mesh has

@@ -90,6 +90,7 @@ fn commands_then_undo_all_return_the_ecs_to_its_start_and_redo_to_its_end() {
         Edit::Stage(StageDoc { axes: true, floor: false, ..StageDoc::default() }),
         Edit::Rebind { character: CharacterId(1), binding: Some(BindingDoc::Nearest) },
         Edit::Skinning { character: CharacterId(2), method: marionette::formats::scene::SkinningDoc::DualQuaternion },
+        Edit::SkinOnGpu { character: CharacterId(1), on: true },
         Edit::Add(Box::new(added)),
         Edit::Pose { character: CharacterId(10), joints: vec![(elbow, JointRotation::euler_xyz(0.3, 0.0, 0.0))] },
         Edit::Remove(CharacterId(2)),

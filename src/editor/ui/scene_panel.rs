@@ -221,7 +221,7 @@ fn selected_character(ui: &mut egui::Ui, panels: &mut Panels, entity: Entity, id
     else {
         return;
     };
-    let skinning = skinning.0;
+    let (skinning, on_gpu) = (skinning.0.0, skinning.1.0);
     let (mut name, source, binding) = (sc.name.clone(), sc.source.label(), sc.binding);
     let (mut p, mut v) = (placement.0, view.0.clone());
     let height = panels.height(entity).unwrap_or(0.0);
@@ -286,6 +286,18 @@ fn selected_character(ui: &mut egui::Ui, panels: &mut Panels, entity: Entity, id
             }
         }
     });
+    ui.horizontal(|ui| {
+        ui.label("Skinned by:");
+        for (label, on) in [("the CPU", false), ("a GPU compute shader", true)] {
+            if ui.selectable_label(on_gpu == on, label).clicked() && on_gpu != on {
+                edits.push(Edit::SkinOnGpu { character: id, on });
+            }
+        }
+    })
+    .response
+    .on_hover_text(
+        "The CPU path is the course assignments'; the GPU path is the 6.837 \"accelerate SSD using shaders\".",
+    );
     if let Some(body) = smpl
         && let Some(state) = super::smpl_panel::smpl_panel(ui, body)
     {
