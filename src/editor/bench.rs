@@ -12,8 +12,6 @@ use bevy::prelude::*;
 use bevy::render::pipelined_rendering::PipelinedRenderingPlugin;
 use bevy::render::render_resource::{TextureFormat, TextureUsages};
 use bevy::render::{Render, RenderApp, RenderSystems};
-use bevy::window::ExitCondition;
-use bevy::winit::WinitPlugin;
 
 use crate::editor::camera::OrbitCamera;
 use crate::editor::crowd::{puppet_crowd, smpl_crowd};
@@ -152,25 +150,14 @@ pub fn table(r: &BenchReport) -> String {
 /// boundaries.
 fn crowd_app(sway: bool) -> App {
     let mut app = App::new();
-    app.add_plugins(
-        DefaultPlugins
-            .set(crate::editor::task_pools())
-            .set(WindowPlugin {
-                primary_window: None,
-                exit_condition: ExitCondition::DontExit,
-                close_when_requested: false,
-                ..default()
-            })
-            .disable::<WinitPlugin>()
-            .disable::<PipelinedRenderingPlugin>(),
-    )
-    .add_plugins((RigCorePlugin, SkinningPlugin, crate::editor::ViewPlugin))
-    .init_resource::<MainClock>()
-    .add_systems(Startup, spawn_offscreen_camera)
-    .add_systems(PostUpdate, stamp::<0>.before(MarionetteSystems::Animate))
-    .add_systems(PostUpdate, stamp::<1>.after(MarionetteSystems::Animate).before(MarionetteSystems::Solve))
-    .add_systems(PostUpdate, stamp::<2>.after(MarionetteSystems::MatrixStack).before(MarionetteSystems::Skin))
-    .add_systems(PostUpdate, stamp::<3>.after(MarionetteSystems::Skin));
+    app.add_plugins(crate::editor::windowless_plugins().disable::<PipelinedRenderingPlugin>())
+        .add_plugins((RigCorePlugin, SkinningPlugin, crate::editor::ViewPlugin))
+        .init_resource::<MainClock>()
+        .add_systems(Startup, spawn_offscreen_camera)
+        .add_systems(PostUpdate, stamp::<0>.before(MarionetteSystems::Animate))
+        .add_systems(PostUpdate, stamp::<1>.after(MarionetteSystems::Animate).before(MarionetteSystems::Solve))
+        .add_systems(PostUpdate, stamp::<2>.after(MarionetteSystems::MatrixStack).before(MarionetteSystems::Skin))
+        .add_systems(PostUpdate, stamp::<3>.after(MarionetteSystems::Skin));
     if sway {
         app.add_systems(PostUpdate, sway_puppets.in_set(MarionetteSystems::Animate));
     }

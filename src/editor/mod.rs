@@ -92,6 +92,20 @@ pub fn task_pools() -> bevy::app::TaskPoolPlugin {
     }
 }
 
+/// Bevy's default plugins without a window (the headless renderer, the bench, tests):
+/// rendering into images, with [`task_pools`].
+pub fn windowless_plugins() -> bevy::app::PluginGroupBuilder {
+    DefaultPlugins
+        .set(task_pools())
+        .set(WindowPlugin {
+            primary_window: None,
+            exit_condition: bevy::window::ExitCondition::DontExit,
+            close_when_requested: false,
+            ..default()
+        })
+        .disable::<bevy::winit::WinitPlugin>()
+}
+
 /// Opens the editor window on `paths` (or on the default scene) and runs until closed.
 pub fn run(paths: Vec<PathBuf>, edits: StartupEdits) {
     App::new()

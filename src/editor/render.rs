@@ -10,8 +10,6 @@ use bevy::camera::RenderTarget;
 use bevy::prelude::*;
 use bevy::render::render_resource::{TextureFormat, TextureUsages};
 use bevy::render::view::screenshot::{Screenshot, ScreenshotCaptured};
-use bevy::window::ExitCondition;
-use bevy::winit::WinitPlugin;
 
 use super::camera::OrbitCamera;
 use super::document::{AssetLibrary, read_scene, scene_path};
@@ -51,24 +49,14 @@ pub fn render(
 ) -> Result<Vec<String>, String> {
     let library = preload(&paths)?;
     let mut app = App::new();
-    app.add_plugins(
-        DefaultPlugins
-            .set(super::task_pools())
-            .set(WindowPlugin {
-                primary_window: None,
-                exit_condition: ExitCondition::DontExit,
-                close_when_requested: false,
-                ..default()
-            })
-            .disable::<WinitPlugin>(),
-    )
-    .add_plugins(ScheduleRunnerPlugin::run_loop(Duration::from_millis(2)))
-    .insert_resource(ClearColor(stage::SKY))
-    .insert_resource(super::camera::FramingAspect(width as f32 / height as f32))
-    .insert_resource(StartupPaths(paths))
-    .insert_resource(library)
-    .insert_resource(edits)
-    .add_plugins((RigCorePlugin, SkinningPlugin, ViewPlugin));
+    app.add_plugins(super::windowless_plugins())
+        .add_plugins(ScheduleRunnerPlugin::run_loop(Duration::from_millis(2)))
+        .insert_resource(ClearColor(stage::SKY))
+        .insert_resource(super::camera::FramingAspect(width as f32 / height as f32))
+        .insert_resource(StartupPaths(paths))
+        .insert_resource(library)
+        .insert_resource(edits)
+        .add_plugins((RigCorePlugin, SkinningPlugin, ViewPlugin));
     let target = {
         let mut images = app.world_mut().resource_mut::<Assets<Image>>();
         let mut image = Image::new_target_texture(width, height, TextureFormat::Rgba8UnormSrgb, None);

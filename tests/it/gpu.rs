@@ -7,8 +7,6 @@ use std::sync::Arc;
 use bevy::prelude::*;
 use bevy::render::RenderApp;
 use bevy::render::pipelined_rendering::PipelinedRenderingPlugin;
-use bevy::window::ExitCondition;
-use bevy::winit::WinitPlugin;
 use marionette::cli::posing::posed_positions_by;
 use marionette::rig::dqs::SkinningMethod;
 use marionette::rig::{CharacterAsset, JointRotation};
@@ -19,18 +17,8 @@ use marionette::scene::*;
 /// submitted within its `update`).
 fn render_app() -> App {
     let mut app = App::new();
-    app.add_plugins(
-        DefaultPlugins
-            .set(WindowPlugin {
-                primary_window: None,
-                exit_condition: ExitCondition::DontExit,
-                close_when_requested: false,
-                ..default()
-            })
-            .disable::<WinitPlugin>()
-            .disable::<PipelinedRenderingPlugin>(),
-    )
-    .add_plugins((RigCorePlugin, SkinningPlugin));
+    app.add_plugins(marionette::editor::windowless_plugins().disable::<PipelinedRenderingPlugin>())
+        .add_plugins((RigCorePlugin, SkinningPlugin));
     app.finish();
     app.cleanup();
     app
