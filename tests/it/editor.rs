@@ -193,7 +193,14 @@ fn bench_reports_a_crowds_frame_times_as_json() {
     let report: serde_json::Value = serde_json::from_str(stdout.trim()).expect("one JSON object");
     assert_eq!(report["characters"], 3);
     assert_eq!(report["kind"], "puppet");
-    for key in ["frame_ms_p50", "frame_ms_p95", "kernel_mvps", "baseline_kernel_mvps"] {
+    for key in [
+        "frame_ms_p50",
+        "frame_ms_p95",
+        "kernel_mvps",
+        "baseline_kernel_mvps",
+        "dual_quaternion_kernel_mvps",
+        "kernel_with_flat_normals_mvps",
+    ] {
         let value = report[key].as_f64().unwrap_or_else(|| panic!("{key} is a number: {report}"));
         assert!(value > 0.0, "{key} = {value}");
     }
@@ -202,6 +209,23 @@ fn bench_reports_a_crowds_frame_times_as_json() {
     let puppet = marionette::formats::puppet::embedded_puppet();
     let per_frame = 3 * puppet.vertex_count() * marionette::scene::upload::SKIN_VERTEX_BYTES;
     assert_eq!(report["upload_bytes_per_frame"], per_frame);
+    assert_eq!(report["gpu_skinning"], false);
+}
+
+/// `marionette bench --gpu` skins the crowd by the compute shader: only the palettes go to
+/// the GPU each frame (one matrix per joint per puppet).
+#[test]
+fn bench_with_gpu_skinning_hands_on_only_palettes() {
+    let output = Command::new(env!("CARGO_BIN_EXE_marionette"))
+        .args(["bench", "--characters", "3", "--frames", "5", "--json", "--gpu"])
+        .env_remove("MARIONETTE_DATA")
+        .output()
+        .unwrap();
+    assert!(output.status.success(), "{}", String::from_utf8_lossy(&output.stderr));
+    let report: serde_json::Value = serde_json::from_str(String::from_utf8_lossy(&output.stdout).trim()).unwrap();
+    assert_eq!(report["gpu_skinning"], true);
+    let puppet = marionette::formats::puppet::embedded_puppet();
+    assert_eq!(report["upload_bytes_per_frame"], 3 * puppet.skeleton.len() * 64);
 }
 
 /// Crowds: every member in its own place on the grid; SMPL members each with their own
