@@ -194,8 +194,25 @@ pub struct SkinScratch {
     pub dual_quaternions: Vec<crate::rig::dqs::DualQuat>,
     /// What the mesh's colours were last written from.
     pub colored_with: Option<Coloring>,
-    /// Each joint's box of the bind vertices it moves (GPU-skinned characters' bounds).
-    pub influence_boxes: Vec<(Vec3, Vec3)>,
+    /// Each joint's box of the bind vertices it moves, and the asset they were taken from
+    /// (GPU-skinned characters' bounds; see [`SkinScratch::influence_hull_bounds`]).
+    influence_boxes: Option<(Arc<CharacterAsset>, Vec<(Vec3, Vec3)>)>,
+}
+
+impl SkinScratch {
+    /// A box that holds the skin posed by `palette` (linear blend) without skinning it:
+    /// the hull of the joints' influence boxes of `asset`, taken again when the asset
+    /// changed (a reshape, a rebind, a morph).
+    pub fn influence_hull_bounds(&mut self, asset: &Arc<CharacterAsset>) -> (Vec3, Vec3) {
+        if !self.influence_boxes.as_ref().is_some_and(|(of, _)| Arc::ptr_eq(of, asset)) {
+            let skin = &asset.skin;
+            let boxes =
+                crate::rig::skinning::influence_boxes(&skin.bind_positions, &skin.weights, asset.skeleton.len());
+            self.influence_boxes = Some((asset.clone(), boxes));
+        }
+        let boxes = self.influence_boxes.as_ref().map_or(&[][..], |(_, b)| b);
+        crate::rig::skinning::influence_hull_bounds(boxes, &self.palette)
+    }
 }
 
 /// What a skin's colours depend on: a view change that leaves this alone (display mode,

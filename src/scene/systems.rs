@@ -8,7 +8,7 @@ use super::gpu_skinning::GpuSkinJob;
 use super::upload::SkinUpload;
 use crate::rig::JointRotation;
 use crate::rig::fk::forward_kinematics_with_rest;
-use crate::rig::skinning::{bounds, heat_colors, influence_boxes, influence_hull_bounds, joint_colors, weight_colors};
+use crate::rig::skinning::{bounds, heat_colors, joint_colors, weight_colors};
 use crate::rig::{dqs, lbs};
 
 /// Clamps changed joint poses to their limits (reads `JointLimits`, writes `JointPose`).
@@ -152,12 +152,10 @@ pub fn skin_changed_characters(
             if on_gpu.0 {
                 // The first skin is done here as well: its positions frame the scene and
                 // stand the characters on the floor when it opens.
-                if never_skinned || dirty.bind {
+                if never_skinned {
                     skin_on_cpu(skin, method.0, scratch);
-                    scratch.influence_boxes =
-                        influence_boxes(&skin.bind_positions, &skin.weights, character.joints.len());
                 } else if moved {
-                    scratch.bounds = influence_hull_bounds(&scratch.influence_boxes, &scratch.palette);
+                    scratch.bounds = scratch.influence_hull_bounds(&character.asset);
                 }
                 job.hand_over(character, method.0, scratch, recolored);
                 return;

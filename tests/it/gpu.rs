@@ -115,3 +115,37 @@ fn largest_error(app: &App, entity: Entity, asset: &CharacterAsset, expected: &[
     }
     Some(worst)
 }
+
+/// A GPU-skinned character's bounds, the hull of its joints' influence boxes moved by the
+/// palette, hold every vertex linear blend skinning puts anywhere: the puppet and, with
+/// the data, Model1, in twenty poses each.
+#[test]
+fn influence_hull_bounds_hold_every_skinned_vertex() {
+    use marionette::rig::skinning::{bounds, influence_boxes, influence_hull_bounds, skin_positions};
+    let mut assets = vec![marionette::formats::puppet::embedded_puppet()];
+    if let Some(data) = crate::common::optional_data_dir() {
+        assets.push(marionette::formats::load_character(&data.join("mit6837/Model1.skel")).unwrap());
+    }
+    for asset in &assets {
+        let skin = &asset.skin;
+        let boxes = influence_boxes(&skin.bind_positions, &skin.weights, asset.skeleton.len());
+        for s in 0..20 {
+            let a = 0.3 * s as f32;
+            let pose: Vec<JointRotation> = (0..asset.skeleton.len())
+                .map(|j| {
+                    JointRotation::euler_xyz((a + j as f32).sin(), (0.7 * a).cos() * 0.8, 0.5 * (a * j as f32).sin())
+                })
+                .collect();
+            let palette =
+                marionette::rig::fk::posed_palette(&asset.skeleton, &asset.bind_world_to_joint, &pose, Mat4::IDENTITY);
+            let mut skinned = vec![Vec3::ZERO; asset.vertex_count()];
+            skin_positions(&skin.bind_positions, &skin.weights, &palette, &mut skinned);
+            let (lo, hi) = influence_hull_bounds(&boxes, &palette);
+            let (tight_lo, tight_hi) = bounds(&skinned);
+            let slack = 1e-5 * (tight_hi - tight_lo).length();
+            assert!(lo.cmple(tight_lo + slack).all() && hi.cmpge(tight_hi - slack).all(), "{} pose {s}", asset.name);
+            // And not far from it: within the size of the model again on each side.
+            assert!((hi - lo).length() <= 3.0 * (tight_hi - tight_lo).length(), "{} pose {s}", asset.name);
+        }
+    }
+}
