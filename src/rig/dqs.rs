@@ -157,7 +157,6 @@ mod avx2 {
     use super::DualQuat;
     use crate::rig::lbs::FixedGroup;
 
-    /// `a × b` of the xyz lanes (w: 0).
     /// `a · b` in every lane, by shuffles and adds (`dpps` is microcoded and slow on
     /// some CPUs, AMD's Zen among them).
     #[inline]
@@ -168,6 +167,7 @@ mod avx2 {
         _mm_add_ps(pairs, _mm_shuffle_ps::<0b01_00_11_10>(pairs, pairs))
     }
 
+    /// `a × b` of the xyz lanes (w: 0).
     #[inline]
     #[target_feature(enable = "avx2,fma")]
     fn cross(a: __m128, b: __m128) -> __m128 {

@@ -2,7 +2,8 @@
 //! weights are built (1, 2, 3 or 4 influences in fixed-size rows; more in a general
 //! group); each vertex blends its palette matrices once (`M = Σ wᵢ Pᵢ`) and transforms its
 //! bind position by `M`. On x86-64 with AVX2 and FMA (detected at run time) the blend is
-//! fused multiply-adds on the matrices' 128-bit columns; elsewhere glam's `Vec4` does it.
+//! fused multiply-adds on 256-bit registers (two columns of a matrix in each); elsewhere
+//! glam's `Vec4` does it.
 //! [`skin_positions`](super::skinning::skin_positions) stays as the plain oracle.
 
 use glam::{Mat4, Vec3, Vec4};
