@@ -277,10 +277,13 @@ impl SkinBuffers {
     /// the packed vertices.
     fn new(device: &RenderDevice, pipeline: &SkinningPipeline, input: &GpuSkinInput) -> Self {
         let skin = &input.asset.skin;
+        // A skin without vertices still gets buffers a binding accepts (not empty ones).
         let with_data = |label: &str, contents: &[u8]| {
+            let mut padded = contents.to_vec();
+            padded.resize(contents.len().max(16), 0);
             device.create_buffer_with_data(&bevy::render::render_resource::BufferInitDescriptor {
                 label: Some(label),
-                contents,
+                contents: &padded,
                 usage: BufferUsages::STORAGE,
             })
         };
