@@ -174,9 +174,13 @@ pub fn skin_positions(bind_positions: &[Vec3], weights: &SkinWeights, palette: &
 
 /// The axis-aligned box `(min, max)` around `points` (both zero for none).
 pub fn bounds(points: &[Vec3]) -> (Vec3, Vec3) {
-    let (lo, hi) = points
-        .iter()
-        .fold((Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)), |(lo, hi), p| (lo.min(*p), hi.max(*p)));
+    bounds_of(points.iter().copied())
+}
+
+/// [`bounds`] of points as they come (none stored).
+fn bounds_of(points: impl Iterator<Item = Vec3>) -> (Vec3, Vec3) {
+    let (lo, hi) =
+        points.fold((Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)), |(lo, hi), p| (lo.min(p), hi.max(p)));
     if lo.x > hi.x { (Vec3::ZERO, Vec3::ZERO) } else { (lo, hi) }
 }
 
@@ -204,8 +208,7 @@ pub fn influence_hull_bounds(boxes: &[(Vec3, Vec3)], palette: &[Mat4]) -> (Vec3,
             m.transform_point3(Vec3::new(pick(1, lo.x, hi.x), pick(2, lo.y, hi.y), pick(4, lo.z, hi.z)))
         })
     });
-    let corners: Vec<Vec3> = corners.collect();
-    bounds(&corners)
+    bounds_of(corners)
 }
 
 /// Unshares the vertices of every triangle and gives each the triangle's unit normal:
