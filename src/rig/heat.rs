@@ -38,15 +38,15 @@ pub enum HeatError {
 /// The bones heat binds to: each joint's segments to its children (zero-length ones
 /// skipped), and for each leaf joint a segment into the part of the mesh beyond it.
 pub fn heat_bones(skeleton: &Skeleton, joints: &[Vec3], vertices: &[Vec3]) -> Vec<Bone> {
-    let mut bones = super::bind::bones(skeleton, joints);
+    let mut bones = distinct(super::bind::bones(skeleton, joints));
     let size = mesh_size(vertices);
     // A sample of the vertices (at most a few thousand) and how near each is to the bones
     // known so far.
     let step = vertices.len().div_ceil(LEAF_SAMPLES).max(1);
     let sample: Vec<Vec3> = vertices.iter().step_by(step).copied().collect();
-    let known: Vec<f32> = sample
+    let everywhere: Vec<(Vec3, f32)> = sample
         .iter()
-        .map(|&v| bones.iter().map(|b| segment_distance(v, b.start, b.end)).fold(f32::INFINITY, f32::min))
+        .map(|&v| (v, bones.iter().map(|b| segment_distance(v, b.start, b.end)).fold(f32::INFINITY, f32::min)))
         .collect();
     let leaves: Vec<usize> =
         (0..skeleton.len()).filter(|&j| skeleton.children(j).is_empty() && skeleton.len() > 1).collect();
@@ -66,38 +66,56 @@ pub fn heat_bones(skeleton: &Skeleton, joints: &[Vec3], vertices: &[Vec3]) -> Ve
         };
         // Only the vertices nearer to this joint than to any other count (a foot's bone is
         // not drawn to the other foot).
-        let mine: Vec<(Vec3, f32)> = sample
+        let mine: Vec<(Vec3, f32)> = everywhere
             .iter()
-            .zip(&known)
-            .filter(|&(&v, _)| joints.iter().all(|&o| o.distance(s) <= 1e-6 * size || v.distance(s) <= v.distance(o)))
-            .map(|(&v, &k)| (v, k))
+            .copied()
+            .filter(|&(v, _)| joints.iter().all(|&o| o.distance(s) <= 1e-6 * size || v.distance(s) <= v.distance(o)))
             .collect();
-        if let Some(end) = leaf_tip(s, limit, &mine).filter(|e| e.distance(s) > 1e-6 * size) {
+        if let Some(end) = leaf_tip(s, limit, &mine, &everywhere).filter(|e| e.distance(s) > 1e-6 * size) {
             bones.push(Bone { joint: j, start: joints[j], end });
         }
     }
     bones
 }
 
+/// The bones without repeats. A joint whose children sit at one point (a 6.837 back, whose
+/// two thighs start at the hips) has one bone there, not one per child: a repeated bone
+/// would count twice in a vertex's heat and pull it from the neighbouring bones.
+fn distinct(bones: Vec<Bone>) -> Vec<Bone> {
+    let mut kept: Vec<Bone> = Vec::with_capacity(bones.len());
+    for bone in bones {
+        if !kept.contains(&bone) {
+            kept.push(bone);
+        }
+    }
+    kept
+}
+
 /// Vertices sampled to place leaf bones.
 const LEAF_SAMPLES: usize = 4096;
 /// Directions tried for a leaf bone (a Fibonacci sphere).
 const LEAF_DIRECTIONS: usize = 512;
+/// A leaf bone points at the vertices it explains that lie at least this fraction of the
+/// farthest one's distance from its joint.
+const EXTREMITY: f32 = 0.9;
 
-/// A leaf's bone end. Its direction is the one in which a segment of length `limit` from
-/// `start` brings the mesh nearest to the skeleton (the least sum over `vertices`, each
-/// with its distance to the known bones, of the nearer of that and the segment): the segment that
-/// runs into the part of the mesh no other bone explains (a head, a hand, a foot), then
-/// turned to the mean direction of the vertices it explains better. The bone
-/// reaches [`LEAF_REACH`] of the way to the farthest vertex that its ray explains better
-/// than the known bones. None when it explains none.
-fn leaf_tip(start: Vec3, limit: f32, vertices: &[(Vec3, f32)]) -> Option<Vec3> {
+/// A leaf's bone end. Its direction is first the one in which a segment of length `limit`
+/// from `start` brings the leaf's `region` nearest to the skeleton (the least sum over the
+/// region's vertices, each with its distance to the known bones, of the nearer of that and
+/// the segment): the segment that runs into the part of the mesh no other bone explains (a
+/// head, a hand, a foot). It is then turned to the extremity of that part: the mean
+/// direction of the vertices anywhere that the segment explains better than the known
+/// bones and that lie at least [`EXTREMITY`] of the farthest one's distance (the top of a
+/// head, the toes, the fingertips). The bone reaches [`LEAF_REACH`] of the way to the
+/// farthest region vertex that its ray explains better than the known bones. None when it
+/// explains none.
+fn leaf_tip(start: Vec3, limit: f32, region: &[(Vec3, f32)], everywhere: &[(Vec3, f32)]) -> Option<Vec3> {
     let along = |v: Vec3, u: Vec3, reach: f32| {
         let d = v - start;
         let t = d.dot(u).clamp(0.0, reach);
         (d - t * u).length()
     };
-    let score = |u: Vec3| -> f32 { vertices.iter().map(|&(v, k)| k.min(along(v, u, limit))).sum() };
+    let score = |u: Vec3| -> f32 { region.iter().map(|&(v, k)| k.min(along(v, u, limit))).sum() };
     let golden = std::f32::consts::PI * (3.0 - 5.0f32.sqrt());
     let direction = (0..LEAF_DIRECTIONS)
         .map(|i| {
@@ -107,10 +125,16 @@ fn leaf_tip(start: Vec3, limit: f32, vertices: &[(Vec3, f32)]) -> Option<Vec3> {
             Vec3::new(r * a.cos(), y, r * a.sin())
         })
         .min_by(|a, b| score(*a).total_cmp(&score(*b)))?;
-    // Refined off the sphere's grid: the mean direction of the vertices it explains.
-    let explained = |u: Vec3| vertices.iter().filter(move |&&(v, k)| along(v, u, limit) < k).map(|&(v, _)| v - start);
-    let direction = explained(direction).sum::<Vec3>().try_normalize().unwrap_or(direction);
-    let reach = vertices
+    let explained: Vec<Vec3> =
+        everywhere.iter().filter(|&&(v, k)| along(v, direction, limit) < k).map(|&(v, _)| v - start).collect();
+    let farthest = explained.iter().map(|d| d.length()).fold(0.0f32, f32::max);
+    let direction = explained
+        .iter()
+        .filter(|d| d.length() >= EXTREMITY * farthest)
+        .sum::<Vec3>()
+        .try_normalize()
+        .unwrap_or(direction);
+    let reach = region
         .iter()
         .filter(|&&(v, k)| along(v, direction, f32::INFINITY) < k)
         .map(|&(v, _)| (v - start).dot(direction))

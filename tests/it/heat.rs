@@ -122,14 +122,14 @@ fn heat_binds_the_course_characters_with_whole_rows() {
 }
 
 /// The 6.837 models' weights are Pinocchio's bone heat: ours agree with them (the
-/// heaviest joint, and the mean L1 distance of the rows). The floors are what this
-/// binder reaches (99.1, 98.9, 94.2, 98.2 %), a little lower; Blender 5's automatic weights
-/// reach 95.8, 96.8, 93.7, 97.3 %.
+/// heaviest joint, and the mean L1 distance of the rows) at least as well as the issue's
+/// target, 98 % and 0.05 (this binder: 99.6, 99.7, 98.5, 98.8 % and 0.008, 0.009, 0.021,
+/// 0.033). Blender 5's automatic weights reach 95.8, 96.8, 93.7, 97.3 %.
 #[test]
 #[cfg_attr(not(marionette_data), ignore = "needs MARIONETTE_DATA (the course data)")]
 fn heat_agrees_with_the_6837_models_own_weights() {
     let dir = crate::common::data_dir().join("mit6837");
-    for (m, floor, ceiling) in [(1, 0.985, 0.025), (2, 0.985, 0.03), (3, 0.935, 0.095), (4, 0.98, 0.05)] {
+    for (m, floor, ceiling) in [(1, 0.99, 0.015), (2, 0.99, 0.015), (3, 0.98, 0.03), (4, 0.98, 0.04)] {
         let model = marionette::formats::load_character(&dir.join(format!("Model{m}.skel"))).unwrap();
         let skin = &model.skin;
         let started = std::time::Instant::now();
@@ -142,4 +142,24 @@ fn heat_agrees_with_the_6837_models_own_weights() {
         );
         assert!(agree >= floor && l1 <= ceiling, "Model{m}: {agree} {l1}");
     }
+}
+
+/// A joint whose children start at one point (the 6.837 back, whose two thighs both start
+/// at the hips) has one bone there: a repeated bone would count twice in a vertex's heat.
+#[test]
+fn heat_counts_a_bone_that_two_children_share_once() {
+    let skeleton = Skeleton::build(vec![
+        RawJoint::new("back", None, Vec3::ZERO),
+        RawJoint::new("left hip", Some(0), -Vec3::Y),
+        RawJoint::new("right hip", Some(0), -Vec3::Y),
+        RawJoint::new("left knee", Some(1), Vec3::new(-0.3, -1.0, 0.0)),
+        RawJoint::new("right knee", Some(2), Vec3::new(0.3, -1.0, 0.0)),
+    ])
+    .unwrap();
+    let joints = [Vec3::ZERO, -Vec3::Y, -Vec3::Y, Vec3::new(-0.3, -2.0, 0.0), Vec3::new(0.3, -2.0, 0.0)];
+    let bones = marionette::rig::heat::heat_bones(&skeleton, &joints, &joints);
+    let back: Vec<_> = bones.iter().filter(|b| b.joint == 0).collect();
+    assert_eq!(back.len(), 1, "{bones:?}");
+    assert_eq!((back[0].start, back[0].end), (Vec3::ZERO, -Vec3::Y));
+    assert_eq!(bones.iter().filter(|b| b.joint == 1 || b.joint == 2).count(), 2);
 }
