@@ -78,17 +78,43 @@ pub fn skin_dq(bind_positions: &[Vec3], weights: &SkinWeights, palette: &[DualQu
     assert!(groups.joint_bound <= palette.len(), "an influence names a joint beyond the palette");
     #[cfg(target_arch = "x86_64")]
     if std::arch::is_x86_feature_detected!("avx2") && std::arch::is_x86_feature_detected!("fma") {
-        // SAFETY: the CPU has AVX2 and FMA (checked above).
-        unsafe {
-            avx2::fixed_rows::<1>(bind_positions, &groups.fixed[0], palette, out);
-            avx2::fixed_rows::<2>(bind_positions, &groups.fixed[1], palette, out);
-            avx2::fixed_rows::<3>(bind_positions, &groups.fixed[2], palette, out);
-            avx2::fixed_rows::<4>(bind_positions, &groups.fixed[3], palette, out);
-        }
+        HEMISPHERES.with_borrow_mut(|by_pivot| {
+            palette_by_pivot(palette, by_pivot);
+            let dq = avx2::Palette { quaternions: palette, by_pivot };
+            // SAFETY: the CPU has AVX2 and FMA (checked above).
+            unsafe {
+                avx2::fixed_rows::<1>(bind_positions, &groups.fixed[0], &dq, out);
+                avx2::fixed_rows::<2>(bind_positions, &groups.fixed[1], &dq, out);
+                avx2::fixed_rows::<3>(bind_positions, &groups.fixed[2], &dq, out);
+                avx2::fixed_rows::<4>(bind_positions, &groups.fixed[3], &dq, out);
+            }
+        });
         skin_wide(bind_positions, weights, palette, out);
         return;
     }
     skin_dq_portable(bind_positions, weights, palette, out);
+}
+
+#[cfg(target_arch = "x86_64")]
+std::thread_local! {
+    /// Each thread's [`palette_by_pivot`] (grown once, then reused: the kernel does not
+    /// allocate per call once it has grown).
+    static HEMISPHERES: std::cell::RefCell<Vec<DualQuat>> = const { std::cell::RefCell::new(Vec::new()) };
+}
+
+/// For every joint `pivot`, the palette flipped into its hemisphere: at `pivot · n + j`,
+/// `j`'s dual quaternion, negated when its real part's dot product with `pivot`'s is
+/// negative. Made once per palette (n² dual quaternions: 18 KB for SMPL's 24 joints), so a
+/// vertex's blend needs no dot product and no sign per influence.
+fn palette_by_pivot(palette: &[DualQuat], by_pivot: &mut Vec<DualQuat>) {
+    by_pivot.clear();
+    for pivot in palette {
+        by_pivot.extend(
+            palette
+                .iter()
+                .map(|q| if q.real.dot(pivot.real) < 0.0 { DualQuat { real: -q.real, dual: -q.dual } } else { *q }),
+        );
+    }
 }
 
 /// [`skin_dq`] without the AVX2 path (what other CPUs run; the SIMD path's oracle).
@@ -177,30 +203,96 @@ mod avx2 {
         _mm_shuffle_ps::<0b11_00_10_01>(c, c)
     }
 
-    /// One fixed group: batches of eight vertices with one vertex per lane of 256-bit
-    /// registers (the dual quaternions transposed into eight registers of eight lanes, so
-    /// the hemisphere tests, the blend, the normalisation and the application are plain
-    /// multiply-adds), then the rows left over one at a time.
+    /// The dual quaternions and their [`palette_by_pivot`](super::palette_by_pivot).
+    pub struct Palette<'a> {
+        pub quaternions: &'a [DualQuat],
+        pub by_pivot: &'a [DualQuat],
+    }
+
+    /// One fixed group: batches of eight vertices, each vertex's dual quaternions blended
+    /// whole (real and dual parts in one 256-bit register, taken from the palette flipped
+    /// into the hemisphere of the row's heaviest influence), the eight blends transposed so that the normalisation and the
+    /// application run with one vertex per lane; then the rows left over one at a time.
     ///
     /// # Safety
     /// The CPU must have AVX2 and FMA. (Indices are checked.)
     #[target_feature(enable = "avx2,fma")]
-    pub unsafe fn fixed_rows<const K: usize>(
-        bind: &[Vec3],
-        group: &FixedGroup,
-        palette: &[DualQuat],
-        out: &mut [Vec3],
-    ) {
+    pub unsafe fn fixed_rows<const K: usize>(bind: &[Vec3], group: &FixedGroup, palette: &Palette, out: &mut [Vec3]) {
+        let n = palette.quaternions.len();
+        assert_eq!(palette.by_pivot.len(), n * n, "a flipped palette for every joint");
         let batches = group.vertices.len() / 8 * 8;
         let rows =
             group.joints[..batches * K].chunks_exact(8 * K).zip(group.weights[..batches * K].chunks_exact(8 * K));
         for (vertices, (joints, weights)) in group.vertices[..batches].chunks_exact(8).zip(rows) {
             let vertices: &[u32; 8] = vertices.try_into().unwrap();
-            batch_of_eight::<K>(bind, vertices, joints, weights, palette, out);
+            let mut blends = [_mm256_setzero_ps(); 8];
+            for (i, b) in blends.iter_mut().enumerate() {
+                *b = blend::<K>(&joints[i * K..][..K], &weights[i * K..][..K], palette);
+            }
+            let [rx, ry, rz, wr, dx, dy, dz, wd] = transpose_eight(blends);
+            let (r, d) = ([rx, ry, rz], [dx, dy, dz]);
+            let points: [Vec4; 8] = std::array::from_fn(|i| bind[vertices[i] as usize].extend(0.0));
+            let [px, py, pz, _] = lanes(std::array::from_fn(|i| &points[i]));
+            let p = [px, py, pz];
+            // The blend (r, w_r) + ε (d, w_d) is not normalised: with n² = |r|² + w_r², the
+            // unit one moves p to p + (2 / n²) (r × t + w_r d - w_d r + r × d), where
+            // t = r × p + w_r p.
+            let scale = _mm256_div_ps(_mm256_set1_ps(2.0), dot8(&[rx, ry, rz, wr], &[rx, ry, rz, wr]));
+            let rxp = cross8(r, p);
+            let mut t = [_mm256_setzero_ps(); 3];
+            for c in 0..3 {
+                t[c] = _mm256_fmadd_ps(wr, p[c], rxp[c]);
+            }
+            let (rxt, rxd) = (cross8(r, t), cross8(r, d));
+            let mut moved = [[0.0f32; 8]; 3];
+            for c in 0..3 {
+                let translation = _mm256_add_ps(_mm256_fmsub_ps(wr, d[c], _mm256_mul_ps(wd, r[c])), rxd[c]);
+                let m = _mm256_fmadd_ps(scale, _mm256_add_ps(rxt[c], translation), p[c]);
+                // SAFETY: `moved[c]` is eight f32s.
+                unsafe { _mm256_storeu_ps(moved[c].as_mut_ptr(), m) };
+            }
+            for (i, &v) in vertices.iter().enumerate() {
+                out[v as usize] = Vec3::new(moved[0][i], moved[1][i], moved[2][i]);
+            }
         }
         let rest = (&group.vertices[batches..], &group.joints[batches * K..], &group.weights[batches * K..]);
         // SAFETY: as this function's.
-        unsafe { rows_one_by_one::<K>(bind, rest, palette, out) };
+        unsafe { rows_one_by_one::<K>(bind, rest, palette.quaternions, out) };
+    }
+
+    /// One row's blend `Σ wₖ qₖ` (real parts in the low half, dual in the high), each
+    /// `qₖ` in the hemisphere of the row's heaviest influence (its first).
+    #[inline]
+    #[target_feature(enable = "avx2,fma")]
+    fn blend<const K: usize>(joints: &[u16], weights: &[f32], palette: &Palette) -> __m256 {
+        let pivot = joints[0] as usize;
+        let n = palette.quaternions.len();
+        let flipped = &palette.by_pivot[pivot * n..][..n];
+        let mut sum = _mm256_setzero_ps();
+        for k in 0..K {
+            let q = &flipped[joints[k] as usize];
+            sum = _mm256_fmadd_ps(_mm256_set1_ps(weights[k]), _mm256_set_m128(q.dual.into(), q.real.into()), sum);
+        }
+        sum
+    }
+
+    /// Eight blended dual quaternions (one per register) as eight registers of eight lanes:
+    /// the real part's x, y, z, w, then the dual part's; lane i holds vertex i.
+    #[inline]
+    #[target_feature(enable = "avx2,fma")]
+    fn transpose_eight(q: [__m256; 8]) -> [__m256; 8] {
+        let low = transpose(q[0], q[1], q[2], q[3]);
+        let high = transpose(q[4], q[5], q[6], q[7]);
+        [
+            _mm256_permute2f128_ps::<0x20>(low[0], high[0]),
+            _mm256_permute2f128_ps::<0x20>(low[1], high[1]),
+            _mm256_permute2f128_ps::<0x20>(low[2], high[2]),
+            _mm256_permute2f128_ps::<0x20>(low[3], high[3]),
+            _mm256_permute2f128_ps::<0x31>(low[0], high[0]),
+            _mm256_permute2f128_ps::<0x31>(low[1], high[1]),
+            _mm256_permute2f128_ps::<0x31>(low[2], high[2]),
+            _mm256_permute2f128_ps::<0x31>(low[3], high[3]),
+        ]
     }
 
     /// Four quaternions, one per lane of each 128-bit half (`a`, `b`, `c`, `d` hold
@@ -223,31 +315,13 @@ mod avx2 {
     #[inline]
     #[target_feature(enable = "avx2,fma")]
     fn lanes(q: [&Vec4; 8]) -> [__m256; 4] {
-        let pair = |i: usize| (<__m128>::from(*q[i + 4]), <__m128>::from(*q[i]));
-        let [(a1, a0), (b1, b0), (c1, c0), (d1, d0)] = [pair(0), pair(1), pair(2), pair(3)];
-        transpose(_mm256_set_m128(a1, a0), _mm256_set_m128(b1, b0), _mm256_set_m128(c1, c0), _mm256_set_m128(d1, d0))
-    }
-
-    /// The weights of eight rows of `K`, one register per influence (lane i: row i).
-    #[inline]
-    #[target_feature(enable = "avx2,fma")]
-    fn lane_weights<const K: usize>(weights: &[f32]) -> [__m256; K] {
-        if K == 4 {
-            // Four rows of four: each half of a register is one row; transposed, as the
-            // quaternions are.
-            let row = |i: usize| Vec4::from_slice(&weights[i * 4..]);
-            let rows: [Vec4; 8] = std::array::from_fn(row);
-            let transposed = lanes(std::array::from_fn(|i| &rows[i]));
-            let mut lanes = [_mm256_setzero_ps(); K];
-            lanes.copy_from_slice(&transposed[..K]);
-            return lanes;
-        }
-        let mut lanes = [_mm256_setzero_ps(); K];
-        for (k, lane) in lanes.iter_mut().enumerate() {
-            let w: [f32; 8] = std::array::from_fn(|i| weights[i * K + k]);
-            *lane = _mm256_setr_ps(w[0], w[1], w[2], w[3], w[4], w[5], w[6], w[7]);
-        }
-        lanes
+        let m: [__m128; 8] = q.map(|v| (*v).into());
+        transpose(
+            _mm256_set_m128(m[4], m[0]),
+            _mm256_set_m128(m[5], m[1]),
+            _mm256_set_m128(m[6], m[2]),
+            _mm256_set_m128(m[7], m[3]),
+        )
     }
 
     #[inline]
@@ -265,79 +339,6 @@ mod avx2 {
     #[target_feature(enable = "avx2,fma")]
     fn dot8(a: &[__m256; 4], b: &[__m256; 4]) -> __m256 {
         _mm256_fmadd_ps(a[3], b[3], _mm256_fmadd_ps(a[2], b[2], _mm256_fmadd_ps(a[1], b[1], _mm256_mul_ps(a[0], b[0]))))
-    }
-
-    #[inline]
-    #[target_feature(enable = "avx2,fma")]
-    fn batch_of_eight<const K: usize>(
-        bind: &[Vec3],
-        vertices: &[u32; 8],
-        joints: &[u16],
-        weights: &[f32],
-        palette: &[DualQuat],
-        out: &mut [Vec3],
-    ) {
-        // SAFETY: `skin_dq` checked that every joint lies inside the palette.
-        let quaternions = |k: usize| -> [&DualQuat; 8] {
-            std::array::from_fn(|i| unsafe { palette.get_unchecked(joints[i * K + k] as usize) })
-        };
-        // Influence 0 is the heaviest (rows are sorted): its real parts are the pivots.
-        // The real parts are blended first and the dual parts after, with the signed
-        // weights kept: fewer registers live at once.
-        let mut w = lane_weights::<K>(weights);
-        let pivot = lanes(quaternions(0).map(|q| &q.real));
-        let mut real = [_mm256_setzero_ps(); 4];
-        for c in 0..4 {
-            real[c] = _mm256_mul_ps(w[0], pivot[c]);
-        }
-        let sign = _mm256_set1_ps(-0.0);
-        for (k, w) in w.iter_mut().enumerate().skip(1) {
-            let r = lanes(quaternions(k).map(|q| &q.real));
-            // q and -q are one rotation: the weight takes the sign of dot(q.real, pivot).
-            *w = _mm256_xor_ps(*w, _mm256_and_ps(dot8(&r, &pivot), sign));
-            for c in 0..4 {
-                real[c] = _mm256_fmadd_ps(*w, r[c], real[c]);
-            }
-        }
-        let mut dual = [_mm256_setzero_ps(); 4];
-        for (k, &w) in w.iter().enumerate() {
-            let d = lanes(quaternions(k).map(|q| &q.dual));
-            for c in 0..4 {
-                dual[c] = _mm256_fmadd_ps(w, d[c], dual[c]);
-            }
-        }
-        // 1/|real| by the reciprocal square root estimate and one Newton step.
-        let n2 = dot8(&real, &real);
-        let y = _mm256_rsqrt_ps(n2);
-        let inv = _mm256_mul_ps(
-            _mm256_mul_ps(_mm256_set1_ps(0.5), y),
-            _mm256_fnmadd_ps(_mm256_mul_ps(n2, y), y, _mm256_set1_ps(3.0)),
-        );
-        for c in 0..4 {
-            real[c] = _mm256_mul_ps(real[c], inv);
-            dual[c] = _mm256_mul_ps(dual[c], inv);
-        }
-        let points: [Vec4; 8] = std::array::from_fn(|i| bind[vertices[i] as usize].extend(0.0));
-        let [px, py, pz, _] = lanes(std::array::from_fn(|i| &points[i]));
-        let (r, wr, d, wd, p) =
-            ([real[0], real[1], real[2]], real[3], [dual[0], dual[1], dual[2]], dual[3], [px, py, pz]);
-        // t = r × p + w p; p' = p + 2 (r × t + w_r d - w_d r + r × d).
-        let rxp = cross8(r, p);
-        let mut t = [_mm256_setzero_ps(); 3];
-        for c in 0..3 {
-            t[c] = _mm256_fmadd_ps(wr, p[c], rxp[c]);
-        }
-        let (rxt, rxd) = (cross8(r, t), cross8(r, d));
-        let mut moved = [_mm256_setzero_ps(); 4];
-        for c in 0..3 {
-            let translation = _mm256_add_ps(_mm256_fmsub_ps(wr, d[c], _mm256_mul_ps(wd, r[c])), rxd[c]);
-            moved[c] = _mm256_fmadd_ps(_mm256_set1_ps(2.0), _mm256_add_ps(rxt[c], translation), p[c]);
-        }
-        let moved = transpose(moved[0], moved[1], moved[2], moved[3]);
-        for i in 0..4 {
-            out[vertices[i] as usize] = Vec4::from(_mm256_castps256_ps128(moved[i])).truncate();
-            out[vertices[i + 4] as usize] = Vec4::from(_mm256_extractf128_ps::<1>(moved[i])).truncate();
-        }
     }
 
     /// Rows one vertex at a time (the rows left over from the batches of eight): each vertex's blend and its application in 128-bit registers:
