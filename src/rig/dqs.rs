@@ -231,9 +231,17 @@ mod avx2 {
             }
             let [rx, ry, rz, wr, dx, dy, dz, wd] = transpose_eight(blends);
             let (r, d) = ([rx, ry, rz], [dx, dy, dz]);
-            let points: [Vec4; 8] = std::array::from_fn(|i| bind[vertices[i] as usize].extend(0.0));
-            let [px, py, pz, _] = lanes(std::array::from_fn(|i| &points[i]));
-            let p = [px, py, pz];
+            // Eight consecutive vertices (every batch of an SMPL body) are read and written as
+            // 24 floats; others one by one.
+            let run = (vertices[7] - vertices[0] == 7).then_some(vertices[0] as usize..vertices[0] as usize + 8);
+            let p = match &run {
+                Some(run) => deinterleave(&bind[run.clone()]),
+                None => {
+                    let points: [Vec4; 8] = std::array::from_fn(|i| bind[vertices[i] as usize].extend(0.0));
+                    let [px, py, pz, _] = lanes(std::array::from_fn(|i| &points[i]));
+                    [px, py, pz]
+                }
+            };
             // The blend (r, w_r) + ε (d, w_d) is not normalised: with n² = |r|² + w_r², the
             // unit one moves p to p + (2 / n²) (r × t + w_r d - w_d r + r × d), where
             // t = r × p + w_r p.
@@ -244,15 +252,23 @@ mod avx2 {
                 t[c] = _mm256_fmadd_ps(wr, p[c], rxp[c]);
             }
             let (rxt, rxd) = (cross8(r, t), cross8(r, d));
-            let mut moved = [[0.0f32; 8]; 3];
+            let mut moved = [_mm256_setzero_ps(); 3];
             for c in 0..3 {
                 let translation = _mm256_add_ps(_mm256_fmsub_ps(wr, d[c], _mm256_mul_ps(wd, r[c])), rxd[c]);
-                let m = _mm256_fmadd_ps(scale, _mm256_add_ps(rxt[c], translation), p[c]);
-                // SAFETY: `moved[c]` is eight f32s.
-                unsafe { _mm256_storeu_ps(moved[c].as_mut_ptr(), m) };
+                moved[c] = _mm256_fmadd_ps(scale, _mm256_add_ps(rxt[c], translation), p[c]);
             }
-            for (i, &v) in vertices.iter().enumerate() {
-                out[v as usize] = Vec3::new(moved[0][i], moved[1][i], moved[2][i]);
+            match run {
+                Some(run) => interleave(moved, &mut out[run]),
+                None => {
+                    let mut lanes = [[0.0f32; 8]; 3];
+                    for c in 0..3 {
+                        // SAFETY: `lanes[c]` is eight f32s.
+                        unsafe { _mm256_storeu_ps(lanes[c].as_mut_ptr(), moved[c]) };
+                    }
+                    for (i, &v) in vertices.iter().enumerate() {
+                        out[v as usize] = Vec3::new(lanes[0][i], lanes[1][i], lanes[2][i]);
+                    }
+                }
             }
         }
         let rest = (&group.vertices[batches..], &group.joints[batches * K..], &group.weights[batches * K..]);
@@ -274,6 +290,46 @@ mod avx2 {
             sum = _mm256_fmadd_ps(_mm256_set1_ps(weights[k]), _mm256_set_m128(q.dual.into(), q.real.into()), sum);
         }
         sum
+    }
+
+    /// Eight points as x, y and z registers (lane i: point i).
+    #[inline]
+    #[target_feature(enable = "avx2,fma")]
+    fn deinterleave(points: &[Vec3]) -> [__m256; 3] {
+        assert_eq!(points.len(), 8, "eight points");
+        // SAFETY: `Vec3` is three f32s (`repr(C)`), so the eight are 24 in a row.
+        let f: &[f32; 24] = unsafe { &*(points.as_ptr() as *const [f32; 24]) };
+        let m03 = _mm256_set_m128(Vec4::from_slice(&f[12..]).into(), Vec4::from_slice(&f[..4]).into());
+        let m14 = _mm256_set_m128(Vec4::from_slice(&f[16..]).into(), Vec4::from_slice(&f[4..]).into());
+        let m25 = _mm256_set_m128(Vec4::from_slice(&f[20..]).into(), Vec4::from_slice(&f[8..]).into());
+        let xy = _mm256_shuffle_ps::<0b10_01_11_10>(m14, m25);
+        let yz = _mm256_shuffle_ps::<0b01_00_10_01>(m03, m14);
+        [
+            _mm256_shuffle_ps::<0b10_00_11_00>(m03, xy),
+            _mm256_shuffle_ps::<0b11_01_10_00>(yz, xy),
+            _mm256_shuffle_ps::<0b11_00_11_01>(yz, m25),
+        ]
+    }
+
+    /// The inverse of [`deinterleave`]: x, y and z registers written as eight points.
+    #[inline]
+    #[target_feature(enable = "avx2,fma")]
+    fn interleave([x, y, z]: [__m256; 3], points: &mut [Vec3]) {
+        assert_eq!(points.len(), 8, "eight points");
+        let xy = _mm256_shuffle_ps::<0b10_00_10_00>(x, y);
+        let yz = _mm256_shuffle_ps::<0b11_01_11_01>(y, z);
+        let zx = _mm256_shuffle_ps::<0b11_01_10_00>(z, x);
+        let m03 = _mm256_shuffle_ps::<0b10_00_10_00>(xy, zx);
+        let m14 = _mm256_shuffle_ps::<0b11_01_10_00>(yz, xy);
+        let m25 = _mm256_shuffle_ps::<0b11_01_11_01>(zx, yz);
+        // SAFETY: as in `deinterleave`.
+        let f: &mut [f32; 24] = unsafe { &mut *(points.as_mut_ptr() as *mut [f32; 24]) };
+        Vec4::from(_mm256_castps256_ps128(m03)).write_to_slice(&mut f[..4]);
+        Vec4::from(_mm256_castps256_ps128(m14)).write_to_slice(&mut f[4..]);
+        Vec4::from(_mm256_castps256_ps128(m25)).write_to_slice(&mut f[8..]);
+        Vec4::from(_mm256_extractf128_ps::<1>(m03)).write_to_slice(&mut f[12..]);
+        Vec4::from(_mm256_extractf128_ps::<1>(m14)).write_to_slice(&mut f[16..]);
+        Vec4::from(_mm256_extractf128_ps::<1>(m25)).write_to_slice(&mut f[20..]);
     }
 
     /// Eight blended dual quaternions (one per register) as eight registers of eight lanes:
