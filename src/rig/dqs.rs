@@ -211,8 +211,9 @@ mod avx2 {
 
     /// One fixed group: batches of eight vertices, each vertex's dual quaternions blended
     /// whole (real and dual parts in one 256-bit register, taken from the palette flipped
-    /// into the hemisphere of the row's heaviest influence), the eight blends transposed so that the normalisation and the
-    /// application run with one vertex per lane; then the rows left over one at a time.
+    /// into the hemisphere of the row's heaviest influence), the eight blends transposed so
+    /// that the normalisation and the application run with one vertex per lane; then the
+    /// rows left over one at a time.
     ///
     /// # Safety
     /// The CPU must have AVX2 and FMA. (Indices are checked.)
@@ -229,46 +230,17 @@ mod avx2 {
             for (i, b) in blends.iter_mut().enumerate() {
                 *b = blend::<K>(&joints[i * K..][..K], &weights[i * K..][..K], palette);
             }
-            let [rx, ry, rz, wr, dx, dy, dz, wd] = transpose_eight(blends);
-            let (r, d) = ([rx, ry, rz], [dx, dy, dz]);
             // Eight consecutive vertices (every batch of an SMPL body) are read and written as
             // 24 floats; others one by one.
             let run = (vertices[7] - vertices[0] == 7).then_some(vertices[0] as usize..vertices[0] as usize + 8);
             let p = match &run {
                 Some(run) => deinterleave(&bind[run.clone()]),
-                None => {
-                    let points: [Vec4; 8] = std::array::from_fn(|i| bind[vertices[i] as usize].extend(0.0));
-                    let [px, py, pz, _] = lanes(std::array::from_fn(|i| &points[i]));
-                    [px, py, pz]
-                }
+                None => gather(bind, vertices),
             };
-            // The blend (r, w_r) + ε (d, w_d) is not normalised: with n² = |r|² + w_r², the
-            // unit one moves p to p + (2 / n²) (r × t + w_r d - w_d r + r × d), where
-            // t = r × p + w_r p.
-            let scale = _mm256_div_ps(_mm256_set1_ps(2.0), dot8(&[rx, ry, rz, wr], &[rx, ry, rz, wr]));
-            let rxp = cross8(r, p);
-            let mut t = [_mm256_setzero_ps(); 3];
-            for c in 0..3 {
-                t[c] = _mm256_fmadd_ps(wr, p[c], rxp[c]);
-            }
-            let (rxt, rxd) = (cross8(r, t), cross8(r, d));
-            let mut moved = [_mm256_setzero_ps(); 3];
-            for c in 0..3 {
-                let translation = _mm256_add_ps(_mm256_fmsub_ps(wr, d[c], _mm256_mul_ps(wd, r[c])), rxd[c]);
-                moved[c] = _mm256_fmadd_ps(scale, _mm256_add_ps(rxt[c], translation), p[c]);
-            }
+            let moved = normalise_and_apply(transpose_eight(blends), p);
             match run {
                 Some(run) => interleave(moved, &mut out[run]),
-                None => {
-                    let mut lanes = [[0.0f32; 8]; 3];
-                    for c in 0..3 {
-                        // SAFETY: `lanes[c]` is eight f32s.
-                        unsafe { _mm256_storeu_ps(lanes[c].as_mut_ptr(), moved[c]) };
-                    }
-                    for (i, &v) in vertices.iter().enumerate() {
-                        out[v as usize] = Vec3::new(lanes[0][i], lanes[1][i], lanes[2][i]);
-                    }
-                }
+                None => scatter(moved, vertices, out),
             }
         }
         let rest = (&group.vertices[batches..], &group.joints[batches * K..], &group.weights[batches * K..]);
@@ -290,6 +262,52 @@ mod avx2 {
             sum = _mm256_fmadd_ps(_mm256_set1_ps(weights[k]), _mm256_set_m128(q.dual.into(), q.real.into()), sum);
         }
         sum
+    }
+
+    /// Normalises eight blends (as [`transpose_eight`] gives them) and applies them to eight
+    /// points (x, y and z registers), one vertex per lane.
+    #[inline]
+    #[target_feature(enable = "avx2,fma")]
+    fn normalise_and_apply([rx, ry, rz, wr, dx, dy, dz, wd]: [__m256; 8], p: [__m256; 3]) -> [__m256; 3] {
+        let (r, d) = ([rx, ry, rz], [dx, dy, dz]);
+        // The blend (r, w_r) + ε (d, w_d) is not normalised: with n² = |r|² + w_r², the unit
+        // one moves p to p + (2 / n²) (r × t + w_r d - w_d r + r × d), where t = r × p + w_r p.
+        let scale = _mm256_div_ps(_mm256_set1_ps(2.0), dot8(&[rx, ry, rz, wr], &[rx, ry, rz, wr]));
+        let rxp = cross8(r, p);
+        let mut t = [_mm256_setzero_ps(); 3];
+        for c in 0..3 {
+            t[c] = _mm256_fmadd_ps(wr, p[c], rxp[c]);
+        }
+        let (rxt, rxd) = (cross8(r, t), cross8(r, d));
+        let mut moved = [_mm256_setzero_ps(); 3];
+        for c in 0..3 {
+            let translation = _mm256_add_ps(_mm256_fmsub_ps(wr, d[c], _mm256_mul_ps(wd, r[c])), rxd[c]);
+            moved[c] = _mm256_fmadd_ps(scale, _mm256_add_ps(rxt[c], translation), p[c]);
+        }
+        moved
+    }
+
+    /// The bind positions of eight vertices anywhere as x, y and z registers.
+    #[inline]
+    #[target_feature(enable = "avx2,fma")]
+    fn gather(bind: &[Vec3], vertices: &[u32; 8]) -> [__m256; 3] {
+        let points: [Vec4; 8] = std::array::from_fn(|i| bind[vertices[i] as usize].extend(0.0));
+        let [x, y, z, _] = lanes(std::array::from_fn(|i| &points[i]));
+        [x, y, z]
+    }
+
+    /// Writes x, y and z registers to eight vertices anywhere.
+    #[inline]
+    #[target_feature(enable = "avx2,fma")]
+    fn scatter(moved: [__m256; 3], vertices: &[u32; 8], out: &mut [Vec3]) {
+        let mut lanes = [[0.0f32; 8]; 3];
+        for c in 0..3 {
+            // SAFETY: `lanes[c]` is eight f32s.
+            unsafe { _mm256_storeu_ps(lanes[c].as_mut_ptr(), moved[c]) };
+        }
+        for (i, &v) in vertices.iter().enumerate() {
+            out[v as usize] = Vec3::new(lanes[0][i], lanes[1][i], lanes[2][i]);
+        }
     }
 
     /// Eight points as x, y and z registers (lane i: point i).
