@@ -107,13 +107,14 @@ std::thread_local! {
 /// negative. Made once per palette (n² dual quaternions: 18 KB for SMPL's 24 joints), so a
 /// vertex's blend needs no dot product and no sign per influence.
 fn palette_by_pivot(palette: &[DualQuat], by_pivot: &mut Vec<DualQuat>) {
-    by_pivot.clear();
-    for pivot in palette {
-        by_pivot.extend(
-            palette
-                .iter()
-                .map(|q| if q.real.dot(pivot.real) < 0.0 { DualQuat { real: -q.real, dual: -q.dual } } else { *q }),
-        );
+    let n = palette.len();
+    by_pivot.resize(n * n, DualQuat { real: Vec4::ZERO, dual: Vec4::ZERO });
+    for (pivot, row) in palette.iter().zip(by_pivot.chunks_exact_mut(n.max(1))) {
+        for (q, flipped) in palette.iter().zip(row) {
+            // −1 where q lies in the other hemisphere; no branch (the signs follow the pose).
+            let sign = 1.0 - 2.0 * f32::from(u8::from(q.real.dot(pivot.real) < 0.0));
+            *flipped = DualQuat { real: q.real * sign, dual: q.dual * sign };
+        }
     }
 }
 
@@ -271,18 +272,19 @@ mod avx2 {
     fn normalise_and_apply([rx, ry, rz, wr, dx, dy, dz, wd]: [__m256; 8], p: [__m256; 3]) -> [__m256; 3] {
         let (r, d) = ([rx, ry, rz], [dx, dy, dz]);
         // The blend (r, w_r) + ε (d, w_d) is not normalised: with n² = |r|² + w_r², the unit
-        // one moves p to p + (2 / n²) (r × t + w_r d - w_d r + r × d), where t = r × p + w_r p.
+        // one moves p to p + (2 / n²) (r × t + w_r d - w_d r + r × d), where t = r × p + w_r p;
+        // r × t + r × d is r × u, with u = t + d.
         let scale = _mm256_div_ps(_mm256_set1_ps(2.0), dot8(&[rx, ry, rz, wr], &[rx, ry, rz, wr]));
         let rxp = cross8(r, p);
-        let mut t = [_mm256_setzero_ps(); 3];
+        let mut u = [_mm256_setzero_ps(); 3];
         for c in 0..3 {
-            t[c] = _mm256_fmadd_ps(wr, p[c], rxp[c]);
+            u[c] = _mm256_add_ps(_mm256_fmadd_ps(wr, p[c], rxp[c]), d[c]);
         }
-        let (rxt, rxd) = (cross8(r, t), cross8(r, d));
+        let rxu = cross8(r, u);
         let mut moved = [_mm256_setzero_ps(); 3];
         for c in 0..3 {
-            let translation = _mm256_add_ps(_mm256_fmsub_ps(wr, d[c], _mm256_mul_ps(wd, r[c])), rxd[c]);
-            moved[c] = _mm256_fmadd_ps(scale, _mm256_add_ps(rxt[c], translation), p[c]);
+            let rest = _mm256_fmsub_ps(wr, d[c], _mm256_mul_ps(wd, r[c]));
+            moved[c] = _mm256_fmadd_ps(scale, _mm256_add_ps(rxu[c], rest), p[c]);
         }
         moved
     }
@@ -415,10 +417,9 @@ mod avx2 {
         _mm256_fmadd_ps(a[3], b[3], _mm256_fmadd_ps(a[2], b[2], _mm256_fmadd_ps(a[1], b[1], _mm256_mul_ps(a[0], b[0]))))
     }
 
-    /// Rows one vertex at a time (the rows left over from the batches of eight): each vertex's blend and its application in 128-bit registers:
-    /// hemisphere test by a broadcast dot product, the sign flipped into the weight,
-    /// one reciprocal square root, rotation `v + 2w (r × v) + 2 r × (r × v)` and
-    /// translation `2 (w_r d - w_d r + r × d)`.
+    /// Rows one vertex at a time (those left over from the batches of eight), in 128-bit
+    /// registers: the hemisphere test by a broadcast dot product, the sign flipped into
+    /// the weight, one reciprocal square root, then the rotation and translation together.
     ///
     /// # Safety
     /// The CPU must have AVX2 and FMA. (Indices are checked.)
@@ -456,13 +457,12 @@ mod avx2 {
             let wd = _mm_shuffle_ps::<0xFF>(dual, dual);
             let b = bind[v as usize];
             let p = _mm_setr_ps(b.x, b.y, b.z, 0.0);
-            let two = _mm_set1_ps(2.0);
-            // t = r × p + w p; p' = p + 2 r × t; translation 2 (w_r d - w_d r + r × d).
-            let t = _mm_fmadd_ps(wr, p, cross(real, p));
-            let rotated = _mm_fmadd_ps(two, cross(real, t), p);
-            let translation =
-                _mm_mul_ps(two, _mm_add_ps(_mm_fmsub_ps(wr, dual, _mm_mul_ps(wd, real)), cross(real, dual)));
-            out[v as usize] = Vec4::from(_mm_add_ps(rotated, translation)).truncate();
+            // p' = p + 2 (r × u + w_r d - w_d r), with u = r × p + w_r p + d (the rotation
+            // p + 2 r × (r × p + w_r p) and the translation 2 (w_r d - w_d r + r × d)).
+            let u = _mm_add_ps(_mm_fmadd_ps(wr, p, cross(real, p)), dual);
+            let rest = _mm_fmsub_ps(wr, dual, _mm_mul_ps(wd, real));
+            let moved = _mm_fmadd_ps(_mm_set1_ps(2.0), _mm_add_ps(cross(real, u), rest), p);
+            out[v as usize] = Vec4::from(moved).truncate();
         }
     }
 }
