@@ -554,6 +554,13 @@ pub fn scene_path(paths: &[PathBuf]) -> Option<&Path> {
     }
 }
 
+/// Where Save writes until the user picks another file: the scene the editor was opened
+/// on (against `cwd` when relative), else `scene.ron` in `cwd`. Edits to an opened scene
+/// go back to it, not to a file elsewhere.
+pub fn initial_save_path(paths: &[PathBuf], cwd: &Path) -> PathBuf {
+    cwd.join(scene_path(paths).unwrap_or(Path::new("scene.ron")))
+}
+
 /// Reads a scene file and resolves its sources against its folder.
 pub fn read_scene(path: &Path) -> Result<SceneDoc, FormatError> {
     let mut doc = crate::formats::scene::parse_scene(crate::formats::error::open(path)?, path)?;

@@ -61,6 +61,19 @@ fn a_failed_save_leaves_the_previous_file_whole() {
     assert_eq!(leftovers, vec![path], "no temporary file is left behind");
 }
 
+/// Save writes back to the scene the editor was opened on (not to `scene.ron` in the
+/// working folder, where the edits would be lost to the opened file).
+#[test]
+fn save_goes_back_to_the_opened_scene() {
+    use marionette::editor::document::initial_save_path;
+    use std::path::{Path, PathBuf};
+    let cwd = Path::new("/work/here");
+    assert_eq!(initial_save_path(&[PathBuf::from("/tmp/crowd.ron")], cwd), Path::new("/tmp/crowd.ron"));
+    assert_eq!(initial_save_path(&[PathBuf::from("scenes/a.ron")], cwd), Path::new("/work/here/scenes/a.ron"));
+    assert_eq!(initial_save_path(&[PathBuf::from("Model1.skel")], cwd), Path::new("/work/here/scene.ron"));
+    assert_eq!(initial_save_path(&[], cwd), Path::new("/work/here/scene.ron"));
+}
+
 #[test]
 fn a_malformed_scene_reports_its_line() {
     let e = parse_scene(

@@ -121,10 +121,17 @@ impl Plugin for InspectorPlugin {
     fn build(&self, app: &mut App) {
         app.init_resource::<InspectorState>()
             .init_resource::<ViewportArea>()
+            .add_systems(Startup, save_to_the_opened_scene)
             .add_systems(PostUpdate, fit_camera_viewport)
             .add_systems(EguiPrimaryContextPass, inspector_ui)
             .add_systems(Update, open_dropped_files);
     }
+}
+
+/// Points the scene path box (what Save writes) at the scene the editor was opened on.
+fn save_to_the_opened_scene(paths: Option<Res<super::StartupPaths>>, mut state: ResMut<InspectorState>) {
+    let (Some(paths), Ok(cwd)) = (paths, std::env::current_dir()) else { return };
+    state.scene_path = super::document::initial_save_path(&paths.0, &cwd).display().to_string();
 }
 
 /// Draws the panels (their edits land in this frame's `Animate`); the viewport is what
