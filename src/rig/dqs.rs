@@ -312,6 +312,9 @@ mod avx2 {
         }
     }
 
+    // `deinterleave` and `interleave` read eight `Vec3`s as 24 f32s.
+    const _: () = assert!(std::mem::size_of::<[Vec3; 8]>() == std::mem::size_of::<[f32; 24]>());
+
     /// Eight points as x, y and z registers (lane i: point i).
     #[inline]
     #[target_feature(enable = "avx2,fma")]
@@ -391,12 +394,11 @@ mod avx2 {
     #[inline]
     #[target_feature(enable = "avx2,fma")]
     fn lanes(q: [&Vec4; 8]) -> [__m256; 4] {
-        let m: [__m128; 8] = q.map(|v| (*v).into());
         transpose(
-            _mm256_set_m128(m[4], m[0]),
-            _mm256_set_m128(m[5], m[1]),
-            _mm256_set_m128(m[6], m[2]),
-            _mm256_set_m128(m[7], m[3]),
+            _mm256_set_m128((*q[4]).into(), (*q[0]).into()),
+            _mm256_set_m128((*q[5]).into(), (*q[1]).into()),
+            _mm256_set_m128((*q[6]).into(), (*q[2]).into()),
+            _mm256_set_m128((*q[7]).into(), (*q[3]).into()),
         )
     }
 
