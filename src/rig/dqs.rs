@@ -102,20 +102,27 @@ std::thread_local! {
     static HEMISPHERES: std::cell::RefCell<Vec<DualQuat>> = const { std::cell::RefCell::new(Vec::new()) };
 }
 
-/// For every joint `pivot`, the palette flipped into its hemisphere: at `pivot · n + j`,
-/// `j`'s dual quaternion, negated when its real part's dot product with `pivot`'s is
-/// negative. Made once per palette (n² dual quaternions: 18 KB for SMPL's 24 joints), so a
-/// vertex's blend needs no dot product and no sign per influence.
+/// For every joint `pivot`, the palette flipped into its hemisphere: at
+/// `pivot · stride + j` (the stride being [`row_stride`]), `j`'s dual quaternion, negated
+/// when its real part's dot product with `pivot`'s is negative. Made once per palette
+/// (24 KB for SMPL's 24 joints), so a vertex's blend needs no dot product and no sign per
+/// influence.
 fn palette_by_pivot(palette: &[DualQuat], by_pivot: &mut Vec<DualQuat>) {
-    let n = palette.len();
-    by_pivot.resize(n * n, DualQuat { real: Vec4::ZERO, dual: Vec4::ZERO });
-    for (pivot, row) in palette.iter().zip(by_pivot.chunks_exact_mut(n.max(1))) {
+    let (n, stride) = (palette.len(), row_stride(palette.len()));
+    by_pivot.resize(n * stride, DualQuat { real: Vec4::ZERO, dual: Vec4::ZERO });
+    for (pivot, row) in palette.iter().zip(by_pivot.chunks_exact_mut(stride)) {
         for (q, flipped) in palette.iter().zip(row) {
             // −1 where q lies in the other hemisphere; no branch (the signs follow the pose).
             let sign = 1.0 - 2.0 * f32::from(u8::from(q.real.dot(pivot.real) < 0.0));
             *flipped = DualQuat { real: q.real * sign, dual: q.dual * sign };
         }
     }
+}
+
+/// The rows of [`palette_by_pivot`] are a power of two long, at least the palette's: a
+/// joint index masked by `stride − 1` then lies in its row without a bounds check.
+fn row_stride(joints: usize) -> usize {
+    joints.next_power_of_two()
 }
 
 /// [`skin_dq`] without the AVX2 path (what other CPUs run; the SIMD path's oracle).
@@ -221,7 +228,7 @@ mod avx2 {
     #[target_feature(enable = "avx2,fma")]
     pub unsafe fn fixed_rows<const K: usize>(bind: &[Vec3], group: &FixedGroup, palette: &Palette, out: &mut [Vec3]) {
         let n = palette.quaternions.len();
-        assert_eq!(palette.by_pivot.len(), n * n, "a flipped palette for every joint");
+        assert_eq!(palette.by_pivot.len(), n * super::row_stride(n), "a flipped palette for every joint");
         let batches = group.vertices.len() / 8 * 8;
         let rows =
             group.joints[..batches * K].chunks_exact(8 * K).zip(group.weights[..batches * K].chunks_exact(8 * K));
@@ -254,12 +261,12 @@ mod avx2 {
     #[inline]
     #[target_feature(enable = "avx2,fma")]
     fn blend<const K: usize>(joints: &[u16], weights: &[f32], palette: &Palette) -> __m256 {
-        let pivot = joints[0] as usize;
-        let n = palette.quaternions.len();
-        let flipped = &palette.by_pivot[pivot * n..][..n];
+        let stride = super::row_stride(palette.quaternions.len());
+        let flipped = &palette.by_pivot[joints[0] as usize * stride..][..stride];
         let mut sum = _mm256_setzero_ps();
         for k in 0..K {
-            let q = &flipped[joints[k] as usize];
+            // The joints lie in the palette (`skin_dq` checked): the mask changes none.
+            let q = &flipped[joints[k] as usize & (stride - 1)];
             sum = _mm256_fmadd_ps(_mm256_set1_ps(weights[k]), _mm256_set_m128(q.dual.into(), q.real.into()), sum);
         }
         sum
