@@ -102,6 +102,24 @@ fn kernel_skin_dual_quaternion(bencher: Bencher, part: &str) {
     });
 }
 
+/// Both kernels on the benchmarked asset (Model1 with the data: 13,336 vertices, up to 13
+/// influences, so rows of every length and few runs of eight alike), in vertices per
+/// second.
+#[divan::bench(args = ["lbs", "dq"])]
+fn kernels_on_the_asset(bencher: Bencher, kernel: &str) {
+    use marionette::rig::dqs::{dual_quaternion_palette, skin_dq};
+    let asset = asset();
+    let palette = posed_palette(&asset);
+    let mut dq = Vec::new();
+    dual_quaternion_palette(&palette, &mut dq);
+    let mut out = vec![Vec3::ZERO; asset.vertex_count()];
+    let (bind, weights) = (&asset.skin.bind_positions, &asset.skin.weights);
+    bencher.counter(divan::counter::ItemsCount::new(asset.vertex_count())).bench_local(|| match kernel {
+        "lbs" => marionette::rig::lbs::skin(bind, weights, &palette, divan::black_box(&mut out)),
+        _ => skin_dq(bind, weights, &dq, divan::black_box(&mut out)),
+    });
+}
+
 /// LBS plus flat normals into unshared render buffers (what one SMPL body costs), per
 /// vertex of the body.
 #[divan::bench(args = ["oracle", "fast"])]

@@ -87,9 +87,9 @@ pub fn skin_dq(bind_positions: &[Vec3], weights: &SkinWeights, palette: &[DualQu
                 avx2::fixed_rows::<2>(bind_positions, &groups.fixed[1], &dq, out);
                 avx2::fixed_rows::<3>(bind_positions, &groups.fixed[2], &dq, out);
                 avx2::fixed_rows::<4>(bind_positions, &groups.fixed[3], &dq, out);
+                avx2::wide_rows(bind_positions, weights, &dq, out);
             }
         });
-        skin_wide(bind_positions, weights, palette, out);
         return;
     }
     skin_dq_portable(bind_positions, weights, palette, out);
@@ -137,12 +137,12 @@ pub fn skin_dq_portable(bind_positions: &[Vec3], weights: &SkinWeights, palette:
     fixed_rows::<2>(bind_positions, &groups.fixed[1], palette, out);
     fixed_rows::<3>(bind_positions, &groups.fixed[2], palette, out);
     fixed_rows::<4>(bind_positions, &groups.fixed[3], palette, out);
-    skin_wide(bind_positions, weights, palette, out);
+    skin_wide(bind_positions, weights, &groups.wide, palette, out);
 }
 
-/// Vertices with more than four influences.
-fn skin_wide(bind_positions: &[Vec3], weights: &SkinWeights, palette: &[DualQuat], out: &mut [Vec3]) {
-    for &v in &weights.groups().wide {
+/// Vertices with more than four influences (`vertices`: some of the skin's wide group).
+fn skin_wide(bind_positions: &[Vec3], weights: &SkinWeights, vertices: &[u32], palette: &[DualQuat], out: &mut [Vec3]) {
+    for &v in vertices {
         let row = weights.of_vertex(v as usize).iter().map(|i| (i.joint, i.weight));
         out[v as usize] = blend_and_apply(row, palette, bind_positions[v as usize]);
     }
@@ -190,6 +190,7 @@ mod avx2 {
 
     use super::DualQuat;
     use crate::rig::lbs::FixedGroup;
+    use crate::rig::skinning::{Influence, SkinWeights};
 
     /// `a · b` in every lane, by shuffles and adds (`dpps` is microcoded and slow on
     /// some CPUs, AMD's Zen among them).
@@ -254,6 +255,55 @@ mod avx2 {
         let rest = (&group.vertices[batches..], &group.joints[batches * K..], &group.weights[batches * K..]);
         // SAFETY: as this function's.
         unsafe { rows_one_by_one::<K>(bind, rest, palette.quaternions, out) };
+    }
+
+    /// The vertices with more than four influences: in batches of eight as [`fixed_rows`]
+    /// does (each row's pivot found first), then the rest one at a time.
+    ///
+    /// # Safety
+    /// The CPU must have AVX2 and FMA. (Indices are checked.)
+    #[target_feature(enable = "avx2,fma")]
+    pub unsafe fn wide_rows(bind: &[Vec3], weights: &SkinWeights, palette: &Palette, out: &mut [Vec3]) {
+        let groups = weights.groups();
+        let batches = groups.wide.len() / 8 * 8;
+        let rows = groups.wide[..batches].chunks_exact(8).zip(groups.wide_pivots.chunks_exact(8));
+        for (vertices, pivots) in rows {
+            let vertices: &[u32; 8] = vertices.try_into().unwrap();
+            let mut blends = [_mm256_setzero_ps(); 8];
+            for ((b, &v), &pivot) in blends.iter_mut().zip(vertices).zip(pivots) {
+                *b = blend_any(weights.of_vertex(v as usize), pivot, palette);
+            }
+            let moved = normalise_and_apply(transpose_eight(blends), gather(bind, vertices));
+            scatter(moved, vertices, out);
+        }
+        super::skin_wide(bind, weights, &groups.wide[batches..], palette.quaternions, out);
+    }
+
+    /// [`blend`] of a row of any length and order, `pivot` its heaviest influence's joint.
+    #[inline]
+    #[target_feature(enable = "avx2,fma")]
+    fn blend_any(row: &[Influence], pivot: u16, palette: &Palette) -> __m256 {
+        let stride = super::row_stride(palette.quaternions.len());
+        let flipped = &palette.by_pivot[pivot as usize * stride..][..stride];
+        // The joints lie in the palette (`skin_dq` checked): the mask changes none.
+        let mask = stride - 1;
+        let term = |i: &Influence| {
+            let q = &flipped[i.joint as usize & mask];
+            (_mm256_set1_ps(i.weight), _mm256_set_m128(q.dual.into(), q.real.into()))
+        };
+        // Two sums (even and odd influences) halve the chain of dependent multiply-adds.
+        let (mut even, mut odd) = (_mm256_setzero_ps(), _mm256_setzero_ps());
+        let pairs = row.chunks_exact(2);
+        if let [last] = pairs.remainder() {
+            let (w, q) = term(last);
+            even = _mm256_mul_ps(w, q);
+        }
+        for pair in pairs {
+            let ((w0, q0), (w1, q1)) = (term(&pair[0]), term(&pair[1]));
+            even = _mm256_fmadd_ps(w0, q0, even);
+            odd = _mm256_fmadd_ps(w1, q1, odd);
+        }
+        _mm256_add_ps(even, odd)
     }
 
     /// One row's blend `Σ wₖ qₖ` (real parts in the low half, dual in the high), each

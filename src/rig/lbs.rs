@@ -28,6 +28,9 @@ pub struct FixedGroup {
 pub struct InfluenceGroups {
     pub fixed: [FixedGroup; 4],
     pub wide: Vec<u32>,
+    /// For each of `wide`, the joint of the first of its row's heaviest influences (the one
+    /// whose hemisphere dual quaternion skinning blends in).
+    pub wide_pivots: Vec<u16>,
     /// One past the largest joint any influence names (0 for no influence).
     pub joint_bound: usize,
 }
@@ -49,7 +52,11 @@ impl InfluenceGroups {
                     group.joints.extend(sorted[..k].iter().map(|i| i.joint));
                     group.weights.extend(sorted[..k].iter().map(|i| i.weight));
                 }
-                _ => groups.wide.push(v as u32),
+                _ => {
+                    groups.wide.push(v as u32);
+                    let heaviest = row.iter().fold(row[0], |best, &i| if i.weight > best.weight { i } else { best });
+                    groups.wide_pivots.push(heaviest.joint);
+                }
             }
         }
         groups
