@@ -1,4 +1,5 @@
-//! Benchmarks: the skinning kernel; one frame of the ECS systems for 1 and 16 characters
+//! Benchmarks: the skinning kernels (LBS and dual quaternions, on an SMPL body and on the
+//! benchmarked asset); one frame of the ECS systems for 1 and 16 characters
 //! (one joint changed per character per frame, so every character re-skins); one of 16
 //! moved or posed (with the bytes of mesh data handed on); an editing frame through the
 //! editor's commands (three SMPL bodies playing, a puppet dragged by IK), with and without
