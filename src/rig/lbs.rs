@@ -93,8 +93,8 @@ pub fn skin_chunk(bind_positions: &[Vec3], weights: &SkinWeights, palette: &[Mat
             avx2::skin_fixed::<2>(bind_positions, &groups.fixed[1], palette, first, out);
             avx2::skin_fixed::<3>(bind_positions, &groups.fixed[2], palette, first, out);
             avx2::skin_fixed::<4>(bind_positions, &groups.fixed[3], palette, first, out);
+            avx2::skin_wide(bind_positions, weights, palette, first, out);
         }
-        skin_wide(bind_positions, weights, &groups.wide, palette, first, out);
         return;
     }
     skin_portable_chunk(bind_positions, weights, palette, first, out);
@@ -126,6 +126,13 @@ fn rows_in<const K: usize>(group: &FixedGroup, first: usize, len: usize) -> (&[u
     (&group.vertices[lo..hi], &group.joints[lo * K..hi * K], &group.weights[lo * K..hi * K])
 }
 
+/// The vertices of `wide` that lie in `first..first + len` (vertices ascend).
+fn wide_in(wide: &[u32], first: usize, len: usize) -> &[u32] {
+    let lo = wide.partition_point(|&v| (v as usize) < first);
+    let hi = wide.partition_point(|&v| (v as usize) < first + len);
+    &wide[lo..hi]
+}
+
 /// The portable path of one fixed group: blend `K` matrices with glam's `Vec4`.
 fn skin_fixed_portable<const K: usize>(
     bind: &[Vec3],
@@ -151,9 +158,7 @@ fn skin_fixed_portable<const K: usize>(
 
 /// Vertices with more than four influences, blended the same way from the compressed rows.
 fn skin_wide(bind: &[Vec3], weights: &SkinWeights, wide: &[u32], palette: &[Mat4], first: usize, out: &mut [Vec3]) {
-    let lo = wide.partition_point(|&v| (v as usize) < first);
-    let hi = wide.partition_point(|&v| (v as usize) < first + out.len());
-    for &v in &wide[lo..hi] {
+    for &v in wide_in(wide, first, out.len()) {
         let mut m = Mat4::ZERO;
         for inf in weights.of_vertex(v as usize) {
             let p = &palette[inf.joint as usize];
@@ -173,6 +178,7 @@ mod avx2 {
     use glam::{Mat4, Vec3, Vec4};
 
     use super::FixedGroup;
+    use crate::rig::skinning::{Influence, SkinWeights};
 
     /// One fixed group with FMA on 256-bit registers: a palette matrix is two of them
     /// (columns 0 and 1, columns 2 and 3), so a blend of `K` matrices is `2K` multiply-adds,
@@ -192,28 +198,69 @@ mod avx2 {
     ) {
         let (vertices, joints, weights) = super::rows_in::<K>(group, first, out.len());
         let rows = joints.chunks_exact(K).zip(weights.chunks_exact(K));
-        let one = _mm_set1_ps(1.0);
         for (&v, (joints, weights)) in vertices.iter().zip(rows) {
             let (joints, weights): (&[u16; K], &[f32; K]) = (joints.try_into().unwrap(), weights.try_into().unwrap());
             // Two accumulators per half (even and odd influences) halve the chain of
             // dependent multiply-adds.
             let mut c = [[_mm256_setzero_ps(); 2]; 2];
             for k in 0..K {
-                let m = &palette[joints[k] as usize];
+                let (c01, c23) = columns(&palette[joints[k] as usize]);
                 let w = _mm256_set1_ps(weights[k]);
                 let acc = &mut c[k % 2];
-                let c01 = _mm256_set_m128(m.y_axis.into(), m.x_axis.into());
-                let c23 = _mm256_set_m128(m.w_axis.into(), m.z_axis.into());
                 acc[0] = _mm256_fmadd_ps(w, c01, acc[0]);
                 acc[1] = _mm256_fmadd_ps(w, c23, acc[1]);
             }
             let (c01, c23) = (_mm256_add_ps(c[0][0], c[1][0]), _mm256_add_ps(c[0][1], c[1][1]));
-            let b = bind[v as usize];
-            let xy = _mm256_set_m128(_mm_set1_ps(b.y), _mm_set1_ps(b.x));
-            let z1 = _mm256_set_m128(one, _mm_set1_ps(b.z));
-            let p = _mm256_fmadd_ps(c01, xy, _mm256_mul_ps(c23, z1));
-            let p = _mm_add_ps(_mm256_castps256_ps128(p), _mm256_extractf128_ps::<1>(p));
-            out[v as usize - first] = Vec4::from(p).truncate();
+            out[v as usize - first] = transform(c01, c23, bind[v as usize]);
         }
+    }
+
+    /// The vertices with more than four influences, blended as in [`skin_fixed`] from their
+    /// compressed rows.
+    ///
+    /// # Safety
+    /// As [`skin_fixed`].
+    #[target_feature(enable = "avx2,fma")]
+    pub unsafe fn skin_wide(bind: &[Vec3], weights: &SkinWeights, palette: &[Mat4], first: usize, out: &mut [Vec3]) {
+        for &v in super::wide_in(&weights.groups().wide, first, out.len()) {
+            let row = weights.of_vertex(v as usize);
+            let term = |i: &Influence| {
+                let (c01, c23) = columns(&palette[i.joint as usize]);
+                (_mm256_set1_ps(i.weight), c01, c23)
+            };
+            // Even and odd influences in their own sums, as in `skin_fixed`.
+            let (mut even, mut odd) = ([_mm256_setzero_ps(); 2], [_mm256_setzero_ps(); 2]);
+            let pairs = row.chunks_exact(2);
+            if let [last] = pairs.remainder() {
+                let (w, c01, c23) = term(last);
+                even = [_mm256_mul_ps(w, c01), _mm256_mul_ps(w, c23)];
+            }
+            for pair in pairs {
+                let ((w0, a01, a23), (w1, b01, b23)) = (term(&pair[0]), term(&pair[1]));
+                even = [_mm256_fmadd_ps(w0, a01, even[0]), _mm256_fmadd_ps(w0, a23, even[1])];
+                odd = [_mm256_fmadd_ps(w1, b01, odd[0]), _mm256_fmadd_ps(w1, b23, odd[1])];
+            }
+            let (c01, c23) = (_mm256_add_ps(even[0], odd[0]), _mm256_add_ps(even[1], odd[1]));
+            out[v as usize - first] = transform(c01, c23, bind[v as usize]);
+        }
+    }
+
+    /// A palette matrix as two registers: columns 0 and 1, columns 2 and 3.
+    #[inline]
+    #[target_feature(enable = "avx2,fma")]
+    fn columns(m: &Mat4) -> (__m256, __m256) {
+        (_mm256_set_m128(m.y_axis.into(), m.x_axis.into()), _mm256_set_m128(m.w_axis.into(), m.z_axis.into()))
+    }
+
+    /// A blended matrix (as [`columns`] gives it) applied to a bind position: one
+    /// multiply-add and one add of the register's halves.
+    #[inline]
+    #[target_feature(enable = "avx2,fma")]
+    fn transform(c01: __m256, c23: __m256, b: Vec3) -> Vec3 {
+        let xy = _mm256_set_m128(_mm_set1_ps(b.y), _mm_set1_ps(b.x));
+        let z1 = _mm256_set_m128(_mm_set1_ps(1.0), _mm_set1_ps(b.z));
+        let p = _mm256_fmadd_ps(c01, xy, _mm256_mul_ps(c23, z1));
+        let p = _mm_add_ps(_mm256_castps256_ps128(p), _mm256_extractf128_ps::<1>(p));
+        Vec4::from(p).truncate()
     }
 }
