@@ -80,7 +80,7 @@ pub fn skin_dq(bind_positions: &[Vec3], weights: &SkinWeights, palette: &[DualQu
     if std::arch::is_x86_feature_detected!("avx2") && std::arch::is_x86_feature_detected!("fma") {
         HEMISPHERES.with_borrow_mut(|by_pivot| {
             palette_by_pivot(palette, by_pivot);
-            let dq = avx2::Palette { quaternions: palette, by_pivot };
+            let dq = avx2::Palette { quaternions: palette, by_pivot, stride: row_stride(palette.len()) };
             // SAFETY: the CPU has AVX2 and FMA (checked above).
             unsafe {
                 avx2::fixed_rows::<1>(bind_positions, &groups.fixed[0], &dq, out);
@@ -216,6 +216,19 @@ mod avx2 {
     pub struct Palette<'a> {
         pub quaternions: &'a [DualQuat],
         pub by_pivot: &'a [DualQuat],
+        /// The length of a row of `by_pivot` ([`row_stride`](super::row_stride)).
+        pub stride: usize,
+    }
+
+    impl Palette<'_> {
+        /// The palette flipped into `pivot`'s hemisphere, and the mask that keeps a joint
+        /// index inside it (the row's length less one). The joints lie in the palette
+        /// (`skin_dq` checked), so the mask changes none; it spares a bounds check.
+        #[inline]
+        fn flipped(&self, pivot: usize) -> (&[DualQuat], usize) {
+            let mask = self.stride - 1;
+            (&self.by_pivot[pivot * self.stride..][..=mask], mask)
+        }
     }
 
     /// One fixed group: batches of eight vertices, each vertex's dual quaternions blended
@@ -229,7 +242,8 @@ mod avx2 {
     #[target_feature(enable = "avx2,fma")]
     pub unsafe fn fixed_rows<const K: usize>(bind: &[Vec3], group: &FixedGroup, palette: &Palette, out: &mut [Vec3]) {
         let n = palette.quaternions.len();
-        assert_eq!(palette.by_pivot.len(), n * super::row_stride(n), "a flipped palette for every joint");
+        assert_eq!(palette.by_pivot.len(), n * palette.stride, "a flipped palette for every joint");
+        assert!(palette.stride.is_power_of_two() && palette.stride >= n, "rows a power of two long");
         let batches = group.vertices.len() / 8 * 8;
         let rows =
             group.joints[..batches * K].chunks_exact(8 * K).zip(group.weights[..batches * K].chunks_exact(8 * K));
@@ -283,10 +297,7 @@ mod avx2 {
     #[inline]
     #[target_feature(enable = "avx2,fma")]
     fn blend_any(row: &[Influence], pivot: u16, palette: &Palette) -> __m256 {
-        let stride = super::row_stride(palette.quaternions.len());
-        let flipped = &palette.by_pivot[pivot as usize * stride..][..stride];
-        // The joints lie in the palette (`skin_dq` checked): the mask changes none.
-        let mask = stride - 1;
+        let (flipped, mask) = palette.flipped(pivot as usize);
         let term = |i: &Influence| {
             let q = &flipped[i.joint as usize & mask];
             (_mm256_set1_ps(i.weight), _mm256_set_m128(q.dual.into(), q.real.into()))
@@ -311,12 +322,10 @@ mod avx2 {
     #[inline]
     #[target_feature(enable = "avx2,fma")]
     fn blend<const K: usize>(joints: &[u16], weights: &[f32], palette: &Palette) -> __m256 {
-        let stride = super::row_stride(palette.quaternions.len());
-        let flipped = &palette.by_pivot[joints[0] as usize * stride..][..stride];
+        let (flipped, mask) = palette.flipped(joints[0] as usize);
         let mut sum = _mm256_setzero_ps();
         for k in 0..K {
-            // The joints lie in the palette (`skin_dq` checked): the mask changes none.
-            let q = &flipped[joints[k] as usize & (stride - 1)];
+            let q = &flipped[joints[k] as usize & mask];
             sum = _mm256_fmadd_ps(_mm256_set1_ps(weights[k]), _mm256_set_m128(q.dual.into(), q.real.into()), sum);
         }
         sum
