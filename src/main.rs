@@ -361,7 +361,8 @@ fn run(cli: Cli) -> Result<()> {
             if let Some(file) = &clip.anim {
                 let anim = marionette::formats::load_clip(file)?.retargeted(&asset.skeleton, &Default::default());
                 if animation {
-                    motion = Some(marionette::editor::export::sampled(&anim, &asset.skeleton, &pose));
+                    let sampled = marionette::editor::export::sampled(&anim, &asset.skeleton, &pose);
+                    motion = Some(sampled.map_err(|e| anyhow::anyhow!("{}: {e}", file.display()))?);
                 }
                 let (root, clip_pose) = anim.pose_at(&asset.skeleton, clip.time.unwrap_or(0.0), &pose);
                 pose = clip_pose;
@@ -376,7 +377,8 @@ fn run(cli: Cli) -> Result<()> {
                 let name = asset.name.clone();
                 let root = origin.transform_point3(asset.skeleton.joint(0).rest_offset);
                 let character = GltfCharacter { root, motion, ..GltfCharacter::new(&name, &asset, &pose) };
-                let glb = write_glb(&[character], if bake { GltfMesh::Baked } else { GltfMesh::Skinned });
+                let glb = write_glb(&[character], if bake { GltfMesh::Baked } else { GltfMesh::Skinned })
+                    .map_err(|e| anyhow::anyhow!("{}: {e}", out.display()))?;
                 write_file(&out, |w| w.write_all(&glb))?;
                 println!(
                     "wrote {} ({} joints, {} vertices)",
@@ -535,5 +537,6 @@ fn write_file(
     path: &std::path::Path,
     write: impl FnOnce(&mut std::io::BufWriter<std::fs::File>) -> std::io::Result<()>,
 ) -> Result<()> {
+    marionette::formats::error::refuse_overwriting_input(path)?;
     marionette::formats::write_atomically(path, write).with_context(|| format!("writing {}", path.display()))
 }

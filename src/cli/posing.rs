@@ -188,6 +188,10 @@ pub fn describe(asset: &CharacterAsset) -> String {
     out += &format!("skin: {kind}\n");
     out += &format!("vertices: {}\n", asset.vertex_count());
     out += &format!("triangles: {}\n", asset.triangle_count());
+    if !asset.morphs.is_empty() {
+        let names: Vec<&str> = asset.morphs.iter().map(|m| m.name.as_str()).collect();
+        out += &format!("morphs: {}\n", names.join(", "));
+    }
     let avg = if w.vertex_count() > 0 { w.total_influences() as f32 / w.vertex_count() as f32 } else { 0.0 };
     out += &format!("influences per vertex: max {}, mean {avg:.2}\n", w.max_influences());
     out += &format!("bounds: ({:.3}, {:.3}, {:.3}) .. ({:.3}, {:.3}, {:.3})\n", lo.x, lo.y, lo.z, hi.x, hi.y, hi.z);

@@ -329,10 +329,16 @@ pub fn write_frames(
                     let mut text = Vec::with_capacity(faces.len() * 2);
                     for (k, frame) in part.iter().enumerate() {
                         poser.frame(frame, &mut positions);
+                        let path = out_dir.join(format!("frame{:03}.obj", c * chunk + k));
+                        if let Some(v) = positions.iter().position(|p| !p.is_finite()) {
+                            return Err(FormatError::other(
+                                &path,
+                                format!("vertex {} is not a finite point: not written", v + 1),
+                            ));
+                        }
                         text.clear();
                         vertices_text(&positions, &mut text);
                         text.extend_from_slice(faces);
-                        let path = out_dir.join(format!("frame{:03}.obj", c * chunk + k));
                         write_atomically(&path, |w| w.write_all(&text)).map_err(|e| FormatError::io(&path, e))?;
                         tick();
                     }
@@ -403,6 +409,9 @@ pub fn write_frames_naive(
                 m += (world[j] * Mat4::from_translation(-joints[j])) * inf.weight;
             }
             let p = m.transform_point3(*x);
+            if !p.is_finite() {
+                return Err(FormatError::other(&path, format!("vertex {} is not a finite point", v + 1)));
+            }
             writeln!(file, "v {} {} {}", p.x, p.y, p.z).map_err(|e| FormatError::io(&path, e))?;
         }
         for t in &model.triangles {

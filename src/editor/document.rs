@@ -155,7 +155,7 @@ impl AssetLibrary {
         parts.get(n).cloned().ok_or_else(|| {
             FormatError::other(
                 path,
-                format!("expected character {} of the file, found {} characters", n + 1, parts.len()),
+                format!("expected character {} of the file, found {} characters", n.saturating_add(1), parts.len()),
             )
         })
     }

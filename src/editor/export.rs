@@ -4,6 +4,7 @@
 
 use crate::formats::FormatError;
 use crate::formats::gltf::{GltfCharacter, GltfMesh, Motion, write_glb};
+use crate::formats::limits::sampled_frames;
 use crate::formats::scene::SceneDoc;
 use crate::rig::fk::RestOverride;
 use crate::rig::node_clip::{NodePose, sample_mix};
@@ -12,14 +13,16 @@ use crate::rig::node_clip::{NodePose, sample_mix};
 pub const EXPORT_FPS: f32 = 30.0;
 
 /// A clip sampled over its range at [`EXPORT_FPS`] (its last time included): the poses
-/// and root translations a glTF animation holds. Joints without keys keep `rest`.
+/// and root translations a glTF animation holds. Joints without keys keep `rest`. A clip
+/// longer than [`MAX_SAMPLED_FRAMES`](crate::formats::limits::MAX_SAMPLED_FRAMES) frames
+/// is refused.
 pub fn sampled(
     clip: &crate::rig::anim::Clip,
     skeleton: &crate::rig::Skeleton,
     rest: &[crate::rig::JointRotation],
-) -> Motion {
+) -> Result<Motion, String> {
     let (start, end) = clip.range;
-    let frames = ((end - start).max(0.0) * EXPORT_FPS).ceil() as usize;
+    let frames = sampled_frames(end - start, EXPORT_FPS)?;
     let mut motion = Motion::default();
     for f in 0..=frames {
         let t = (start + f as f32 / EXPORT_FPS).min(end);
@@ -28,7 +31,7 @@ pub fn sampled(
         motion.poses.push(pose);
         motion.roots.push(root);
     }
-    motion
+    Ok(motion)
 }
 
 /// A character's asset as the document shapes it: an SMPL body by its β, a mesh with morph
@@ -90,7 +93,7 @@ pub fn scene_glb(doc: &SceneDoc, mesh: GltfMesh, animated: bool) -> Result<Vec<u
             motion: posed.motion.clone(),
         })
         .collect();
-    Ok(write_glb(&characters, mesh))
+    write_glb(&characters, mesh).map_err(|e| FormatError::other(std::path::Path::new("the exported scene"), e))
 }
 
 /// A character's pose from its document and clips at their times, and (with `animated`)
@@ -112,14 +115,16 @@ fn posed(
         };
         let clip = clip.retargeted(skeleton, &anim.names);
         if animated {
-            posed.motion = Some(sampled(&clip, skeleton, &posed.pose));
+            let clip_file = if anim.file.as_os_str().is_empty() { std::path::Path::new(&c.name) } else { &anim.file };
+            posed.motion = Some(sampled(&clip, skeleton, &posed.pose).map_err(|e| FormatError::other(clip_file, e))?);
         }
         (posed.root, posed.pose) = clip.pose_at(skeleton, anim.time, &posed.pose);
     }
     if let Some(playback) = &c.playback
         && let Some(part) = library.gltf_source(&c.source)
     {
-        play_node_clip(&mut posed, skeleton, &part.clips, playback, animated);
+        play_node_clip(&mut posed, skeleton, &part.clips, playback, animated)
+            .map_err(|e| FormatError::other(c.source.path().unwrap_or(std::path::Path::new(&c.name)), e))?;
     }
     if animated && let Some(motion) = smpl_motion(library, c, asset)? {
         posed.motion = Some(motion);
@@ -128,16 +133,17 @@ fn posed(
 }
 
 /// A glTF clip's pose at the playback's time on `posed` (its keyed joints, root and rest),
-/// and with `animated` the clip sampled at [`EXPORT_FPS`] over its length.
+/// and with `animated` the clip sampled at [`EXPORT_FPS`] over its length (or why it
+/// cannot be).
 fn play_node_clip(
     posed: &mut Posed,
     skeleton: &crate::rig::Skeleton,
     clips: &[crate::rig::node_clip::NodeClip],
     playback: &crate::formats::scene::PlaybackDoc,
     animated: bool,
-) {
+) -> Result<(), String> {
     let find = |name: &Option<String>| clips.iter().find(|k| Some(&k.name) == name.as_ref());
-    let Some(clip) = find(&playback.clip) else { return };
+    let Some(clip) = find(&playback.clip) else { return Ok(()) };
     let blend = find(&playback.blend_clip).map(|k| (k, playback.blend));
     let at = |t: f32| sample_mix(skeleton, clip, blend, t);
     let keyed = |pose: &mut Vec<crate::rig::JointRotation>, sample: &NodePose| {
@@ -155,9 +161,9 @@ fn play_node_clip(
         posed.rest = Some(rest_of(skeleton, &now));
     }
     if !animated {
-        return;
+        return Ok(());
     }
-    let frames = (clip.duration() * EXPORT_FPS).ceil() as usize;
+    let frames = sampled_frames(clip.duration(), EXPORT_FPS)?;
     let mut motion = Motion::default();
     for f in 0..=frames {
         let t = (f as f32 / EXPORT_FPS).min(clip.duration());
@@ -172,6 +178,7 @@ fn play_node_clip(
         }
     }
     posed.motion = Some(motion);
+    Ok(())
 }
 
 /// A sampled pose's offsets (the root's left at the skeleton's, as `root` carries it) and

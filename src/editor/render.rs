@@ -47,7 +47,8 @@ pub fn render(
     width: u32,
     height: u32,
 ) -> Result<Vec<String>, String> {
-    let library = preload(&paths)?;
+    let library = preload(&paths, &edits)?;
+    crate::formats::error::refuse_overwriting_input(&out).map_err(|e| e.to_string())?;
     let mut app = App::new();
     app.add_plugins(super::windowless_plugins())
         .add_plugins(ScheduleRunnerPlugin::run_loop(Duration::from_millis(2)))
@@ -89,24 +90,32 @@ pub fn render(
 }
 
 /// Loads everything the render will show before any window or GPU work, so that a missing
-/// file, an unparsable scene or a character that fails to load is an error (and no picture
-/// is written). Returns the loaded assets for the app to reuse.
-fn preload(paths: &[PathBuf]) -> Result<AssetLibrary, String> {
+/// file, an unparsable scene, a character or a clip that fails to load is an error (and no
+/// picture is written). Returns the loaded assets for the app to reuse.
+fn preload(paths: &[PathBuf], edits: &StartupEdits) -> Result<AssetLibrary, String> {
     let mut library = AssetLibrary::default();
-    // Each source, with what names it in a scene file (for the message).
-    let sources: Vec<(SourceDoc, Option<BindingDoc>, String)> = match scene_path(paths) {
+    // Each source and the clip file it plays, with what names it in a scene file (for the message).
+    let mut sources: Vec<(SourceDoc, Option<BindingDoc>, Option<PathBuf>, String)> = match scene_path(paths) {
         Some(scene) => read_scene(scene)
             .map_err(|e| e.to_string())?
             .characters
             .into_iter()
-            .map(|c| (c.source, c.binding, format!(" (character `{}` of {})", c.name, scene.display())))
+            .map(|c| {
+                let clip = c.anim.filter(|a| a.keys.is_none()).map(|a| a.file);
+                (c.source, c.binding, clip, format!(" (character `{}` of {})", c.name, scene.display()))
+            })
             .collect(),
-        None => paths.iter().flat_map(|p| library.sources_of(p)).map(|s| (s, None, String::new())).collect(),
+        None => paths.iter().flat_map(|p| library.sources_of(p)).map(|s| (s, None, None, String::new())).collect(),
     };
+    if let Some(anim) = &edits.anim {
+        sources.iter_mut().for_each(|s| s.2 = Some(anim.file.clone()));
+    }
     let errors: Vec<String> = sources
         .iter()
-        .filter_map(|(source, binding, named_in)| {
-            library.load_bound(source, *binding).err().map(|e| format!("{e}{named_in}"))
+        .filter_map(|(source, binding, clip, named_in)| {
+            let loaded = library.load_bound(source, *binding).map(drop);
+            let clip = clip.as_ref().map_or(Ok(()), |file| library.keyframe_clip(file).map(drop));
+            loaded.and(clip).err().map(|e| format!("{e}{named_in}"))
         })
         .collect();
     if errors.is_empty() { Ok(library) } else { Err(errors.join("\n")) }

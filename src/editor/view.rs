@@ -378,8 +378,7 @@ fn attach_skin_material(
 /// A skin texture's pixels: a BMP file read now, or the image its character's file held.
 fn picture_of(texture: &SkinTexture) -> Result<std::sync::Arc<crate::rig::Picture>, crate::formats::FormatError> {
     match texture {
-        SkinTexture::File(path) => std::fs::read(path)
-            .map_err(|e| crate::formats::FormatError::io(path, e))
+        SkinTexture::File(path) => crate::formats::error::read_file(path)
             .and_then(|bytes| crate::formats::bmp::decode_bmp(&bytes, path))
             .map(std::sync::Arc::new),
         SkinTexture::Picture { picture, .. } => Ok(picture.clone()),

@@ -13,9 +13,9 @@ use std::path::Path;
 use glam::{Quat, Vec3};
 
 use super::cse169::{Tokens, tokenize};
-use super::error::FormatError;
+use super::error::{FormatError, Lines, excerpt};
 use crate::rig::anim::{Channel, Clip, Extrapolation, Key, Tangent};
-use crate::rig::{EulerOrder, JointRotation, RawJoint, Skeleton};
+use crate::rig::{EulerOrder, JointRotation, MAX_JOINTS, RawJoint, Skeleton};
 
 /// A BVH file: its skeleton and its motion as a clip.
 #[derive(Debug, Clone)]
@@ -39,7 +39,9 @@ struct Read {
 
 /// Parses a BVH file.
 pub fn parse_bvh(reader: impl BufRead, path: &Path) -> Result<BvhFile, FormatError> {
-    let mut tokens = Tokens::new(tokenize(reader, path)?, path);
+    let mut lines = Lines::new(reader, path);
+    let hierarchy = hierarchy_text(&mut lines)?;
+    let mut tokens = Tokens::new(tokenize(hierarchy.as_bytes(), path)?, path);
     tokens.expect("HIERARCHY")?;
     let mut joints: Vec<Read> = Vec::new();
     let mut open: Vec<usize> = Vec::new();
@@ -53,10 +55,17 @@ pub fn parse_bvh(reader: impl BufRead, path: &Path) -> Result<BvhFile, FormatErr
                     return Err(FormatError::syntax(
                         path,
                         word.line,
-                        format!("expected one ROOT first, found `{}`", word.text),
+                        format!("expected one ROOT first, found `{}`", excerpt(&word.text)),
                     ));
                 }
                 first = false;
+                if joints.len() >= MAX_JOINTS {
+                    return Err(FormatError::syntax(
+                        path,
+                        word.line,
+                        format!("expected at most {MAX_JOINTS} joints, found more"),
+                    ));
+                }
                 let name = tokens.next_token("a joint name")?.text;
                 tokens.expect("{")?;
                 tokens.expect("OFFSET")?;
@@ -81,7 +90,7 @@ pub fn parse_bvh(reader: impl BufRead, path: &Path) -> Result<BvhFile, FormatErr
                             return Err(FormatError::syntax(
                                 path,
                                 t.line,
-                                format!("expected a channel (Xposition … Zrotation), found `{other}`"),
+                                format!("expected a channel (Xposition … Zrotation), found `{}`", excerpt(other)),
                             ));
                         }
                     };
@@ -113,27 +122,38 @@ pub fn parse_bvh(reader: impl BufRead, path: &Path) -> Result<BvhFile, FormatErr
                 return Err(FormatError::syntax(
                     path,
                     word.line,
-                    format!("expected `JOINT`, `End` or `}}`, found `{other}`"),
+                    format!("expected `JOINT`, `End` or `}}`, found `{}`", excerpt(other)),
                 ));
             }
         }
     }
-    let frames = frame_header(&mut tokens, "Frames:")?;
-    tokens.expect("Frame")?;
-    tokens.expect("Time:")?;
-    let frame_time = tokens.number("the frame time")?;
-    if frame_time <= 0.0 {
-        return Err(tokens.error("a positive frame time"));
+    if !tokens.at_end() {
+        return Err(tokens.error("the line end after `MOTION`"));
     }
-    if (frames as u64) * (columns as u64) > 50_000_000 {
-        return Err(tokens.error("at most 50 million channel values"));
+    let mut motion = Numbers { lines, words: Vec::new(), next: 0, path };
+    let frames = frame_header(&mut motion)?;
+    motion.expect("Frame")?;
+    motion.expect("Time:")?;
+    let frame_time = motion.number("the frame time")?;
+    if frame_time <= 0.0 {
+        return Err(motion.error("a positive frame time"));
+    }
+    if (frames as u64) * (columns as u64) > MAX_CHANNEL_VALUES as u64 {
+        return Err(
+            motion.error(&format!("at most {MAX_CHANNEL_VALUES} channel values ({frames} frames of {columns})"))
+        );
+    }
+    if !(frames.saturating_sub(1) as f64 * f64::from(frame_time)).is_finite()
+        || frames as f64 * f64::from(frame_time) > f64::from(f32::MAX)
+    {
+        return Err(motion.error("a frame time that keeps the clip's length finite"));
     }
     let mut values = Vec::with_capacity(frames * columns);
     for _ in 0..frames * columns {
-        values.push(tokens.number("a channel value")?);
+        values.push(motion.number("a channel value")?);
     }
-    if !tokens.at_end() {
-        return Err(tokens.error(&format!("the end of the file after {frames} frames of {columns} values")));
+    if !motion.at_end()? {
+        return Err(motion.error(&format!("the end of the file after {frames} frames of {columns} values")));
     }
     let names: Vec<String> = joints.iter().map(|j| j.raw.name.clone()).collect();
     give_bone_boxes(&mut joints);
@@ -145,12 +165,17 @@ pub fn parse_bvh(reader: impl BufRead, path: &Path) -> Result<BvhFile, FormatErr
 }
 
 /// Each joint a box along the bone to its first child (a small cube at a tip), so the
-/// skeleton shows as boxes whatever the file's units.
+/// skeleton shows as boxes whatever the file's units. One pass over the joints.
 fn give_bone_boxes(joints: &mut [Read]) {
-    let lengths: Vec<f32> = joints.iter().map(|j| j.raw.rest_offset.length()).collect();
-    let typical = lengths.iter().copied().fold(0.0, f32::max).max(1e-3) * 0.08;
+    let typical = joints.iter().map(|j| j.raw.rest_offset.length()).fold(0.0, f32::max).max(1e-3) * 0.08;
+    let mut first_child: Vec<Option<usize>> = vec![None; joints.len()];
+    for (c, joint) in joints.iter().enumerate().rev() {
+        if let Some(p) = joint.raw.parent {
+            first_child[p] = Some(c);
+        }
+    }
     for j in 0..joints.len() {
-        let bone = joints.iter().find(|c| c.raw.parent == Some(j)).map(|c| c.raw.rest_offset);
+        let bone = first_child[j].map(|c| joints[c].raw.rest_offset);
         let thick = bone.map_or(typical, |b| (b.length() * 0.15).min(typical)).max(1e-4);
         let end = bone.unwrap_or(Vec3::ZERO);
         joints[j].raw.bone_box = Some(crate::rig::BoneBox {
@@ -161,13 +186,80 @@ fn give_bone_boxes(joints: &mut [Read]) {
 }
 
 /// `Frames:` and a whole count.
-fn frame_header(tokens: &mut Tokens, word: &str) -> Result<usize, FormatError> {
-    tokens.expect(word)?;
-    let n = tokens.number("the number of frames")?;
+fn frame_header<R: BufRead>(motion: &mut Numbers<R>) -> Result<usize, FormatError> {
+    motion.expect("Frames:")?;
+    let n = motion.number("the number of frames")?;
     if n < 0.0 || n.fract() != 0.0 || n > 1e7 {
-        return Err(tokens.error("a whole number of frames"));
+        return Err(motion.error("a whole number of frames"));
     }
     Ok(n as usize)
+}
+
+/// The most channel values (frames × channels) a BVH file may hold.
+const MAX_CHANNEL_VALUES: usize = 50_000_000;
+
+/// The text up to the line of `MOTION` (that line included), read line by line: the rest,
+/// the frames, is read as a stream of numbers.
+fn hierarchy_text<R: BufRead>(lines: &mut Lines<'_, R>) -> Result<String, FormatError> {
+    let mut text = String::new();
+    while let Some((_, line)) = lines.next_line()? {
+        text.push_str(line);
+        text.push('\n');
+        if line.split_whitespace().next() == Some("MOTION") {
+            break;
+        }
+    }
+    Ok(text)
+}
+
+/// The words of the motion section, read a line at a time (one frame's values are never
+/// all held as text).
+struct Numbers<'p, R> {
+    lines: Lines<'p, R>,
+    words: Vec<String>,
+    next: usize,
+    path: &'p Path,
+}
+
+impl<R: BufRead> Numbers<'_, R> {
+    /// The next word, or none at the end of the file.
+    fn peek(&mut self) -> Result<Option<&str>, FormatError> {
+        while self.next >= self.words.len() {
+            let Some((_, line)) = self.lines.next_line()? else { return Ok(None) };
+            self.words = line.split_whitespace().map(str::to_string).collect();
+            self.next = 0;
+        }
+        Ok(Some(&self.words[self.next]))
+    }
+
+    fn error(&self, expected: &str) -> FormatError {
+        let found = self.words.get(self.next).map_or("the end of the file".into(), |w| format!("`{}`", excerpt(w)));
+        FormatError::syntax(self.path, self.lines.line().max(1), format!("expected {expected}, found {found}"))
+    }
+
+    fn expect(&mut self, word: &str) -> Result<(), FormatError> {
+        if self.peek()? == Some(word) {
+            self.next += 1;
+            Ok(())
+        } else {
+            Err(self.error(&format!("`{word}`")))
+        }
+    }
+
+    fn number(&mut self, what: &str) -> Result<f32, FormatError> {
+        match self.peek()?.map(str::parse::<f32>) {
+            Some(Ok(v)) if v.is_finite() => {
+                self.next += 1;
+                Ok(v)
+            }
+            Some(Ok(_)) => Err(self.error(&format!("a finite number ({what})"))),
+            _ => Err(self.error(&format!("a number ({what})"))),
+        }
+    }
+
+    fn at_end(&mut self) -> Result<bool, FormatError> {
+        Ok(self.peek()?.is_none())
+    }
 }
 
 /// The motion as a clip: per frame, the root's position and each joint's rotation as x, y,

@@ -77,8 +77,11 @@ impl CharacterSource {
 
 /// Whether a `.skel` is the CSE169 kind (its first word is `balljoint`).
 fn is_cse169_skel(path: &Path) -> Result<bool, FormatError> {
-    let text = std::fs::read(path).map_err(|e| FormatError::io(path, e))?;
-    let text = String::from_utf8_lossy(&text);
+    use std::io::Read;
+    // The first word is in the first few kilobytes of any real file.
+    let mut head = Vec::new();
+    open(path)?.take(64 << 10).read_to_end(&mut head).map_err(|e| FormatError::io(path, e))?;
+    let text = String::from_utf8_lossy(&head);
     Ok(text.split_whitespace().next().is_some_and(|w| w.starts_with("balljoint")))
 }
 
@@ -194,9 +197,9 @@ fn load_cse169_skin(name: String, skeleton: Skeleton, path: &Path) -> Result<Cha
 /// `head2.morph` for `head.skin`), in name order, as moves from the skin's positions (the
 /// files give where the vertices go).
 fn morphs_beside(skin: &Path, positions: &[glam::Vec3]) -> Result<Vec<crate::rig::MorphTarget>, FormatError> {
-    let (Some(dir), Some(stem)) = (skin.parent(), skin.file_stem().and_then(|s| s.to_str())) else {
-        return Ok(Vec::new());
-    };
+    let Some(stem) = skin.file_stem().and_then(|s| s.to_str()) else { return Ok(Vec::new()) };
+    // `head.skin` (no folder in the path) has its siblings in the working folder.
+    let dir = skin.parent().filter(|d| !d.as_os_str().is_empty()).unwrap_or(Path::new("."));
     let mut files: Vec<PathBuf> = std::fs::read_dir(dir)
         .map(|entries| entries.filter_map(|e| Some(e.ok()?.path())).collect())
         .unwrap_or_default();

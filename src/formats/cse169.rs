@@ -1,12 +1,13 @@
 //! UCSD CSE169 `.skel`: nested `balljoint name { offset boxmin boxmax rotxlimit
 //! rotylimit rotzlimit pose balljoint... }` blocks.
 
-use std::io::BufRead;
+use std::io::{BufRead, Read};
 use std::path::Path;
 
 use glam::Vec3;
 
 use super::error::FormatError;
+use super::limits::{MAX_FILE_BYTES, MAX_TOKENS};
 use crate::rig::{BoneBox, DofLimits, JointRotation, MAX_JOINTS, RawJoint, Skeleton};
 
 /// A token and the line it starts on.
@@ -18,9 +19,15 @@ pub struct Token {
 
 /// Splits text into whitespace-separated tokens with their line numbers. LF, CRLF and bare
 /// CR all end a line; `{` and `}` are tokens of their own even when glued to a word.
-pub fn tokenize(mut reader: impl BufRead, path: &Path) -> Result<Vec<Token>, FormatError> {
+pub fn tokenize(reader: impl BufRead, path: &Path) -> Result<Vec<Token>, FormatError> {
     let mut bytes = Vec::new();
-    reader.read_to_end(&mut bytes).map_err(|e| FormatError::io(path, e))?;
+    reader.take(MAX_FILE_BYTES + 1).read_to_end(&mut bytes).map_err(|e| FormatError::io(path, e))?;
+    if bytes.len() as u64 > MAX_FILE_BYTES {
+        return Err(FormatError::other(
+            path,
+            format!("the input is larger than the {} MiB Marionette reads", MAX_FILE_BYTES >> 20),
+        ));
+    }
     let text = String::from_utf8_lossy(&bytes);
     let mut tokens = Vec::new();
     let mut line = 1;
@@ -33,6 +40,13 @@ pub fn tokenize(mut reader: impl BufRead, path: &Path) -> Result<Vec<Token>, For
         }
     };
     for c in text.chars() {
+        if tokens.len() >= MAX_TOKENS {
+            return Err(FormatError::syntax(
+                path,
+                line,
+                format!("expected at most {MAX_TOKENS} words and braces, found more"),
+            ));
+        }
         match c {
             '\n' | '\r' => {
                 flush(&mut current, &mut tokens, start_line);
@@ -85,7 +99,8 @@ impl<'a> Tokens<'a> {
     }
 
     pub fn error(&self, expected: &str) -> FormatError {
-        let found = self.peek().map_or("the end of the file".to_string(), |t| format!("`{}`", t.text));
+        let found =
+            self.peek().map_or("the end of the file".to_string(), |t| format!("`{}`", super::error::excerpt(&t.text)));
         FormatError::syntax(self.path, self.line(), format!("expected {expected}, found {found}"))
     }
 

@@ -99,7 +99,9 @@ pub fn parse_skin(reader: impl BufRead, path: &Path) -> Result<SkinFile, FormatE
                     let key = tokens.next_token("`texture`")?;
                     let value = tokens.next_token("a file name")?;
                     if key.text == "texture" {
-                        skin.texture = Some(path.parent().unwrap_or(Path::new(".")).join(value.text));
+                        let texture = super::uri::inside_folder(path, &value.text)
+                            .map_err(|e| FormatError::syntax(path, value.line, e))?;
+                        skin.texture = Some(texture);
                     }
                 }
                 tokens.expect("}")?;
@@ -128,7 +130,8 @@ pub fn parse_skin(reader: impl BufRead, path: &Path) -> Result<SkinFile, FormatE
                     path,
                     tokens.line(),
                     format!(
-                        "expected `positions`, `normals`, `texcoords`, `skinweights`, `material`, `triangles` or `bindings`, found `{other}`"
+                        "expected `positions`, `normals`, `texcoords`, `skinweights`, `material`, `triangles` or `bindings`, found `{}`",
+                        super::error::excerpt(other)
                     ),
                 ));
             }
@@ -184,7 +187,7 @@ pub fn parse_morph(reader: impl BufRead, path: &Path, vertex_count: usize) -> Re
                 return Err(FormatError::syntax(
                     path,
                     tokens.line(),
-                    format!("expected `positions` or `normals`, found `{other}`"),
+                    format!("expected `positions` or `normals`, found `{}`", super::error::excerpt(other)),
                 ));
             }
         };
@@ -207,6 +210,9 @@ pub fn parse_anim(reader: impl BufRead, path: &Path) -> Result<Clip, FormatError
     let range = (tokens.number("the range's start")?, tokens.number("the range's end")?);
     tokens.expect("numchannels")?;
     let count = index(&mut tokens, "the number of channels", 1 << 20)?;
+    if !(range.1 - range.0).is_finite() {
+        return Err(FormatError::syntax(path, tokens.line(), "expected a range whose length is finite"));
+    }
     let channels = (0..count).map(|_| channel(&mut tokens)).collect::<Result<_, _>>()?;
     tokens.expect("}")?;
     if !tokens.at_end() {
@@ -227,8 +233,10 @@ fn channel(tokens: &mut Tokens) -> Result<Channel, FormatError> {
     let after = extrapolation(tokens)?;
     tokens.expect("keys")?;
     let n = counted_block(tokens, "keys")?;
+    let mut lines = Vec::new();
     let keys = (0..n)
         .map(|_| {
+            lines.push(tokens.line());
             Ok(Key {
                 time: tokens.number("a key's time")?,
                 value: tokens.number("a key's value")?,
@@ -239,7 +247,18 @@ fn channel(tokens: &mut Tokens) -> Result<Channel, FormatError> {
         .collect::<Result<Vec<_>, FormatError>>()?;
     tokens.expect("}")?;
     tokens.expect("}")?;
-    Ok(Channel::new(keys, before, after))
+    // The channel sorts its keys by time (stably): the lines in the same order.
+    let mut by_time: Vec<(f32, usize)> = keys.iter().map(|k| k.time).zip(lines).collect();
+    by_time.sort_by(|a, b| a.0.total_cmp(&b.0));
+    let channel = Channel::new(keys, before, after);
+    if let Some(k) = channel.first_unusable_key() {
+        return Err(FormatError::syntax(
+            tokens.path(),
+            by_time[k].1,
+            "expected a key whose curve stays finite (its value or slope overflows)",
+        ));
+    }
+    Ok(channel)
 }
 
 fn extrapolation(tokens: &mut Tokens) -> Result<Extrapolation, FormatError> {

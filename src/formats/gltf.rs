@@ -82,6 +82,8 @@ struct Builder {
     views: Vec<Value>,
     accessors: Vec<Value>,
     nodes: Vec<Value>,
+    /// The first float accessor that holds a number that is not finite.
+    non_finite: Option<usize>,
 }
 
 impl Builder {
@@ -94,6 +96,12 @@ impl Builder {
         let mut view = json!({ "buffer": 0, "byteOffset": self.bin.len(), "byteLength": bytes.len() });
         if let Some(t) = target {
             view["target"] = json!(t);
+        }
+        if accessor["componentType"] == json!(FLOAT)
+            && self.non_finite.is_none()
+            && bytes.chunks_exact(4).any(|f| !f32::from_le_bytes([f[0], f[1], f[2], f[3]]).is_finite())
+        {
+            self.non_finite = Some(self.accessors.len());
         }
         self.bin.extend_from_slice(bytes);
         self.views.push(view);
@@ -116,8 +124,9 @@ impl Builder {
     }
 }
 
-/// The characters as one binary glTF file.
-pub fn write_glb(characters: &[GltfCharacter], mesh: GltfMesh) -> Vec<u8> {
+/// The characters as one binary glTF file, or where it would hold a number that is not
+/// finite (a NaN pose or position: nothing is written then).
+pub fn write_glb(characters: &[GltfCharacter], mesh: GltfMesh) -> Result<Vec<u8>, String> {
     let mut b = Builder::default();
     let (mut meshes, mut skins, mut materials, mut roots) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
     let mut animations = Vec::new();
@@ -224,7 +233,26 @@ pub fn write_glb(characters: &[GltfCharacter], mesh: GltfMesh) -> Vec<u8> {
     if !animations.is_empty() {
         doc["animations"] = json!(animations);
     }
-    glb(&serde_json::to_vec(&doc).expect("a JSON value serialises"), &b.bin)
+    if let Some(a) = b.non_finite {
+        return Err(format!("at $.accessors[{a}]: the glTF would hold a number that is not finite"));
+    }
+    // serde_json writes a NaN or infinite number as null: no array of a glTF file holds one.
+    if let Some(at) = null_in_array(&doc, "$") {
+        return Err(format!("at {at}: the glTF would hold a number that is not finite"));
+    }
+    Ok(glb(&serde_json::to_vec(&doc).expect("a JSON value serialises"), &b.bin))
+}
+
+/// The path of the first null inside an array of `value` (where a non-finite number went).
+fn null_in_array(value: &Value, at: &str) -> Option<String> {
+    match value {
+        Value::Array(items) => items.iter().enumerate().find_map(|(i, v)| match v {
+            Value::Null => Some(format!("{at}[{i}]")),
+            v => null_in_array(v, &format!("{at}[{i}]")),
+        }),
+        Value::Object(fields) => fields.iter().find_map(|(k, v)| null_in_array(v, &format!("{at}.{k}"))),
+        _ => None,
+    }
 }
 
 /// A glTF animation of the joint nodes `joints`: every joint's rotation and the root's

@@ -36,14 +36,14 @@ pub fn is_gltf(path: &Path) -> bool {
 
 /// Loads every skinned character of a glTF file, in the order of its skins.
 pub fn load_gltf(path: &Path) -> Result<Vec<ImportedCharacter>, FormatError> {
-    let bytes = std::fs::read(path).map_err(|e| FormatError::io(path, e))?;
+    let bytes = super::error::read_file(path)?;
     parse_gltf(&bytes, path)
 }
 
 /// The skinned characters of a glTF file's bytes (`.bin` files are looked for beside
 /// `path`), one per skin that a mesh uses, in the order of the skins.
 pub fn parse_gltf(bytes: &[u8], path: &Path) -> Result<Vec<ImportedCharacter>, FormatError> {
-    let gltf = validated(bytes).map_err(|e| FormatError::other(path, format!("at $: expected glTF 2.0, {e}")))?;
+    let gltf = validated(bytes).map_err(|e| FormatError::other(path, e))?;
     if let Some(ext) = gltf.extensions_required().next() {
         return Err(FormatError::other(path, format!("at $.extensionsRequired: needs `{ext}`, which is not read")));
     }
@@ -101,7 +101,15 @@ impl File<'_> {
         let mut inverse = vec![Mat4::IDENTITY; skeleton.len()];
         if let Some(ibm) = skin.reader(self.data()).read_inverse_bind_matrices() {
             for (j, m) in ibm.enumerate().take(skeleton.len()) {
-                inverse[new_index[j]] = Mat4::from_cols_array_2d(&m);
+                let m = Mat4::from_cols_array_2d(&m);
+                if !m.is_finite() || m.determinant().abs() < 1e-12 || !m.inverse().is_finite() {
+                    let what = if m.is_finite() { "a singular matrix" } else { "numbers that are not finite" };
+                    return Err(self.error(format!(
+                        "at $.skins[{}].inverseBindMatrices: expected an invertible matrix for joint {j}, found {what}",
+                        skin.index()
+                    )));
+                }
+                inverse[new_index[j]] = m;
             }
         }
         let mut skin_data = Skin::default();
@@ -128,8 +136,15 @@ impl File<'_> {
                     let uv = primitive.reader(self.data()).read_tex_coords(info.tex_coord());
                     texcoords.resize(first, Vec2::ZERO);
                     texcoords.extend(uv.into_iter().flat_map(|t| t.into_f32()).map(Vec2::from));
+                    if let Some(v) = texcoords[first..].iter().position(|t| !t.is_finite()) {
+                        return Err(self.error(format!(
+                            "{at}.attributes.TEXCOORD_{}: expected finite numbers, found vertex {v}'s {}",
+                            info.tex_coord(),
+                            texcoords[first + v]
+                        )));
+                    }
                 }
-                self.morph_targets(mesh, &primitive, first, &mut morphs);
+                self.morph_targets(mesh, &primitive, &at, first, &mut morphs)?;
             }
         }
         let (weights, normalised) = SkinWeights::from_rows(rows, skeleton.len())
@@ -168,7 +183,8 @@ impl File<'_> {
     /// The skin's joints as a skeleton (reordered parents first: `new_index[file joint]`)
     /// and the transform of the nodes above its root.
     fn skeleton(&self, skin: &gltf::Skin, joints: &[gltf::Node]) -> Result<(Skeleton, Vec<usize>, Mat4), FormatError> {
-        let joint_of = |node: usize| joints.iter().position(|j| j.index() == node);
+        let joint_of = joint_of_node(self.gltf, joints);
+        let joint_of = |node: usize| joint_of[node];
         let mut raw = Vec::with_capacity(joints.len());
         let mut root_parent = Mat4::IDENTITY;
         for (j, node) in joints.iter().enumerate() {
@@ -209,6 +225,12 @@ impl File<'_> {
             .ok_or_else(|| self.error(format!("{at}.attributes.POSITION: expected positions, found none")))?
             .map(Vec3::from)
             .collect();
+        if let Some(v) = points.iter().position(|p| !p.is_finite()) {
+            return Err(self.error(format!(
+                "{at}.attributes.POSITION: expected finite numbers, found vertex {v} at {}",
+                points[v]
+            )));
+        }
         let count = points.len();
         skin.bind_positions.extend(points);
         let indices: Vec<u32> = match reader.read_indices() {
@@ -223,6 +245,11 @@ impl File<'_> {
         let mut set = 0;
         while let (Some(js), Some(ws)) = (reader.read_joints(set), reader.read_weights(set)) {
             for (v, (j, w)) in js.into_u16().zip(ws.into_f32()).enumerate().take(count) {
+                if let Some(bad) = w.iter().find(|w| !(w.is_finite() && **w >= 0.0)) {
+                    return Err(self.error(format!(
+                        "{at}.attributes.WEIGHTS_{set}: expected weights that are finite and not negative, found {bad} at vertex {v}"
+                    )));
+                }
                 for k in 0..4 {
                     if w[k] > 0.0 {
                         let joint = *new_index.get(j[k] as usize).ok_or_else(|| {
@@ -251,23 +278,31 @@ impl File<'_> {
         &self,
         mesh: &gltf::Mesh,
         primitive: &gltf::Primitive,
+        at_primitive: &str,
         first: usize,
         morphs: &mut Vec<MorphTarget>,
-    ) {
+    ) -> Result<(), FormatError> {
         let names = target_names(mesh);
         let reader = primitive.reader(self.data());
         for (k, (positions, _, _)) in reader.read_morph_targets().enumerate() {
             let name = names.get(k).cloned().unwrap_or_else(|| format!("{} target {k}", mesh.name().unwrap_or("mesh")));
-            let at = match morphs.iter().position(|m| m.name == name) {
-                Some(at) => at,
+            let index = match morphs.iter().position(|m| m.name == name) {
+                Some(index) => index,
                 None => {
                     morphs.push(MorphTarget { name, deltas: Vec::new() });
                     morphs.len() - 1
                 }
             };
-            let deltas = positions.into_iter().flatten().enumerate().filter(|(_, d)| *d != [0.0; 3]);
-            morphs[at].deltas.extend(deltas.map(|(v, d)| ((first + v) as u32, Vec3::from(d))));
+            let deltas: Vec<(usize, [f32; 3])> =
+                positions.into_iter().flatten().enumerate().filter(|(_, d)| *d != [0.0; 3]).collect();
+            if let Some((v, _)) = deltas.iter().find(|(_, d)| !d.iter().all(|x| x.is_finite())) {
+                return Err(self.error(format!(
+                    "{at_primitive}.targets[{k}].POSITION: expected finite numbers, found vertex {v}'s"
+                )));
+            }
+            morphs[index].deltas.extend(deltas.into_iter().map(|(v, d)| ((first + v) as u32, Vec3::from(d))));
         }
+        Ok(())
     }
 
     /// A texture's image, decoded (PNG or JPEG, from the file's buffers or a file beside
@@ -281,7 +316,15 @@ impl File<'_> {
                 buffer.get(view.offset()..view.offset() + view.length()).map(<[u8]>::to_vec)
             }
             gltf::image::Source::Uri { uri, .. } if !uri.starts_with("data:") => {
-                std::fs::read(self.path.parent().unwrap_or(Path::new(".")).join(uri)).ok()
+                match super::uri::beside_uri(self.path, uri)
+                    .and_then(|f| super::error::read_file(&f).map_err(|e| e.to_string()))
+                {
+                    Ok(bytes) => Some(bytes),
+                    Err(e) => {
+                        warnings.push(format!("{at}.uri: the base colour texture is not shown ({e})"));
+                        return None;
+                    }
+                }
             }
             gltf::image::Source::Uri { .. } => None,
         };
@@ -310,12 +353,13 @@ impl File<'_> {
         warnings: &mut Vec<String>,
     ) -> Result<Vec<NodeClip>, FormatError> {
         let mut clips = Vec::new();
+        let joint_of = joint_of_node(self.gltf, joints);
         for animation in self.gltf.animations() {
             let mut tracks = vec![JointTracks::default(); joints.len()];
             let mut moved = false;
             for (c, channel) in animation.channels().enumerate() {
                 let node = channel.target().node().index();
-                let Some(j) = joints.iter().position(|n| n.index() == node) else { continue };
+                let Some(j) = joint_of[node] else { continue };
                 let at = format!("at $.animations[{}].channels[{c}]", animation.index());
                 let sampler = format!("at $.animations[{}].samplers[{}]", animation.index(), channel.sampler().index());
                 let reader = channel.reader(self.data());
@@ -323,6 +367,10 @@ impl File<'_> {
                     .read_inputs()
                     .ok_or_else(|| self.error(format!("{sampler}.input: expected key times, found none")))?
                     .collect();
+                if let Some(k) = times.iter().position(|t| !t.is_finite()) {
+                    return Err(self
+                        .error(format!("{sampler}.input: expected finite key times, found {} at key {k}", times[k])));
+                }
                 if let Some(k) = times.windows(2).position(|w| w[0].partial_cmp(&w[1]).is_none_or(|o| o.is_gt())) {
                     return Err(self.error(format!(
                         "{sampler}.input: key time {} follows {} (times must increase and be numbers)",
@@ -345,16 +393,28 @@ impl File<'_> {
                 use gltf::animation::util::ReadOutputs;
                 match outputs {
                     ReadOutputs::Translations(v) => {
-                        let track = Track { times: times.clone(), values: v.map(Vec3::from).collect(), interpolation };
+                        let values: Vec<Vec3> = v.map(Vec3::from).collect();
+                        finite_keys(values.iter().map(|v| v.is_finite()), &sampler).map_err(|e| self.error(e))?;
+                        let track = Track { times: times.clone(), values, interpolation };
                         joint.translation = Some(track).filter(Track::is_complete).ok_or_else(incomplete).map(Some)?;
                     }
                     ReadOutputs::Rotations(v) => {
-                        let values = v.into_f32().map(Quat::from_array).collect();
+                        let values: Vec<Quat> = v.into_f32().map(Quat::from_array).collect();
+                        // CUBICSPLINE tangents may be zero; values must be rotations.
+                        let rotation = |k: usize, q: &Quat| {
+                            q.is_finite()
+                                && (interpolation == Interpolation::CubicSpline && k % 3 != 1
+                                    || q.length_squared() > 1e-12)
+                        };
+                        finite_keys(values.iter().enumerate().map(|(k, q)| rotation(k, q)), &sampler)
+                            .map_err(|e| self.error(format!("{e} (a rotation that is not zero)")))?;
                         let track = Track { times: times.clone(), values, interpolation };
                         joint.rotation = Some(track).filter(Track::is_complete).ok_or_else(incomplete).map(Some)?;
                     }
                     ReadOutputs::Scales(v) => {
-                        let track = Track { times: times.clone(), values: v.map(Vec3::from).collect(), interpolation };
+                        let values: Vec<Vec3> = v.map(Vec3::from).collect();
+                        finite_keys(values.iter().map(|v| v.is_finite()), &sampler).map_err(|e| self.error(e))?;
+                        let track = Track { times: times.clone(), values, interpolation };
                         joint.scale = Some(track).filter(Track::is_complete).ok_or_else(incomplete).map(Some)?;
                     }
                     ReadOutputs::MorphTargetWeights(_) => {
@@ -378,25 +438,34 @@ impl File<'_> {
     }
 }
 
-/// The file parsed and validated by the `gltf` crate, after the checks its validation
-/// takes for granted: its hook for primitives indexes `accessors` by every `POSITION`
-/// without a bounds check (a panic on a bad index), so those indices are checked first.
+/// The file split (GLB), parsed, checked by [`gltf_check`](super::gltf_check) and then
+/// by the `gltf` crate's own validation: nothing is read through the crate before every
+/// index, layout and type it relies on was checked.
 fn validated(bytes: &[u8]) -> Result<gltf::Gltf, String> {
-    let unchecked = gltf::Gltf::from_slice_without_validation(bytes).map_err(|e| e.to_string())?;
-    let json = unchecked.document.into_json();
-    for (m, mesh) in json.meshes.iter().enumerate() {
-        for (p, primitive) in mesh.primitives.iter().enumerate() {
-            if let Some(bad) = primitive.attributes.values().find(|a| a.value() >= json.accessors.len()) {
-                return Err(format!(
-                    "$.meshes[{m}].primitives[{p}].attributes: accessor {} is beyond the file's {}",
-                    bad.value(),
-                    json.accessors.len()
-                ));
-            }
-        }
+    let (json, bin) = super::gltf_check::split_glb(bytes)?;
+    let root = gltf::json::Root::from_slice(json).map_err(|e| format!("at $: expected glTF 2.0 JSON, {e}"))?;
+    super::gltf_check::check(&root, bin)?;
+    let document = gltf::Document::from_json(root).map_err(|e| format!("at $: expected valid glTF 2.0, {e}"))?;
+    Ok(gltf::Gltf { document, blob: bin.map(<[u8]>::to_vec) })
+}
+
+/// `sampler.output: expected finite key values, found … at value k` for the first value
+/// that fails.
+fn finite_keys(good: impl Iterator<Item = bool>, sampler: &str) -> Result<(), String> {
+    let mut good = good;
+    match good.position(|g| !g) {
+        Some(k) => Err(format!("{sampler}.output: expected finite key values, found an unusable one at value {k}")),
+        None => Ok(()),
     }
-    let document = gltf::Document::from_json(json).map_err(|e| e.to_string())?;
-    Ok(gltf::Gltf { document, blob: unchecked.blob })
+}
+
+/// Each node's joint of the skin `joints` (none for the nodes that are not its joints).
+fn joint_of_node(gltf: &gltf::Gltf, joints: &[gltf::Node]) -> Vec<Option<usize>> {
+    let mut joint = vec![None; gltf.nodes().len()];
+    for (j, node) in joints.iter().enumerate() {
+        joint[node.index()] = Some(j);
+    }
+    joint
 }
 
 /// Each node's parent (none for a scene root).
@@ -424,7 +493,8 @@ fn global(gltf: &gltf::Gltf, parent: &[Option<usize>], node: Option<usize>) -> M
     let mut m = Mat4::IDENTITY;
     let mut at = node;
     while let Some(n) = at {
-        let node = gltf.nodes().nth(n).expect("a node of the file");
+        // The nodes are a forest (checked): the walk ends at a root.
+        let Some(node) = gltf.document.nodes().nth(n) else { break };
         m = Mat4::from_cols_array_2d(&node.transform().matrix()) * m;
         at = parent[n];
     }
@@ -447,8 +517,9 @@ fn buffers(gltf: &gltf::Gltf, path: &Path) -> Result<Vec<Vec<u8>>, FormatError> 
                     ));
                 }
                 gltf::buffer::Source::Uri(uri) => {
-                    let file = path.parent().unwrap_or(Path::new(".")).join(uri);
-                    std::fs::read(&file).map_err(|e| FormatError::io(&file, e))?
+                    let read = super::uri::beside_uri(path, uri)
+                        .and_then(|file| super::error::read_file(&file).map_err(|e| e.to_string()));
+                    read.map_err(|e| FormatError::other(path, format!("{at}.uri: {e}")))?
                 }
             };
             if data.len() < b.length() {

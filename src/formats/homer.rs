@@ -70,7 +70,11 @@ pub fn parse_rig(reader: impl BufRead, path: &Path) -> Result<HomerRig, FormatEr
         for (k, child) in joint.children.iter().enumerate() {
             let at = || format!("$[{name:?}].children[{k}]");
             let c = *index.get(child.as_str()).ok_or_else(|| {
-                json_error(path, &at(), format!("expected a joint name, found `{child}`, which is not defined"))
+                json_error(
+                    path,
+                    &at(),
+                    format!("expected a joint name, found `{}`, which is not defined", super::error::excerpt(child)),
+                )
             })?;
             if let Some(other) = parent[c] {
                 return Err(json_error(
@@ -102,7 +106,11 @@ pub fn parse_rig(reader: impl BufRead, path: &Path) -> Result<HomerRig, FormatEr
             for (vertex, weight) in w {
                 let at = || format!("$[{name:?}].weights[{vertex:?}]");
                 let v: usize = vertex.parse().map_err(|_| {
-                    json_error(path, &at(), format!("expected a vertex index as key, found `{vertex}`"))
+                    json_error(
+                        path,
+                        &at(),
+                        format!("expected a vertex index as key, found `{}`", super::error::excerpt(vertex)),
+                    )
                 })?;
                 if !(weight.is_finite() && *weight >= 0.0) {
                     return Err(json_error(path, &at(), format!("expected a finite weight >= 0, found {weight}")));

@@ -29,7 +29,11 @@ pub fn parse_skel(reader: impl BufRead, path: &Path) -> Result<Skeleton, FormatE
         }
         let xyz = tokens[..3].iter().map(|t| parse_number::<f32>(t, path, line_no)).collect::<Result<Vec<_>, _>>()?;
         let parent: i64 = tokens[3].parse().map_err(|_| {
-            FormatError::syntax(path, line_no, format!("expected an integer parent index, found `{}`", tokens[3]))
+            FormatError::syntax(
+                path,
+                line_no,
+                format!("expected an integer parent index, found `{}`", super::error::excerpt(tokens[3])),
+            )
         })?;
         let index = raw.len();
         if index == MAX_JOINTS {

@@ -9,14 +9,17 @@ pub mod cse169;
 pub mod cse169_skin;
 pub mod error;
 pub mod gltf;
+pub mod gltf_check;
 pub mod gltf_import;
 pub mod homer;
+pub mod limits;
 pub mod mit6837;
 pub mod obj;
 pub mod off;
 pub mod puppet;
 pub mod scene;
 pub mod smpl;
+pub mod uri;
 
 pub use character::{CharacterSource, load_character};
 

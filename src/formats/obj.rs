@@ -46,7 +46,11 @@ pub fn parse_obj(reader: impl BufRead, path: &Path) -> Result<ObjMesh, FormatErr
                     .map(|t| {
                         let first = t.split('/').next().unwrap_or("");
                         first.parse::<i64>().map_err(|_| {
-                            FormatError::syntax(path, line_no, format!("expected a vertex index, found `{t}`"))
+                            FormatError::syntax(
+                                path,
+                                line_no,
+                                format!("expected a vertex index, found `{}`", super::error::excerpt(t)),
+                            )
                         })
                     })
                     .collect::<Result<Vec<_>, _>>()?;
@@ -88,6 +92,12 @@ pub fn parse_obj(reader: impl BufRead, path: &Path) -> Result<ObjMesh, FormatErr
 
 /// Writes `v` lines (one per vertex, in order) then `f` lines (1-based).
 pub fn write_obj(mut out: impl Write, positions: &[Vec3], triangles: &[[u32; 3]]) -> std::io::Result<()> {
+    if let Some(v) = positions.iter().position(|p| !p.is_finite()) {
+        return Err(std::io::Error::new(
+            std::io::ErrorKind::InvalidData,
+            format!("vertex {} is at {}, not a finite point: nothing was written", v + 1, positions[v]),
+        ));
+    }
     for p in positions {
         writeln!(out, "v {} {} {}", p.x, p.y, p.z)?;
     }

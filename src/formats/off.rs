@@ -20,7 +20,11 @@ pub fn parse_off(reader: impl BufRead, path: &Path) -> Result<ObjMesh, FormatErr
         lines.next().ok_or_else(|| FormatError::syntax(path, 1, "expected `OFF`, found an empty file"))?;
     let mut header_tokens = header.split_whitespace();
     if header_tokens.next() != Some("OFF") {
-        return Err(FormatError::syntax(path, n, format!("expected `OFF`, found `{}`", header.trim())));
+        return Err(FormatError::syntax(
+            path,
+            n,
+            format!("expected `OFF`, found `{}`", super::error::excerpt(header.trim())),
+        ));
     }
     // The counts may follow OFF on the same line.
     let rest: Vec<&str> = header_tokens.collect();
@@ -74,7 +78,7 @@ pub fn parse_off(reader: impl BufRead, path: &Path) -> Result<ObjMesh, FormatErr
             return Err(FormatError::syntax(
                 path,
                 n,
-                format!("expected a polygon `k i0 .. i(k-1)` with k >= 3, found `{}`", l.trim()),
+                format!("expected a polygon `k i0 .. i(k-1)` with k >= 3, found `{}`", super::error::excerpt(l.trim())),
             ));
         }
         let idx = t[1..=k]

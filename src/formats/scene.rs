@@ -445,34 +445,34 @@ impl SceneDoc {
     pub fn validate(&self) -> Result<(), String> {
         for (i, c) in self.characters.iter().enumerate() {
             let at = |field: &str| format!("characters[{i}].{field}");
+            if let SourceDoc::Part(_, n) = c.source
+                && n >= MAX_PARTS
+            {
+                return Err(format!("{}: expected a character index below {MAX_PARTS}, found {n}", at("source")));
+            }
             finite(&at("placement.translation"), &c.placement.translation.to_array())?;
             finite(&at("placement.yaw"), &[c.placement.yaw])?;
             positive(&at("placement.scale"), c.placement.scale)?;
-            for (key, rotation) in &c.pose {
-                let at = at(&format!("pose[{key:?}]"));
-                match rotation {
-                    JointRotation::Euler(angles, _) => finite(&at, &angles.to_array())?,
-                    JointRotation::Quat(q) => {
-                        finite(&at, &q.to_array())?;
-                        if q.length_squared() < 1e-12 {
-                            return Err(format!("{at}: expected a rotation, found a zero quaternion"));
-                        }
-                    }
-                }
-            }
+            rotations(&at("pose"), &c.pose)?;
             finite(&at("view.tint"), &c.view.tint)?;
             if let Some(smpl) = &c.smpl {
                 finite(&at("smpl.betas"), &smpl.betas)?;
                 finite(&at("smpl.time"), &[smpl.time])?;
                 finite(&at("smpl.speed"), &[smpl.speed])?;
-                finite(&at("smpl.blend"), &[smpl.blend])?;
-                if !(0.0..=1.0).contains(&smpl.blend) {
-                    return Err(format!(
-                        "{}: expected a blend weight in 0..=1, found {}",
-                        at("smpl.blend"),
-                        smpl.blend
-                    ));
+                blend_weight(&at("smpl.blend"), smpl.blend)?;
+            }
+            if let Some(anim) = &c.anim {
+                finite(&at("anim.time"), &[anim.time])?;
+                finite(&at("anim.speed"), &[anim.speed])?;
+                if let Some(keys) = &anim.keys {
+                    keys.check().map_err(|e| format!("{}.{e}", at("anim.keys")))?;
                 }
+            }
+            finite(&at("morphs"), &c.morphs)?;
+            if let Some(playback) = &c.playback {
+                finite(&at("playback.time"), &[playback.time])?;
+                finite(&at("playback.speed"), &[playback.speed])?;
+                blend_weight(&at("playback.blend"), playback.blend)?;
             }
         }
         if let Some(camera) = &self.camera {
@@ -480,7 +480,40 @@ impl SceneDoc {
             finite("camera.yaw", &[camera.yaw, camera.pitch])?;
             positive("camera.distance", camera.distance)?;
         }
+        for (name, pose) in &self.poses {
+            rotations(&format!("poses[{name:?}].joints"), &pose.joints)?;
+            finite(&format!("poses[{name:?}].thumbnail"), pose.thumbnail.as_flattened())?;
+        }
         finite("stage.floor_height", &[self.stage.floor_height])
+    }
+}
+
+/// The most characters a scene may take from one file (`Part(file, n)`).
+pub const MAX_PARTS: usize = 1 << 16;
+
+/// Rotations by joint: finite, and quaternions not zero.
+fn rotations(at: &str, pose: &BTreeMap<String, JointRotation>) -> Result<(), String> {
+    for (key, rotation) in pose {
+        let at = format!("{at}[{key:?}]");
+        match rotation {
+            JointRotation::Euler(angles, _) => finite(&at, &angles.to_array())?,
+            JointRotation::Quat(q) => {
+                finite(&at, &q.to_array())?;
+                if q.length_squared() < 1e-12 {
+                    return Err(format!("{at}: expected a rotation, found a zero quaternion"));
+                }
+            }
+        }
+    }
+    Ok(())
+}
+
+/// A blend weight: finite, in 0..=1.
+fn blend_weight(at: &str, value: f32) -> Result<(), String> {
+    if (0.0..=1.0).contains(&value) {
+        Ok(())
+    } else {
+        Err(format!("{at}: expected a blend weight in 0..=1, found {value}"))
     }
 }
 
@@ -507,6 +540,8 @@ pub fn scene_to_string(doc: &SceneDoc) -> Result<String, ron::Error> {
 
 /// Writes a scene whole or not at all (temporary file, then rename).
 pub fn save_scene(path: &Path, doc: &SceneDoc) -> Result<(), FormatError> {
+    // What we write must read back: no NaN, no zero quaternion, no overflowing key.
+    doc.validate().map_err(|e| FormatError::other(path, format!("cannot be written: {e}")))?;
     let text = scene_to_string(doc).map_err(|e| FormatError::other(path, format!("cannot be written: {e}")))?;
     super::write_atomically(path, |w| std::io::Write::write_all(w, text.as_bytes()))
         .map_err(|e| FormatError::io(path, e))

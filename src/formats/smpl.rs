@@ -63,7 +63,11 @@ pub fn parse_hierarchy(reader: impl BufRead, path: &Path) -> Result<Skeleton, Fo
             return Err(FormatError::syntax(path, *n, format!("expected a parent index in {allowed}, found {parent}")));
         }
         if t[2] != "EULER_XYZ" {
-            return Err(FormatError::syntax(path, *n, format!("expected rotation order EULER_XYZ, found `{}`", t[2])));
+            return Err(FormatError::syntax(
+                path,
+                *n,
+                format!("expected rotation order EULER_XYZ, found `{}`", super::error::excerpt(t[2])),
+            ));
         }
         let mut joint = RawJoint::new(t[3], (parent >= 0).then_some(parent as usize), Vec3::ZERO);
         joint.initial_rotation = crate::rig::JointRotation::Euler(Vec3::ZERO, EulerOrder::Xyz);
@@ -88,7 +92,7 @@ pub fn parse_skeleton_positions(
         return Err(FormatError::syntax(
             path,
             *header_line,
-            format!("expected `frames {joint_count}`, found `{}`", header.trim()),
+            format!("expected `frames {joint_count}`, found `{}`", super::error::excerpt(header.trim())),
         ));
     }
     let (n, row) = lines.get(1).ok_or_else(|| {
@@ -187,7 +191,7 @@ pub fn parse_clip(reader: impl BufRead, path: &Path, joint_count: usize) -> Resu
         return Err(FormatError::syntax(
             path,
             *header_line,
-            format!("expected `frames {joint_count}`, found `{}`", header.trim()),
+            format!("expected `frames {joint_count}`, found `{}`", super::error::excerpt(header.trim())),
         ));
     }
     let rows = &lines[1..];

@@ -97,6 +97,32 @@ impl Channel {
         })
     }
 
+    /// The first key (in time order) whose numbers the curve cannot use: a time, value or
+    /// slope that is not finite, or a span whose Hermite terms overflow (values near ±3e38,
+    /// keys a hair apart); none when every value the channel gives is finite.
+    pub fn first_unusable_key(&self) -> Option<usize> {
+        let keys = &self.keys;
+        if let Some(k) = keys.iter().position(|key| !(key.time.is_finite() && key.value.is_finite())) {
+            return Some(k);
+        }
+        for (k, key) in keys.iter().enumerate() {
+            let (slope_in, slope_out) = self.slopes[k];
+            if !(slope_in.is_finite() && slope_out.is_finite()) {
+                return Some(k);
+            }
+            if let Some(next) = keys.get(k + 1) {
+                let span = next.time - key.time;
+                // The Hermite basis is within [-1, 1] on [0, 1]: this sum bounds every value.
+                let bound =
+                    key.value.abs() + (slope_out * span).abs() + next.value.abs() + (self.slopes[k + 1].0 * span).abs();
+                if !bound.is_finite() || !(next.value - keys[0].value).is_finite() {
+                    return Some(k + 1);
+                }
+            }
+        }
+        None
+    }
+
     /// The key's (in, out) slopes.
     pub fn slopes(&self, key: usize) -> (f32, f32) {
         self.slopes[key]
@@ -233,6 +259,26 @@ pub struct Clip {
 }
 
 impl Clip {
+    /// Why the clip cannot be played, if it cannot: a range that is not finite (or whose
+    /// length is not), or a channel with an unusable key (see
+    /// [`Channel::first_unusable_key`]). The message starts with the field's path.
+    pub fn check(&self) -> Result<(), String> {
+        let (start, end) = self.range;
+        if !(start.is_finite() && end.is_finite() && (end - start).is_finite()) {
+            return Err(format!("range: expected two finite times a finite length apart, found {start} and {end}"));
+        }
+        for (c, channel) in self.channels.iter().enumerate() {
+            if let Some(k) = channel.first_unusable_key() {
+                let key = channel.keys[k];
+                return Err(format!(
+                    "channels[{c}].keys[{k}]: expected finite numbers whose curve stays finite, found time {} and value {}",
+                    key.time, key.value
+                ));
+            }
+        }
+        Ok(())
+    }
+
     /// Every channel's value at `t`.
     pub fn values_at(&self, t: f32) -> Vec<f32> {
         self.channels.iter().map(|c| c.value_at(t)).collect()
@@ -251,10 +297,12 @@ impl Clip {
         if self.joint_names.is_empty() {
             return self.clone();
         }
-        let source = |target: &str| {
-            let wanted = names.get(target).map_or(target, String::as_str);
-            self.joint_names.iter().position(|n| n == wanted)
-        };
+        // The clip's joints by name (the first of a repeated name), for one look-up per joint.
+        let mut by_name = std::collections::HashMap::with_capacity(self.joint_names.len());
+        for (i, name) in self.joint_names.iter().enumerate() {
+            by_name.entry(name.as_str()).or_insert(i);
+        }
+        let source = |target: &str| by_name.get(names.get(target).map_or(target, String::as_str)).copied();
         let mut clip = Clip::empty(skeleton.len());
         clip.range = self.range;
         for (j, def) in skeleton.joints().iter().enumerate() {

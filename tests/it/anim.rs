@@ -375,7 +375,7 @@ fn a_scene_plays_a_clip_on_the_wasp_and_keeps_it_in_the_file() {
     let mut reloaded = back.characters[0].anim.clone().expect("the clip is kept");
     assert_eq!(
         std::fs::canonicalize(&reloaded.file).unwrap(),
-        anim.file,
+        std::fs::canonicalize(&anim.file).unwrap(),
         "the same file, written relative to the scene"
     );
     reloaded.file = anim.file.clone();

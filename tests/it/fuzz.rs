@@ -29,7 +29,7 @@ const MEMORY_PER_INPUT_BYTE: usize = 256;
 
 /// Which reader a seed goes to, with what it needs besides the bytes.
 #[derive(Debug, Clone, Copy, PartialEq)]
-enum Reader {
+pub(crate) enum Reader {
     Skel6837,
     Attach {
         joints: usize,
@@ -101,7 +101,7 @@ fn names_a_place(e: &FormatError) -> bool {
     match e {
         FormatError::Syntax { line, .. } => *line >= 1,
         FormatError::Other { message, .. } => {
-            ["at $", "characters[", "camera.", "stage."].iter().any(|p| message.starts_with(p))
+            ["at $", "at byte ", "characters[", "camera.", "stage.", "poses["].iter().any(|p| message.starts_with(p))
         }
         FormatError::Rig { .. } | FormatError::Io { .. } => false,
     }
@@ -278,7 +278,7 @@ const EXTREMES: &[&str] = &[
 ];
 
 /// A splitmix64 stream: the bytes `arbitrary` draws its decisions from.
-fn random_bytes(seed: u64, n: usize) -> Vec<u8> {
+pub(crate) fn random_bytes(seed: u64, n: usize) -> Vec<u8> {
     let mut state = seed;
     let mut out = Vec::with_capacity(n + 8);
     while out.len() < n {
@@ -361,7 +361,7 @@ fn mutate(mut bytes: Vec<u8>, u: &mut Unstructured) -> arbitrary::Result<Vec<u8>
 }
 
 /// Runs one case: whether the reader accepted the input, or what it did wrong.
-fn check_case(reader: Reader, input: Vec<u8>) -> Result<bool, String> {
+pub(crate) fn check_case(reader: Reader, input: Vec<u8>) -> Result<bool, String> {
     let limit = MEMORY_BASE + MEMORY_PER_INPUT_BYTE * input.len();
     let (tx, rx) = std::sync::mpsc::channel();
     let case = input.clone();
@@ -440,6 +440,7 @@ fn regressions_are_rejected_with_a_place() {
             "json" if name.contains("character") => Reader::HomerCharacter,
             "json" => Reader::HomerRig,
             "ron" => Reader::Scene,
+            "glb" | "gltf" => Reader::Glb,
             "txt" if name.contains("skin") => Reader::SmplSkin,
             "txt" if name.contains("clip") => Reader::SmplClip,
             "txt" if name.contains("hierarchy") => Reader::SmplHierarchy,

@@ -88,7 +88,7 @@ fn an_exported_character_skins_back_to_our_vertices_with_its_names_and_weights()
         tint: [0.2, 0.4, 0.6],
         ..GltfCharacter::new("p", &puppet, &pose)
     };
-    let (json, bin) = chunks(&write_glb(&[character], GltfMesh::Skinned));
+    let (json, bin) = chunks(&write_glb(&[character], GltfMesh::Skinned).unwrap());
 
     // Our skinned vertices, placed.
     let placement =
@@ -141,7 +141,7 @@ fn more_than_four_influences_go_into_further_sets() {
     let model = marionette::formats::load_character(&crate::common::data_dir().join("mit6837/Model1.skel")).unwrap();
     let pose = model.skeleton.initial_pose();
     let character = GltfCharacter::new("m", &model, &pose);
-    let (json, bin) = chunks(&write_glb(&[character], GltfMesh::Skinned));
+    let (json, bin) = chunks(&write_glb(&[character], GltfMesh::Skinned).unwrap());
     let attributes = &json["meshes"][0]["primitives"][0]["attributes"];
     let sets = model.skin.weights.max_influences().div_ceil(4);
     assert!(sets > 1);
@@ -236,10 +236,10 @@ fn a_clip_goes_out_as_an_animation_of_the_joints() {
     let wasp = marionette::formats::load_character(&data.join("wasp.skel")).unwrap();
     let clip = marionette::formats::load_clip(&data.join("wasp_walk.anim")).unwrap();
     let rest = wasp.skeleton.initial_pose();
-    let motion = marionette::editor::export::sampled(&clip, &wasp.skeleton, &rest);
+    let motion = marionette::editor::export::sampled(&clip, &wasp.skeleton, &rest).unwrap();
     assert_eq!(motion.times.len(), 121, "4 s at 30 frames per second, both ends");
     let character = GltfCharacter { motion: Some(motion), ..GltfCharacter::new("w", &wasp, &rest) };
-    let (json, bin) = chunks(&write_glb(&[character], GltfMesh::Skinned));
+    let (json, bin) = chunks(&write_glb(&[character], GltfMesh::Skinned).unwrap());
     let animation = &json["animations"][0];
     let joints: Vec<u64> = json["skins"][0]["joints"].as_array().unwrap().iter().map(|j| j.as_u64().unwrap()).collect();
     let sampler = |c: &serde_json::Value| &animation["samplers"][c["sampler"].as_u64().unwrap() as usize];
@@ -274,7 +274,7 @@ fn a_round_trip_through_glb_keeps_vertices_names_hierarchy_and_weights() {
     pose[skeleton.find("l_knee").unwrap()] = JointRotation::euler_xyz(0.9, 0.0, 0.0);
     let character = GltfCharacter::new("p", &puppet, &pose);
     let path = crate::common::scratch("gltf-round-trip").join("p.glb");
-    std::fs::write(&path, write_glb(&[character], GltfMesh::Skinned)).unwrap();
+    std::fs::write(&path, write_glb(&[character], GltfMesh::Skinned).unwrap()).unwrap();
     let back = marionette::formats::load_character(&path).unwrap();
     let names =
         |s: &marionette::rig::Skeleton| s.joints().iter().map(|j| (j.name.clone(), j.parent)).collect::<Vec<_>>();
@@ -422,7 +422,7 @@ fn bad_gltf_files_say_what_and_where() {
     let pose = puppet.skeleton.initial_pose();
     let character = GltfCharacter::new("p", &puppet, &pose);
     let baked = dir.join("baked.glb");
-    std::fs::write(&baked, write_glb(&[character], GltfMesh::Baked)).unwrap();
+    std::fs::write(&baked, write_glb(&[character], GltfMesh::Baked).unwrap()).unwrap();
     let e = marionette::formats::load_character(&baked).unwrap_err().to_string();
     assert!(e.contains("baked.glb") && e.contains("skins[0]"), "{e}");
 }
