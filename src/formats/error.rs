@@ -5,7 +5,7 @@ use std::path::{Path, PathBuf};
 
 use crate::rig::RigError;
 
-pub use super::limits::{MAX_EXCERPT_CHARS, MAX_FILE_BYTES};
+pub use super::limits::{MAX_EXCERPT_CHARS, MAX_FILE_BYTES, MAX_MESSAGE_CHARS};
 
 /// A reader's failure.
 #[derive(Debug, thiserror::Error)]
@@ -27,12 +27,12 @@ pub enum FormatError {
 
 impl FormatError {
     pub fn syntax(path: &Path, line: usize, message: impl fmt::Display) -> Self {
-        Self::Syntax { path: path.to_path_buf(), line, column: None, message: message.to_string() }
+        Self::Syntax { path: path.to_path_buf(), line, column: None, message: bounded(message) }
     }
 
     /// As [`syntax`](Self::syntax), at a column of the line (counted from 1).
     pub fn syntax_at(path: &Path, line: usize, column: usize, message: impl fmt::Display) -> Self {
-        Self::Syntax { path: path.to_path_buf(), line, column: Some(column), message: message.to_string() }
+        Self::Syntax { path: path.to_path_buf(), line, column: Some(column), message: bounded(message) }
     }
 
     pub fn rig(path: &Path, source: RigError) -> Self {
@@ -44,7 +44,17 @@ impl FormatError {
     }
 
     pub fn other(path: &Path, message: impl fmt::Display) -> Self {
-        Self::Other { path: path.to_path_buf(), message: message.to_string() }
+        Self::Other { path: path.to_path_buf(), message: bounded(message) }
+    }
+}
+
+/// A message cut to [`MAX_MESSAGE_CHARS`] characters: the last guard against quoting a
+/// huge token (a RON parser's error names the identifier it found, whatever its length).
+fn bounded(message: impl fmt::Display) -> String {
+    let message = message.to_string();
+    match message.char_indices().nth(MAX_MESSAGE_CHARS) {
+        None => message,
+        Some((cut, _)) => format!("{}…", &message[..cut]),
     }
 }
 
@@ -82,13 +92,12 @@ pub fn open_regular(path: &Path) -> Result<std::fs::File, FormatError> {
 
 /// Every file this process opened for reading (their canonical paths), so a command can
 /// refuse to write over one of its own inputs.
-static FILES_READ: std::sync::Mutex<Vec<PathBuf>> = std::sync::Mutex::new(Vec::new());
+static FILES_READ: std::sync::Mutex<std::collections::BTreeSet<PathBuf>> =
+    std::sync::Mutex::new(std::collections::BTreeSet::new());
 
 fn remember_read(path: &Path) {
-    if let (Ok(real), Ok(mut read)) = (path.canonicalize(), FILES_READ.lock())
-        && !read.contains(&real)
-    {
-        read.push(real);
+    if let (Ok(real), Ok(mut read)) = (path.canonicalize(), FILES_READ.lock()) {
+        read.insert(real);
     }
 }
 

@@ -297,7 +297,7 @@ impl File<'_> {
                 positions.into_iter().flatten().enumerate().filter(|(_, d)| *d != [0.0; 3]).collect();
             if let Some((v, _)) = deltas.iter().find(|(_, d)| !d.iter().all(|x| x.is_finite())) {
                 return Err(self.error(format!(
-                    "{at_primitive}.targets[{k}].POSITION: expected finite numbers, found vertex {v}'s"
+                    "{at_primitive}.targets[{k}].POSITION: expected finite numbers, found a move of vertex {v} that is not"
                 )));
             }
             morphs[index].deltas.extend(deltas.into_iter().map(|(v, d)| ((first + v) as u32, Vec3::from(d))));
@@ -451,8 +451,7 @@ fn validated(bytes: &[u8]) -> Result<gltf::Gltf, String> {
 
 /// `sampler.output: expected finite key values, found … at value k` for the first value
 /// that fails.
-fn finite_keys(good: impl Iterator<Item = bool>, sampler: &str) -> Result<(), String> {
-    let mut good = good;
+fn finite_keys(mut good: impl Iterator<Item = bool>, sampler: &str) -> Result<(), String> {
     match good.position(|g| !g) {
         Some(k) => Err(format!("{sampler}.output: expected finite key values, found an unusable one at value {k}")),
         None => Ok(()),

@@ -22,6 +22,9 @@ pub const MAX_SAMPLED_FRAMES: usize = 120_000;
 /// The most characters of a token an error message quotes.
 pub const MAX_EXCERPT_CHARS: usize = 40;
 
+/// The most characters of an error message (past a quoted excerpt, the rest is cut).
+pub const MAX_MESSAGE_CHARS: usize = 600;
+
 /// How many frames a clip `seconds` long takes sampled at `fps` (besides its first), or
 /// why it cannot be sampled: more than [`MAX_SAMPLED_FRAMES`] (a clip keyed at 0 and 1e30
 /// seconds would otherwise ask for `usize::MAX` frames).

@@ -302,6 +302,7 @@ fn a_file_over_the_limit_is_refused_before_it_is_read() {
         });
         assert!(e.0.contains(&format!("larger than the {} MiB", MAX_FILE_BYTES >> 20)), "{name}: {}", e.0);
         assert!(e.1 < 1 << 20, "{name}: {} bytes of heap to refuse it", e.1);
+        std::fs::remove_file(&path).unwrap();
     }
 }
 
