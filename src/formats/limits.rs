@@ -34,7 +34,7 @@ pub fn sampled_frames(seconds: f32, fps: f32) -> Result<usize, String> {
         Ok(frames as usize)
     } else {
         Err(format!(
-            "the clip is {seconds} s long: {frames} frames at {fps} frames per second, more than the \
+            "the clip is {seconds:.3e} s long: {frames:.3e} frames at {fps} frames per second, more than the \
              {MAX_SAMPLED_FRAMES} a clip is sampled into (MAX_SAMPLED_FRAMES)"
         ))
     }
