@@ -120,6 +120,7 @@ CASES = {
     "gltf-rotation-key-zero": lambda d, b: put_floats(d, b, 6, 1, [0, 0, 0, 0]),
     "gltf-node-scale-zero": lambda d, b: d["nodes"][2].update(scale=[1, 0, 1]),
     "gltf-node-translation-inf": lambda d, b: d["nodes"][2].update(translation=[0, 1e39, 0]),
+    "gltf-node-matrix-singular": lambda d, b: d["nodes"][1].update(matrix=[0.0] * 16),
     "gltf-weight-negative": lambda d, b: put_floats(d, b, 3, 1, [1.5, -0.5]),
     "gltf-weight-nan": lambda d, b: put_floats(d, b, 3, 1, [math.nan, 1.0]),
 }

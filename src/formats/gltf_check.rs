@@ -473,6 +473,9 @@ fn nodes(root: &Root) -> Result<(), String> {
 fn node_numbers(node: &json::Node, at: &str) -> Result<(), String> {
     if let Some(matrix) = &node.matrix {
         finite_numbers(matrix, &format!("{at}.matrix"))?;
+        if glam::Mat4::from_cols_array(matrix).determinant().abs() < 1e-12 {
+            return Err(format!("at {at}.matrix: expected an invertible transform, found a singular matrix"));
+        }
     }
     if let Some(t) = &node.translation {
         finite_numbers(t, &format!("{at}.translation"))?;

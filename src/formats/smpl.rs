@@ -219,7 +219,20 @@ pub fn parse_clip(reader: impl BufRead, path: &Path, joint_count: usize) -> Resu
             ));
         }
         clip.root_positions.push(Vec3::new(v[0], v[1], v[2]));
-        clip.rotations.extend(v[3..].chunks_exact(4).map(|q| Quat::from_xyzw(q[0], q[1], q[2], q[3]).normalize()));
+        for (joint, q) in v[3..].chunks_exact(4).enumerate() {
+            let q = Quat::from_xyzw(q[0], q[1], q[2], q[3]);
+            // A zero (or overflowing) quaternion normalises to NaN.
+            if !(q.length_squared().is_finite() && q.length_squared() > 1e-12) {
+                return Err(FormatError::syntax(
+                    path,
+                    *n,
+                    format!(
+                        "expected a rotation for joint {joint}, found the quaternion {q}, which cannot be normalised"
+                    ),
+                ));
+            }
+            clip.rotations.push(q.normalize());
+        }
     }
     Ok(clip)
 }

@@ -113,6 +113,10 @@ const GLTF_CASES: &[(&str, &str)] = &[
     ),
     ("gltf-node-translation-inf.glb", "at $.nodes[2].translation: expected finite numbers, found inf"),
     (
+        "gltf-node-matrix-singular.glb",
+        "at $.nodes[1].matrix: expected an invertible transform, found a singular matrix",
+    ),
+    (
         "gltf-weight-negative.glb",
         "at $.meshes[0].primitives[0].attributes.WEIGHTS_0: expected weights that are finite and not negative, found -0.5 at vertex 1",
     ),
@@ -163,6 +167,14 @@ fn each_hostile_scene_is_refused_at_its_field() {
         let e = scene::parse_scene(Cursor::new(bytes), &path).expect_err(file);
         assert!(e.to_string().contains(expected), "{file}:\n  said     {e}\n  expected {expected}");
     }
+}
+
+#[test]
+fn an_smpl_clip_with_a_zero_quaternion_is_refused_at_its_line() {
+    let path = regressions().join("smpl-clip-zero-quaternion.txt");
+    let bytes = std::fs::read(&path).unwrap();
+    let e = marionette::formats::smpl::parse_clip(Cursor::new(bytes), &path, 24).unwrap_err();
+    assert!(e.to_string().contains("smpl-clip-zero-quaternion.txt:2: expected a rotation for joint 5"), "{e}");
 }
 
 #[test]
