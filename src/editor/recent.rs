@@ -8,7 +8,6 @@ use std::path::{Path, PathBuf};
 use bevy::prelude::*;
 
 use super::state::Messages;
-use super::ui::InspectorState;
 
 /// How many recent files are kept.
 pub const KEPT: usize = 8;
@@ -25,6 +24,17 @@ impl RecentFilesStore {
             .or_else(|| var("XDG_CONFIG_HOME").map(|d| d.join("marionette")))
             .or_else(|| var("HOME").map(|d| d.join(".config/marionette")))?;
         Some(Self(dir.join("recent.txt")))
+    }
+}
+
+/// The recently opened files, most recent first (the panel's "Recent" row).
+#[derive(Resource, Clone, Debug, Default, PartialEq)]
+pub struct RecentFiles(pub Vec<String>);
+
+impl RecentFiles {
+    /// `path` first, once, at most [`KEPT`] kept.
+    pub fn remember(&mut self, path: &str) {
+        remember(&mut self.0, path);
     }
 }
 
@@ -60,32 +70,32 @@ impl Plugin for RecentFilesPlugin {
         if let Some(store) = RecentFilesStore::for_user() {
             app.insert_resource(store);
         }
-        app.add_systems(Startup, load_recent_files).add_systems(Last, save_recent_files);
+        app.init_resource::<RecentFiles>().add_systems(Startup, load_recent_files).add_systems(Last, save_recent_files);
     }
 }
 
-/// Fills the panel's list from the store (reads `RecentFilesStore`; writes `InspectorState`).
-fn load_recent_files(store: Option<Res<RecentFilesStore>>, mut state: ResMut<InspectorState>) {
+/// Fills the list from the store (reads `RecentFilesStore`; writes `RecentFiles`).
+fn load_recent_files(store: Option<Res<RecentFilesStore>>, mut recent: ResMut<RecentFiles>) {
     if let Some(store) = store {
-        state.recent = read_recent(&store.0);
+        recent.0 = read_recent(&store.0);
     }
 }
 
-/// Writes the list when it changed (reads `InspectorState`; a failure is a message).
+/// Writes the list when it changed (reads `RecentFiles`; a failure is a message).
 fn save_recent_files(
     store: Option<Res<RecentFilesStore>>,
-    state: Res<InspectorState>,
+    recent: Res<RecentFiles>,
     mut saved: Local<Option<Vec<String>>>,
     mut messages: ResMut<Messages>,
 ) {
     let Some(store) = store else { return };
-    if saved.as_ref() == Some(&state.recent) {
+    if saved.as_ref() == Some(&recent.0) {
         return;
     }
     if saved.is_some()
-        && let Err(e) = write_recent(&store.0, &state.recent)
+        && let Err(e) = write_recent(&store.0, &recent.0)
     {
         messages.push(format!("{}: the recent files were not kept: {e}", store.0.display()));
     }
-    *saved = Some(state.recent.clone());
+    *saved = Some(recent.0.clone());
 }

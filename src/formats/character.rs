@@ -167,7 +167,7 @@ fn load_cse169_skin(name: String, skeleton: Skeleton, path: &Path) -> Result<Cha
     }
     let (weights, normalised) =
         crate::rig::SkinWeights::from_rows(file.weights, skeleton.len()).map_err(|e| FormatError::rig(path, e))?;
-    let mut warnings = normalised_warnings(path, &normalised);
+    let mut warnings = super::weight_warnings::normalised_warnings(path, &normalised);
     let inverse_binds = file.bindings.iter().map(|m| m.inverse()).collect();
     let morphs = morphs_beside(path, &file.positions)?;
     let textured = file.texcoords.len() == file.positions.len();
@@ -228,28 +228,7 @@ fn load_6837_skin(
     let mesh = obj::parse_obj(open(obj_path)?, obj_path)?;
     let (weights, normalised) =
         mit6837::parse_attach(open(attach_path)?, attach_path, skeleton.len(), mesh.positions.len())?;
-    let warnings = normalised_warnings(attach_path, &normalised);
+    let warnings = super::weight_warnings::normalised_warnings(attach_path, &normalised);
     let skin = Skin { bind_positions: mesh.positions, triangles: mesh.triangles, weights, texcoords: Vec::new() };
     CharacterAsset::new(name, skeleton, skin, warnings).map_err(|e| FormatError::rig(obj_path, e))
-}
-
-/// One warning line for a set of normalised weight rows.
-pub fn normalised_warnings(path: &Path, rows: &[crate::rig::skinning::NormalisedRow]) -> Vec<String> {
-    if rows.is_empty() {
-        return Vec::new();
-    }
-    let (lo, hi) = rows.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), r| (lo.min(r.sum), hi.max(r.sum)));
-    vec![format!(
-        "{}: {} weight rows did not sum to 1 (sums {}..{}; first at vertex {}) and were normalised",
-        path.display(),
-        rows.len(),
-        sum_text(lo),
-        sum_text(hi),
-        rows[0].vertex
-    )]
-}
-
-/// A weight sum for a message: four decimals, or scientific notation when huge.
-fn sum_text(sum: f64) -> String {
-    if sum.abs() < 1e6 { format!("{sum:.4}") } else { format!("{sum:.3e}") }
 }

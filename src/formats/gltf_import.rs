@@ -149,7 +149,7 @@ impl File<'_> {
         }
         let (weights, normalised) = SkinWeights::from_rows(rows, skeleton.len())
             .map_err(|e| self.error(format!("at $.skins[{}] meshes (JOINTS_n, WEIGHTS_n): {e}", skin.index())))?;
-        warnings.extend(super::character::normalised_warnings(self.path, &normalised));
+        warnings.extend(super::weight_warnings::normalised_warnings(self.path, &normalised));
         skin_data.weights = weights;
         if texture.is_some() {
             texcoords.resize(skin_data.bind_positions.len(), Vec2::ZERO);

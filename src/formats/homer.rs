@@ -172,7 +172,7 @@ pub fn homer_character(
             }
             let (weights, normalised) =
                 SkinWeights::from_rows(rows, rig.skeleton.len()).map_err(|e| json_error(rig_path, "$", e))?;
-            warnings.extend(super::character::normalised_warnings(rig_path, &normalised));
+            warnings.extend(super::weight_warnings::normalised_warnings(rig_path, &normalised));
             weights
         }
         None => {

@@ -20,6 +20,7 @@ pub mod puppet;
 pub mod scene;
 pub mod smpl;
 pub mod uri;
+pub mod weight_warnings;
 
 pub use character::{CharacterSource, load_character};
 

@@ -306,7 +306,7 @@ pub fn load_smpl_dir(dir: &Path) -> Result<(SmplModel, Vec<String>), FormatError
             format!("expected {} weight rows (as smpl_00.obj), found {}", base.positions.len(), weights.vertex_count()),
         ));
     }
-    let warnings = super::character::normalised_warnings(&skin_path, &normalised);
+    let warnings = super::weight_warnings::normalised_warnings(&skin_path, &normalised);
     let model = SmplModel {
         skeleton,
         base_positions: base.positions,

@@ -7,7 +7,7 @@
 
 use glam::{Mat4, Quat, Vec3, Vec4};
 
-use super::lbs::FixedGroup;
+use super::influences::FixedGroup;
 use super::skinning::SkinWeights;
 
 /// How a character's vertices follow its joints.
@@ -189,7 +189,7 @@ mod avx2 {
     use glam::{Vec3, Vec4};
 
     use super::DualQuat;
-    use crate::rig::lbs::FixedGroup;
+    use crate::rig::influences::FixedGroup;
     use crate::rig::skinning::{Influence, SkinWeights};
 
     /// `a · b` in every lane, by shuffles and adds (`dpps` is microcoded and slow on

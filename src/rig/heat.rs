@@ -15,7 +15,7 @@
 
 use glam::{DVec3, Vec3};
 
-use super::bind::{Bone, segment_distance};
+use super::bones::{Bone, segment_distance};
 use super::skeleton::Skeleton;
 use super::skinning::SkinWeights;
 use super::triangle_tree::TriangleTree;
@@ -38,7 +38,7 @@ pub enum HeatError {
 /// The bones heat binds to: each joint's segments to its children (zero-length ones
 /// skipped), and for each leaf joint a segment into the part of the mesh beyond it.
 pub fn heat_bones(skeleton: &Skeleton, joints: &[Vec3], vertices: &[Vec3]) -> Vec<Bone> {
-    let mut bones = distinct(super::bind::bones(skeleton, joints));
+    let mut bones = distinct(super::bones::bones(skeleton, joints));
     let size = mesh_size(vertices);
     // A sample of the vertices (at most a few thousand) and how near each is to the bones
     // known so far.

@@ -3,11 +3,13 @@
 
 pub mod anim;
 pub mod bind;
+pub mod bones;
 pub mod character;
 pub mod dqs;
 pub mod fk;
 pub mod heat;
 pub mod ik;
+pub mod influences;
 pub mod lbs;
 pub mod matrix_stack;
 pub mod mirror;

@@ -4,14 +4,8 @@
 use glam::{Mat4, Vec3, Vec3A};
 
 use super::RigError;
-use super::lbs::InfluenceGroups;
-
-/// One joint's influence on a vertex.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Influence {
-    pub joint: u16,
-    pub weight: f32,
-}
+pub use super::influences::Influence;
+use super::influences::InfluenceGroups;
 
 /// Sparse per-vertex influences, stored compressed: the influences of vertex `v` are
 /// `influences[offsets[v]..offsets[v + 1]]`. Any number per vertex.

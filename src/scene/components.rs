@@ -19,9 +19,9 @@ use crate::rig::{CharacterAsset, DofLimits, JointRotation};
     Transform,
     Visibility,
     RestOverrides,
-    super::upload::SkinUpload,
+    super::handoff::SkinUpload,
     SkinOnGpu,
-    super::gpu_skinning::GpuSkinJob
+    super::handoff::GpuSkinJob
 )]
 pub struct Character {
     pub asset: Arc<CharacterAsset>,

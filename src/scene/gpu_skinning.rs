@@ -35,55 +35,34 @@ use super::upload::pack_vertices;
 use crate::rig::CharacterAsset;
 use crate::rig::dqs::{self, SkinningMethod};
 
-/// What the render world needs to skin a character on the GPU (`None`: it is skinned on
-/// the CPU). Replaced whenever the character is re-posed or recoloured.
-#[derive(Component, Default)]
-pub struct GpuSkinJob(pub Option<GpuSkinInput>);
+pub use super::handoff::{GpuSkinInput, GpuSkinJob};
 
-/// One character's input to the compute shader.
-#[derive(Clone)]
-pub struct GpuSkinInput {
-    /// The asset whose bind positions and influences are skinned.
-    pub asset: Arc<CharacterAsset>,
-    /// Linear blend: the palette matrices. Dual quaternion: columns (real, dual, 0, 0).
-    pub palette: Arc<Vec<Mat4>>,
-    pub method: SkinningMethod,
-    /// The packed vertices at the bind pose (positions, texture coordinates, colours);
-    /// the shader overwrites the positions.
-    pub template: Arc<Vec<f32>>,
-    /// Floats per packed vertex.
-    pub floats: usize,
-}
-
-impl GpuSkinJob {
-    /// Hands over the character's palette (from `scratch`, as `method` takes it), and a
-    /// new template when the colours changed or there was none.
-    pub fn hand_over(
-        &mut self,
-        character: &Character,
-        method: SkinningMethod,
-        scratch: &mut SkinScratch,
-        recolored: bool,
-    ) {
-        let skin = &character.asset.skin;
-        let kept = self.0.as_ref().filter(|job| !recolored && Arc::ptr_eq(&job.asset, &character.asset));
-        let (template, floats) = match kept {
-            Some(job) => (job.template.clone(), job.floats),
-            None => {
-                let mut template = Vec::new();
-                let floats = pack_vertices(&skin.bind_positions, &skin.texcoords, &scratch.colors, &mut template);
-                (Arc::new(template), floats)
-            }
-        };
-        let palette = if method.is_linear() {
-            scratch.palette.clone()
-        } else {
-            dqs::dual_quaternion_palette(&scratch.palette, &mut scratch.dual_quaternions);
-            scratch.dual_quaternions.iter().map(|q| Mat4::from_cols(q.real, q.dual, Vec4::ZERO, Vec4::ZERO)).collect()
-        };
-        self.0 =
-            Some(GpuSkinInput { asset: character.asset.clone(), palette: Arc::new(palette), method, template, floats });
-    }
+/// Hands over the character's palette (from `scratch`, as `method` takes it) in its
+/// job, and a new template when the colours changed or there was none.
+pub fn hand_over(
+    job: &mut GpuSkinJob,
+    character: &Character,
+    method: SkinningMethod,
+    scratch: &mut SkinScratch,
+    recolored: bool,
+) {
+    let skin = &character.asset.skin;
+    let kept = job.0.as_ref().filter(|job| !recolored && Arc::ptr_eq(&job.asset, &character.asset));
+    let (template, floats) = match kept {
+        Some(job) => (job.template.clone(), job.floats),
+        None => {
+            let mut template = Vec::new();
+            let floats = pack_vertices(&skin.bind_positions, &skin.texcoords, &scratch.colors, &mut template);
+            (Arc::new(template), floats)
+        }
+    };
+    let palette = if method.is_linear() {
+        scratch.palette.clone()
+    } else {
+        dqs::dual_quaternion_palette(&scratch.palette, &mut scratch.dual_quaternions);
+        scratch.dual_quaternions.iter().map(|q| Mat4::from_cols(q.real, q.dual, Vec4::ZERO, Vec4::ZERO)).collect()
+    };
+    job.0 = Some(GpuSkinInput { asset: character.asset.clone(), palette: Arc::new(palette), method, template, floats });
 }
 
 /// The compute path: culling off for GPU-skinned skins, extraction of the jobs, the

@@ -16,6 +16,7 @@
 
 pub mod components;
 pub mod gpu_skinning;
+pub mod handoff;
 pub mod keyframes;
 pub mod morphs;
 pub mod node_clips;

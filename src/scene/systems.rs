@@ -4,8 +4,7 @@ use bevy::camera::primitives::Aabb;
 use bevy::prelude::*;
 
 use super::components::*;
-use super::gpu_skinning::GpuSkinJob;
-use super::upload::SkinUpload;
+use super::handoff::{GpuSkinJob, SkinUpload};
 use crate::rig::JointRotation;
 use crate::rig::fk::forward_kinematics_with_rest;
 use crate::rig::skinning::{bounds, heat_colors, joint_colors, weight_colors};
@@ -157,7 +156,7 @@ pub fn skin_changed_characters(
                 } else if moved {
                     scratch.bounds = scratch.influence_hull_bounds(&character.asset);
                 }
-                job.hand_over(character, method.0, scratch, recolored);
+                super::gpu_skinning::hand_over(&mut job, character, method.0, scratch, recolored);
                 return;
             }
             if job.0.is_some() {

@@ -15,62 +15,7 @@ use bevy::render::{Extract, ExtractSchedule, Render, RenderApp, RenderSystems};
 
 use super::components::Character;
 
-/// Bytes per skin vertex without texture coordinates: position (3 × f32) then colour
-/// (4 × f32), the order in which Bevy packs the mesh's attributes. Texture coordinates
-/// (2 × f32) go between them where a skin has them.
-pub const SKIN_VERTEX_BYTES: usize = 7 * 4;
-
-/// A character's packed vertices (`floats` per vertex), replaced whenever it is re-skinned
-/// or recoloured (its change tick is what the render world looks for).
-#[derive(Component, Default, Debug)]
-pub struct SkinUpload {
-    pub vertices: Arc<Vec<f32>>,
-    pub floats: usize,
-}
-
-impl SkinUpload {
-    /// The buffer to pack into: the previous one when nothing else holds it any more (no
-    /// allocation per frame), a new one otherwise.
-    pub fn buffer(&mut self) -> &mut Vec<f32> {
-        if Arc::get_mut(&mut self.vertices).is_none() {
-            self.vertices = Arc::new(Vec::with_capacity(self.vertices.len()));
-        }
-        Arc::get_mut(&mut self.vertices).expect("the buffer is not shared")
-    }
-
-    /// Packs a skin's vertices into this upload (see [`pack_vertices`]).
-    pub fn pack(&mut self, positions: &[Vec3], texcoords: &[Vec2], colors: &[[f32; 4]]) {
-        self.floats = pack_vertices(positions, texcoords, colors, self.buffer());
-    }
-
-    /// The vertices as the bytes the GPU takes.
-    pub fn bytes(&self) -> &[u8] {
-        bytemuck::cast_slice(&self.vertices)
-    }
-}
-
-/// Packs positions, texture coordinates (none, or one per vertex) and colours as the skin
-/// mesh's vertex buffer holds them; returns the floats per vertex.
-///
-/// # Panics
-/// When the lengths differ.
-pub fn pack_vertices(positions: &[Vec3], texcoords: &[Vec2], colors: &[[f32; 4]], out: &mut Vec<f32>) -> usize {
-    assert_eq!(positions.len(), colors.len(), "one colour per vertex");
-    out.clear();
-    if texcoords.is_empty() {
-        out.extend(positions.iter().zip(colors).flat_map(|(p, c)| [p.x, p.y, p.z, c[0], c[1], c[2], c[3]]));
-        return 7;
-    }
-    assert_eq!(positions.len(), texcoords.len(), "texture coordinates for every vertex");
-    out.extend(
-        positions
-            .iter()
-            .zip(texcoords)
-            .zip(colors)
-            .flat_map(|((p, t), c)| [p.x, p.y, p.z, t.x, t.y, c[0], c[1], c[2], c[3]]),
-    );
-    9
-}
+pub use super::handoff::{SKIN_VERTEX_BYTES, SkinUpload, pack_vertices};
 
 /// Bytes handed to the GPU in the last frame (the packed uploads that changed, and the
 /// palettes of characters skinned on the GPU), for benchmarks and readouts.
@@ -81,7 +26,7 @@ pub struct HandedOn(pub usize);
 /// palettes (reads `SkinUpload`, `GpuSkinJob`; writes `HandedOn`).
 fn count_handed_on(
     changed: Query<&SkinUpload, Changed<SkinUpload>>,
-    gpu_jobs: Query<&super::gpu_skinning::GpuSkinJob, Changed<super::gpu_skinning::GpuSkinJob>>,
+    gpu_jobs: Query<&super::handoff::GpuSkinJob, Changed<super::handoff::GpuSkinJob>>,
     mut handed: ResMut<HandedOn>,
 ) {
     let palettes: usize =

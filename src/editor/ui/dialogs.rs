@@ -75,14 +75,16 @@ pub fn show(ctx: &egui::Context, state: &mut InspectorState, panels: &mut Panels
     match purpose {
         DialogPurpose::OpenScene => {
             state.scene_path = text.clone();
-            crate::editor::recent::remember(&mut state.recent, &text);
+            if let Some(recent) = panels.recent.as_mut() {
+                recent.remember(&text);
+            }
             crate::editor::document::open_scene_from(&text, &mut panels.pending, &mut panels.messages);
         }
         DialogPurpose::SaveScene => {
             state.scene_path = text.clone();
             crate::editor::document::save_scene_to(&text, &panels.scene.capture(), &mut panels.messages);
         }
-        DialogPurpose::AddFile => super::scene_panel::open_path(&text, state, panels),
+        DialogPurpose::AddFile => super::open::open_path(&text, state, panels),
         DialogPurpose::ExportGltf => export_gltf(&path, panels),
         DialogPurpose::ScreenshotFolder => shot.dir_text = text,
     }

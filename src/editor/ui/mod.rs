@@ -6,6 +6,7 @@ pub mod clip_panel;
 pub mod dialogs;
 pub mod joint_panel;
 pub mod keyframe_panel;
+pub mod open;
 pub mod pose_panel;
 pub mod scene_panel;
 pub mod smpl_panel;
@@ -26,7 +27,6 @@ use super::state::{Messages, Selection};
 #[derive(Resource)]
 pub struct InspectorState {
     pub add_path: String,
-    pub recent: Vec<String>,
     pub scene_path: String,
     /// The DOF being dragged and its value, shown in the viewport.
     pub active_dof: Option<String>,
@@ -51,7 +51,6 @@ impl Default for InspectorState {
         let cwd = std::env::current_dir().map(|d| d.display().to_string()).unwrap_or_default();
         Self {
             add_path: format!("{cwd}/"),
-            recent: Vec::new(),
             scene_path: format!("{cwd}/scene.ron"),
             copied_keys: Vec::new(),
             picked_key: None,
@@ -80,6 +79,8 @@ pub struct Panels<'w, 's> {
     pub library: ResMut<'w, AssetLibrary>,
     pub ids: ResMut<'w, NextCharacterId>,
     pub pending: ResMut<'w, PendingScene>,
+    /// The recent files (none in an app without the inspector: nothing is remembered).
+    pub recent: Option<ResMut<'w, crate::editor::recent::RecentFiles>>,
 }
 
 impl Panels<'_, '_> {
@@ -120,6 +121,7 @@ pub struct InspectorPlugin;
 impl Plugin for InspectorPlugin {
     fn build(&self, app: &mut App) {
         app.init_resource::<InspectorState>()
+            .init_resource::<crate::editor::recent::RecentFiles>()
             .init_resource::<ViewportArea>()
             .add_systems(Startup, save_to_the_opened_scene)
             .add_systems(PostUpdate, fit_camera_viewport)
@@ -195,7 +197,7 @@ pub fn open_dropped_files(
 ) {
     for drop in drops.read() {
         if let bevy::window::FileDragAndDrop::DroppedFile { path_buf, .. } = drop {
-            scene_panel::open_path(&path_buf.to_string_lossy(), &mut state, &mut panels);
+            open::open_path(&path_buf.to_string_lossy(), &mut state, &mut panels);
         }
     }
 }

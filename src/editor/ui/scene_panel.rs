@@ -15,9 +15,7 @@ use crate::editor::document::{open_scene_from, save_scene_to};
 use crate::editor::history::HistoryRequest;
 use crate::editor::screenshot::ScreenshotRequest;
 use crate::editor::state::Selection;
-use crate::formats::scene::{
-    AnimDoc, BindingDoc, CharacterDoc, CharacterId, DisplayDoc, PlacementDoc, SkinningDoc, ViewDoc,
-};
+use crate::formats::scene::{BindingDoc, CharacterId, DisplayDoc, PlacementDoc, SkinningDoc, ViewDoc};
 
 pub fn scene_panel(ui: &mut egui::Ui, state: &mut InspectorState, panels: &mut Panels, shot: &mut ScreenshotRequest) {
     ui.heading("Scene");
@@ -85,7 +83,7 @@ fn add_row(ui: &mut egui::Ui, state: &mut InspectorState, panels: &mut Panels) {
         ui.add(egui::TextEdit::singleline(&mut state.add_path).desired_width(220.0));
         if ui.button("Add").clicked() {
             let path = state.add_path.trim().to_string();
-            open_path(&path, state, panels);
+            super::open::open_path(&path, state, panels);
         }
         if ui.button("…").on_hover_text("choose a file").clicked() {
             let near = state.add_path.clone();
@@ -100,75 +98,19 @@ fn add_row(ui: &mut egui::Ui, state: &mut InspectorState, panels: &mut Panels) {
             add_crowd(state, panels);
         }
     });
-    if state.recent.is_empty() {
+    let recent = panels.recent.as_ref().map(|r| r.0.clone()).unwrap_or_default();
+    if recent.is_empty() {
         return;
     }
     ui.horizontal_wrapped(|ui| {
         ui.label("Recent:");
-        for r in state.recent.clone() {
+        for r in recent {
             let label = Path::new(&r).file_name().map_or(r.clone(), |n| n.to_string_lossy().into_owned());
             if ui.small_button(label).on_hover_text(&r).clicked() {
-                open_path(&r, state, panels);
+                super::open::open_path(&r, state, panels);
             }
         }
     });
-}
-
-/// Puts the clip at `path` on the selected character, playing.
-fn add_clip(path: &str, panels: &mut Panels) {
-    match panels.selection.character {
-        Some(character) => panels.push(Edit::Clip { character, anim: Some(AnimDoc::of(path)) }),
-        None => panels.messages.push(format!("select the character that {path} should play on")),
-    }
-}
-
-/// What a path given to the editor (typed in Add, or dropped on the window) does: a
-/// `.ron` opens as the scene, a `.anim` plays on the selected character, anything else is
-/// added as a character.
-pub fn open_path(path: &str, state: &mut InspectorState, panels: &mut Panels) {
-    if !path.is_empty() {
-        crate::editor::recent::remember(&mut state.recent, path);
-    }
-    if path.ends_with(".ron") {
-        crate::editor::document::open_scene_from(path, &mut panels.pending, &mut panels.messages);
-        state.scene_path = path.to_string();
-    } else if path.ends_with(".anim") {
-        add_clip(path, panels);
-    } else {
-        add_character(path, state, panels);
-    }
-}
-
-/// Loads a character file (every character of a glTF file) and adds it right of the
-/// others, standing on the floor, and selects it; errors go to the messages.
-fn add_character(path: &str, state: &mut InspectorState, panels: &mut Panels) {
-    if path.is_empty() {
-        return;
-    }
-    let mut loaded = Vec::new();
-    for source in panels.library.sources_of(Path::new(path)) {
-        match panels.library.load(&source) {
-            Ok(asset) => loaded.push((source, asset)),
-            Err(e) => return panels.messages.push(e.to_string()),
-        }
-    }
-    // The characters of one file move together: they keep the layout the file gives them.
-    let (lo, hi) = crate::editor::arrange::union(loaded.iter().map(|(_, a)| a.bounds()));
-    let translation = beside(&panels.world_boxes(), lo, hi, 1.0);
-    for (source, asset) in loaded {
-        panels.messages.0.extend(asset.warnings.iter().cloned());
-        let id = panels.ids.take();
-        let doc = panels.library.new_character_doc(source, &asset);
-        panels.push(Edit::Add(Box::new(CharacterDoc {
-            id: Some(id),
-            placement: PlacementDoc { translation, yaw: 0.0, scale: 1.0 },
-            ..doc
-        })));
-        *panels.selection = Selection { character: Some(id), joints: Vec::new() };
-    }
-    if let Some(dir) = Path::new(path).parent() {
-        state.add_path = format!("{}/", dir.display());
-    }
 }
 
 /// Adds a crowd right of the characters already there (one undo step: its edits land in
