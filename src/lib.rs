@@ -2,6 +2,8 @@
 //!
 //! - [`rig`]: skeletons, matrix stack, poses, skinning kernels (no Bevy).
 //! - [`formats`]: readers and writers of the course formats (no Bevy).
+//! - [`document`]: the asset library, scene documents and files, layout, the default and
+//!   crowd scenes, posing specs and export (no Bevy).
 //! - [`scene`]: the ECS (joints as entities, matrix-stack and skinning systems).
 //! - [`editor`]: the windowed app and the headless renderer.
 //! - [`cli`]: the command line's specs, summaries and the SMPL exercise's tasks (no Bevy).
@@ -11,6 +13,7 @@
 #![allow(clippy::type_complexity)]
 
 pub mod cli;
+pub mod document;
 pub mod editor;
 pub mod formats;
 pub mod rig;

@@ -10,7 +10,7 @@ use std::io::Write;
 use glam::Mat4;
 use marionette::formats::gltf::{GltfCharacter, GltfMesh, write_glb};
 
-use marionette::cli::posing::{
+use marionette::document::posing::{
     IkSpec, PoseSpec, apply_ik_specs, apply_pose_specs, describe, describe_ik, posed_positions_by,
 };
 use marionette::formats::{load_character, obj};
@@ -256,14 +256,16 @@ fn export_gltf_file(
 ) -> Result<()> {
     let time = clip.time.unwrap_or(0.0);
     if is_glb(out) {
-        let mut library = marionette::editor::document::AssetLibrary::default();
+        let mut library = marionette::document::AssetLibrary::default();
         let mut doc = marionette::formats::scene::SceneDoc::default();
         for source in library.sources_of(path) {
             let asset = library.load(&source)?;
             let mut c = library.new_character_doc(source.clone(), &asset);
             let part = library.gltf_source(&source);
-            let found =
-                clip.clip.as_deref().and_then(|spec| marionette::cli::posing::find_clip(&part?.clips, spec).cloned());
+            let found = clip
+                .clip
+                .as_deref()
+                .and_then(|spec| marionette::document::posing::find_clip(&part?.clips, spec).cloned());
             c.playback = found.map(|k| marionette::formats::scene::PlaybackDoc {
                 clip: Some(k.name),
                 time,
@@ -272,7 +274,7 @@ fn export_gltf_file(
             doc.characters.push(c);
         }
         let mesh = if bake { GltfMesh::Baked } else { GltfMesh::Skinned };
-        let glb = marionette::editor::export::scene_glb(&doc, mesh, animation)?;
+        let glb = marionette::document::export::scene_glb(&doc, mesh, animation)?;
         write_file(out, |w| w.write_all(&glb))?;
         println!("wrote {} ({} characters)", out.display(), doc.characters.len());
         return Ok(());
@@ -280,7 +282,7 @@ fn export_gltf_file(
     let characters = marionette::formats::gltf_import::load_gltf(path)?;
     characters.iter().flat_map(|c| &c.asset.warnings).for_each(|w| eprintln!("warning: {w}"));
     let (positions, triangles) =
-        marionette::cli::posing::posed_gltf(&characters, clip.clip.as_deref(), time, poses, method)
+        marionette::document::posing::posed_gltf(&characters, clip.clip.as_deref(), time, poses, method)
             .map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
     write_file(out, |w| obj::write_obj(w, &positions, &triangles))?;
     println!(
@@ -344,9 +346,9 @@ fn run(cli: Cli) -> Result<()> {
             export_gltf_file(&path, &out, &poses, skinning.into(), &clip, bake, animation)?
         }
         Some(Command::Export { path, out, bake, animation, .. }) if is_glb(&out) && is_scene(&path) => {
-            let doc = marionette::editor::document::read_scene(&path)?;
+            let doc = marionette::document::scenes::read_scene(&path)?;
             let mesh = if bake { GltfMesh::Baked } else { GltfMesh::Skinned };
-            let glb = marionette::editor::export::scene_glb(&doc, mesh, animation)?;
+            let glb = marionette::document::export::scene_glb(&doc, mesh, animation)?;
             write_file(&out, |w| w.write_all(&glb))?;
             println!("wrote {} ({} characters)", out.display(), doc.characters.len());
         }
@@ -361,7 +363,7 @@ fn run(cli: Cli) -> Result<()> {
             if let Some(file) = &clip.anim {
                 let anim = marionette::formats::load_clip(file)?.retargeted(&asset.skeleton, &Default::default());
                 if animation {
-                    let sampled = marionette::editor::export::sampled(&anim, &asset.skeleton, &pose);
+                    let sampled = marionette::document::export::sampled(&anim, &asset.skeleton, &pose);
                     motion = Some(sampled.map_err(|e| anyhow::anyhow!("{}: {e}", file.display()))?);
                 }
                 let (root, clip_pose) = anim.pose_at(&asset.skeleton, clip.time.unwrap_or(0.0), &pose);
@@ -432,9 +434,9 @@ fn run(cli: Cli) -> Result<()> {
             marionette::formats::puppet::write_6837(&marionette::formats::puppet::puppet(), &dir, "puppet")
                 .with_context(|| format!("writing {}", dir.display()))?;
             let scene = dir.join("default_scene.ron");
-            marionette::formats::scene::save_scene(&scene, &marionette::editor::default_scene::generate())?;
+            marionette::formats::scene::save_scene(&scene, &marionette::document::default_scene::generate())?;
             let crowd = dir.join("crowd_scene.ron");
-            marionette::formats::scene::save_scene(&crowd, &marionette::editor::crowd::shipped_crowd())?;
+            marionette::formats::scene::save_scene(&crowd, &marionette::document::crowd::shipped_crowd())?;
             println!("wrote {}/puppet.{{skel,obj,attach}}, {} and {}", dir.display(), scene.display(), crowd.display());
         }
     }

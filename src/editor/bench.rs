@@ -13,8 +13,8 @@ use bevy::render::pipelined_rendering::PipelinedRenderingPlugin;
 use bevy::render::render_resource::{TextureFormat, TextureUsages};
 use bevy::render::{Render, RenderApp, RenderSystems};
 
+use crate::document::crowd::{puppet_crowd, smpl_crowd};
 use crate::editor::camera::OrbitCamera;
-use crate::editor::crowd::{puppet_crowd, smpl_crowd};
 use crate::editor::document::PendingScene;
 use crate::editor::readiness::CaptureGate;
 use crate::rig::{CharacterAsset, JointRotation};

@@ -7,7 +7,7 @@
 use bevy::ecs::system::SystemState;
 use bevy::prelude::*;
 
-use super::document::{AssetLibrary, CharacterIndex, NextCharacterId, SceneCharacter, SceneReader, spawn_from_doc};
+use super::document::{CharacterIndex, Library, NextCharacterId, SceneCharacter, SceneReader, spawn_from_doc};
 use super::history::History;
 use super::pose_library::PoseLibrary;
 use super::stage::StageSettings;
@@ -387,7 +387,7 @@ fn write(world: &mut World, edit: Edit) -> Result<(), String> {
 /// Spawns a character from its document (same entity layout as any scene character).
 fn add_character(world: &mut World, doc: &CharacterDoc) -> Result<(), String> {
     let id = doc.id.ok_or("a character to add has an id")?;
-    let spawned = world.resource_scope(|world, mut library: Mut<AssetLibrary>| {
+    let spawned = world.resource_scope(|world, mut library: Mut<Library>| {
         world.resource_scope(|world, mut meshes: Mut<Assets<Mesh>>| {
             spawn_from_doc(&mut world.commands(), &mut meshes, &mut library, doc, id)
         })
@@ -416,9 +416,8 @@ fn set_clip(world: &mut World, id: CharacterId, anim: Option<AnimDoc>) -> Result
     }
     let found = character_of(world, id)?;
     let name = component::<SceneCharacter>(world, id)?.name.clone();
-    let (player, note) =
-        super::document::clip_player(&mut world.resource_mut::<AssetLibrary>(), &found.asset, &name, &anim)
-            .map_err(|e| e.to_string())?;
+    let (player, note) = super::document::clip_player(&mut world.resource_mut::<Library>(), &found.asset, &name, &anim)
+        .map_err(|e| e.to_string())?;
     if let Some(note) = note {
         world.resource_mut::<Messages>().push(note);
     }
@@ -431,7 +430,7 @@ fn set_clip(world: &mut World, id: CharacterId, anim: Option<AnimDoc>) -> Result
 fn rebind_character(world: &mut World, id: CharacterId, binding: Option<BindingDoc>) -> Result<(), String> {
     let entity = entity_of(world, id)?;
     let source = component::<SceneCharacter>(world, id)?.source.clone();
-    let asset = world.resource_mut::<AssetLibrary>().load_bound(&source, binding).map_err(|e| e.to_string())?;
+    let asset = world.resource_mut::<Library>().load_bound(&source, binding).map_err(|e| e.to_string())?;
     let mut character = world.entity_mut(entity);
     if let Some(mut morphs) = character.get_mut::<crate::scene::morphs::Morphs>() {
         // The morphs blend from the rebound asset (and put it on the character).

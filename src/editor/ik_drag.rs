@@ -13,7 +13,7 @@ use super::document::SceneCharacter;
 use super::draw::SkeletonGizmos;
 use super::picking::{CLICK_SLOP_PX, JointPicker, PICK_RADIUS_PX};
 use super::state::{Drag, JointDrag, Selection};
-use crate::cli::posing::{IK_ROUNDS, IK_TOLERANCE};
+use crate::document::posing::{IK_ROUNDS, IK_TOLERANCE};
 use crate::formats::scene::CharacterId;
 use crate::rig::ik::{IkGoal, solve_ik};
 use crate::scene::{Character, CurrentJointToWorld, JointPose, Placement};
@@ -140,7 +140,7 @@ fn drag_joint(
     let mut goals = vec![IkGoal { end: active.joint, target }];
     goals.extend(active.pins.iter().map(|&(end, target)| IkGoal { end, target }));
     let reports = solve_ik(skeleton, &mut pose, placement.to_mat4(), &goals, IK_TOLERANCE, IK_ROUNDS.min(8));
-    drag.note = reports.first().map(|r| crate::cli::posing::describe_ik(skeleton, r)).unwrap_or_default();
+    drag.note = reports.first().map(|r| crate::document::posing::describe_ik(skeleton, r)).unwrap_or_default();
     let joints: Vec<_> = pose.into_iter().enumerate().filter(|&(j, p)| p != before[j]).collect();
     if !joints.is_empty() {
         edits.push(Edit::Pose { character: active.character, joints });

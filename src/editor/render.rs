@@ -12,11 +12,13 @@ use bevy::render::render_resource::{TextureFormat, TextureUsages};
 use bevy::render::view::screenshot::{Screenshot, ScreenshotCaptured};
 
 use super::camera::OrbitCamera;
-use super::document::{AssetLibrary, read_scene, scene_path};
+use super::document::Library;
 use super::readiness::CaptureGate;
 use super::stage;
 use super::state::{Messages, StartupEdits, StartupPaths};
 use super::view::ViewPlugin;
+use crate::document::AssetLibrary;
+use crate::document::scenes::{read_scene, scene_path};
 use crate::formats::scene::{BindingDoc, SourceDoc};
 use crate::scene::{RigCorePlugin, SkinningPlugin};
 
@@ -55,7 +57,7 @@ pub fn render(
         .insert_resource(ClearColor(stage::SKY))
         .insert_resource(super::camera::FramingAspect(width as f32 / height as f32))
         .insert_resource(StartupPaths(paths))
-        .insert_resource(library)
+        .insert_resource(Library(library))
         .insert_resource(edits)
         .add_plugins((RigCorePlugin, SkinningPlugin, ViewPlugin));
     let target = {

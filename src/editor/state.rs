@@ -16,8 +16,8 @@ pub struct StartupPaths(pub Vec<PathBuf>);
 /// scene that has the named joint (`--pose`, then `--ik`), and the skinning method.
 #[derive(Resource, Clone, Debug, Default)]
 pub struct StartupEdits {
-    pub poses: Vec<crate::cli::posing::PoseSpec>,
-    pub ik: Vec<crate::cli::posing::IkSpec>,
+    pub poses: Vec<crate::document::posing::PoseSpec>,
+    pub ik: Vec<crate::document::posing::IkSpec>,
     /// `--skinning`: every character skinned this way.
     pub skinning: Option<crate::rig::dqs::SkinningMethod>,
     /// `--match-height`: every character scaled to the first one's height.

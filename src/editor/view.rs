@@ -5,15 +5,15 @@
 use bevy::prelude::*;
 
 use super::camera::{FramingAspect, OrbitCamera, apply_orbit_camera};
-use super::document::{
-    AssetLibrary, NextCharacterId, PendingScene, SceneCharacter, scene_path, spawn_from_doc, startup_doc,
-};
+use super::document::{Library, NextCharacterId, PendingScene, SceneCharacter, spawn_from_doc};
 use super::skin_material::SkinMaterial;
 use super::stage::{
     StageExtent, StageSettings, apply_stage_settings, draw_grid_and_axes, fit_stage_to_scene, spawn_stage,
 };
 use super::state::{Messages, Selection, StartupEdits, StartupPaths, UnloadedCharacters};
 use super::{draw, history, ik_drag};
+use crate::document::AssetLibrary;
+use crate::document::scenes::{scene_path, startup_doc};
 use crate::formats::scene::{CharacterId, DisplayDoc};
 use crate::rig::SkinTexture;
 use crate::scene::{Character, CharacterView, HeatJoint, MarionetteSystems, SkinMesh};
@@ -31,7 +31,7 @@ impl Plugin for ScenePlugin {
             .init_resource::<UnloadedCharacters>()
             .init_resource::<PendingScene>()
             .init_resource::<ik_drag::Pins>()
-            .init_resource::<AssetLibrary>()
+            .init_resource::<Library>()
             .init_resource::<FramingAspect>()
             .init_resource::<FrameWhenSkinned>()
             .init_resource::<super::arrange::ArrangeWhenSkinned>()
@@ -88,7 +88,7 @@ impl Plugin for ViewPlugin {
 fn queue_startup_scene(
     paths: Res<StartupPaths>,
     edits: Res<StartupEdits>,
-    mut library: ResMut<AssetLibrary>,
+    mut library: ResMut<Library>,
     mut messages: ResMut<Messages>,
     mut pending: ResMut<PendingScene>,
     mut arrange: ResMut<super::arrange::ArrangeWhenSkinned>,
@@ -132,14 +132,14 @@ fn apply_startup_edits(
     for c in &mut doc.characters {
         let Ok(asset) = library.load(&c.source) else { continue };
         let skeleton = &asset.skeleton;
-        let (mut pose, _) = super::document::pose_from_doc(&asset, c);
+        let (mut pose, _) = crate::document::scenes::pose_from_doc(&asset, c);
         let poses: Vec<_> = edits.poses.iter().filter(|p| skeleton.resolve(&p.joint).is_some()).cloned().collect();
         let ik: Vec<_> = edits.ik.iter().filter(|p| skeleton.resolve(&p.joint).is_some()).cloned().collect();
-        let _ = crate::cli::posing::apply_pose_specs(skeleton, &mut pose, &poses);
-        if let Ok(reports) = crate::cli::posing::apply_ik_specs(skeleton, &mut pose, c.placement.to_mat4(), &ik) {
-            reports
-                .iter()
-                .for_each(|r| messages.push(format!("{}: {}", c.name, crate::cli::posing::describe_ik(skeleton, r))));
+        let _ = crate::document::posing::apply_pose_specs(skeleton, &mut pose, &poses);
+        if let Ok(reports) = crate::document::posing::apply_ik_specs(skeleton, &mut pose, c.placement.to_mat4(), &ik) {
+            reports.iter().for_each(|r| {
+                messages.push(format!("{}: {}", c.name, crate::document::posing::describe_ik(skeleton, r)))
+            });
         }
         let initial = skeleton.initial_pose();
         c.pose =
@@ -155,7 +155,7 @@ fn pause_clips_at(doc: &mut crate::formats::scene::SceneDoc, t: f32) {
             anim.playing = false;
         }
         if let Some(smpl) = c.smpl.as_mut().filter(|s| s.clip.is_some()) {
-            smpl.time = t * crate::scene::smpl::CLIP_FPS;
+            smpl.time = t * crate::rig::smpl::CLIP_FPS;
             smpl.playing = false;
         }
         if let Some(playback) = c.playback.as_mut().filter(|p| p.clip.is_some()) {
@@ -176,7 +176,7 @@ fn play_gltf_clip(
     let mut played = 0;
     for c in &mut doc.characters {
         let Some(part) = library.gltf_source(&c.source) else { continue };
-        if let Some(clip) = crate::cli::posing::find_clip(&part.clips, spec) {
+        if let Some(clip) = crate::document::posing::find_clip(&part.clips, spec) {
             let state =
                 c.playback.take().unwrap_or(crate::formats::scene::PlaybackDoc { playing: true, ..Default::default() });
             c.playback = Some(crate::formats::scene::PlaybackDoc { clip: Some(clip.name.clone()), ..state });
@@ -230,7 +230,7 @@ pub fn apply_pending_scene(
     mut commands: Commands,
     mut pending: ResMut<PendingScene>,
     mut meshes: ResMut<Assets<Mesh>>,
-    mut library: ResMut<AssetLibrary>,
+    mut library: ResMut<Library>,
     mut ids: ResMut<NextCharacterId>,
     mut messages: ResMut<Messages>,
     mut stage: ResMut<StageSettings>,

@@ -3,6 +3,9 @@
 
 use glam::{Quat, Vec3};
 
+/// Frames per second of the SMPL clips.
+pub const CLIP_FPS: f32 = 30.0;
+
 use super::RigError;
 use super::character::{CharacterAsset, Skin};
 use super::skeleton::Skeleton;

@@ -11,8 +11,7 @@ use crate::rig::JointRotation;
 use crate::rig::smpl::{BlendMode, Clip, SmplModel, blend_rotations};
 use crate::scene::{Character, JointPose, MarionetteSystems, PoseDirty};
 
-/// Frames per second of the SMPL clips.
-pub const CLIP_FPS: f32 = 30.0;
+pub use crate::rig::smpl::CLIP_FPS;
 
 /// An SMPL body: the model and the clips of its folder, and its live state, the scene
 /// file's own `SmplDoc` (β, clips by file name, time, playback, blend).

@@ -335,8 +335,9 @@ fn the_wasp_walks_as_an_independent_evaluation_says() {
 #[cfg_attr(not(marionette_data), ignore = "needs MARIONETTE_DATA (the course data)")]
 fn a_scene_plays_a_clip_on_the_wasp_and_keeps_it_in_the_file() {
     use bevy::prelude::*;
+    use marionette::document::scenes::{read_scene, write_scene};
     use marionette::editor::ScenePlugin;
-    use marionette::editor::document::{PendingScene, SceneReader, read_scene, write_scene};
+    use marionette::editor::document::{PendingScene, SceneReader};
     use marionette::formats::scene::{AnimDoc, CharacterDoc, SceneDoc, SourceDoc};
     use marionette::scene::{Character, CurrentJointToWorld};
 

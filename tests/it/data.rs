@@ -3,7 +3,7 @@
 use std::process::Command;
 
 use glam::{Mat4, Quat, Vec3};
-use marionette::cli::posing::posed_positions;
+use marionette::document::posing::posed_positions;
 use marionette::formats::{load_character, obj};
 use marionette::rig::JointRotation;
 

@@ -107,11 +107,11 @@ fn dual_quaternion_skinning_in_the_ecs_matches_the_kernel() {
     let mut pose = asset.skeleton.initial_pose();
     pose[elbow] = rotation;
     let expected =
-        marionette::cli::posing::posed_positions_by(&asset, &pose, Mat4::IDENTITY, SkinningMethod::DualQuaternion);
+        marionette::document::posing::posed_positions_by(&asset, &pose, Mat4::IDENTITY, SkinningMethod::DualQuaternion);
     let got = &app.world().get::<marionette::scene::SkinScratch>(character).unwrap().positions;
     let worst = got.iter().zip(&expected).map(|(a, b)| a.distance(*b)).fold(0.0f32, f32::max);
     assert!(worst < 1e-5, "largest difference {worst}");
-    let linear = marionette::cli::posing::posed_positions(&asset, &pose, Mat4::IDENTITY);
+    let linear = marionette::document::posing::posed_positions(&asset, &pose, Mat4::IDENTITY);
     assert!(linear.iter().zip(&expected).any(|(a, b)| a.distance(*b) > 1e-3), "DQ differs from LBS at the elbow");
 }
 

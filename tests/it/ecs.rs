@@ -5,7 +5,7 @@ use std::sync::Arc;
 use bevy::asset::AssetEvent;
 use bevy::ecs::message::Messages;
 use bevy::prelude::*;
-use marionette::cli::posing::posed_positions;
+use marionette::document::posing::posed_positions;
 use marionette::formats::puppet::embedded_puppet;
 use marionette::rig::{CharacterAsset, JointRotation};
 use marionette::scene::*;

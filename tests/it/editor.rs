@@ -5,7 +5,7 @@ use std::io::Cursor;
 use std::path::PathBuf;
 use std::process::Command;
 
-use marionette::editor::document::{pose_from_doc, read_scene, write_scene};
+use marionette::document::scenes::{pose_from_doc, read_scene, write_scene};
 use marionette::editor::screenshot::timestamp;
 use marionette::formats::scene::{
     CharacterDoc, PlacementDoc, SceneDoc, SourceDoc, ViewDoc, parse_scene, scene_to_string,
@@ -65,7 +65,7 @@ fn a_failed_save_leaves_the_previous_file_whole() {
 /// working folder, where the edits would be lost to the opened file).
 #[test]
 fn save_goes_back_to_the_opened_scene() {
-    use marionette::editor::document::initial_save_path;
+    use marionette::document::scenes::initial_save_path;
     use std::path::{Path, PathBuf};
     let cwd = Path::new("/work/here");
     assert_eq!(initial_save_path(&[PathBuf::from("/tmp/crowd.ron")], cwd), Path::new("/tmp/crowd.ron"));
@@ -108,8 +108,8 @@ fn screenshot_names_carry_the_utc_date_and_time() {
 
 #[test]
 fn the_shipped_assets_are_what_the_generator_makes() {
-    let scene = marionette::editor::document::default_scene_doc();
-    assert_eq!(scene, marionette::editor::default_scene::generate());
+    let scene = marionette::document::scenes::default_scene_doc();
+    assert_eq!(scene, marionette::document::default_scene::generate());
     assert!(scene.characters.len() >= 2);
     let dir = scratch("gen-assets");
     marionette::formats::puppet::write_6837(&marionette::formats::puppet::puppet(), &dir, "puppet").unwrap();
@@ -120,7 +120,7 @@ fn the_shipped_assets_are_what_the_generator_makes() {
     }
     let _ = scene_to_string(&scene).expect("serialises");
     let crowd = read_scene(&PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("assets/crowd_scene.ron")).unwrap();
-    assert_eq!(crowd, marionette::editor::crowd::shipped_crowd(), "assets/crowd_scene.ron is stale");
+    assert_eq!(crowd, marionette::document::crowd::shipped_crowd(), "assets/crowd_scene.ron is stale");
 }
 
 /// Renders a small scene headlessly (Vulkan; llvmpipe without a GPU) and checks the picture.
@@ -245,7 +245,7 @@ fn bench_with_gpu_skinning_hands_on_only_palettes() {
 /// shape and a clip, every third blending a second.
 #[test]
 fn crowd_members_stand_apart_with_their_own_shape_and_clip() {
-    let doc = marionette::editor::crowd::puppet_crowd(10);
+    let doc = marionette::document::crowd::puppet_crowd(10);
     let places: Vec<_> = doc.characters.iter().map(|c| c.placement.translation).collect();
     for (i, a) in places.iter().enumerate() {
         for b in &places[i + 1..] {
@@ -253,7 +253,7 @@ fn crowd_members_stand_apart_with_their_own_shape_and_clip() {
         }
     }
     if let Some(data) = crate::common::optional_data_dir() {
-        let crowd = marionette::editor::crowd::smpl_crowd(&data.join("smpl"), 6).unwrap();
+        let crowd = marionette::document::crowd::smpl_crowd(&data.join("smpl"), 6).unwrap();
         let smpl: Vec<_> = crowd.characters.iter().map(|c| c.smpl.clone().unwrap()).collect();
         assert!(smpl.iter().all(|s| s.playing && s.clip.is_some()));
         assert_ne!(smpl[0].betas, smpl[1].betas);

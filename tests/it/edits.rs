@@ -458,13 +458,13 @@ fn a_glb_of_two_characters_plays_its_clips_in_the_ecs_as_the_rig_samples_them() 
     let saved = doc.characters.iter().find(|c| c.id == Some(waver)).unwrap();
     assert_eq!(saved.playback.as_ref(), Some(&playing));
     let file = crate::common::scratch("glb-scene").join("pair.ron");
-    marionette::editor::document::write_scene(&file, &doc).unwrap();
+    marionette::document::scenes::write_scene(&file, &doc).unwrap();
 
     request(&mut app, HistoryRequest::Undo);
     matrices(&app).iter().zip(&file_pose).for_each(|(a, b)| crate::common::assert_mat_close(*a, *b, 1e-6));
 
     let mut reopened = scene_app();
-    let doc = marionette::editor::document::read_scene(&file).unwrap();
+    let doc = marionette::document::scenes::read_scene(&file).unwrap();
     let part = doc.characters.iter().find_map(|c| match &c.source {
         SourceDoc::Part(p, 1) => Some(p.canonicalize().unwrap()),
         _ => None,

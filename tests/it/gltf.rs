@@ -94,7 +94,7 @@ fn an_exported_character_skins_back_to_our_vertices_with_its_names_and_weights()
     let placement =
         Mat4::from_scale_rotation_translation(Vec3::splat(1.5), Quat::from_rotation_y(0.6), Vec3::new(1.0, 0.0, -2.0));
     let origin = Mat4::from_translation(root - skeleton.joint(0).rest_offset);
-    let ours: Vec<Vec3> = marionette::cli::posing::posed_positions(&puppet, &pose, origin)
+    let ours: Vec<Vec3> = marionette::document::posing::posed_positions(&puppet, &pose, origin)
         .into_iter()
         .map(|p| placement.transform_point3(p))
         .collect();
@@ -168,7 +168,7 @@ fn a_scene_exports_its_smpl_body_in_its_shape() {
         ..CharacterDoc::new(SourceDoc::File(dir.clone()), "b")
     };
     let doc = SceneDoc { characters: vec![body], ..SceneDoc::default() };
-    let (json, bin) = chunks(&marionette::editor::export::scene_glb(&doc, GltfMesh::Skinned, false).unwrap());
+    let (json, bin) = chunks(&marionette::document::export::scene_glb(&doc, GltfMesh::Skinned, false).unwrap());
     let positions =
         read(&json, &bin, json["meshes"][0]["primitives"][0]["attributes"]["POSITION"].as_u64().unwrap() as usize);
     let (model, _) = marionette::formats::smpl::load_smpl_dir(&dir).unwrap();
@@ -196,7 +196,7 @@ fn an_smpl_body_playing_a_clip_goes_out_as_an_animation_of_its_frames() {
         ..CharacterDoc::new(SourceDoc::File(dir.clone()), "b")
     };
     let doc = SceneDoc { characters: vec![body], ..SceneDoc::default() };
-    let (json, bin) = chunks(&marionette::editor::export::scene_glb(&doc, GltfMesh::Skinned, true).unwrap());
+    let (json, bin) = chunks(&marionette::document::export::scene_glb(&doc, GltfMesh::Skinned, true).unwrap());
     let (model, _) = marionette::formats::smpl::load_smpl_dir(&dir).unwrap();
     let clip = marionette::formats::smpl::parse_clip(
         std::io::BufReader::new(std::fs::File::open(&clip_path).unwrap()),
@@ -236,7 +236,7 @@ fn a_clip_goes_out_as_an_animation_of_the_joints() {
     let wasp = marionette::formats::load_character(&data.join("wasp.skel")).unwrap();
     let clip = marionette::formats::load_clip(&data.join("wasp_walk.anim")).unwrap();
     let rest = wasp.skeleton.initial_pose();
-    let motion = marionette::editor::export::sampled(&clip, &wasp.skeleton, &rest).unwrap();
+    let motion = marionette::document::export::sampled(&clip, &wasp.skeleton, &rest).unwrap();
     assert_eq!(motion.times.len(), 121, "4 s at 30 frames per second, both ends");
     let character = GltfCharacter { motion: Some(motion), ..GltfCharacter::new("w", &wasp, &rest) };
     let (json, bin) = chunks(&write_glb(&[character], GltfMesh::Skinned).unwrap());
@@ -279,8 +279,8 @@ fn a_round_trip_through_glb_keeps_vertices_names_hierarchy_and_weights() {
     let names =
         |s: &marionette::rig::Skeleton| s.joints().iter().map(|j| (j.name.clone(), j.parent)).collect::<Vec<_>>();
     assert_eq!(names(&back.skeleton), names(skeleton), "names and hierarchy");
-    let ours = marionette::cli::posing::posed_positions(&puppet, &pose, Mat4::IDENTITY);
-    let theirs = marionette::cli::posing::posed_positions(&back, &back.skeleton.initial_pose(), Mat4::IDENTITY);
+    let ours = marionette::document::posing::posed_positions(&puppet, &pose, Mat4::IDENTITY);
+    let theirs = marionette::document::posing::posed_positions(&back, &back.skeleton.initial_pose(), Mat4::IDENTITY);
     let worst = largest_distance(&ours, &theirs);
     assert!(worst <= 1e-5, "skinned vertices differ by {worst}");
     for v in 0..puppet.vertex_count() {
@@ -298,7 +298,7 @@ fn a_blender_made_glb_deforms_as_blender_deforms_it() {
     let data = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data");
     let arm = marionette::formats::load_character(&data.join("blender_arm.glb")).unwrap();
     assert_eq!(arm.skeleton.joints().iter().map(|j| j.name.as_str()).collect::<Vec<_>>(), ["upper", "lower"]);
-    let ours = marionette::cli::posing::posed_positions(&arm, &arm.skeleton.initial_pose(), Mat4::IDENTITY);
+    let ours = marionette::document::posing::posed_positions(&arm, &arm.skeleton.initial_pose(), Mat4::IDENTITY);
     let text = std::fs::read_to_string(data.join("blender_arm.txt")).unwrap();
     let blender: Vec<Vec3> = text.lines().map(|l| Vec3::from_slice(&numbers(l))).collect();
     assert_eq!(ours.len(), blender.len());

@@ -3,7 +3,7 @@
 use std::process::Command;
 
 use glam::{Mat4, Vec3};
-use marionette::cli::posing::posed_positions;
+use marionette::document::posing::posed_positions;
 use marionette::formats::load_character;
 use marionette::rig::fk::forward_kinematics;
 use marionette::rig::ik::{IkGoal, chain_to_sub_base, fabrik, solve_ik};
@@ -223,7 +223,7 @@ fn homer_rig_with_weights_loads_normalised() {
 
 #[test]
 fn rebinding_in_the_editor_replaces_the_weights_only() {
-    use marionette::editor::document::rebind;
+    use marionette::document::rebind;
     use marionette::formats::scene::BindingDoc;
     let puppet = marionette::formats::puppet::embedded_puppet();
     let rigid = rebind(&puppet, BindingDoc::Nearest);

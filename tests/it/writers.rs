@@ -101,7 +101,7 @@ fn no_obj_gltf_or_scene_written_from_a_valid_model_holds_a_non_finite_number() {
             Quat::from_euler(EulerRot::YXZ, yaw, 0.0, 0.0),
             translation,
         );
-        let positions = marionette::cli::posing::posed_positions_by(asset, &pose, placement, method);
+        let positions = marionette::document::posing::posed_positions_by(asset, &pose, placement, method);
         let mut text = Vec::new();
         match obj::write_obj(&mut text, &positions, &asset.skin.triangles) {
             Ok(()) => {

@@ -93,7 +93,7 @@ pub fn show(ctx: &egui::Context, state: &mut InspectorState, panels: &mut Panels
 /// Writes the scene as it is to `path` as glTF, saying so in the messages.
 fn export_gltf(path: &Path, panels: &mut Panels) {
     let doc = panels.scene.capture();
-    let written = crate::editor::export::scene_glb(&doc, crate::formats::gltf::GltfMesh::Skinned, true)
+    let written = crate::document::export::scene_glb(&doc, crate::formats::gltf::GltfMesh::Skinned, true)
         .map_err(|e| e.to_string())
         .and_then(|glb| {
             crate::formats::write_atomically(path, |w| std::io::Write::write_all(w, &glb)).map_err(|e| e.to_string())

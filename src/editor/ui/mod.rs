@@ -18,7 +18,7 @@ use bevy_egui::{EguiContexts, EguiPrimaryContextPass, egui};
 
 use super::camera::{ViewportArea, fit_camera_viewport};
 use super::commands::{Edit, EditQueue, GestureHold};
-use super::document::{AssetLibrary, NextCharacterId, PendingScene, SceneReader};
+use super::document::{Library, NextCharacterId, PendingScene, SceneReader};
 use super::history::History;
 use super::screenshot::ScreenshotRequest;
 use super::state::{Messages, Selection};
@@ -76,7 +76,7 @@ pub struct Panels<'w, 's> {
     pub selection: ResMut<'w, Selection>,
     pub history: ResMut<'w, History>,
     pub messages: ResMut<'w, Messages>,
-    pub library: ResMut<'w, AssetLibrary>,
+    pub library: ResMut<'w, Library>,
     pub ids: ResMut<'w, NextCharacterId>,
     pub pending: ResMut<'w, PendingScene>,
     /// The recent files (none in an app without the inspector: nothing is remembered).
@@ -133,7 +133,7 @@ impl Plugin for InspectorPlugin {
 /// Points the scene path box (what Save writes) at the scene the editor was opened on.
 fn save_to_the_opened_scene(paths: Option<Res<super::StartupPaths>>, mut state: ResMut<InspectorState>) {
     let (Some(paths), Ok(cwd)) = (paths, std::env::current_dir()) else { return };
-    state.scene_path = super::document::initial_save_path(&paths.0, &cwd).display().to_string();
+    state.scene_path = crate::document::scenes::initial_save_path(&paths.0, &cwd).display().to_string();
 }
 
 /// Draws the panels (their edits land in this frame's `Animate`); the viewport is what

@@ -122,8 +122,8 @@ fn add_crowd(state: &InspectorState, panels: &mut Panels) {
     let typed = PathBuf::from(state.add_path.trim());
     let folder = selected_body.or_else(|| crate::formats::smpl::is_smpl_dir(&typed).then_some(typed));
     let crowd = match &folder {
-        Some(dir) => crate::editor::crowd::smpl_crowd(dir, state.crowd_size),
-        None => Ok(crate::editor::crowd::puppet_crowd(state.crowd_size)),
+        Some(dir) => crate::document::crowd::smpl_crowd(dir, state.crowd_size),
+        None => Ok(crate::document::crowd::puppet_crowd(state.crowd_size)),
     };
     let crowd = match crowd {
         Ok(doc) => doc,

@@ -4,7 +4,7 @@
 
 use std::path::Path;
 
-use bevy::math::Vec3;
+use glam::Vec3;
 
 use crate::formats::scene::{CharacterDoc, PlacementDoc, SceneDoc, SmplDoc, SourceDoc};
 

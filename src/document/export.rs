@@ -37,7 +37,7 @@ pub fn sampled(
 /// A character's asset as the document shapes it: an SMPL body by its β, a mesh with morph
 /// targets by their weights.
 fn shaped(
-    library: &mut super::document::AssetLibrary,
+    library: &mut super::AssetLibrary,
     c: &crate::formats::scene::CharacterDoc,
 ) -> Result<std::sync::Arc<crate::rig::CharacterAsset>, FormatError> {
     let mut asset = library.load_bound(&c.source, c.binding)?;
@@ -68,7 +68,7 @@ struct Posed {
 /// its source's own animation, SMPL playback) at its time, its placement and tint; with
 /// `animated`, the clips as glTF animations.
 pub fn scene_glb(doc: &SceneDoc, mesh: GltfMesh, animated: bool) -> Result<Vec<u8>, FormatError> {
-    let mut library = super::document::AssetLibrary::default();
+    let mut library = super::AssetLibrary::default();
     let mut loaded = Vec::new();
     for c in &doc.characters {
         let asset = shaped(&mut library, c)?;
@@ -99,14 +99,14 @@ pub fn scene_glb(doc: &SceneDoc, mesh: GltfMesh, animated: bool) -> Result<Vec<u
 /// A character's pose from its document and clips at their times, and (with `animated`)
 /// its clip sampled over its length.
 fn posed(
-    library: &mut super::document::AssetLibrary,
+    library: &mut super::AssetLibrary,
     c: &crate::formats::scene::CharacterDoc,
     asset: &crate::rig::CharacterAsset,
     animated: bool,
 ) -> Result<Posed, FormatError> {
     let skeleton = &asset.skeleton;
-    let (pose, notes) = super::document::pose_from_doc(asset, c);
-    notes.iter().for_each(|n| bevy::log::warn!("{n}"));
+    let (pose, notes) = super::scenes::pose_from_doc(asset, c);
+    notes.iter().for_each(|n| eprintln!("warning: {n}"));
     let mut posed = Posed { pose, root: skeleton.joint(0).rest_offset, rest: None, motion: None };
     if let Some(anim) = &c.anim {
         let clip = match &anim.keys {
@@ -192,7 +192,7 @@ fn rest_of(skeleton: &crate::rig::Skeleton, sample: &NodePose) -> (Vec<glam::Vec
 /// An SMPL body's playing clip, every frame (at its 30 frames per second), with the body's
 /// own root and the clip's rotations.
 fn smpl_motion(
-    library: &mut super::document::AssetLibrary,
+    library: &mut super::AssetLibrary,
     c: &crate::formats::scene::CharacterDoc,
     asset: &crate::rig::CharacterAsset,
 ) -> Result<Option<Motion>, FormatError> {
@@ -203,7 +203,7 @@ fn smpl_motion(
     let mut motion = Motion::default();
     let root = asset.skeleton.joint(0).rest_offset;
     for f in 0..clip.frame_count() {
-        motion.times.push(f as f32 / crate::scene::smpl::CLIP_FPS);
+        motion.times.push(f as f32 / crate::rig::smpl::CLIP_FPS);
         motion.poses.push(clip.frame(f).iter().map(|&q| crate::rig::JointRotation::Quat(q)).collect());
         motion.roots.push(root);
     }

@@ -1,0 +1,15 @@
+//! The document layer, no Bevy: what the editor and the command line share. The asset
+//! library (characters by source), scene documents and files, the layout of characters
+//! side by side, the default and crowd scenes, posing by `--pose`/`--ik` specs, and export
+//! (OBJ posing, glTF, animations). `export`, `info`, `bind`, `smpl` and `gen-assets` run on
+//! it alone; the editor calls it.
+
+pub mod crowd;
+pub mod default_scene;
+pub mod export;
+pub mod layout;
+pub mod library;
+pub mod posing;
+pub mod scenes;
+
+pub use library::{AssetLibrary, GltfPart, SmplSet, own_motion, rebind};
