@@ -19,6 +19,7 @@ mod gpu;
 mod heat;
 mod ik;
 mod kernel;
+mod layers;
 mod poses;
 mod rig;
 mod robust;
