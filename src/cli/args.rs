@@ -1,0 +1,249 @@
+//! The command line's words: commands, their flags and what they parse into (clap). No
+//! Bevy; `main.rs` parses these and dispatches.
+
+use std::path::PathBuf;
+
+use crate::document::posing::{IkSpec, PoseSpec};
+
+/// The largest picture side `render` accepts (the texture limit of common GPUs).
+pub const MAX_PICTURE_SIDE: i64 = 8192;
+
+#[derive(clap::Parser)]
+#[command(name = "marionette", version, about = "Build scenes of skinned characters: load, pose, see and export them.")]
+pub struct Cli {
+    #[command(subcommand)]
+    pub command: Option<Command>,
+}
+
+#[derive(clap::Subcommand)]
+pub enum Command {
+    /// Open the editor on characters (`Model1.skel` finds `Model1.obj` and `Model1.attach`).
+    Edit {
+        /// Character files; none opens the default scene.
+        paths: Vec<PathBuf>,
+        #[command(flatten)]
+        clip: ClipArgs,
+    },
+    /// Print what a character file loads as: joints, vertices, triangles, weight checks.
+    Info { path: PathBuf },
+    /// Write the posed, skinned mesh as OBJ: one `v` per source vertex in source order,
+    /// then the source faces.
+    Export(ExportArgs),
+    /// Bind a mesh without weights to a skeleton and write 6.837-style weights: by bone heat
+    /// (weights diffused over the mesh from the bones each vertex sees), to the nearest
+    /// bone, or smoothly to the nearest few.
+    Bind(BindArgs),
+    /// Render a scene (.ron) or characters offscreen to a PNG, without a window.
+    Render {
+        /// A scene file or character files; none renders the default scene.
+        paths: Vec<PathBuf>,
+        #[arg(long)]
+        out: PathBuf,
+        #[arg(long, default_value_t = 1280, value_parser = clap::value_parser!(u32).range(1..=MAX_PICTURE_SIDE))]
+        width: u32,
+        #[arg(long, default_value_t = 720, value_parser = clap::value_parser!(u32).range(1..=MAX_PICTURE_SIDE))]
+        height: u32,
+        /// `JOINT=rx,ry,rz` applied to every character that has the joint. Repeatable.
+        #[arg(long = "pose", value_name = "JOINT=rx,ry,rz")]
+        poses: Vec<PoseSpec>,
+        /// `JOINT=x,y,z` world-space IK target for every character that has the joint.
+        #[arg(long = "ik", value_name = "JOINT=x,y,z")]
+        ik: Vec<IkSpec>,
+        /// Skin every character by linear blend (`lbs`) or dual quaternion (`dq`) skinning
+        /// (default: as the scene file says).
+        #[arg(long, value_enum)]
+        skinning: Option<Skinning>,
+        /// Scale every character to the first one's height (as they stand, feet on the
+        /// floor); characters named on the command line then stand side by side.
+        #[arg(long)]
+        match_height: bool,
+        #[command(flatten)]
+        clip: ClipArgs,
+    },
+    /// The SMPL exercise: writes frame000.obj, frame001.obj, ... into --out.
+    ///
+    /// Tasks: 1 the shapes β0, β1, β2 (unskinned); 2 L_Elbow moved +0.2 in y, absolute
+    /// (descendants stay); 3 the same, relative (descendants follow); 4 L_Shoulder rotated
+    /// by (0, 0, -0.3827, 0.9239); 5 clip 7516 for β0, β1, β2 (480 frames).
+    ///
+    /// --sequence SPEC plays segments one after another: SPEC is CLIP[:FROM-TO][:BETA]
+    /// joined by commas. CLIP is a clip file or the end of its name (7516); FROM-TO an
+    /// inclusive frame range (40- runs to the end); BETA is 0, 1, 2 (the exercise's βs) or
+    /// ten numbers joined by /. Consecutive segments overlap by --transition frames with
+    /// α from 0 (first transition frame) to 1 (N-th); β blends linearly, rotations by
+    /// normalised linear interpolation (or --slerp).
+    /// Example: --sequence 7516:0-99:1,8806:20-:2 --transition 30
+    #[command(verbatim_doc_comment)]
+    Smpl(SmplArgs),
+    /// A crowd of animated characters headless through the app and the render world:
+    /// frame time (p50/p95) by phase, mesh data handed on, and the skinning kernel's speed.
+    Bench {
+        /// How many characters (SMPL bodies from the data folder, else puppets).
+        #[arg(long, default_value_t = 64, value_parser = clap::value_parser!(u32).range(1..=4096))]
+        characters: u32,
+        /// Frames measured (after warming up).
+        #[arg(long, default_value_t = 300, value_parser = clap::value_parser!(u32).range(1..=100_000))]
+        frames: u32,
+        /// The course data folder (its `smpl`); defaults to MARIONETTE_DATA.
+        #[arg(long)]
+        data: Option<PathBuf>,
+        /// Print one JSON object instead of the table.
+        #[arg(long)]
+        json: bool,
+        /// Skin the crowd with the GPU skinning compute shader instead of on the CPU.
+        #[arg(long)]
+        gpu: bool,
+    },
+    /// Rebuild the project's own characters into a folder (normally `assets`).
+    GenAssets {
+        #[arg(default_value = "assets")]
+        dir: PathBuf,
+    },
+}
+
+/// `--skinning`.
+#[derive(Clone, Copy, Debug, clap::ValueEnum)]
+pub enum Skinning {
+    /// Linear blend skinning.
+    Lbs,
+    /// Dual quaternion skinning.
+    Dq,
+}
+
+impl From<Skinning> for crate::rig::dqs::SkinningMethod {
+    fn from(s: Skinning) -> Self {
+        match s {
+            Skinning::Lbs => Self::Linear,
+            Skinning::Dq => Self::DualQuaternion,
+        }
+    }
+}
+
+/// How `bind` computes weights.
+#[derive(clap::ValueEnum, Clone, Copy, Debug)]
+pub enum BindMethod {
+    /// Bone heat (Baran and Popović 2007).
+    Heat,
+    /// Each vertex rigidly to its nearest bone.
+    Nearest,
+    /// The nearest few bones, falling off with distance.
+    Smooth,
+}
+
+impl From<BindMethod> for crate::rig::bind::Binding {
+    fn from(m: BindMethod) -> Self {
+        match m {
+            BindMethod::Heat => Self::Heat,
+            BindMethod::Nearest => Self::Nearest,
+            BindMethod::Smooth => Self::Smooth,
+        }
+    }
+}
+
+/// `--anim FILE --time T`: pose characters from a keyframed clip.
+#[derive(clap::Args, Debug, Clone)]
+pub struct ClipArgs {
+    /// A CSE169 `.anim` clip (channels 0-2 move the root, then x, y, z rotation per joint
+    /// in the skeleton's order) or a `.bvh` (its joints by name), on every character whose
+    /// skeleton it fits.
+    #[arg(long, value_name = "FILE.anim|FILE.bvh")]
+    pub anim: Option<PathBuf>,
+    /// The time in seconds at which clips are sampled: `--anim`'s, `--clip`'s, and a
+    /// scene's own keyframes, SMPL and glTF clips (extrapolated outside their keys as each
+    /// clip says).
+    #[arg(long, value_parser = finite_seconds)]
+    pub time: Option<f32>,
+    /// A glTF file's animation, by name or by index among the file's animations, on every
+    /// character of the file it moves (without it the file's node transforms are the pose).
+    #[arg(long, value_name = "NAME|INDEX")]
+    pub clip: Option<String>,
+}
+
+impl ClipArgs {
+    pub fn anim_doc(&self, playing: bool) -> Option<crate::formats::scene::AnimDoc> {
+        let file = self.anim.clone()?;
+        Some(crate::formats::scene::AnimDoc {
+            time: self.time.unwrap_or(0.0),
+            playing,
+            ..crate::formats::scene::AnimDoc::of(file)
+        })
+    }
+}
+
+/// `export`'s flags.
+#[derive(clap::Args)]
+pub struct ExportArgs {
+    pub path: PathBuf,
+    #[arg(long)]
+    pub out: PathBuf,
+    /// `JOINT=rx,ry,rz` in radians (x applied first); JOINT is a name or an index.
+    /// Angles outside the joint's limits are clamped. Repeatable.
+    #[arg(long = "pose", value_name = "JOINT=rx,ry,rz")]
+    pub poses: Vec<PoseSpec>,
+    /// `JOINT=x,y,z`: move JOINT to this world-space point by inverse kinematics
+    /// (FABRIK), after --pose. Repeatable.
+    #[arg(long = "ik", value_name = "JOINT=x,y,z")]
+    pub ik: Vec<IkSpec>,
+    /// Linear blend (`lbs`) or dual quaternion (`dq`) skinning.
+    #[arg(long, value_enum, default_value_t = Skinning::Lbs)]
+    pub skinning: Skinning,
+    #[command(flatten)]
+    pub clip: ClipArgs,
+    /// With `--out X.glb`: the posed mesh without a skin, instead of a skinned mesh
+    /// with its skeleton.
+    #[arg(long)]
+    pub bake: bool,
+    /// With `--out X.glb`: keyframed clips (a scene's, or `--anim`) go out as glTF
+    /// animations, sampled at 30 frames per second.
+    #[arg(long)]
+    pub animation: bool,
+}
+
+/// `bind`'s flags.
+#[derive(clap::Args)]
+pub struct BindArgs {
+    /// The mesh (.obj or .off).
+    pub mesh: PathBuf,
+    /// The skeleton (.skel of either course, or a Homer rig .json).
+    pub skeleton: PathBuf,
+    #[arg(long)]
+    pub out: PathBuf,
+    #[arg(long, value_enum, default_value_t = BindMethod::Heat)]
+    pub method: BindMethod,
+    /// The same as `--method smooth` (kept for older scripts).
+    #[arg(long, conflicts_with = "method")]
+    pub smooth: bool,
+    /// Weights to compare with (a 6.837 `.attach` for the same mesh and skeleton):
+    /// prints how often the heaviest joint agrees and the mean L1 distance of the rows.
+    #[arg(long, value_name = "F.attach")]
+    pub against: Option<PathBuf>,
+}
+
+/// `smpl`'s flags.
+#[derive(clap::Args)]
+pub struct SmplArgs {
+    /// The folder with smpl_00.obj ... smpl_skin.txt and the clips.
+    #[arg(long)]
+    pub data: PathBuf,
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=5), conflicts_with = "sequence", required_unless_present = "sequence")]
+    pub task: Option<u32>,
+    #[arg(long, value_name = "SPEC")]
+    pub sequence: Option<String>,
+    #[arg(long, default_value_t = 20)]
+    pub transition: usize,
+    #[arg(long)]
+    pub slerp: bool,
+    #[arg(long)]
+    pub out: PathBuf,
+    /// Use the straightforward single-threaded writer (for timing against it).
+    #[arg(long)]
+    pub naive: bool,
+}
+
+/// A finite number of seconds.
+pub fn finite_seconds(text: &str) -> Result<f32, String> {
+    match text.parse::<f32>() {
+        Ok(t) if t.is_finite() => Ok(t),
+        _ => Err(format!("expected a finite number of seconds, found `{text}`")),
+    }
+}
