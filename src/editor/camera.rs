@@ -1,5 +1,6 @@
 //! The orbit camera: left drag rotates, middle drag pans, right drag or the wheel zooms.
 
+use super::pointer::{PointerOwner, ViewportArea, ViewportHasPointer};
 use bevy::input::mouse::{AccumulatedMouseMotion, AccumulatedMouseScroll, MouseScrollUnit};
 use bevy::prelude::*;
 
@@ -88,16 +89,6 @@ impl OrbitCamera {
     }
 }
 
-/// Whether the pointer belongs to the viewport this frame (false while egui uses it).
-#[derive(Resource)]
-pub struct ViewportHasPointer(pub bool);
-
-impl Default for ViewportHasPointer {
-    fn default() -> Self {
-        Self(true)
-    }
-}
-
 /// Reads mouse drags and the wheel into the orbit (reads input; writes `OrbitCamera`).
 pub fn orbit_camera_input(
     buttons: Res<ButtonInput<MouseButton>>,
@@ -105,12 +96,12 @@ pub fn orbit_camera_input(
     scroll: Res<AccumulatedMouseScroll>,
     pointer: Option<Res<ViewportHasPointer>>,
     drag: Option<Res<super::state::JointDrag>>,
-    gizmo: Option<Res<super::rotate_gizmo::RotateGizmo>>,
+    owner: Option<Res<PointerOwner>>,
     mut cameras: Query<&mut OrbitCamera>,
 ) {
     if pointer.is_some_and(|p| !p.0)
         || drag.is_some_and(|d| d.active.is_some())
-        || gizmo.is_some_and(|g| g.holds_pointer || g.turn.is_some())
+        || owner.is_some_and(|o| o.gizmo_holds_pointer || o.gizmo_turning)
     {
         return;
     }
@@ -144,34 +135,6 @@ pub fn apply_orbit_camera(mut cameras: Query<(&OrbitCamera, &mut Transform), Cha
         *transform = orbit.transform();
     }
 }
-
-/// Notes whether the pointer belongs to the 3D view: inside the area between the panels
-/// and not used by egui (a popup, a drag that started on a widget), so clicks and drags
-/// on the panels neither orbit nor pick (reads `EguiWantsInput`, `ViewportArea`, the
-/// cursor; writes `ViewportHasPointer`).
-pub fn track_egui_pointer(
-    wants: Option<Res<bevy_egui::input::EguiWantsInput>>,
-    area: Option<Res<ViewportArea>>,
-    windows: Query<&Window, With<bevy::window::PrimaryWindow>>,
-    buttons: Res<ButtonInput<MouseButton>>,
-    mut pointer: ResMut<ViewportHasPointer>,
-) {
-    let egui_wants = wants.is_some_and(|w| w.wants_any_pointer_input());
-    let cursor = windows.single().ok().and_then(Window::cursor_position);
-    let in_view = match (area.and_then(|a| a.0), cursor) {
-        (Some(rect), Some(cursor)) => rect.contains(cursor),
-        _ => true,
-    };
-    // Decide when a drag starts and keep it for the whole drag.
-    if buttons.get_just_pressed().next().is_some() || !buttons.get_pressed().any(|_| true) {
-        pointer.0 = in_view && !egui_wants;
-    }
-}
-
-/// The part of the window between the side panels (logical pixels), set by the inspector;
-/// `None` leaves the camera on the whole window.
-#[derive(Resource, Clone, Copy, Debug, Default, PartialEq)]
-pub struct ViewportArea(pub Option<Rect>);
 
 /// Gives the window's camera the area between the panels as its viewport, so the view is
 /// centred (and F frames) in the visible middle (reads `ViewportArea`, the window; writes

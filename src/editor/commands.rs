@@ -8,169 +8,32 @@ use bevy::ecs::system::SystemState;
 use bevy::prelude::*;
 
 use super::document::{CharacterIndex, Library, NextCharacterId, SceneCharacter, SceneReader, spawn_from_doc};
+pub use super::edit::{Edit, EditQueue, GestureHold};
 use super::history::History;
 use super::pose_library::PoseLibrary;
 use super::stage::StageSettings;
 use super::state::Messages;
-use crate::formats::scene::{
-    AnimDoc, BindingDoc, CharacterDoc, CharacterId, LibraryPoseDoc, PlacementDoc, PlaybackDoc, SkinningDoc, SmplDoc,
-    StageDoc, ViewDoc,
-};
+use crate::formats::scene::{AnimDoc, BindingDoc, CharacterDoc, CharacterId};
 use crate::rig::JointRotation;
 use crate::scene::keyframes::ClipPlayer;
 use crate::scene::node_clips::NodeClipPlayer;
 use crate::scene::smpl::SmplCharacter;
 use crate::scene::{
-    Character, CharacterSkinning, CharacterView, JointLimits, JointPose, MarionetteSystems, Placement, PoseDirty,
-    SkinOnGpu,
+    Character, CharacterSkinning, CharacterView, JointLimits, JointPose, Placement, PoseDirty, SkinOnGpu,
 };
-
-/// One user action on the scene.
-#[derive(Clone, Debug, PartialEq)]
-pub enum Edit {
-    /// Turn joints (by index) to these rotations, clamped to their limits.
-    Pose {
-        character: CharacterId,
-        joints: Vec<(usize, JointRotation)>,
-    },
-    /// Move, turn or scale a character.
-    Place {
-        character: CharacterId,
-        placement: PlacementDoc,
-    },
-    /// Display mode, visibility, weight colours, heat map, tint.
-    View {
-        character: CharacterId,
-        view: ViewDoc,
-    },
-    Rename {
-        character: CharacterId,
-        name: String,
-    },
-    /// β, clips, time, playback and blend of an SMPL body.
-    Smpl {
-        character: CharacterId,
-        state: SmplDoc,
-    },
-    /// Weights from the file (`None`) or computed from the bones.
-    Rebind {
-        character: CharacterId,
-        binding: Option<BindingDoc>,
-    },
-    /// Linear blend or dual quaternion skinning.
-    Skinning {
-        character: CharacterId,
-        method: SkinningDoc,
-    },
-    /// Skinning by the GPU compute shader (`true`) or on the CPU.
-    SkinOnGpu {
-        character: CharacterId,
-        on: bool,
-    },
-    /// A keyframed clip on a character, its time and playback (none: no clip).
-    Clip {
-        character: CharacterId,
-        anim: Option<AnimDoc>,
-    },
-    /// Clip, time, playback and blend of a source's own clips (glTF animations).
-    Playback {
-        character: CharacterId,
-        state: PlaybackDoc,
-    },
-    /// Morph target weights.
-    Morph {
-        character: CharacterId,
-        weights: Vec<f32>,
-    },
-    /// A pose kept in the scene's library under `name` (none: taken out).
-    Library {
-        name: String,
-        pose: Option<LibraryPoseDoc>,
-    },
-    /// Floor, shadows, axes.
-    Stage(StageDoc),
-    /// A character from its document (a fresh id is given when it has none).
-    Add(Box<CharacterDoc>),
-    Remove(CharacterId),
-}
-
-impl Edit {
-    /// The character it edits (none for the stage).
-    pub fn character(&self) -> Option<CharacterId> {
-        match self {
-            Edit::Pose { character, .. }
-            | Edit::Place { character, .. }
-            | Edit::View { character, .. }
-            | Edit::Rename { character, .. }
-            | Edit::Smpl { character, .. }
-            | Edit::Rebind { character, .. }
-            | Edit::Skinning { character, .. }
-            | Edit::SkinOnGpu { character, .. }
-            | Edit::Clip { character, .. }
-            | Edit::Morph { character, .. }
-            | Edit::Playback { character, .. }
-            | Edit::Remove(character) => Some(*character),
-            Edit::Add(doc) => doc.id,
-            Edit::Stage(_) | Edit::Library { .. } => None,
-        }
-    }
-}
-
-impl Edit {
-    /// Whether `self` and `other` set the same thing (within a gesture, only the first
-    /// value of each thing is kept): the same kind of edit of the same character, or the
-    /// same pose of the library. Poses, adds and removes are judged by the history itself.
-    pub fn same_slot(&self, other: &Edit) -> bool {
-        match (self, other) {
-            (Edit::Library { name: a, .. }, Edit::Library { name: b, .. }) => a == b,
-            _ => std::mem::discriminant(self) == std::mem::discriminant(other) && self.character() == other.character(),
-        }
-    }
-}
-
-/// Edits waiting for this frame's `Animate`.
-#[derive(Resource, Default, Debug)]
-pub struct EditQueue(pub Vec<Edit>);
-
-impl EditQueue {
-    pub fn push(&mut self, edit: Edit) {
-        self.0.push(edit);
-    }
-}
-
-/// Held while a gesture goes on without a mouse button held: a widget of the panels held
-/// or typed into (a slider drag, a name being typed), or a rotation being typed in the
-/// viewport. The gesture stays one undo step, even between mouse presses.
-#[derive(Resource, Default, Debug, PartialEq, Eq)]
-pub struct GestureHold {
-    pub panels: bool,
-    pub typing: bool,
-}
-
-impl GestureHold {
-    pub fn held(&self) -> bool {
-        self.panels || self.typing
-    }
-}
 
 /// Edits as commands, and their history.
 pub struct CommandsPlugin;
 
 impl Plugin for CommandsPlugin {
     fn build(&self, app: &mut App) {
+        super::order::add_editor_order(app);
         app.init_resource::<EditQueue>()
             .init_resource::<History>()
             .init_resource::<GestureHold>()
             .init_resource::<CharacterIndex>()
             .init_resource::<NextCharacterId>()
-            .add_systems(
-                PostUpdate,
-                apply_edits
-                    .in_set(MarionetteSystems::Animate)
-                    .after(super::view::apply_pending_scene)
-                    .before(super::view::sync_character_views)
-                    .before(crate::scene::smpl::SmplPlayback),
-            );
+            .add_systems(PostUpdate, apply_edits.in_set(super::order::EditorSystems::Edits));
     }
 }
 

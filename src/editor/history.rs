@@ -4,7 +4,7 @@
 
 use bevy::prelude::*;
 
-use super::commands::Edit;
+use super::edit::Edit;
 
 /// The undo and redo steps, and what undoes the gesture under way.
 #[derive(Resource, Default, Debug)]

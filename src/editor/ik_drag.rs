@@ -7,11 +7,11 @@ use std::collections::BTreeMap;
 
 use bevy::prelude::*;
 
-use super::camera::ViewportHasPointer;
-use super::commands::{Edit, EditQueue};
 use super::document::SceneCharacter;
 use super::draw::SkeletonGizmos;
+use super::edit::{Edit, EditQueue};
 use super::picking::{CLICK_SLOP_PX, JointPicker, PICK_RADIUS_PX};
+use super::pointer::{PointerOwner, ViewportHasPointer};
 use super::state::{Drag, JointDrag, Selection};
 use crate::document::posing::{IK_ROUNDS, IK_TOLERANCE};
 use crate::formats::scene::CharacterId;
@@ -30,10 +30,7 @@ impl Plugin for IkDragPlugin {
             .init_resource::<Pins>()
             .add_systems(
                 Update,
-                (toggle_pins, start_drag, drag_joint)
-                    .chain()
-                    .after(super::camera::track_egui_pointer)
-                    .before(super::camera::orbit_camera_input),
+                (toggle_pins, start_drag, drag_joint).chain().in_set(super::order::EditorSystems::Drag),
             )
             .add_systems(PostUpdate, (draw_handles, draw_dragged_chain).in_set(crate::scene::MarionetteSystems::Draw));
     }
@@ -68,10 +65,10 @@ pub fn start_drag(
     picker: JointPicker,
     pointer: Res<ViewportHasPointer>,
     pins: Res<Pins>,
-    gizmo: Res<super::rotate_gizmo::RotateGizmo>,
+    owner: Res<PointerOwner>,
     mut drag: ResMut<JointDrag>,
 ) {
-    if !buttons.just_pressed(MouseButton::Left) || !pointer.0 || gizmo.holds_pointer {
+    if !buttons.just_pressed(MouseButton::Left) || !pointer.0 || owner.gizmo_holds_pointer {
         return;
     }
     let (Some(cursor), Some((_, camera_transform))) = (picker.cursor(), picker.camera()) else { return };

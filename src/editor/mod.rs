@@ -17,9 +17,12 @@ pub mod camera;
 pub mod commands;
 pub mod document;
 pub mod draw;
+pub mod edit;
 pub mod history;
 pub mod ik_drag;
+pub mod order;
 pub mod picking;
+pub mod pointer;
 pub mod pose_library;
 pub mod readiness;
 pub mod recent;
@@ -48,21 +51,26 @@ pub struct InteractionPlugin;
 
 impl Plugin for InteractionPlugin {
     fn build(&self, app: &mut App) {
+        order::add_editor_order(app);
         app.add_plugins((ik_drag::IkDragPlugin, rotate_gizmo::RotateGizmoPlugin));
-        app.init_resource::<camera::ViewportHasPointer>()
+        app.init_resource::<pointer::ViewportHasPointer>()
+            .init_resource::<pointer::PointerOwner>()
             .init_resource::<picking::PointerPress>()
             .init_resource::<picking::HoveredJoint>()
             .add_systems(
                 Update,
+                (pointer::track_egui_pointer, picking::hover_joint).chain().in_set(order::EditorSystems::Pointer),
+            )
+            .add_systems(
+                Update,
                 (
-                    camera::track_egui_pointer,
-                    picking::hover_joint,
                     orbit_camera_input,
                     picking::pick_joint_on_click,
                     shortcuts::scene_shortcuts,
                     shortcuts::frame_selection,
                 )
-                    .chain(),
+                    .chain()
+                    .in_set(order::EditorSystems::Viewport),
             );
     }
 }

@@ -4,8 +4,9 @@ use bevy::ecs::system::SystemParam;
 use bevy::prelude::*;
 use bevy::window::PrimaryWindow;
 
-use super::camera::{OrbitCamera, ViewportHasPointer};
+use super::camera::OrbitCamera;
 use super::document::SceneCharacter;
+use super::pointer::{PointerOwner, ViewportHasPointer};
 use super::state::Selection;
 use crate::formats::scene::CharacterId;
 use crate::scene::{Character, CurrentJointToWorld, Placement};
@@ -83,12 +84,12 @@ pub fn pick_joint_on_click(
     keys: Res<ButtonInput<KeyCode>>,
     picker: JointPicker,
     pointer: Res<ViewportHasPointer>,
-    gizmo: Res<super::rotate_gizmo::RotateGizmo>,
+    owner: Res<PointerOwner>,
     mut press: ResMut<PointerPress>,
     mut selection: ResMut<Selection>,
 ) {
     let cursor = picker.cursor();
-    if gizmo.holds_pointer || gizmo.is_typing() {
+    if owner.gizmo_holds_pointer || owner.gizmo_typing {
         // The press turns the joint (or applies a typed turn): no pick.
         press.0 = None;
         return;

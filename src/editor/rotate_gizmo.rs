@@ -12,10 +12,10 @@
 use bevy::input::mouse::AccumulatedMouseMotion;
 use bevy::prelude::*;
 
-use super::camera::ViewportHasPointer;
-use super::commands::{Edit, EditQueue, GestureHold};
 use super::draw::SkeletonGizmos;
+use super::edit::{Edit, EditQueue, GestureHold};
 use super::picking::{JointPicker, PICK_RADIUS_PX};
+use super::pointer::ViewportHasPointer;
 use super::state::{JointDrag, Selection};
 use crate::formats::scene::CharacterId;
 use crate::rig::turn::{dof_angles, dof_axes, turn_dof, turn_freely, wrap_angle};
@@ -132,18 +132,28 @@ impl RotateGizmo {
     }
 }
 
+/// Tells the camera, picking and IK drags whether the gizmo has the pointer (reads
+/// `RotateGizmo`; writes `PointerOwner`).
+fn publish_pointer_owner(gizmo: Res<RotateGizmo>, mut owner: ResMut<super::pointer::PointerOwner>) {
+    let now = super::pointer::PointerOwner {
+        gizmo_holds_pointer: gizmo.holds_pointer,
+        gizmo_turning: gizmo.turn.is_some(),
+        gizmo_typing: gizmo.is_typing(),
+    };
+    owner.set_if_neq(now);
+}
+
 pub struct RotateGizmoPlugin;
 
 impl Plugin for RotateGizmoPlugin {
     fn build(&self, app: &mut App) {
         app.init_resource::<RotateGizmo>()
+            .init_resource::<super::pointer::PointerOwner>()
             .add_systems(
                 Update,
-                (grab_gizmo, follow_gizmo, type_rotation)
+                (grab_gizmo, follow_gizmo, type_rotation, publish_pointer_owner)
                     .chain()
-                    .after(super::camera::track_egui_pointer)
-                    .before(super::ik_drag::start_drag)
-                    .before(super::camera::orbit_camera_input),
+                    .in_set(super::order::EditorSystems::Gizmo),
             )
             .add_systems(PostUpdate, draw_rotate_gizmo.in_set(crate::scene::MarionetteSystems::Draw));
     }

@@ -5,8 +5,8 @@
 use bevy::prelude::*;
 
 use super::camera::OrbitCamera;
-use super::commands::{Edit, EditQueue};
 use super::document::{PendingScene, SceneReader, open_scene_from, save_scene_to};
+use super::edit::{Edit, EditQueue};
 use super::history::{History, HistoryRequest};
 use super::screenshot::ScreenshotRequest;
 use super::state::{Messages, Selection};

@@ -45,10 +45,10 @@ impl Plugin for ScenePlugin {
             ))
             .add_systems(
                 PostUpdate,
-                (apply_pending_scene, sync_character_views)
-                    .chain()
-                    .in_set(MarionetteSystems::Animate)
-                    .before(crate::scene::smpl::SmplPlayback),
+                (
+                    apply_pending_scene.in_set(super::order::EditorSystems::OpenScene),
+                    sync_character_views.in_set(super::order::EditorSystems::SyncViews),
+                ),
             )
             .add_systems(PostUpdate, super::arrange::arrange_when_skinned.in_set(MarionetteSystems::Draw));
     }

@@ -4,7 +4,7 @@
 use bevy_egui::egui;
 
 use super::{InspectorState, Panels};
-use crate::editor::commands::Edit;
+use crate::editor::edit::Edit;
 use crate::editor::state::Selection;
 use crate::formats::scene::CharacterId;
 use crate::rig::{EulerOrder, JointRotation, Skeleton};

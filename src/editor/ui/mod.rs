@@ -16,10 +16,11 @@ use bevy::ecs::system::SystemParam;
 use bevy::prelude::*;
 use bevy_egui::{EguiContexts, EguiPrimaryContextPass, egui};
 
-use super::camera::{ViewportArea, fit_camera_viewport};
-use super::commands::{Edit, EditQueue, GestureHold};
+use super::camera::fit_camera_viewport;
 use super::document::{Library, NextCharacterId, PendingScene, SceneReader};
+use super::edit::{Edit, EditQueue, GestureHold};
 use super::history::History;
+use super::pointer::ViewportArea;
 use super::screenshot::ScreenshotRequest;
 use super::state::{Messages, Selection};
 

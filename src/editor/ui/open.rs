@@ -5,7 +5,7 @@ use std::path::Path;
 
 use super::{InspectorState, Panels};
 use crate::editor::arrange::beside;
-use crate::editor::commands::Edit;
+use crate::editor::edit::Edit;
 use crate::editor::state::Selection;
 use crate::formats::scene::{AnimDoc, CharacterDoc, PlacementDoc};
 
