@@ -226,7 +226,7 @@ fn ecs_frame_one_of_16_edited(bencher: Bencher, edit: &str) {
 }
 
 /// The document capture the editor ran every frame before edits became commands.
-fn capture_scene_document(reader: marionette::editor::document::SceneReader) {
+fn capture_scene_document(reader: marionette::editor::scene_doc::document::SceneReader) {
     divan::black_box(reader.capture());
 }
 
@@ -238,8 +238,8 @@ fn capture_scene_document(reader: marionette::editor::document::SceneReader) {
 /// every frame before edits became commands.
 #[divan::bench(args = ["after", "before"])]
 fn editing_frame_3_smpl_playing_1_puppet_dragged(bencher: Bencher, variant: &str) {
-    use marionette::editor::commands::{Edit, EditQueue};
-    use marionette::editor::document::{CharacterIndex, PendingScene};
+    use marionette::editor::edits::commands::{Edit, EditQueue};
+    use marionette::editor::scene_doc::document::{CharacterIndex, PendingScene};
     use marionette::formats::scene::{CharacterDoc, CharacterId, SceneDoc, SmplDoc, SourceDoc};
     use marionette::rig::ik::{IkGoal, solve_ik};
     let mut app = App::new();

@@ -43,7 +43,7 @@ fn run(cli: Cli) -> Result<()> {
                 time: clip.time,
                 clip: clip.clip.clone(),
             };
-            let notes = marionette::editor::render::render(paths, edits, out.clone(), width, height)
+            let notes = marionette::editor::present::render::render(paths, edits, out.clone(), width, height)
                 .map_err(anyhow::Error::msg)?;
             for n in notes {
                 eprintln!("note: {n}");

@@ -3,38 +3,22 @@
 //! egui panels, screenshots, and the headless renderer.
 //!
 //! The ECS is the only live model. The panels, the shortcuts and drags in the viewport read
-//! it and push [`commands::Edit`]s, applied in `Animate`; a `SceneDoc` is built only to save,
+//! it and push [`edits::commands::Edit`]s, applied in `Animate`; a `SceneDoc` is built only to save,
 //! duplicate or remove (what a history entry needs).
 //!
 //! Plugins (one per capability): [`ViewPlugin`] (stage, scene, edits and history, drawing;
 //! also used headless), [`InteractionPlugin`] (camera input, picking, IK drag, shortcuts),
-//! [`ui::InspectorPlugin`], [`screenshot::ScreenshotPlugin`]. Children import shared state
+//! [`ui::InspectorPlugin`], [`present::screenshot::ScreenshotPlugin`]. Children import shared state
 //! ([`state`], [`document`], [`commands`]), never this module.
 
-pub mod arrange;
 pub mod bench;
-pub mod camera;
-pub mod commands;
-pub mod document;
-pub mod draw;
-pub mod edit;
-pub mod history;
-pub mod ik_drag;
+pub mod edits;
+pub mod interact;
 pub mod order;
-pub mod picking;
-pub mod pointer;
-pub mod pose_library;
-pub mod readiness;
-pub mod recent;
-pub mod render;
-pub mod rotate_gizmo;
-pub mod screenshot;
-pub mod shortcuts;
-pub mod skin_material;
-pub mod stage;
+pub mod present;
+pub mod scene_doc;
 pub mod state;
 pub mod ui;
-pub mod view;
 
 use std::path::PathBuf;
 
@@ -42,9 +26,9 @@ use bevy::prelude::*;
 use bevy::window::WindowResolution;
 
 use crate::scene::{MarionetteSystems, RigCorePlugin, SkinningPlugin};
-use camera::{OrbitCamera, orbit_camera_input};
+use interact::camera::{OrbitCamera, orbit_camera_input};
+pub use present::view::{ScenePlugin, ViewPlugin, apply_pending_scene};
 pub use state::{Messages, Selection, StartupEdits, StartupPaths, UnloadedCharacters};
-pub use view::{ScenePlugin, ViewPlugin, apply_pending_scene};
 
 /// Mouse and keyboard in the viewport: orbit camera, picking, shortcuts.
 pub struct InteractionPlugin;
@@ -52,22 +36,24 @@ pub struct InteractionPlugin;
 impl Plugin for InteractionPlugin {
     fn build(&self, app: &mut App) {
         order::add_editor_order(app);
-        app.add_plugins((ik_drag::IkDragPlugin, rotate_gizmo::RotateGizmoPlugin));
-        app.init_resource::<pointer::ViewportHasPointer>()
-            .init_resource::<pointer::PointerOwner>()
-            .init_resource::<picking::PointerPress>()
-            .init_resource::<picking::HoveredJoint>()
+        app.add_plugins((interact::ik_drag::IkDragPlugin, interact::rotate_gizmo::RotateGizmoPlugin));
+        app.init_resource::<interact::pointer::ViewportHasPointer>()
+            .init_resource::<interact::pointer::PointerOwner>()
+            .init_resource::<interact::picking::PointerPress>()
+            .init_resource::<interact::picking::HoveredJoint>()
             .add_systems(
                 Update,
-                (pointer::track_egui_pointer, picking::hover_joint).chain().in_set(order::EditorSystems::Pointer),
+                (interact::pointer::track_egui_pointer, interact::picking::hover_joint)
+                    .chain()
+                    .in_set(order::EditorSystems::Pointer),
             )
             .add_systems(
                 Update,
                 (
                     orbit_camera_input,
-                    picking::pick_joint_on_click,
-                    shortcuts::scene_shortcuts,
-                    shortcuts::frame_selection,
+                    interact::picking::pick_joint_on_click,
+                    interact::shortcuts::scene_shortcuts,
+                    interact::shortcuts::frame_selection,
                 )
                     .chain()
                     .in_set(order::EditorSystems::Viewport),
@@ -126,19 +112,19 @@ pub fn run(paths: Vec<PathBuf>, edits: StartupEdits) {
         .add_plugins(bevy::diagnostic::FrameTimeDiagnosticsPlugin::default())
         // egui lives on its own full-window camera (see `spawn_window_camera`).
         .insert_resource(bevy_egui::EguiGlobalSettings { auto_create_primary_context: false, ..default() })
-        .insert_resource(ClearColor(stage::SKY))
+        .insert_resource(ClearColor(present::stage::SKY))
         .insert_resource(StartupPaths(paths))
         .insert_resource(edits)
         // The viewport between the default panels (1280 − 2 × 250 wide, 800 high).
-        .insert_resource(camera::FramingAspect(780.0 / 800.0))
+        .insert_resource(interact::camera::FramingAspect(780.0 / 800.0))
         .add_plugins((
             RigCorePlugin,
             SkinningPlugin,
             ViewPlugin,
             InteractionPlugin,
             ui::InspectorPlugin,
-            recent::RecentFilesPlugin,
-            screenshot::ScreenshotPlugin,
+            ui::recent::RecentFilesPlugin,
+            present::screenshot::ScreenshotPlugin,
         ))
         // The inspector's edits (bevy_egui's pass) land before the chain that animates,
         // solves, runs the matrix stack and skins: an edit is skinned the frame it is made.

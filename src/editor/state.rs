@@ -65,7 +65,7 @@ pub struct Drag {
     /// Pinned joints of that character and where they must stay (world).
     pub pins: Vec<(usize, Vec3)>,
     /// Where the button went down (window pixels): the pose changes only once the cursor
-    /// has moved beyond [`CLICK_SLOP_PX`](super::picking::CLICK_SLOP_PX) from it, so a click is no edit.
+    /// has moved beyond [`CLICK_SLOP_PX`](crate::editor::interact::picking::CLICK_SLOP_PX) from it, so a click is no edit.
     pub pressed_at: Vec2,
     pub moved: bool,
 }

@@ -337,7 +337,7 @@ fn a_scene_plays_a_clip_on_the_wasp_and_keeps_it_in_the_file() {
     use bevy::prelude::*;
     use marionette::document::scenes::{read_scene, write_scene};
     use marionette::editor::ScenePlugin;
-    use marionette::editor::document::{PendingScene, SceneReader};
+    use marionette::editor::scene_doc::document::{PendingScene, SceneReader};
     use marionette::formats::scene::{AnimDoc, CharacterDoc, SceneDoc, SourceDoc};
     use marionette::scene::{Character, CurrentJointToWorld};
 

@@ -2,8 +2,8 @@
 
 use bevy::prelude::*;
 use marionette::editor::ScenePlugin;
-use marionette::editor::arrange::{ArrangeWhenSkinned, beside, side_by_side, world_box};
-use marionette::editor::document::{PendingScene, SceneCharacter};
+use marionette::editor::scene_doc::arrange::{ArrangeWhenSkinned, beside, side_by_side, world_box};
+use marionette::editor::scene_doc::document::{PendingScene, SceneCharacter};
 use marionette::formats::scene::{CharacterDoc, PlacementDoc, SceneDoc, SourceDoc};
 use marionette::scene::{Placement, SkinScratch};
 
@@ -120,7 +120,7 @@ fn match_height_makes_heights_equal_and_the_row_does_not_overlap() {
 #[test]
 fn framing_sees_every_corner_and_fills_most_of_the_picture() {
     use bevy::camera::CameraProjection;
-    use marionette::editor::camera::OrbitCamera;
+    use marionette::editor::interact::camera::OrbitCamera;
     let boxes = [
         (Vec3::new(-0.5, 0.0, -0.3), Vec3::new(0.5, 1.8, 0.3)),
         (Vec3::new(-8.0, 0.0, -2.0), Vec3::new(8.0, 1.0, 2.0)),
@@ -157,7 +157,7 @@ fn framing_sees_every_corner_and_fills_most_of_the_picture() {
 /// character stands alone, even one from the same non-glTF file.
 #[test]
 fn characters_of_one_gltf_file_are_placed_together() {
-    use marionette::editor::arrange::{gltf_file, one_file_groups};
+    use marionette::editor::scene_doc::arrange::{gltf_file, one_file_groups};
     use marionette::formats::scene::SourceDoc;
     let glb = std::path::PathBuf::from("pair.glb");
     let sources = [

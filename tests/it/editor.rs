@@ -6,7 +6,7 @@ use std::path::PathBuf;
 use std::process::Command;
 
 use marionette::document::scenes::{pose_from_doc, read_scene, write_scene};
-use marionette::editor::screenshot::timestamp;
+use marionette::editor::present::screenshot::timestamp;
 use marionette::formats::scene::{
     CharacterDoc, PlacementDoc, SceneDoc, SourceDoc, ViewDoc, parse_scene, scene_to_string,
 };
@@ -306,7 +306,7 @@ fn render_frames_the_characters_to_fill_the_picture() {
 /// spacing with at most 20 lines a side.
 #[test]
 fn the_stage_grows_with_the_scene() {
-    use marionette::editor::stage::StageExtent;
+    use marionette::editor::present::stage::StageExtent;
     assert_eq!(StageExtent::reaching(0.0), StageExtent { half: 10.0, step: 0.5 });
     assert_eq!(StageExtent::reaching(3.0), StageExtent { half: 10.0, step: 0.5 });
     for reach in [6.0, 31.0, 250.0, 4000.0] {
@@ -322,7 +322,7 @@ fn the_stage_grows_with_the_scene() {
 /// folder made) and read back; a missing file is an empty list.
 #[test]
 fn recent_files_are_kept_newest_first_and_read_back() {
-    use marionette::editor::recent::{KEPT, read_recent, remember, write_recent};
+    use marionette::editor::ui::recent::{KEPT, read_recent, remember, write_recent};
     let file = crate::common::scratch("recent").join("config/marionette/recent.txt");
     assert!(read_recent(&file).is_empty());
     let mut recent = Vec::new();

@@ -2,10 +2,10 @@
 //! one step, a click none; opening a scene replaces the world; ids are stable.
 
 use bevy::prelude::*;
-use marionette::editor::commands::{Edit, EditQueue, GestureHold};
-use marionette::editor::document::{CharacterIndex, PendingScene, SceneCharacter, SceneReader};
-use marionette::editor::history::{History, HistoryRequest};
-use marionette::editor::ik_drag::Pins;
+use marionette::editor::edits::commands::{Edit, EditQueue, GestureHold};
+use marionette::editor::edits::history::{History, HistoryRequest};
+use marionette::editor::interact::ik_drag::Pins;
+use marionette::editor::scene_doc::document::{CharacterIndex, PendingScene, SceneCharacter, SceneReader};
 use marionette::editor::{Messages, ScenePlugin, Selection};
 use marionette::formats::scene::{
     BindingDoc, CharacterDoc, CharacterId, DisplayDoc, SceneDoc, SourceDoc, StageDoc, ViewDoc,
@@ -273,7 +273,7 @@ fn smpl_shape_and_clip_edits_undo_and_redo() {
 /// is cancelled (its start pushed back) leaves the pose exactly as it was and no step.
 #[test]
 fn a_gizmo_drag_is_one_undo_step_and_a_cancelled_one_none() {
-    use marionette::editor::rotate_gizmo::{Grip, Turn};
+    use marionette::editor::interact::rotate_gizmo::{Grip, Turn};
     let mut app = scene_app();
     open_puppets(&mut app, &[Some(1)]);
     let elbow = joint(&app, 1, "l_elbow");

@@ -5,7 +5,7 @@ use std::f32::consts::{FRAC_PI_2, PI};
 
 use bevy::math::{Dir3, Ray3d};
 use glam::{Quat, Vec3};
-use marionette::editor::rotate_gizmo::{Grip, Turn, angle_on_ring};
+use marionette::editor::interact::rotate_gizmo::{Grip, Turn, angle_on_ring};
 use marionette::formats::scene::CharacterId;
 use marionette::rig::turn::{dof_angles, dof_axes, turn_dof, turn_freely, wrap_angle};
 use marionette::rig::{DofLimits, EulerOrder, JointRotation};

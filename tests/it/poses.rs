@@ -2,8 +2,8 @@
 //! kept pose reapplied gives the same matrices.
 
 use glam::{Mat4, Quat, Vec3};
-use marionette::editor::commands::Edit;
-use marionette::editor::pose_library::{apply_named_pose, library_pose, pose_by_name};
+use marionette::editor::edits::commands::Edit;
+use marionette::editor::edits::pose_library::{apply_named_pose, library_pose, pose_by_name};
 use marionette::formats::scene::CharacterId;
 use marionette::rig::mirror::{mirrored_name, mirrored_pose, mirrored_rotation};
 use marionette::rig::{EulerOrder, JointRotation, forward_kinematics};

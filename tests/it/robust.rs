@@ -7,7 +7,7 @@ use std::process::Command;
 use std::sync::Arc;
 
 use bevy::prelude::*;
-use marionette::editor::readiness::{CaptureGate, GpuStatus, Readiness, readiness};
+use marionette::editor::present::readiness::{CaptureGate, GpuStatus, Readiness, readiness};
 use marionette::formats::scene::{SceneDoc, joint_of_pose_key, pose_key, save_scene};
 use marionette::formats::{cse169, homer, mit6837, write_atomically};
 use marionette::rig::ik::{IkGoal, solve_ik};

@@ -8,7 +8,7 @@ use bevy_egui::egui;
 use egui_file_dialog::FileDialog;
 
 use super::{InspectorState, Panels};
-use crate::editor::screenshot::ScreenshotRequest;
+use crate::editor::present::screenshot::ScreenshotRequest;
 
 /// What the open dialog is for.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -78,11 +78,11 @@ pub fn show(ctx: &egui::Context, state: &mut InspectorState, panels: &mut Panels
             if let Some(recent) = panels.recent.as_mut() {
                 recent.remember(&text);
             }
-            crate::editor::document::open_scene_from(&text, &mut panels.pending, &mut panels.messages);
+            crate::editor::scene_doc::document::open_scene_from(&text, &mut panels.pending, &mut panels.messages);
         }
         DialogPurpose::SaveScene => {
             state.scene_path = text.clone();
-            crate::editor::document::save_scene_to(&text, &panels.scene.capture(), &mut panels.messages);
+            crate::editor::scene_doc::document::save_scene_to(&text, &panels.scene.capture(), &mut panels.messages);
         }
         DialogPurpose::AddFile => super::open::open_path(&text, state, panels),
         DialogPurpose::ExportGltf => export_gltf(&path, panels),

@@ -4,7 +4,7 @@
 use bevy_egui::egui;
 
 use super::{InspectorState, Panels};
-use crate::editor::edit::Edit;
+use crate::editor::edits::edit::Edit;
 use crate::editor::state::Selection;
 use crate::formats::scene::CharacterId;
 use crate::rig::{EulerOrder, JointRotation, Skeleton};
@@ -122,7 +122,7 @@ fn joint_tree(
             let is_selected = selection.character == Some(id) && selection.joints.contains(&j);
             let label = format!("{} ({j})", skeleton.joint(j).name);
             if ui.selectable_label(is_selected, label).clicked() {
-                crate::editor::picking::select_joint(selection, id, j, additive);
+                crate::editor::interact::picking::select_joint(selection, id, j, additive);
             }
         });
         if !collapsed {

@@ -7,7 +7,7 @@
 use bevy_egui::egui;
 
 use super::{InspectorState, Panels};
-use crate::editor::edit::Edit;
+use crate::editor::edits::edit::Edit;
 use crate::formats::scene::{AnimDoc, CharacterId};
 use crate::rig::JointRotation;
 use crate::rig::anim::{Channel, Clip, Extrapolation, Key, SAME_TIME, Tangent};

@@ -8,6 +8,7 @@ pub mod joint_panel;
 pub mod keyframe_panel;
 pub mod open;
 pub mod pose_panel;
+pub mod recent;
 pub mod scene_panel;
 pub mod smpl_panel;
 
@@ -16,13 +17,13 @@ use bevy::ecs::system::SystemParam;
 use bevy::prelude::*;
 use bevy_egui::{EguiContexts, EguiPrimaryContextPass, egui};
 
-use super::camera::fit_camera_viewport;
-use super::document::{Library, NextCharacterId, PendingScene, SceneReader};
-use super::edit::{Edit, EditQueue, GestureHold};
-use super::history::History;
-use super::pointer::ViewportArea;
-use super::screenshot::ScreenshotRequest;
 use super::state::{Messages, Selection};
+use crate::editor::edits::edit::{Edit, EditQueue, GestureHold};
+use crate::editor::edits::history::History;
+use crate::editor::interact::camera::fit_camera_viewport;
+use crate::editor::interact::pointer::ViewportArea;
+use crate::editor::present::screenshot::ScreenshotRequest;
+use crate::editor::scene_doc::document::{Library, NextCharacterId, PendingScene, SceneReader};
 
 /// Text fields and transient state of the panels.
 #[derive(Resource)]
@@ -81,7 +82,7 @@ pub struct Panels<'w, 's> {
     pub ids: ResMut<'w, NextCharacterId>,
     pub pending: ResMut<'w, PendingScene>,
     /// The recent files (none in an app without the inspector: nothing is remembered).
-    pub recent: Option<ResMut<'w, crate::editor::recent::RecentFiles>>,
+    pub recent: Option<ResMut<'w, crate::editor::ui::recent::RecentFiles>>,
 }
 
 impl Panels<'_, '_> {
@@ -96,7 +97,7 @@ impl Panels<'_, '_> {
             .iter()
             .filter_map(|(entity, _, _, placement, ..)| {
                 let (lo, hi) = self.skins.get(entity).ok()?.bounds;
-                Some(crate::editor::arrange::world_box(lo, hi, &placement.0))
+                Some(crate::editor::scene_doc::arrange::world_box(lo, hi, &placement.0))
             })
             .collect()
     }
@@ -113,8 +114,8 @@ impl Panels<'_, '_> {
 #[derive(SystemParam)]
 pub struct ViewportOverlays<'w> {
     diagnostics: Res<'w, DiagnosticsStore>,
-    hovered: Res<'w, super::picking::HoveredJoint>,
-    gizmo: Res<'w, super::rotate_gizmo::RotateGizmo>,
+    hovered: Res<'w, crate::editor::interact::picking::HoveredJoint>,
+    gizmo: Res<'w, crate::editor::interact::rotate_gizmo::RotateGizmo>,
 }
 
 pub struct InspectorPlugin;
@@ -122,7 +123,7 @@ pub struct InspectorPlugin;
 impl Plugin for InspectorPlugin {
     fn build(&self, app: &mut App) {
         app.init_resource::<InspectorState>()
-            .init_resource::<crate::editor::recent::RecentFiles>()
+            .init_resource::<crate::editor::ui::recent::RecentFiles>()
             .init_resource::<ViewportArea>()
             .add_systems(Startup, save_to_the_opened_scene)
             .add_systems(PostUpdate, fit_camera_viewport)
@@ -218,7 +219,11 @@ fn frame_time_readout(ctx: &egui::Context, viewport: egui::Rect, diagnostics: &D
 }
 
 /// The joint under the cursor, named beside it: "character · joint (index)".
-fn hovered_joint_tooltip(ctx: &egui::Context, panels: &Panels, hovered: &super::picking::HoveredJoint) {
+fn hovered_joint_tooltip(
+    ctx: &egui::Context,
+    panels: &Panels,
+    hovered: &crate::editor::interact::picking::HoveredJoint,
+) {
     let Some(hit) = hovered.0 else { return };
     let Ok((_, sc, character, ..)) = panels.scene.characters.get(hit.entity) else { return };
     let (Some(pointer), Some(joint)) = (ctx.pointer_hover_pos(), character.asset.skeleton.joints().get(hit.joint))

@@ -4,8 +4,8 @@
 use std::path::Path;
 
 use super::{InspectorState, Panels};
-use crate::editor::arrange::beside;
-use crate::editor::edit::Edit;
+use crate::editor::edits::edit::Edit;
+use crate::editor::scene_doc::arrange::beside;
 use crate::editor::state::Selection;
 use crate::formats::scene::{AnimDoc, CharacterDoc, PlacementDoc};
 
@@ -27,7 +27,7 @@ pub fn open_path(path: &str, state: &mut InspectorState, panels: &mut Panels) {
         recent.remember(path);
     }
     if path.ends_with(".ron") {
-        crate::editor::document::open_scene_from(path, &mut panels.pending, &mut panels.messages);
+        crate::editor::scene_doc::document::open_scene_from(path, &mut panels.pending, &mut panels.messages);
         state.scene_path = path.to_string();
     } else if path.ends_with(".anim") {
         add_clip(path, panels);
@@ -50,7 +50,7 @@ fn add_character(path: &str, state: &mut InspectorState, panels: &mut Panels) {
         }
     }
     // The characters of one file move together: they keep the layout the file gives them.
-    let (lo, hi) = crate::editor::arrange::union(loaded.iter().map(|(_, a)| a.bounds()));
+    let (lo, hi) = crate::editor::scene_doc::arrange::union(loaded.iter().map(|(_, a)| a.bounds()));
     let translation = beside(&panels.world_boxes(), lo, hi, 1.0);
     for (source, asset) in loaded {
         panels.messages.0.extend(asset.warnings.iter().cloned());

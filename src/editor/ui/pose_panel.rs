@@ -5,8 +5,8 @@
 use bevy_egui::egui;
 
 use super::{InspectorState, Panels};
-use crate::editor::edit::Edit;
-use crate::editor::pose_library::{apply_named_pose, library_pose, pose_by_name};
+use crate::editor::edits::edit::Edit;
+use crate::editor::edits::pose_library::{apply_named_pose, library_pose, pose_by_name};
 use crate::formats::scene::{CharacterId, LibraryPoseDoc};
 use crate::rig::JointRotation;
 

@@ -9,11 +9,11 @@ use bevy_egui::egui;
 
 use super::dialogs::DialogPurpose;
 use super::{InspectorState, Panels};
-use crate::editor::arrange::{beside, rescaled_keeping_feet};
-use crate::editor::document::{open_scene_from, save_scene_to};
-use crate::editor::edit::Edit;
-use crate::editor::history::HistoryRequest;
-use crate::editor::screenshot::ScreenshotRequest;
+use crate::editor::edits::edit::Edit;
+use crate::editor::edits::history::HistoryRequest;
+use crate::editor::present::screenshot::ScreenshotRequest;
+use crate::editor::scene_doc::arrange::{beside, rescaled_keeping_feet};
+use crate::editor::scene_doc::document::{open_scene_from, save_scene_to};
 use crate::editor::state::Selection;
 use crate::formats::scene::{BindingDoc, CharacterId, DisplayDoc, PlacementDoc, SkinningDoc, ViewDoc};
 

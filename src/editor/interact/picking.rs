@@ -4,10 +4,10 @@ use bevy::ecs::system::SystemParam;
 use bevy::prelude::*;
 use bevy::window::PrimaryWindow;
 
-use super::camera::OrbitCamera;
-use super::document::SceneCharacter;
-use super::pointer::{PointerOwner, ViewportHasPointer};
-use super::state::Selection;
+use crate::editor::interact::camera::OrbitCamera;
+use crate::editor::interact::pointer::{PointerOwner, ViewportHasPointer};
+use crate::editor::scene_doc::document::SceneCharacter;
+use crate::editor::state::Selection;
 use crate::formats::scene::CharacterId;
 use crate::scene::{Character, CurrentJointToWorld, Placement};
 
@@ -53,7 +53,7 @@ pub fn hover_joint(
     buttons: Res<ButtonInput<MouseButton>>,
     picker: JointPicker,
     pointer: Res<ViewportHasPointer>,
-    drag: Res<super::state::JointDrag>,
+    drag: Res<crate::editor::state::JointDrag>,
     mut hovered: ResMut<HoveredJoint>,
 ) {
     let hit = (pointer.0 && drag.active.is_none() && buttons.get_pressed().next().is_none())

@@ -4,8 +4,8 @@
 
 use bevy::prelude::*;
 
-use super::document::SceneCharacter;
-use super::state::Selection;
+use crate::editor::scene_doc::document::SceneCharacter;
+use crate::editor::state::Selection;
 use crate::formats::scene::DisplayDoc;
 use crate::rig::character::SkinKind;
 use crate::scene::{Character, CharacterView, CurrentJointToWorld, Placement};
@@ -34,7 +34,7 @@ pub fn draw_skeletons(
     characters: Query<(&Character, &CharacterView, &Placement, Option<&SceneCharacter>, &InheritedVisibility)>,
     joints: Query<&CurrentJointToWorld>,
     selection: Res<Selection>,
-    hovered: Option<Res<super::picking::HoveredJoint>>,
+    hovered: Option<Res<crate::editor::interact::picking::HoveredJoint>>,
     mut gizmos: Gizmos<SkeletonGizmos>,
 ) {
     if let Some(hit) = hovered.as_ref().and_then(|h| h.0)

@@ -6,8 +6,8 @@ use std::path::{Path, PathBuf};
 use bevy::prelude::*;
 use bevy::render::view::screenshot::{Screenshot, ScreenshotCaptured};
 
-use super::readiness::CaptureGate;
-use super::state::Messages;
+use crate::editor::present::readiness::CaptureGate;
+use crate::editor::state::Messages;
 
 /// A pending screenshot and the options of the next one.
 #[derive(Resource)]
@@ -44,7 +44,7 @@ pub struct ScreenshotPlugin;
 impl Plugin for ScreenshotPlugin {
     fn build(&self, app: &mut App) {
         app.init_resource::<ScreenshotRequest>()
-            .add_systems(Last, take_requested_screenshot.after(super::readiness::UpdateCaptureGate));
+            .add_systems(Last, take_requested_screenshot.after(crate::editor::present::readiness::UpdateCaptureGate));
     }
 }
 

@@ -7,12 +7,14 @@
 use bevy::ecs::system::SystemState;
 use bevy::prelude::*;
 
-use super::document::{CharacterIndex, Library, NextCharacterId, SceneCharacter, SceneReader, spawn_from_doc};
-pub use super::edit::{Edit, EditQueue, GestureHold};
-use super::history::History;
-use super::pose_library::PoseLibrary;
-use super::stage::StageSettings;
-use super::state::Messages;
+pub use crate::editor::edits::edit::{Edit, EditQueue, GestureHold};
+use crate::editor::edits::history::History;
+use crate::editor::edits::pose_library::PoseLibrary;
+use crate::editor::present::stage::StageSettings;
+use crate::editor::scene_doc::document::{
+    CharacterIndex, Library, NextCharacterId, SceneCharacter, SceneReader, spawn_from_doc,
+};
+use crate::editor::state::Messages;
 use crate::formats::scene::{AnimDoc, BindingDoc, CharacterDoc, CharacterId};
 use crate::rig::JointRotation;
 use crate::scene::keyframes::ClipPlayer;
@@ -27,13 +29,13 @@ pub struct CommandsPlugin;
 
 impl Plugin for CommandsPlugin {
     fn build(&self, app: &mut App) {
-        super::order::add_editor_order(app);
+        crate::editor::order::add_editor_order(app);
         app.init_resource::<EditQueue>()
             .init_resource::<History>()
             .init_resource::<GestureHold>()
             .init_resource::<CharacterIndex>()
             .init_resource::<NextCharacterId>()
-            .add_systems(PostUpdate, apply_edits.in_set(super::order::EditorSystems::Edits));
+            .add_systems(PostUpdate, apply_edits.in_set(crate::editor::order::EditorSystems::Edits));
     }
 }
 
@@ -279,8 +281,13 @@ fn set_clip(world: &mut World, id: CharacterId, anim: Option<AnimDoc>) -> Result
     }
     let found = character_of(world, id)?;
     let name = component::<SceneCharacter>(world, id)?.name.clone();
-    let (player, note) = super::document::clip_player(&mut world.resource_mut::<Library>(), &found.asset, &name, &anim)
-        .map_err(|e| e.to_string())?;
+    let (player, note) = crate::editor::scene_doc::document::clip_player(
+        &mut world.resource_mut::<Library>(),
+        &found.asset,
+        &name,
+        &anim,
+    )
+    .map_err(|e| e.to_string())?;
     if let Some(note) = note {
         world.resource_mut::<Messages>().push(note);
     }

@@ -11,14 +11,14 @@ use bevy::prelude::*;
 use bevy::render::render_resource::{TextureFormat, TextureUsages};
 use bevy::render::view::screenshot::{Screenshot, ScreenshotCaptured};
 
-use super::camera::OrbitCamera;
-use super::document::Library;
-use super::readiness::CaptureGate;
-use super::stage;
-use super::state::{Messages, StartupEdits, StartupPaths};
-use super::view::ViewPlugin;
 use crate::document::AssetLibrary;
 use crate::document::scenes::{read_scene, scene_path};
+use crate::editor::interact::camera::OrbitCamera;
+use crate::editor::present::readiness::CaptureGate;
+use crate::editor::present::stage;
+use crate::editor::present::view::ViewPlugin;
+use crate::editor::scene_doc::document::Library;
+use crate::editor::state::{Messages, StartupEdits, StartupPaths};
 use crate::formats::scene::{BindingDoc, SourceDoc};
 use crate::scene::{RigCorePlugin, SkinningPlugin};
 
@@ -52,10 +52,10 @@ pub fn render(
     let library = preload(&paths, &edits)?;
     crate::formats::error::refuse_overwriting_input(&out).map_err(|e| e.to_string())?;
     let mut app = App::new();
-    app.add_plugins(super::windowless_plugins())
+    app.add_plugins(crate::editor::windowless_plugins())
         .add_plugins(ScheduleRunnerPlugin::run_loop(Duration::from_millis(2)))
         .insert_resource(ClearColor(stage::SKY))
-        .insert_resource(super::camera::FramingAspect(width as f32 / height as f32))
+        .insert_resource(crate::editor::interact::camera::FramingAspect(width as f32 / height as f32))
         .insert_resource(StartupPaths(paths))
         .insert_resource(Library(library))
         .insert_resource(edits)
@@ -79,7 +79,7 @@ pub fn render(
         let orbit = OrbitCamera::default();
         commands.spawn((Camera3d::default(), RenderTarget::Image(target.clone().into()), orbit, orbit.transform()));
     });
-    app.add_systems(Last, capture_when_ready.after(super::readiness::UpdateCaptureGate));
+    app.add_systems(Last, capture_when_ready.after(crate::editor::present::readiness::UpdateCaptureGate));
     let exit = app.run();
     // `App::run` hands the world to the runner: the outcome comes back through `outcome`.
     let (done, messages) = outcome.lock().map(|o| o.clone()).unwrap_or_default();
@@ -155,7 +155,7 @@ fn capture_when_ready(
     let out = job.out.clone();
     commands.spawn(Screenshot::image(job.target.clone())).observe(
         move |captured: On<ScreenshotCaptured>, mut job: ResMut<RenderJob>| {
-            job.done = Some(super::screenshot::save_png(&captured.image, &out));
+            job.done = Some(crate::editor::present::screenshot::save_png(&captured.image, &out));
         },
     );
 }

@@ -15,7 +15,7 @@ use bevy::render::render_resource::{CachedPipelineState, PipelineCache};
 use bevy::render::texture::GpuImage;
 use bevy::render::{Render, RenderApp, RenderSystems};
 
-use super::document::PendingScene;
+use crate::editor::scene_doc::document::PendingScene;
 use crate::scene::PoseDirty;
 
 /// Rendered frames in a row that must be ready before a capture.

@@ -7,7 +7,7 @@ use std::path::{Path, PathBuf};
 
 use bevy::prelude::*;
 
-use super::state::Messages;
+use crate::editor::state::Messages;
 
 /// How many recent files are kept.
 pub const KEPT: usize = 8;

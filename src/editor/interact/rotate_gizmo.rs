@@ -12,11 +12,11 @@
 use bevy::input::mouse::AccumulatedMouseMotion;
 use bevy::prelude::*;
 
-use super::draw::SkeletonGizmos;
-use super::edit::{Edit, EditQueue, GestureHold};
-use super::picking::{JointPicker, PICK_RADIUS_PX};
-use super::pointer::ViewportHasPointer;
-use super::state::{JointDrag, Selection};
+use crate::editor::edits::edit::{Edit, EditQueue, GestureHold};
+use crate::editor::interact::picking::{JointPicker, PICK_RADIUS_PX};
+use crate::editor::interact::pointer::ViewportHasPointer;
+use crate::editor::present::draw::SkeletonGizmos;
+use crate::editor::state::{JointDrag, Selection};
 use crate::formats::scene::CharacterId;
 use crate::rig::turn::{dof_angles, dof_axes, turn_dof, turn_freely, wrap_angle};
 use crate::rig::{DofLimits, JointRotation};
@@ -134,8 +134,8 @@ impl RotateGizmo {
 
 /// Tells the camera, picking and IK drags whether the gizmo has the pointer (reads
 /// `RotateGizmo`; writes `PointerOwner`).
-fn publish_pointer_owner(gizmo: Res<RotateGizmo>, mut owner: ResMut<super::pointer::PointerOwner>) {
-    let now = super::pointer::PointerOwner {
+fn publish_pointer_owner(gizmo: Res<RotateGizmo>, mut owner: ResMut<crate::editor::interact::pointer::PointerOwner>) {
+    let now = crate::editor::interact::pointer::PointerOwner {
         gizmo_holds_pointer: gizmo.holds_pointer,
         gizmo_turning: gizmo.turn.is_some(),
         gizmo_typing: gizmo.is_typing(),
@@ -148,12 +148,12 @@ pub struct RotateGizmoPlugin;
 impl Plugin for RotateGizmoPlugin {
     fn build(&self, app: &mut App) {
         app.init_resource::<RotateGizmo>()
-            .init_resource::<super::pointer::PointerOwner>()
+            .init_resource::<crate::editor::interact::pointer::PointerOwner>()
             .add_systems(
                 Update,
                 (grab_gizmo, follow_gizmo, type_rotation, publish_pointer_owner)
                     .chain()
-                    .in_set(super::order::EditorSystems::Gizmo),
+                    .in_set(crate::editor::order::EditorSystems::Gizmo),
             )
             .add_systems(PostUpdate, draw_rotate_gizmo.in_set(crate::scene::MarionetteSystems::Draw));
     }
@@ -276,7 +276,7 @@ pub fn angle_on_ring(center: Vec3, normal: Vec3, across: Vec3, ray: Ray3d) -> Op
 
 /// A character's size in the world (its bind mesh's diagonal times its scale).
 fn character_scale(character: &Character, scale: f32) -> f32 {
-    super::draw::character_size(character) * scale
+    crate::editor::present::draw::character_size(character) * scale
 }
 
 fn distance_to_segment(p: Vec2, a: Vec2, b: Vec2) -> f32 {
@@ -494,7 +494,7 @@ fn draw_rotate_gizmo(
     poses: Query<&JointPose>,
     gizmo: Res<RotateGizmo>,
     ik: Res<JointDrag>,
-    cameras: Query<&GlobalTransform, With<super::camera::OrbitCamera>>,
+    cameras: Query<&GlobalTransform, With<crate::editor::interact::camera::OrbitCamera>>,
     mut gizmos: Gizmos<SkeletonGizmos>,
 ) {
     if ik.active.is_some() {
@@ -548,10 +548,10 @@ fn draw_moving_joints(picker: &JointPicker, view: &GizmoView, gizmos: &mut Gizmo
     let mut todo = vec![view.joint];
     while let Some(j) = todo.pop() {
         let Some(p) = world(j) else { continue };
-        gizmos.sphere(Isometry3d::from_translation(p), radius, super::ik_drag::CHAIN_COLOR);
+        gizmos.sphere(Isometry3d::from_translation(p), radius, crate::editor::interact::ik_drag::CHAIN_COLOR);
         for &c in skeleton.children(j) {
             if let Some(q) = world(c) {
-                gizmos.line(p, q, super::ik_drag::CHAIN_COLOR);
+                gizmos.line(p, q, crate::editor::interact::ik_drag::CHAIN_COLOR);
             }
             todo.push(c);
         }

@@ -16,7 +16,7 @@ pub struct FlatNormals {}
 
 impl MaterialExtension for FlatNormals {
     fn fragment_shader() -> ShaderRef {
-        "embedded://marionette/editor/flat_normals.wgsl".into()
+        "embedded://marionette/editor/present/flat_normals.wgsl".into()
     }
 }
 

@@ -4,13 +4,13 @@
 
 use bevy::prelude::*;
 
-use super::camera::OrbitCamera;
-use super::document::{PendingScene, SceneReader, open_scene_from, save_scene_to};
-use super::edit::{Edit, EditQueue};
-use super::history::{History, HistoryRequest};
-use super::screenshot::ScreenshotRequest;
-use super::state::{Messages, Selection};
-use super::ui::InspectorState;
+use crate::editor::edits::edit::{Edit, EditQueue};
+use crate::editor::edits::history::{History, HistoryRequest};
+use crate::editor::interact::camera::OrbitCamera;
+use crate::editor::present::screenshot::ScreenshotRequest;
+use crate::editor::scene_doc::document::{PendingScene, SceneReader, open_scene_from, save_scene_to};
+use crate::editor::state::{Messages, Selection};
+use crate::editor::ui::InspectorState;
 use crate::formats::scene::ViewDoc;
 use crate::scene::{Character, CurrentJointToWorld, Placement};
 
@@ -88,7 +88,7 @@ pub fn frame_selection(
     keys: Res<ButtonInput<KeyCode>>,
     wants: Option<Res<bevy_egui::input::EguiWantsInput>>,
     selection: Res<Selection>,
-    characters: Query<(&super::document::SceneCharacter, &Character, &Placement)>,
+    characters: Query<(&crate::editor::scene_doc::document::SceneCharacter, &Character, &Placement)>,
     joints: Query<&CurrentJointToWorld>,
     mut cameras: Query<&mut OrbitCamera>,
 ) {

@@ -4,16 +4,18 @@
 
 use bevy::prelude::*;
 
-use super::camera::{FramingAspect, OrbitCamera, apply_orbit_camera};
-use super::document::{Library, NextCharacterId, PendingScene, SceneCharacter, spawn_from_doc};
-use super::skin_material::SkinMaterial;
-use super::stage::{
-    StageExtent, StageSettings, apply_stage_settings, draw_grid_and_axes, fit_stage_to_scene, spawn_stage,
-};
-use super::state::{Messages, Selection, StartupEdits, StartupPaths, UnloadedCharacters};
-use super::{draw, history, ik_drag};
 use crate::document::AssetLibrary;
 use crate::document::scenes::{scene_path, startup_doc};
+use crate::editor::edits::history;
+use crate::editor::interact::camera::{FramingAspect, OrbitCamera, apply_orbit_camera};
+use crate::editor::interact::ik_drag;
+use crate::editor::present::draw;
+use crate::editor::present::skin_material::SkinMaterial;
+use crate::editor::present::stage::{
+    StageExtent, StageSettings, apply_stage_settings, draw_grid_and_axes, fit_stage_to_scene, spawn_stage,
+};
+use crate::editor::scene_doc::document::{Library, NextCharacterId, PendingScene, SceneCharacter, spawn_from_doc};
+use crate::editor::state::{Messages, Selection, StartupEdits, StartupPaths, UnloadedCharacters};
 use crate::formats::scene::{CharacterId, DisplayDoc};
 use crate::rig::SkinTexture;
 use crate::scene::{Character, CharacterView, HeatJoint, MarionetteSystems, SkinMesh};
@@ -34,23 +36,26 @@ impl Plugin for ScenePlugin {
             .init_resource::<Library>()
             .init_resource::<FramingAspect>()
             .init_resource::<FrameWhenSkinned>()
-            .init_resource::<super::arrange::ArrangeWhenSkinned>()
-            .init_resource::<super::pose_library::PoseLibrary>()
+            .init_resource::<crate::editor::scene_doc::arrange::ArrangeWhenSkinned>()
+            .init_resource::<crate::editor::edits::pose_library::PoseLibrary>()
             .add_plugins((
                 crate::scene::smpl::SmplPlugin,
                 crate::scene::keyframes::KeyframePlugin,
                 crate::scene::node_clips::NodeClipPlugin,
                 crate::scene::morphs::MorphPlugin,
-                super::commands::CommandsPlugin,
+                crate::editor::edits::commands::CommandsPlugin,
             ))
             .add_systems(
                 PostUpdate,
                 (
-                    apply_pending_scene.in_set(super::order::EditorSystems::OpenScene),
-                    sync_character_views.in_set(super::order::EditorSystems::SyncViews),
+                    apply_pending_scene.in_set(crate::editor::order::EditorSystems::OpenScene),
+                    sync_character_views.in_set(crate::editor::order::EditorSystems::SyncViews),
                 ),
             )
-            .add_systems(PostUpdate, super::arrange::arrange_when_skinned.in_set(MarionetteSystems::Draw));
+            .add_systems(
+                PostUpdate,
+                crate::editor::scene_doc::arrange::arrange_when_skinned.in_set(MarionetteSystems::Draw),
+            );
     }
 }
 
@@ -64,8 +69,8 @@ impl Plugin for ViewPlugin {
         app.init_resource::<StartupPaths>()
             .init_resource::<StageExtent>()
             .init_resource::<StartupEdits>()
-            .add_plugins((ScenePlugin, super::readiness::ReadinessPlugin))
-            .add_plugins(super::skin_material::SkinMaterialPlugin)
+            .add_plugins((ScenePlugin, crate::editor::present::readiness::ReadinessPlugin))
+            .add_plugins(crate::editor::present::skin_material::SkinMaterialPlugin)
             .add_systems(Startup, (spawn_stage, queue_startup_scene).chain())
             .add_systems(
                 PostUpdate,
@@ -73,7 +78,9 @@ impl Plugin for ViewPlugin {
                     attach_skin_material,
                     apply_display_mode,
                     apply_stage_settings,
-                    frame_when_skinned.after(super::arrange::arrange_when_skinned).before(apply_orbit_camera),
+                    frame_when_skinned
+                        .after(crate::editor::scene_doc::arrange::arrange_when_skinned)
+                        .before(apply_orbit_camera),
                     apply_orbit_camera,
                     draw::draw_skeletons,
                     fit_stage_to_scene.before(draw_grid_and_axes),
@@ -91,11 +98,11 @@ fn queue_startup_scene(
     mut library: ResMut<Library>,
     mut messages: ResMut<Messages>,
     mut pending: ResMut<PendingScene>,
-    mut arrange: ResMut<super::arrange::ArrangeWhenSkinned>,
+    mut arrange: ResMut<crate::editor::scene_doc::arrange::ArrangeWhenSkinned>,
 ) {
     let mut notes = Vec::new();
     let doc = startup_doc(&paths.0, &mut library, &mut notes);
-    *arrange = super::arrange::ArrangeWhenSkinned {
+    *arrange = crate::editor::scene_doc::arrange::ArrangeWhenSkinned {
         side_by_side: !paths.0.is_empty() && scene_path(&paths.0).is_none(),
         match_height: edits.match_height,
     };
@@ -307,7 +314,7 @@ pub struct SceneReset<'w> {
     pins: ResMut<'w, ik_drag::Pins>,
     history: ResMut<'w, history::History>,
     unloaded: ResMut<'w, UnloadedCharacters>,
-    pose_library: ResMut<'w, super::pose_library::PoseLibrary>,
+    pose_library: ResMut<'w, crate::editor::edits::pose_library::PoseLibrary>,
 }
 
 impl SceneReset<'_> {
@@ -330,7 +337,7 @@ pub fn sync_character_views(
             .then(|| selection.joints.first().copied())
             .flatten();
         heat.set_if_neq(HeatJoint(joint));
-        visibility.set_if_neq(super::document::visibility_of(view));
+        visibility.set_if_neq(crate::editor::scene_doc::document::visibility_of(view));
     }
 }
 
@@ -339,9 +346,9 @@ pub fn sync_character_views(
 fn attach_skin_material(
     mut commands: Commands,
     material: Res<SkinMaterial>,
-    mut textured: ResMut<super::skin_material::TexturedSkinMaterials>,
+    mut textured: ResMut<crate::editor::present::skin_material::TexturedSkinMaterials>,
     mut images: ResMut<Assets<Image>>,
-    mut materials: ResMut<Assets<super::skin_material::SkinMaterialAsset>>,
+    mut materials: ResMut<Assets<crate::editor::present::skin_material::SkinMaterialAsset>>,
     mut messages: ResMut<Messages>,
     characters: Query<&Character>,
     new_skins: Query<(Entity, &SkinMesh), Added<SkinMesh>>,
@@ -358,7 +365,11 @@ fn attach_skin_material(
                     Some(handle) => handle.clone(),
                     None => match picture_of(&texture) {
                         Ok(image) => {
-                            let handle = super::skin_material::textured_material(&image, &mut images, &mut materials);
+                            let handle = crate::editor::present::skin_material::textured_material(
+                                &image,
+                                &mut images,
+                                &mut materials,
+                            );
                             textured.0.insert(key, handle.clone());
                             handle
                         }

@@ -10,7 +10,7 @@ use crate::formats::scene::{CharacterId, LibraryPoseDoc, pose_key};
 use crate::rig::mirror::mirrored_pose;
 use crate::rig::{JointRotation, Skeleton};
 
-use super::edit::Edit;
+use crate::editor::edits::edit::Edit;
 
 /// The scene's poses by name (the scene file's `poses`).
 #[derive(Resource, Clone, Debug, Default, PartialEq)]

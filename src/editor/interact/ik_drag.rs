@@ -7,13 +7,13 @@ use std::collections::BTreeMap;
 
 use bevy::prelude::*;
 
-use super::document::SceneCharacter;
-use super::draw::SkeletonGizmos;
-use super::edit::{Edit, EditQueue};
-use super::picking::{CLICK_SLOP_PX, JointPicker, PICK_RADIUS_PX};
-use super::pointer::{PointerOwner, ViewportHasPointer};
-use super::state::{Drag, JointDrag, Selection};
 use crate::document::posing::{IK_ROUNDS, IK_TOLERANCE};
+use crate::editor::edits::edit::{Edit, EditQueue};
+use crate::editor::interact::picking::{CLICK_SLOP_PX, JointPicker, PICK_RADIUS_PX};
+use crate::editor::interact::pointer::{PointerOwner, ViewportHasPointer};
+use crate::editor::present::draw::SkeletonGizmos;
+use crate::editor::scene_doc::document::SceneCharacter;
+use crate::editor::state::{Drag, JointDrag, Selection};
 use crate::formats::scene::CharacterId;
 use crate::rig::ik::{IkGoal, solve_ik};
 use crate::scene::{Character, CurrentJointToWorld, JointPose, Placement};
@@ -30,7 +30,7 @@ impl Plugin for IkDragPlugin {
             .init_resource::<Pins>()
             .add_systems(
                 Update,
-                (toggle_pins, start_drag, drag_joint).chain().in_set(super::order::EditorSystems::Drag),
+                (toggle_pins, start_drag, drag_joint).chain().in_set(crate::editor::order::EditorSystems::Drag),
             )
             .add_systems(PostUpdate, (draw_handles, draw_dragged_chain).in_set(crate::scene::MarionetteSystems::Draw));
     }
@@ -160,7 +160,7 @@ fn draw_handles(
         if !selected && pinned.is_none_or(|p| p.is_empty()) {
             continue;
         }
-        let size = super::draw::character_size(character) * 0.02;
+        let size = crate::editor::present::draw::character_size(character) * 0.02;
         let skeleton = &character.asset.skeleton;
         for j in 0..skeleton.len() {
             let is_pin = pinned.is_some_and(|p| p.contains(&j));
@@ -197,7 +197,7 @@ fn draw_dragged_chain(
         .into_iter()
         .filter_map(world)
         .collect();
-    let radius = super::draw::character_size(character) * placement.scale * 0.02;
+    let radius = crate::editor::present::draw::character_size(character) * placement.scale * 0.02;
     for pair in chain.windows(2) {
         gizmos.line(pair[0], pair[1], CHAIN_COLOR);
     }

@@ -11,10 +11,10 @@ use bevy::ecs::system::SystemParam;
 use bevy::ecs::world::DeferredWorld;
 use bevy::prelude::*;
 
-use super::camera::OrbitCamera;
-use super::stage::StageSettings;
 use crate::document::AssetLibrary;
 use crate::document::scenes::{pose_from_doc, read_scene, write_scene};
+use crate::editor::interact::camera::OrbitCamera;
+use crate::editor::present::stage::StageSettings;
 use crate::formats::FormatError;
 use crate::formats::scene::{BindingDoc, CharacterDoc, CharacterId, SceneDoc, SourceDoc, ViewDoc, pose_key};
 use crate::rig::CharacterAsset;
@@ -116,8 +116,8 @@ pub struct SceneReader<'w, 's> {
     pub poses: Query<'w, 's, &'static JointPose>,
     pub cameras: Query<'w, 's, &'static OrbitCamera>,
     pub stage: Res<'w, StageSettings>,
-    pub unloaded: Res<'w, super::state::UnloadedCharacters>,
-    pub pose_library: Res<'w, super::pose_library::PoseLibrary>,
+    pub unloaded: Res<'w, crate::editor::state::UnloadedCharacters>,
+    pub pose_library: Res<'w, crate::editor::edits::pose_library::PoseLibrary>,
 }
 
 impl SceneReader<'_, '_> {
@@ -273,7 +273,7 @@ fn clip_joint(clip: &crate::rig::anim::Clip, anim: &crate::formats::scene::AnimD
 }
 
 /// Saves the scene to `path`, saying so (or why not) in the messages.
-pub fn save_scene_to(path: &str, doc: &SceneDoc, messages: &mut super::state::Messages) {
+pub fn save_scene_to(path: &str, doc: &SceneDoc, messages: &mut crate::editor::state::Messages) {
     match write_scene(Path::new(path), doc) {
         Ok(()) => messages.push(format!("saved the scene to {path}")),
         Err(e) => messages.push(format!("the scene was not saved: {e}")),
@@ -281,7 +281,7 @@ pub fn save_scene_to(path: &str, doc: &SceneDoc, messages: &mut super::state::Me
 }
 
 /// Queues the scene file at `path` to replace the current scene, or says why it cannot.
-pub fn open_scene_from(path: &str, pending: &mut PendingScene, messages: &mut super::state::Messages) {
+pub fn open_scene_from(path: &str, pending: &mut PendingScene, messages: &mut crate::editor::state::Messages) {
     match read_scene(Path::new(path)) {
         Ok(doc) => *pending = PendingScene { frame: doc.camera.is_none(), doc: Some(doc) },
         Err(e) => messages.push(e.to_string()),

@@ -1,10 +1,10 @@
 //! Undo and redo as commands: each step is the list of edits that undoes one gesture (a
 //! whole slider or IK drag, one key press, one button), in the order they were recorded.
-//! [`apply_edits`](super::commands::apply_edits) fills and replays it.
+//! [`apply_edits`](crate::editor::edits::commands::apply_edits) fills and replays it.
 
 use bevy::prelude::*;
 
-use super::edit::Edit;
+use crate::editor::edits::edit::Edit;
 
 /// The undo and redo steps, and what undoes the gesture under way.
 #[derive(Resource, Default, Debug)]

@@ -1,6 +1,6 @@
 //! The orbit camera: left drag rotates, middle drag pans, right drag or the wheel zooms.
 
-use super::pointer::{PointerOwner, ViewportArea, ViewportHasPointer};
+use crate::editor::interact::pointer::{PointerOwner, ViewportArea, ViewportHasPointer};
 use bevy::input::mouse::{AccumulatedMouseMotion, AccumulatedMouseScroll, MouseScrollUnit};
 use bevy::prelude::*;
 
@@ -95,7 +95,7 @@ pub fn orbit_camera_input(
     motion: Res<AccumulatedMouseMotion>,
     scroll: Res<AccumulatedMouseScroll>,
     pointer: Option<Res<ViewportHasPointer>>,
-    drag: Option<Res<super::state::JointDrag>>,
+    drag: Option<Res<crate::editor::state::JointDrag>>,
     owner: Option<Res<PointerOwner>>,
     mut cameras: Query<&mut OrbitCamera>,
 ) {

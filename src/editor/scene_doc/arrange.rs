@@ -4,10 +4,10 @@
 use bevy::math::Vec3;
 use bevy::prelude::*;
 
-use super::document::SceneCharacter;
 pub use crate::document::layout::{
     GAP_SHARE, beside, gltf_file, one_file_groups, rescaled_keeping_feet, side_by_side, union, world_box,
 };
+use crate::editor::scene_doc::document::SceneCharacter;
 use crate::formats::scene::PlacementDoc;
 use crate::scene::{Placement, PoseDirty, SkinScratch};
 
