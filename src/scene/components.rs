@@ -173,7 +173,9 @@ pub struct SkinMesh {
     pub character: Entity,
 }
 
-/// Scratch buffers of the matrix-stack pass, by joint index (no allocation per frame).
+/// The matrix-stack pass's output and scratch, by joint index (no allocation per frame):
+/// `matrices` are the joints' current model-space matrices, which the skinning reads (the
+/// joint entities' `CurrentJointToWorld` get the same, for picking and drawing).
 #[derive(Component, Default)]
 pub struct JointScratch {
     pub pose: Vec<crate::rig::JointRotation>,

@@ -111,10 +111,11 @@ pub fn compute_joint_to_world(
 }
 
 /// Skins characters marked dirty, in model space and in parallel on Bevy's compute task
-/// pool: palette `CurrentJointToWorld · BindWorldToJoint`, the LBS or DQ kernel of the bind
-/// vertices and their bounds; the colours when they changed; then packs the vertices for
-/// the GPU. Characters skinned on the GPU hand over the palette instead (reads joint
-/// matrices; writes `SkinScratch`, `SkinUpload`, `GpuSkinJob`).
+/// pool: palette `current · bind` from the matrix stack's output (`JointScratch`) and the
+/// asset's shared inverse binds, the LBS or DQ kernel of the bind vertices and their
+/// bounds; the colours when they changed; then packs the vertices for the GPU. Characters
+/// skinned on the GPU hand over the palette instead (reads `JointScratch`, `Character`;
+/// writes `SkinScratch`, `SkinUpload`, `GpuSkinJob`).
 pub fn skin_changed_characters(
     mut characters: Query<(
         &Character,
@@ -126,11 +127,11 @@ pub fn skin_changed_characters(
         &mut SkinScratch,
         &mut SkinUpload,
         &mut GpuSkinJob,
+        &JointScratch,
     )>,
-    joints: Query<(&CurrentJointToWorld, &BindWorldToJoint)>,
 ) {
     characters.par_iter_mut().for_each(
-        |(character, view, method, on_gpu, heat, dirty, mut scratch, mut upload, mut job)| {
+        |(character, view, method, on_gpu, heat, dirty, mut scratch, mut upload, mut job, joints)| {
             if *dirty == PoseDirty::default() {
                 return;
             }
@@ -139,10 +140,12 @@ pub fn skin_changed_characters(
             let never_skinned = scratch.positions.len() != skin.bind_positions.len();
             let moved = dirty.matrices || dirty.bind || never_skinned;
             if moved {
+                // The matrix stack's own output and the asset's shared inverse binds: no
+                // joint entity is read back.
+                let current = |j: usize| joints.matrices.get(j).copied().unwrap_or(Mat4::IDENTITY);
+                let binds = &character.asset.bind_world_to_joint;
                 scratch.palette.clear();
-                scratch
-                    .palette
-                    .extend(character.joints.iter().map(|&e| joints.get(e).map_or(Mat4::IDENTITY, |(c, b)| c.0 * b.0)));
+                scratch.palette.extend(binds.iter().enumerate().map(|(j, bind)| current(j) * *bind));
             }
             let recolored = dirty.colors || scratch.colors.len() != skin.bind_positions.len();
             if recolored {
