@@ -2,8 +2,9 @@
 //! who has it (panels or viewport), then the rotation gizmo, then IK drags, then the
 //! viewport's own input (orbit, picking, shortcuts). In `PostUpdate`, inside the scene's
 //! `Animate` (before SMPL playback): a pending scene replaces the world, then the queued
-//! edits apply, then the characters' views follow their documents; then the scene's own
-//! chain, `Solve → MatrixStack → Skin → Draw`. Plugins put their systems in these sets and
+//! edits apply, then the characters' views follow their documents (and morphs blend after
+//! them); then the scene's own chain, `Solve → MatrixStack → Skin → Draw`, and in `Draw`
+//! the characters re-placed once skinned, then the stage, the camera and the drawing. Plugins put their systems in these sets and
 //! import nothing else of each other to be ordered.
 
 use bevy::prelude::*;
@@ -27,6 +28,10 @@ pub enum EditorSystems {
     Edits,
     /// `PostUpdate`, in `Animate`: the characters' views follow their documents.
     SyncViews,
+    /// `PostUpdate`, in `Draw`: characters re-placed once skinned (side by side, one height).
+    Arrange,
+    /// `PostUpdate`, in `Draw`: the stage, the camera, and drawing skeletons and tools.
+    Present,
 }
 
 /// Configures [`EditorSystems`] (added by the plugins that use them, once).
@@ -35,13 +40,17 @@ pub struct EditorOrderPlugin;
 impl Plugin for EditorOrderPlugin {
     fn build(&self, app: &mut App) {
         use EditorSystems::*;
-        app.configure_sets(Update, (Pointer, Gizmo, Drag, Viewport).chain()).configure_sets(
-            PostUpdate,
-            (OpenScene, Edits, SyncViews)
-                .chain()
-                .in_set(MarionetteSystems::Animate)
-                .before(crate::scene::smpl::SmplPlayback),
-        );
+        app.configure_sets(Update, (Pointer, Gizmo, Drag, Viewport).chain())
+            .configure_sets(
+                PostUpdate,
+                (OpenScene, Edits, SyncViews)
+                    .chain()
+                    .in_set(MarionetteSystems::Animate)
+                    .before(crate::scene::smpl::SmplPlayback),
+            )
+            // Morph weights blend once the scene and its edits are in.
+            .configure_sets(PostUpdate, SyncViews.before(crate::scene::morphs::blend_morphs))
+            .configure_sets(PostUpdate, (Arrange, Present).chain().in_set(MarionetteSystems::Draw));
     }
 }
 

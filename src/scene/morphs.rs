@@ -20,13 +20,14 @@ pub struct MorphPlugin;
 
 impl Plugin for MorphPlugin {
     fn build(&self, app: &mut App) {
-        app.add_systems(PostUpdate, blend_morphs.in_set(MarionetteSystems::Animate));
+        // Before playback, so the playing systems never see a character mid-swap.
+        app.add_systems(PostUpdate, blend_morphs.in_set(MarionetteSystems::Animate).before(super::smpl::SmplPlayback));
     }
 }
 
 /// Rebuilds the bind mesh of characters whose weights changed (writes `Character`'s asset
 /// and `PoseDirty`; the skinning follows).
-fn blend_morphs(mut characters: Query<(&Morphs, &mut Character, &mut PoseDirty), Changed<Morphs>>) {
+pub fn blend_morphs(mut characters: Query<(&Morphs, &mut Character, &mut PoseDirty), Changed<Morphs>>) {
     for (morphs, mut character, mut dirty) in &mut characters {
         let mut asset = (*morphs.base).clone();
         asset.skin.bind_positions = morphs.base.morphed_positions(&morphs.weights);

@@ -20,6 +20,7 @@ mod heat;
 mod ik;
 mod kernel;
 mod layers;
+mod order;
 mod poses;
 mod rig;
 mod robust;

@@ -32,7 +32,10 @@ impl Plugin for IkDragPlugin {
                 Update,
                 (toggle_pins, start_drag, drag_joint).chain().in_set(crate::editor::order::EditorSystems::Drag),
             )
-            .add_systems(PostUpdate, (draw_handles, draw_dragged_chain).in_set(crate::scene::MarionetteSystems::Draw));
+            .add_systems(
+                PostUpdate,
+                (draw_handles, draw_dragged_chain).in_set(crate::editor::order::EditorSystems::Present),
+            );
     }
 }
 

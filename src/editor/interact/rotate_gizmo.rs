@@ -155,7 +155,7 @@ impl Plugin for RotateGizmoPlugin {
                     .chain()
                     .in_set(crate::editor::order::EditorSystems::Gizmo),
             )
-            .add_systems(PostUpdate, draw_rotate_gizmo.in_set(crate::scene::MarionetteSystems::Draw));
+            .add_systems(PostUpdate, draw_rotate_gizmo.in_set(crate::editor::order::EditorSystems::Present));
     }
 }
 

@@ -18,7 +18,7 @@ use crate::editor::scene_doc::document::{Library, NextCharacterId, PendingScene,
 use crate::editor::state::{Messages, Selection, StartupEdits, StartupPaths, UnloadedCharacters};
 use crate::formats::scene::{CharacterId, DisplayDoc};
 use crate::rig::SkinTexture;
-use crate::scene::{Character, CharacterView, HeatJoint, MarionetteSystems, SkinMesh};
+use crate::scene::{Character, CharacterView, HeatJoint, SkinMesh};
 
 /// The live scene without drawing: opening documents, edits and their history, SMPL
 /// playback, each character's view in step with its options (used by the window, the
@@ -54,7 +54,8 @@ impl Plugin for ScenePlugin {
             )
             .add_systems(
                 PostUpdate,
-                crate::editor::scene_doc::arrange::arrange_when_skinned.in_set(MarionetteSystems::Draw),
+                crate::editor::scene_doc::arrange::arrange_when_skinned
+                    .in_set(crate::editor::order::EditorSystems::Arrange),
             );
     }
 }
@@ -78,15 +79,14 @@ impl Plugin for ViewPlugin {
                     attach_skin_material,
                     apply_display_mode,
                     apply_stage_settings,
-                    frame_when_skinned
-                        .after(crate::editor::scene_doc::arrange::arrange_when_skinned)
-                        .before(apply_orbit_camera),
+                    frame_when_skinned,
                     apply_orbit_camera,
                     draw::draw_skeletons,
-                    fit_stage_to_scene.before(draw_grid_and_axes),
+                    fit_stage_to_scene,
                     draw_grid_and_axes,
                 )
-                    .in_set(MarionetteSystems::Draw),
+                    .chain()
+                    .in_set(crate::editor::order::EditorSystems::Present),
             );
     }
 }
