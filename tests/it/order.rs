@@ -19,9 +19,10 @@ fn our_conflicts(app: &mut App, label: impl ScheduleLabel + Clone) -> Vec<(Strin
     let world = app.world_mut();
     let mut schedule = world.resource_mut::<Schedules>().remove(label.clone()).expect("the schedule exists");
     {
-        let mut settings = ScheduleBuildSettings::default();
-        settings.ambiguity_detection = LogLevel::Warn;
-        schedule.set_build_settings(settings);
+        schedule.set_build_settings(ScheduleBuildSettings {
+            ambiguity_detection: LogLevel::Warn,
+            ..ScheduleBuildSettings::default()
+        });
         schedule.initialize(world).expect("the schedule builds");
         // The systems have moved into the executable schedule: their names by key.
         let names: std::collections::HashMap<_, String> =
