@@ -223,9 +223,7 @@ impl std::str::FromStr for IkSpec {
     }
 }
 
-/// Default IK tolerance (model units) and FK↔FABRIK rounds.
-pub const IK_TOLERANCE: f32 = 1e-4;
-pub const IK_ROUNDS: usize = 24;
+pub use crate::rig::ik::{IK_ROUNDS, IK_TOLERANCE};
 
 /// Solves the IK specs in turn on top of `pose` (after `--pose`), for a character placed
 /// by `placement`.

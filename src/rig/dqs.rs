@@ -10,21 +10,7 @@ use glam::{Mat4, Quat, Vec3, Vec4};
 use super::influences::FixedGroup;
 use super::skinning::SkinWeights;
 
-/// How a character's vertices follow its joints.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default, serde::Serialize, serde::Deserialize)]
-pub enum SkinningMethod {
-    /// Linear blend skinning: the weighted sum of the palette matrices.
-    #[default]
-    Linear,
-    /// Dual quaternion skinning: the normalised weighted sum of unit dual quaternions.
-    DualQuaternion,
-}
-
-impl SkinningMethod {
-    pub fn is_linear(&self) -> bool {
-        *self == SkinningMethod::Linear
-    }
-}
+pub use super::skinning::SkinningMethod;
 
 /// A rigid transform as a unit dual quaternion `real + ε dual`: rotation `real`,
 /// translation `t` with `dual = ½ (t, 0) · real`.

@@ -6,6 +6,10 @@ use super::fk::{forward_kinematics, forward_kinematics_along};
 use super::pose::JointRotation;
 use super::skeleton::Skeleton;
 
+/// Default IK tolerance (model units) and FK↔FABRIK rounds.
+pub const IK_TOLERANCE: f32 = 1e-4;
+pub const IK_ROUNDS: usize = 24;
+
 /// What a FABRIK solve did.
 #[derive(Debug, Clone, PartialEq)]
 pub struct FabrikResult {

@@ -7,6 +7,22 @@ use super::RigError;
 pub use super::influences::Influence;
 use super::influences::InfluenceGroups;
 
+/// How a character's vertices follow its joints.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default, serde::Serialize, serde::Deserialize)]
+pub enum SkinningMethod {
+    /// Linear blend skinning: the weighted sum of the palette matrices.
+    #[default]
+    Linear,
+    /// Dual quaternion skinning: the normalised weighted sum of unit dual quaternions.
+    DualQuaternion,
+}
+
+impl SkinningMethod {
+    pub fn is_linear(&self) -> bool {
+        *self == SkinningMethod::Linear
+    }
+}
+
 /// Sparse per-vertex influences, stored compressed: the influences of vertex `v` are
 /// `influences[offsets[v]..offsets[v + 1]]`. Any number per vertex.
 #[derive(Debug, Clone, PartialEq, Default)]

@@ -46,6 +46,16 @@ pub enum MarionetteSystems {
     Draw,
 }
 
+/// Every kind of playback in `Animate`: SMPL clips, keyframed clips, a glTF file's own
+/// clips, and morph weights (each its own plugin, in the order their sets give).
+pub struct PlaybackPlugin;
+
+impl Plugin for PlaybackPlugin {
+    fn build(&self, app: &mut App) {
+        app.add_plugins((smpl::SmplPlugin, keyframes::KeyframePlugin, node_clips::NodeClipPlugin, morphs::MorphPlugin));
+    }
+}
+
 /// Configures the set chain (once) and runs the matrix stack.
 pub struct RigCorePlugin;
 

@@ -7,7 +7,6 @@ use std::collections::BTreeMap;
 
 use bevy::prelude::*;
 
-use crate::document::posing::{IK_ROUNDS, IK_TOLERANCE};
 use crate::editor::edits::edit::{Edit, EditQueue};
 use crate::editor::interact::picking::{CLICK_SLOP_PX, JointPicker, PICK_RADIUS_PX};
 use crate::editor::interact::pointer::{PointerOwner, ViewportHasPointer};
@@ -15,6 +14,7 @@ use crate::editor::present::draw::SkeletonGizmos;
 use crate::editor::scene_doc::document::SceneCharacter;
 use crate::editor::state::{Drag, JointDrag, Selection};
 use crate::formats::scene::CharacterId;
+use crate::rig::ik::{IK_ROUNDS, IK_TOLERANCE};
 use crate::rig::ik::{IkGoal, solve_ik};
 use crate::scene::{Character, CurrentJointToWorld, JointPose, Placement};
 

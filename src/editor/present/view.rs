@@ -38,13 +38,7 @@ impl Plugin for ScenePlugin {
             .init_resource::<FrameWhenSkinned>()
             .init_resource::<crate::editor::scene_doc::arrange::ArrangeWhenSkinned>()
             .init_resource::<crate::editor::edits::pose_library::PoseLibrary>()
-            .add_plugins((
-                crate::scene::smpl::SmplPlugin,
-                crate::scene::keyframes::KeyframePlugin,
-                crate::scene::node_clips::NodeClipPlugin,
-                crate::scene::morphs::MorphPlugin,
-                crate::editor::edits::commands::CommandsPlugin,
-            ))
+            .add_plugins((crate::scene::PlaybackPlugin, crate::editor::edits::commands::CommandsPlugin))
             .add_systems(
                 PostUpdate,
                 (
