@@ -61,11 +61,12 @@ pub fn scene_shortcuts(
     }
     if keys.just_pressed(KeyCode::KeyK)
         && let Some(id) = selection.character
-        && let Some((_, _, character, .., player, _, _)) = scene.characters.iter().find(|c| c.1.id == id)
+        && let Some(c) = scene.characters.iter().find(|c| c.scene.id == id)
     {
+        let character = c.character;
         let pose: Vec<_> =
             character.joints.iter().map(|&e| scene.poses.get(e).map_or(Default::default(), |p| p.0)).collect();
-        let anim = crate::scene::keyframes::keyed(player, character.joints.len(), &selection.joints, &pose);
+        let anim = crate::scene::keyframes::keyed(c.player, character.joints.len(), &selection.joints, &pose);
         edits.push(Edit::Clip { character: id, anim: Some(anim) });
     }
     if keys.just_pressed(KeyCode::KeyA) {
@@ -73,7 +74,8 @@ pub fn scene_shortcuts(
     }
     if keys.just_pressed(KeyCode::KeyS) {
         // The selected character, or every character when none is selected.
-        for (_, sc, _, _, view, ..) in &scene.characters {
+        for c in &scene.characters {
+            let (sc, view) = (c.scene, c.view);
             if selection.character.is_none_or(|id| id == sc.id) {
                 let view = ViewDoc { display: view.display.next(), ..view.0.clone() };
                 edits.push(Edit::View { character: sc.id, view });

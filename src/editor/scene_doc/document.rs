@@ -7,6 +7,7 @@ use std::path::Path;
 use std::sync::Arc;
 
 use bevy::ecs::lifecycle::HookContext;
+use bevy::ecs::query::QueryData;
 use bevy::ecs::system::SystemParam;
 use bevy::ecs::world::DeferredWorld;
 use bevy::prelude::*;
@@ -95,24 +96,25 @@ impl NextCharacterId {
 }
 
 /// Everything needed to capture the scene as a document (read only).
+/// What the panels and capture read of a scene character, by name.
+#[derive(QueryData)]
+pub struct SceneCharacterData {
+    pub entity: Entity,
+    pub scene: &'static SceneCharacter,
+    pub character: &'static Character,
+    pub placement: &'static Placement,
+    pub view: &'static CharacterView,
+    pub smpl: Option<&'static SmplCharacter>,
+    pub skinning: &'static CharacterSkinning,
+    pub on_gpu: &'static SkinOnGpu,
+    pub player: Option<&'static ClipPlayer>,
+    pub morphs: Option<&'static crate::scene::morphs::Morphs>,
+    pub node_clips: Option<&'static crate::scene::node_clips::NodeClipPlayer>,
+}
+
 #[derive(SystemParam)]
 pub struct SceneReader<'w, 's> {
-    pub characters: Query<
-        'w,
-        's,
-        (
-            Entity,
-            &'static SceneCharacter,
-            &'static Character,
-            &'static Placement,
-            &'static CharacterView,
-            Option<&'static SmplCharacter>,
-            (&'static CharacterSkinning, &'static SkinOnGpu),
-            Option<&'static ClipPlayer>,
-            Option<&'static crate::scene::morphs::Morphs>,
-            Option<&'static crate::scene::node_clips::NodeClipPlayer>,
-        ),
-    >,
+    pub characters: Query<'w, 's, SceneCharacterData>,
     pub poses: Query<'w, 's, &'static JointPose>,
     pub cameras: Query<'w, 's, &'static OrbitCamera>,
     pub stage: Res<'w, StageSettings>,
@@ -125,7 +127,7 @@ impl SceneReader<'_, '_> {
     /// duplicated or removed, never every frame).
     pub fn capture(&self) -> SceneDoc {
         let mut characters: Vec<CharacterDoc> =
-            self.characters.iter().filter_map(|c| self.character_doc(c.0)).collect();
+            self.characters.iter().filter_map(|c| self.character_doc(c.entity)).collect();
         characters.sort_by_key(|c| c.id);
         SceneDoc {
             // Characters that failed to load stay in the document as they were.
@@ -139,8 +141,8 @@ impl SceneReader<'_, '_> {
     /// The document of one live character: joints listed where they differ from the
     /// source's pose.
     pub fn character_doc(&self, entity: Entity) -> Option<CharacterDoc> {
-        let (_, sc, character, placement, view, smpl, skinning, player, morphs, node_clips) =
-            self.characters.get(entity).ok()?;
+        let c = self.characters.get(entity).ok()?;
+        let (sc, character) = (c.scene, c.character);
         let skeleton = &character.asset.skeleton;
         let initial = skeleton.initial_pose();
         let pose = character
@@ -156,16 +158,16 @@ impl SceneReader<'_, '_> {
             id: Some(sc.id),
             source: sc.source.clone(),
             name: sc.name.clone(),
-            placement: placement.0,
+            placement: c.placement.0,
             pose,
-            view: view.0.clone(),
-            smpl: smpl.map(|body| body.state.clone()),
+            view: c.view.0.clone(),
+            smpl: c.smpl.map(|body| body.state.clone()),
             binding: sc.binding,
-            skinning: skinning.0.0,
-            gpu_skinning: skinning.1.0,
-            anim: player.map(|p| p.state.clone()),
-            morphs: morphs.map(|m| m.weights.clone()).unwrap_or_default(),
-            playback: node_clips.map(|p| p.state.clone()),
+            skinning: c.skinning.0,
+            gpu_skinning: c.on_gpu.0,
+            anim: c.player.map(|p| p.state.clone()),
+            morphs: c.morphs.map(|m| m.weights.clone()).unwrap_or_default(),
+            playback: c.node_clips.map(|p| p.state.clone()),
         })
     }
 }

@@ -18,7 +18,9 @@ pub fn joint_panel(ui: &mut egui::Ui, state: &mut InspectorState, panels: &mut P
         ui.label("Select a character (left panel) or click a joint in the viewport.");
         return;
     };
-    let Some((_, _, character, ..)) = panels.scene.characters.iter().find(|c| c.1.id == id) else { return };
+    let Some(character) = panels.scene.characters.iter().find(|c| c.scene.id == id).map(|c| c.character) else {
+        return;
+    };
     let character = character.clone();
     let skeleton = &character.asset.skeleton;
     let mut edits = Vec::new();

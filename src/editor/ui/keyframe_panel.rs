@@ -32,7 +32,9 @@ pub struct PickedKey {
 
 /// The keyframe section of the joint panel for character `id`.
 pub fn keyframe_panel(ui: &mut egui::Ui, state: &mut InspectorState, panels: &mut Panels, id: CharacterId) {
-    let Some((_, _, character, _, _, _, _, player, ..)) = panels.scene.characters.iter().find(|c| c.1.id == id) else {
+    let Some((character, player)) =
+        panels.scene.characters.iter().find(|c| c.scene.id == id).map(|c| (c.character, c.player))
+    else {
         return;
     };
     let joint_count = character.asset.skeleton.len();

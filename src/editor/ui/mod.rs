@@ -95,16 +95,16 @@ impl Panels<'_, '_> {
         self.scene
             .characters
             .iter()
-            .filter_map(|(entity, _, _, placement, ..)| {
-                let (lo, hi) = self.skins.get(entity).ok()?.bounds;
-                Some(crate::editor::scene_doc::arrange::world_box(lo, hi, &placement.0))
+            .filter_map(|c| {
+                let (lo, hi) = self.skins.get(c.entity).ok()?.bounds;
+                Some(crate::editor::scene_doc::arrange::world_box(lo, hi, &c.placement.0))
             })
             .collect()
     }
 
     /// A character's height as it stands (its skinned vertices, times its scale).
     pub fn height(&self, entity: Entity) -> Option<f32> {
-        let (_, _, _, placement, ..) = self.scene.characters.get(entity).ok()?;
+        let placement = self.scene.characters.get(entity).ok()?.placement;
         let (lo, hi) = self.skins.get(entity).ok()?.bounds;
         Some((hi.y - lo.y) * placement.scale)
     }
@@ -225,7 +225,8 @@ fn hovered_joint_tooltip(
     hovered: &crate::editor::interact::picking::HoveredJoint,
 ) {
     let Some(hit) = hovered.0 else { return };
-    let Ok((_, sc, character, ..)) = panels.scene.characters.get(hit.entity) else { return };
+    let Ok(c) = panels.scene.characters.get(hit.entity) else { return };
+    let (sc, character) = (c.scene, c.character);
     let (Some(pointer), Some(joint)) = (ctx.pointer_hover_pos(), character.asset.skeleton.joints().get(hit.joint))
     else {
         return;

@@ -13,7 +13,9 @@ use crate::rig::JointRotation;
 const THUMBNAIL: f32 = 56.0;
 
 pub fn pose_panel(ui: &mut egui::Ui, state: &mut InspectorState, panels: &mut Panels, id: CharacterId) {
-    let Some((_, _, character, ..)) = panels.scene.characters.iter().find(|c| c.1.id == id) else { return };
+    let Some(character) = panels.scene.characters.iter().find(|c| c.scene.id == id).map(|c| c.character) else {
+        return;
+    };
     let character = character.clone();
     let skeleton = &character.asset.skeleton;
     let pose: Vec<JointRotation> =

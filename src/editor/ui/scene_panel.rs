@@ -24,7 +24,7 @@ pub fn scene_panel(ui: &mut egui::Ui, state: &mut InspectorState, panels: &mut P
     ui.separator();
     add_row(ui, state, panels);
     ui.separator();
-    let mut list: Vec<(Entity, CharacterId)> = panels.scene.characters.iter().map(|c| (c.0, c.1.id)).collect();
+    let mut list: Vec<(Entity, CharacterId)> = panels.scene.characters.iter().map(|c| (c.entity, c.scene.id)).collect();
     list.sort_by_key(|c| c.1);
     for (entity, id) in list {
         character_row(ui, panels, entity, id);
@@ -117,7 +117,7 @@ fn add_row(ui: &mut egui::Ui, state: &mut InspectorState, panels: &mut Panels) {
 /// one frame).
 fn add_crowd(state: &InspectorState, panels: &mut Panels) {
     let selected_body = panels.selection.character.and_then(|id| {
-        panels.scene.characters.iter().find(|c| c.1.id == id).and_then(|c| c.5.map(|body| body.dir.clone()))
+        panels.scene.characters.iter().find(|c| c.scene.id == id).and_then(|c| c.smpl.map(|body| body.dir.clone()))
     });
     let typed = PathBuf::from(state.add_path.trim());
     let folder = selected_body.or_else(|| crate::formats::smpl::is_smpl_dir(&typed).then_some(typed));
@@ -129,7 +129,7 @@ fn add_crowd(state: &InspectorState, panels: &mut Panels) {
         Ok(doc) => doc,
         Err(e) => return panels.messages.push(e),
     };
-    let right = panels.scene.characters.iter().map(|c| c.3.translation.x).fold(f32::NEG_INFINITY, f32::max);
+    let right = panels.scene.characters.iter().map(|c| c.placement.translation.x).fold(f32::NEG_INFINITY, f32::max);
     let width = crowd.characters.iter().map(|c| c.placement.translation.x).fold(0.0f32, |m, x| m.max(x.abs()));
     let shift = if right.is_finite() { right + 1.0 + width } else { 0.0 };
     for mut c in crowd.characters {
@@ -141,7 +141,8 @@ fn add_crowd(state: &InspectorState, panels: &mut Panels) {
 
 /// The character's name (a click selects it) and its visibility.
 fn character_row(ui: &mut egui::Ui, panels: &mut Panels, entity: Entity, id: CharacterId) {
-    let Ok((_, sc, _, _, view, ..)) = panels.scene.characters.get(entity) else { return };
+    let Ok(c) = panels.scene.characters.get(entity) else { return };
+    let (sc, view) = (c.scene, c.view);
     let selected = panels.selection.character == Some(id);
     let mut shown = view.visible;
     let (name, view) = (sc.name.clone(), view.0.clone());
@@ -158,12 +159,10 @@ fn character_row(ui: &mut egui::Ui, panels: &mut Panels, entity: Entity, id: Cha
 /// Name, source, duplicate/remove, placement, display and colours, weights, SMPL state of
 /// the selected character.
 fn selected_character(ui: &mut egui::Ui, panels: &mut Panels, entity: Entity, id: CharacterId) {
-    let Ok((_, sc, character, placement, view, smpl, skinning, player, morphs, node_clips)) =
-        panels.scene.characters.get(entity)
-    else {
-        return;
-    };
-    let (skinning, on_gpu) = (skinning.0.0, skinning.1.0);
+    let Ok(c) = panels.scene.characters.get(entity) else { return };
+    let (sc, character, placement, view, smpl) = (c.scene, c.character, c.placement, c.view, c.smpl);
+    let (player, morphs, node_clips) = (c.player, c.morphs, c.node_clips);
+    let (skinning, on_gpu) = (c.skinning.0, c.on_gpu.0);
     let (mut name, source, binding) = (sc.name.clone(), sc.source.label(), sc.binding);
     let (mut p, mut v) = (placement.0, view.0.clone());
     let height = panels.height(entity).unwrap_or(0.0);
@@ -288,8 +287,9 @@ fn match_heights(panels: &Panels, entity: Entity, height: f32) -> Vec<Edit> {
         .scene
         .characters
         .iter()
-        .filter(|c| c.0 != entity)
-        .filter_map(|(other, sc, _, placement, ..)| {
+        .filter(|c| c.entity != entity)
+        .filter_map(|c| {
+            let (other, sc, placement) = (c.entity, c.scene, c.placement);
             let own = panels.height(other).filter(|&h| h > 0.0)?;
             let lowest = panels.skins.get(other).ok()?.bounds.0.y;
             let placement = rescaled_keeping_feet(&placement.0, lowest, placement.scale * height / own);
