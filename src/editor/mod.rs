@@ -1,15 +1,18 @@
-//! The app around the ECS core: the stage, the scene (opened from and saved to documents),
-//! edits as commands with undo and redo, the orbit camera, skeleton drawing, picking, the
-//! egui panels, screenshots, and the headless renderer.
+//! The app around the ECS core, in rooms by purpose: [`interact`] (who has the pointer, the
+//! orbit camera, picking, IK drags, the rotation gizmo, shortcuts), [`ui`] (the egui panels
+//! and dialogs), [`edits`] (edits as commands with undo and redo, the pose library),
+//! [`present`] (stage, drawing, readiness, screenshots, the headless renderer) and
+//! [`scene_doc`] (the scene's identity, capture and spawning from documents). Files,
+//! layout and export are the Bevy-free [`crate::document`] layer's.
 //!
 //! The ECS is the only live model. The panels, the shortcuts and drags in the viewport read
-//! it and push [`edits::commands::Edit`]s, applied in `Animate`; a `SceneDoc` is built only to save,
-//! duplicate or remove (what a history entry needs).
+//! it and push [`edits::edit::Edit`]s, applied in `Animate`; a `SceneDoc` is built only to
+//! save, duplicate or remove (what a history entry needs). The order is declared once, in
+//! [`order`].
 //!
-//! Plugins (one per capability): [`ViewPlugin`] (stage, scene, edits and history, drawing;
-//! also used headless), [`InteractionPlugin`] (camera input, picking, IK drag, shortcuts),
-//! [`ui::InspectorPlugin`], [`present::screenshot::ScreenshotPlugin`]. Children import shared state
-//! ([`state`], [`document`], [`commands`]), never this module.
+//! Plugins (one per capability): [`present::view::ViewPlugin`] (stage, scene, edits and
+//! history, drawing; also used headless), [`InteractionPlugin`] (camera input, picking, IK
+//! drag, gizmo, shortcuts), [`ui::InspectorPlugin`], [`present::screenshot::ScreenshotPlugin`].
 
 pub mod bench;
 pub mod edits;
