@@ -328,6 +328,27 @@ impl Clip {
     /// rotation clamped to its joint's limits. A channel that is missing or has no keys
     /// leaves its number as `fallback` (and the root's offset) has it.
     pub fn pose_at(&self, skeleton: &Skeleton, t: f32, fallback: &[JointRotation]) -> (Vec3, Vec<JointRotation>) {
+        self.sampled_pose(skeleton, t, fallback, true)
+    }
+
+    /// As [`pose_at`](Self::pose_at), the keyed rotations not clamped: for the ECS, whose
+    /// `Solve` step clamps every changed pose (once).
+    pub fn pose_at_unclamped(
+        &self,
+        skeleton: &Skeleton,
+        t: f32,
+        fallback: &[JointRotation],
+    ) -> (Vec3, Vec<JointRotation>) {
+        self.sampled_pose(skeleton, t, fallback, false)
+    }
+
+    fn sampled_pose(
+        &self,
+        skeleton: &Skeleton,
+        t: f32,
+        fallback: &[JointRotation],
+        clamp: bool,
+    ) -> (Vec3, Vec<JointRotation>) {
         let value = |c: usize, otherwise: f32| match self.channels.get(c) {
             Some(channel) if !channel.keys.is_empty() => channel.value_at(t),
             _ => otherwise,
@@ -347,7 +368,8 @@ impl Clip {
                     value(channels.start + 1, old.y),
                     value(channels.start + 2, old.z),
                 );
-                JointRotation::Euler(angles, EulerOrder::Xyz).clamped(&skeleton.joint(j).limits)
+                let rotation = JointRotation::Euler(angles, EulerOrder::Xyz);
+                if clamp { rotation.clamped(&skeleton.joint(j).limits) } else { rotation }
             })
             .collect();
         (root, pose)

@@ -82,7 +82,8 @@ pub fn pose_from_keyframes(
     for (player, character, mut root) in &mut players {
         let skeleton = &character.asset.skeleton;
         let now: Vec<_> = character.joints.iter().map(|&e| poses.get(e).map_or(Default::default(), |p| p.0)).collect();
-        let (translation, pose) = player.clip.pose_at(skeleton, player.state.time, &now);
+        // Not clamped here: `Solve` clamps every changed pose.
+        let (translation, pose) = player.clip.pose_at_unclamped(skeleton, player.state.time, &now);
         root.set_if_neq(RootTranslation(Some(translation)));
         for (&entity, rotation) in character.joints.iter().zip(pose) {
             if let Ok(mut p) = poses.get_mut(entity) {

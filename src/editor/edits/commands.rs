@@ -207,10 +207,11 @@ fn write(world: &mut World, edit: Edit) -> Result<(), String> {
     match edit {
         Edit::Pose { character, joints } => {
             let found = character_of(world, character)?;
+            // Not clamped here: `Solve` clamps every changed pose (once).
             for (j, rotation) in joints {
-                let (_, limits) = joint_state(world, &found, j)?;
+                joint_state(world, &found, j)?;
                 if let Some(mut pose) = world.get_mut::<JointPose>(found.joints[j]) {
-                    pose.set_if_neq(JointPose(rotation.clamped(&limits)));
+                    pose.set_if_neq(JointPose(rotation));
                 }
             }
         }
