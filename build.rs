@@ -1,8 +1,11 @@
 //! Sets `cfg(marionette_data)` when `MARIONETTE_DATA` (the course data folder) is set at
 //! build time: tests that need the data are marked ignored without it, so the runner
-//! reports them as ignored rather than as passed.
+//! reports them as ignored rather than as passed. Also names the build profile for `bench`.
 
 fn main() {
+    // The build profile (`debug` for the dev profile, `release`), for `bench` to say how it
+    // was measured.
+    println!("cargo::rustc-env=MARIONETTE_BUILD_PROFILE={}", std::env::var("PROFILE").unwrap_or_default());
     println!("cargo::rerun-if-env-changed=MARIONETTE_DATA");
     println!("cargo::rustc-check-cfg=cfg(marionette_data)");
     if std::env::var_os("MARIONETTE_DATA").is_some() {

@@ -52,11 +52,10 @@ fn run(cli: Cli) -> Result<()> {
         }
         Some(Command::Bind(args)) => marionette::cli::bind::run(&args)?,
         Some(Command::Smpl(args)) => marionette::cli::smpl::run(&args)?,
-        Some(Command::Bench { characters, frames, data, json, gpu }) => {
+        Some(Command::Bench { characters, frames, data, puppets, json, gpu }) => {
             use marionette::editor::bench;
-            let data = bench::data_folder(data);
-            let report =
-                bench::run(characters as usize, frames as usize, data.as_deref(), gpu).map_err(anyhow::Error::msg)?;
+            let crowd = bench::crowd_of(data, puppets).map_err(anyhow::Error::msg)?;
+            let report = bench::run(characters as usize, frames as usize, &crowd, gpu).map_err(anyhow::Error::msg)?;
             if json {
                 println!("{}", serde_json::to_string(&report)?);
             } else {

@@ -84,9 +84,13 @@ pub enum Command {
         /// Frames measured (after warming up).
         #[arg(long, default_value_t = 300, value_parser = clap::value_parser!(u32).range(1..=100_000))]
         frames: u32,
-        /// The course data folder (its `smpl`); defaults to MARIONETTE_DATA.
-        #[arg(long)]
+        /// The course data folder (with its `smpl`) or an SMPL folder itself; defaults to
+        /// MARIONETTE_DATA. A folder without an SMPL body is refused.
+        #[arg(long, conflicts_with = "puppets")]
         data: Option<PathBuf>,
+        /// A crowd of the project's puppets instead of SMPL bodies.
+        #[arg(long)]
+        puppets: bool,
         /// Print one JSON object instead of the table.
         #[arg(long)]
         json: bool,

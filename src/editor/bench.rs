@@ -3,7 +3,7 @@
 //! offscreen target), timed per phase over many frames; and the skinning kernel against the
 //! plain loop it replaced.
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::time::{Duration, Instant};
 
 use bevy::app::AppExit;
@@ -25,6 +25,9 @@ use crate::scene::{Character, JointPose, MarionetteSystems, RigCorePlugin, Skinn
 /// What one run measured.
 #[derive(Debug, Clone, serde::Serialize)]
 pub struct BenchReport {
+    pub measured: Measured,
+    /// Every phase's (and the whole frame's) 50th and 95th percentiles.
+    pub phases_ms: std::collections::BTreeMap<String, Percentiles>,
     pub characters: usize,
     pub kind: String,
     /// Skinned by the GPU skinning compute shader (else on the CPU).
@@ -54,6 +57,66 @@ pub struct BenchReport {
     pub kernel_with_flat_normals_mvps: f64,
 }
 
+/// The 50th and 95th percentiles of a phase, in milliseconds.
+#[derive(Debug, Clone, Copy, serde::Serialize)]
+pub struct Percentiles {
+    pub p50: f64,
+    pub p95: f64,
+}
+
+/// How a run was measured, so two runs can be compared.
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct Measured {
+    /// The cores the process may use.
+    pub cores: usize,
+    /// The build profile (`debug` is the dev profile, marionette at opt-level 3) and whether
+    /// debug assertions (and overflow checks) were on.
+    pub profile: String,
+    pub debug_assertions: bool,
+    /// Bevy's pipelined rendering (off: each phase is timed in order).
+    pub pipelined_rendering: bool,
+}
+
+impl Measured {
+    fn now(pipelined_rendering: bool) -> Self {
+        Self {
+            cores: std::thread::available_parallelism().map_or(1, |n| n.get()),
+            profile: env!("MARIONETTE_BUILD_PROFILE").to_string(),
+            debug_assertions: cfg!(debug_assertions),
+            pipelined_rendering,
+        }
+    }
+}
+
+/// What the crowd is made of.
+#[derive(Debug, Clone, PartialEq)]
+pub enum CrowdOf {
+    /// SMPL bodies from this SMPL folder.
+    Smpl(PathBuf),
+    Puppets,
+}
+
+/// The crowd `bench` runs: puppets when asked (`--puppets`); else SMPL bodies from `data`
+/// (the data folder with its `smpl`, or an SMPL folder itself; `MARIONETTE_DATA` when not
+/// given); puppets when no folder is named at all. A folder named that holds no SMPL body
+/// is refused (it used to fall back to puppets without a word).
+pub fn crowd_of(data: Option<PathBuf>, puppets: bool) -> Result<CrowdOf, String> {
+    if puppets {
+        return Ok(CrowdOf::Puppets);
+    }
+    let Some(dir) = data.or_else(|| std::env::var_os("MARIONETTE_DATA").map(PathBuf::from)) else {
+        return Ok(CrowdOf::Puppets);
+    };
+    let is_smpl = crate::formats::smpl::is_smpl_dir;
+    [dir.join("smpl"), dir.clone()].into_iter().find(|d| is_smpl(d)).map(CrowdOf::Smpl).ok_or_else(|| {
+        format!(
+            "{}: expected the data folder (with `smpl/`) or an SMPL folder (smpl_00.obj, smpl_skin.txt …), found neither \
+             (`--puppets` benchmarks the project's puppets)",
+            dir.display()
+        )
+    })
+}
+
 /// Instants at the phase boundaries of the main world's frame.
 #[derive(Resource, Default)]
 struct MainClock([Option<Instant>; 4]);
@@ -62,11 +125,14 @@ struct MainClock([Option<Instant>; 4]);
 #[derive(Resource, Default)]
 struct RenderClock([Option<Instant>; 2]);
 
-/// Runs the crowd bench: `characters` SMPL bodies from `data` (clips and β varied, all
-/// playing), or puppets swaying when there is no SMPL folder; skinned on the CPU, or by the
-/// GPU skinning compute shader with `gpu`.
-pub fn run(characters: usize, frames: usize, data: Option<&Path>, gpu: bool) -> Result<BenchReport, String> {
-    let smpl_dir = data.map(|d| d.join("smpl")).filter(|d| crate::formats::smpl::is_smpl_dir(d));
+/// Runs the crowd bench: `characters` SMPL bodies (clips and β varied, all playing) or
+/// puppets swaying, as `crowd` says; skinned on the CPU, or by the GPU skinning compute
+/// shader with `gpu`.
+pub fn run(characters: usize, frames: usize, crowd: &CrowdOf, gpu: bool) -> Result<BenchReport, String> {
+    let smpl_dir = match crowd {
+        CrowdOf::Smpl(dir) => Some(dir.clone()),
+        CrowdOf::Puppets => None,
+    };
     let (mut doc, kind) = match &smpl_dir {
         Some(dir) => (smpl_crowd(dir, characters)?, "SMPL body"),
         None => (puppet_crowd(characters), "puppet"),
@@ -75,6 +141,7 @@ pub fn run(characters: usize, frames: usize, data: Option<&Path>, gpu: bool) -> 
     doc.stage.shadows = false;
     doc.characters.iter_mut().for_each(|c| c.gpu_skinning = gpu);
     let mut app = crowd_app(smpl_dir.is_none());
+    let pipelined_rendering = app.is_plugin_added::<PipelinedRenderingPlugin>();
     app.finish();
     app.cleanup();
     app.update();
@@ -90,7 +157,22 @@ pub fn run(characters: usize, frames: usize, data: Option<&Path>, gpu: bool) -> 
     let kernels = kernel_speeds(&asset);
     let phase = |k: usize| median(samples.iter().map(|s| s[k]).collect());
     let frame: Vec<f64> = samples.iter().map(|s| s[1] + s[2] + s[3] + s[4] + s[5]).collect();
+    let names = ["sampling", "fk", "skin", "extract", "upload", "render_world"];
+    let phases_ms = names
+        .iter()
+        .enumerate()
+        .map(|(k, name)| {
+            let v: Vec<f64> = samples.iter().map(|s| s[k + 1]).collect();
+            (name.to_string(), Percentiles { p50: percentile(v.clone(), 0.5), p95: percentile(v, 0.95) })
+        })
+        .chain([(
+            "frame".to_string(),
+            Percentiles { p50: percentile(frame.clone(), 0.5), p95: percentile(frame.clone(), 0.95) },
+        )])
+        .collect();
     Ok(BenchReport {
+        measured: Measured::now(pipelined_rendering),
+        phases_ms,
         characters,
         kind: kind.to_string(),
         gpu_skinning: gpu,
@@ -114,7 +196,18 @@ pub fn run(characters: usize, frames: usize, data: Option<&Path>, gpu: bool) -> 
 
 /// The report as a table.
 pub fn table(r: &BenchReport) -> String {
-    format!(
+    let m = &r.measured;
+    let profile = if m.debug_assertions {
+        format!("{} profile, debug assertions on", m.profile)
+    } else {
+        format!("{} profile", m.profile)
+    };
+    let how = format!(
+        "measured on {} cores, {profile}, pipelined rendering {}\n",
+        m.cores,
+        if m.pipelined_rendering { "on" } else { "off" }
+    );
+    how + &format!(
         "{} × {} ({} vertices each), {} frames, skinned {}\n\
          frame (CPU: main world + extraction + upload)  p50 {:.2} ms  p95 {:.2} ms\n\
          \x20 sampling {:.2} ms | FK {:.2} ms | skin {:.2} ms | extract {:.2} ms | upload {:.2} ms   (medians)\n\
@@ -327,9 +420,4 @@ fn percentile(mut v: Vec<f64>, q: f64) -> f64 {
     v.sort_by(f64::total_cmp);
     let rank = ((q * v.len() as f64).ceil() as usize).clamp(1, v.len());
     v[rank - 1]
-}
-
-/// The data folder: `--data`, else `MARIONETTE_DATA`.
-pub fn data_folder(data: Option<PathBuf>) -> Option<PathBuf> {
-    data.or_else(|| std::env::var_os("MARIONETTE_DATA").map(PathBuf::from))
 }

@@ -225,6 +225,40 @@ fn bench_reports_a_crowds_frame_times_as_json() {
     assert_eq!(report["gpu_skinning"], false);
 }
 
+/// `bench --data` takes the data folder or the SMPL folder itself, refuses a folder with no
+/// SMPL body (it used to bench puppets without a word), and `--puppets` asks for puppets;
+/// the JSON says how it was measured and every phase's percentiles.
+#[test]
+fn bench_finds_the_smpl_bodies_it_is_given_or_says_why_not() {
+    use marionette::editor::bench::{CrowdOf, crowd_of};
+    let dir = crate::common::scratch("bench-no-smpl");
+    let e = crowd_of(Some(dir.clone()), false).unwrap_err();
+    assert!(e.starts_with(&format!("{}: expected the data folder", dir.display())) && e.contains("--puppets"), "{e}");
+    assert_eq!(crowd_of(Some(dir), true), Ok(CrowdOf::Puppets));
+    if let Some(data) = crate::common::optional_data_dir() {
+        let smpl = data.join("smpl");
+        assert_eq!(crowd_of(Some(data), false), Ok(CrowdOf::Smpl(smpl.clone())));
+        assert_eq!(crowd_of(Some(smpl.clone()), false), Ok(CrowdOf::Smpl(smpl)));
+    }
+    let output = Command::new(env!("CARGO_BIN_EXE_marionette"))
+        .args(["bench", "--characters", "1", "--frames", "2", "--json", "--data", "/"])
+        .output()
+        .unwrap();
+    assert_eq!(output.status.code(), Some(1));
+    let output = Command::new(env!("CARGO_BIN_EXE_marionette"))
+        .args(["bench", "--characters", "1", "--frames", "2", "--json", "--puppets"])
+        .output()
+        .unwrap();
+    let report: serde_json::Value = serde_json::from_str(String::from_utf8_lossy(&output.stdout).trim()).unwrap();
+    assert_eq!(report["kind"], "puppet");
+    assert!(report["measured"]["cores"].as_u64() >= Some(1));
+    assert_eq!(report["measured"]["pipelined_rendering"], false);
+    for phase in ["sampling", "fk", "skin", "extract", "upload", "render_world", "frame"] {
+        let p = &report["phases_ms"][phase];
+        assert!(p["p95"].as_f64() >= p["p50"].as_f64(), "{phase}: {p}");
+    }
+}
+
 /// `marionette bench --gpu` skins the crowd by the compute shader: only the palettes go to
 /// the GPU each frame (one matrix per joint per puppet).
 #[test]
