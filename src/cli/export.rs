@@ -14,7 +14,7 @@ use crate::formats::{load_character, obj};
 
 /// Runs `export`: a glTF file's characters, a scene as glTF, or a character as OBJ or glTF.
 pub fn run(a: &ExportArgs) -> Result<()> {
-    if is_gltf(&a.path) {
+    if crate::formats::gltf_import::is_gltf(&a.path) {
         return export_gltf_file(&a.path, &a.out, &a.poses, a.skinning.into(), &a.clip, a.bake, a.animation);
     }
     if is_glb(&a.out) && is_scene(&a.path) {
@@ -70,10 +70,6 @@ fn export_character(a: &ExportArgs) -> Result<()> {
     write_file(out, |w| obj::write_obj(w, &positions, &asset.skin.triangles))?;
     println!("wrote {} ({} vertices, {} triangles)", out.display(), positions.len(), asset.triangle_count());
     Ok(())
-}
-
-fn is_gltf(path: &Path) -> bool {
-    crate::formats::gltf_import::is_gltf(path)
 }
 
 /// `export FILE.glb|FILE.gltf`: every character of the file, posed by `--clip` at `--time`

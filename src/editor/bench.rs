@@ -64,6 +64,12 @@ pub struct Percentiles {
     pub p95: f64,
 }
 
+impl Percentiles {
+    fn of(samples: Vec<f64>) -> Self {
+        Self { p50: percentile(samples.clone(), 0.5), p95: percentile(samples, 0.95) }
+    }
+}
+
 /// How a run was measured, so two runs can be compared.
 #[derive(Debug, Clone, serde::Serialize)]
 pub struct Measured {
@@ -158,17 +164,12 @@ pub fn run(characters: usize, frames: usize, crowd: &CrowdOf, gpu: bool) -> Resu
     let phase = |k: usize| median(samples.iter().map(|s| s[k]).collect());
     let frame: Vec<f64> = samples.iter().map(|s| s[1] + s[2] + s[3] + s[4] + s[5]).collect();
     let names = ["sampling", "fk", "skin", "extract", "upload", "render_world"];
+    let whole = Percentiles::of(frame);
     let phases_ms = names
         .iter()
         .enumerate()
-        .map(|(k, name)| {
-            let v: Vec<f64> = samples.iter().map(|s| s[k + 1]).collect();
-            (name.to_string(), Percentiles { p50: percentile(v.clone(), 0.5), p95: percentile(v, 0.95) })
-        })
-        .chain([(
-            "frame".to_string(),
-            Percentiles { p50: percentile(frame.clone(), 0.5), p95: percentile(frame.clone(), 0.95) },
-        )])
+        .map(|(k, name)| (name.to_string(), Percentiles::of(samples.iter().map(|s| s[k + 1]).collect())))
+        .chain([("frame".to_string(), whole)])
         .collect();
     Ok(BenchReport {
         measured: Measured::now(pipelined_rendering),
@@ -178,8 +179,8 @@ pub fn run(characters: usize, frames: usize, crowd: &CrowdOf, gpu: bool) -> Resu
         gpu_skinning: gpu,
         vertices_per_character: asset.vertex_count(),
         frames,
-        frame_ms_p50: percentile(frame.clone(), 0.5),
-        frame_ms_p95: percentile(frame, 0.95),
+        frame_ms_p50: whole.p50,
+        frame_ms_p95: whole.p95,
         sampling_ms_p50: phase(1),
         fk_ms_p50: phase(2),
         skin_ms_p50: phase(3),

@@ -1,13 +1,13 @@
 //! UCSD CSE169 `.skel`: nested `balljoint name { offset boxmin boxmax rotxlimit
 //! rotylimit rotzlimit pose balljoint... }` blocks.
 
-use std::io::{BufRead, Read};
+use std::io::BufRead;
 use std::path::Path;
 
 use glam::Vec3;
 
 use super::error::FormatError;
-use super::limits::{MAX_FILE_BYTES, MAX_TOKENS};
+use super::limits::MAX_TOKENS;
 use crate::rig::{BoneBox, DofLimits, JointRotation, MAX_JOINTS, RawJoint, Skeleton};
 
 /// A token and the line it starts on.
@@ -20,14 +20,7 @@ pub struct Token {
 /// Splits text into whitespace-separated tokens with their line numbers. LF, CRLF and bare
 /// CR all end a line; `{` and `}` are tokens of their own even when glued to a word.
 pub fn tokenize(reader: impl BufRead, path: &Path) -> Result<Vec<Token>, FormatError> {
-    let mut bytes = Vec::new();
-    reader.take(MAX_FILE_BYTES + 1).read_to_end(&mut bytes).map_err(|e| FormatError::io(path, e))?;
-    if bytes.len() as u64 > MAX_FILE_BYTES {
-        return Err(FormatError::other(
-            path,
-            format!("the input is larger than the {} MiB Marionette reads", MAX_FILE_BYTES >> 20),
-        ));
-    }
+    let bytes = super::error::read_all(reader, path)?;
     let text = String::from_utf8_lossy(&bytes);
     let mut tokens = Vec::new();
     let mut line = 1;

@@ -51,10 +51,14 @@ impl FormatError {
 /// A message cut to [`MAX_MESSAGE_CHARS`] characters: the last guard against quoting a
 /// huge token (a RON parser's error names the identifier it found, whatever its length).
 fn bounded(message: impl fmt::Display) -> String {
-    let message = message.to_string();
-    match message.char_indices().nth(MAX_MESSAGE_CHARS) {
-        None => message,
-        Some((cut, _)) => format!("{}…", &message[..cut]),
+    cut_to(&message.to_string(), MAX_MESSAGE_CHARS).into_owned()
+}
+
+/// `text`, or its first `chars` characters and `…` where it is longer.
+fn cut_to(text: &str, chars: usize) -> std::borrow::Cow<'_, str> {
+    match text.char_indices().nth(chars) {
+        None => text.into(),
+        Some((cut, _)) => format!("{}…", &text[..cut]).into(),
     }
 }
 
@@ -67,9 +71,15 @@ pub fn open(path: &Path) -> Result<std::io::BufReader<std::io::Take<std::fs::Fil
 
 /// A whole file's bytes: a regular file of at most [`MAX_FILE_BYTES`].
 pub fn read_file(path: &Path) -> Result<Vec<u8>, FormatError> {
+    read_all(open_regular(path)?, path)
+}
+
+/// Every byte of `reader`, or an error once it passes [`MAX_FILE_BYTES`] (reading stops
+/// there).
+pub fn read_all(reader: impl std::io::Read, path: &Path) -> Result<Vec<u8>, FormatError> {
     use std::io::Read;
     let mut bytes = Vec::new();
-    open_regular(path)?.take(MAX_FILE_BYTES + 1).read_to_end(&mut bytes).map_err(|e| FormatError::io(path, e))?;
+    reader.take(MAX_FILE_BYTES + 1).read_to_end(&mut bytes).map_err(|e| FormatError::io(path, e))?;
     within_limit(bytes.len() as u64, path)?;
     Ok(bytes)
 }
@@ -135,20 +145,13 @@ fn within_limit(len: u64, path: &Path) -> Result<(), FormatError> {
 /// At most [`MAX_EXCERPT_CHARS`] characters of a token for an error message, with `…`
 /// where it was cut (a malformed file's "token" may be gigabytes long).
 pub fn excerpt(token: &str) -> std::borrow::Cow<'_, str> {
-    match token.char_indices().nth(MAX_EXCERPT_CHARS) {
-        None => token.into(),
-        Some((cut, _)) => format!("{}…", &token[..cut]).into(),
-    }
+    cut_to(token, MAX_EXCERPT_CHARS)
 }
 
 /// Reads the whole input as UTF-8 text; bytes that are not UTF-8 are an error at their line.
 /// Input beyond [`MAX_FILE_BYTES`] is refused.
 pub fn read_text(reader: impl std::io::BufRead, path: &Path) -> Result<String, FormatError> {
-    use std::io::Read;
-    let mut bytes = Vec::new();
-    reader.take(MAX_FILE_BYTES + 1).read_to_end(&mut bytes).map_err(|e| FormatError::io(path, e))?;
-    within_limit(bytes.len() as u64, path)?;
-    String::from_utf8(bytes).map_err(|e| {
+    String::from_utf8(read_all(reader, path)?).map_err(|e| {
         let bytes = e.as_bytes();
         let at = e.utf8_error().valid_up_to();
         let line = 1 + bytes[..at].iter().filter(|&&b| b == b'\n').count();

@@ -496,7 +496,7 @@ fn node_numbers(node: &json::Node, at: &str) -> Result<(), String> {
 }
 
 /// Every number finite, or `at $.path: expected finite numbers, found inf`.
-pub fn finite_numbers<'a>(values: impl IntoIterator<Item = &'a f32>, at: &str) -> Result<(), String> {
+fn finite_numbers<'a>(values: impl IntoIterator<Item = &'a f32>, at: &str) -> Result<(), String> {
     match values.into_iter().find(|v| !v.is_finite()) {
         Some(v) => Err(format!("at {at}: expected finite numbers, found {v}")),
         None => Ok(()),

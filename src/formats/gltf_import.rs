@@ -6,6 +6,7 @@
 //! normalised; morph targets; the base colour factor and texture; and the file's animations of the
 //! skin's joints as clips. Transforms of nodes above the skeleton are folded into its root.
 
+use std::borrow::Cow;
 use std::path::Path;
 
 use glam::{Mat4, Quat, Vec2, Vec3};
@@ -43,11 +44,11 @@ pub fn load_gltf(path: &Path) -> Result<Vec<ImportedCharacter>, FormatError> {
 /// The skinned characters of a glTF file's bytes (`.bin` files are looked for beside
 /// `path`), one per skin that a mesh uses, in the order of the skins.
 pub fn parse_gltf(bytes: &[u8], path: &Path) -> Result<Vec<ImportedCharacter>, FormatError> {
-    let gltf = validated(bytes).map_err(|e| FormatError::other(path, e))?;
+    let (gltf, bin) = validated(bytes).map_err(|e| FormatError::other(path, e))?;
     if let Some(ext) = gltf.extensions_required().next() {
         return Err(FormatError::other(path, format!("at $.extensionsRequired: needs `{ext}`, which is not read")));
     }
-    let buffers = buffers(&gltf, path)?;
+    let buffers = buffers(&gltf, bin, path)?;
     let file = File { gltf: &gltf, buffers: &buffers, path, parent: parents(&gltf) };
     let mut characters = Vec::new();
     for skin in gltf.skins() {
@@ -74,7 +75,7 @@ pub fn parse_gltf(bytes: &[u8], path: &Path) -> Result<Vec<ImportedCharacter>, F
 /// A parsed file: its JSON, its buffers and each node's parent.
 struct File<'a> {
     gltf: &'a gltf::Gltf,
-    buffers: &'a [Vec<u8>],
+    buffers: &'a [Cow<'a, [u8]>],
     path: &'a Path,
     parent: Vec<Option<usize>>,
 }
@@ -85,7 +86,7 @@ impl File<'_> {
     }
 
     fn data<'s>(&'s self) -> impl Clone + Fn(gltf::Buffer) -> Option<&'s [u8]> {
-        |b: gltf::Buffer| self.buffers.get(b.index()).map(Vec::as_slice)
+        |b: gltf::Buffer| self.buffers.get(b.index()).map(|data| &**data)
     }
 
     /// The character of `skin`, drawn by `meshes`.
@@ -440,13 +441,14 @@ impl File<'_> {
 
 /// The file split (GLB), parsed, checked by [`gltf_check`](super::gltf_check) and then
 /// by the `gltf` crate's own validation: nothing is read through the crate before every
-/// index, layout and type it relies on was checked.
-fn validated(bytes: &[u8]) -> Result<gltf::Gltf, String> {
+/// index, layout and type it relies on was checked. The binary chunk is returned as a slice
+/// of `bytes` (not copied).
+fn validated(bytes: &[u8]) -> Result<(gltf::Gltf, Option<&[u8]>), String> {
     let (json, bin) = super::gltf_check::split_glb(bytes)?;
     let root = gltf::json::Root::from_slice(json).map_err(|e| format!("at $: expected glTF 2.0 JSON, {e}"))?;
     super::gltf_check::check(&root, bin)?;
     let document = gltf::Document::from_json(root).map_err(|e| format!("at $: expected valid glTF 2.0, {e}"))?;
-    Ok(gltf::Gltf { document, blob: bin.map(<[u8]>::to_vec) })
+    Ok((gltf::Gltf { document, blob: None }, bin))
 }
 
 /// `sampler.output: expected finite key values, found … at value k` for the first value
@@ -500,15 +502,15 @@ fn global(gltf: &gltf::Gltf, parent: &[Option<usize>], node: Option<usize>) -> M
     m
 }
 
-/// The file's buffers: the GLB's binary chunk, or `.bin` files beside a `.gltf`.
-fn buffers(gltf: &gltf::Gltf, path: &Path) -> Result<Vec<Vec<u8>>, FormatError> {
+/// The file's buffers: the GLB's binary chunk (borrowed), or `.bin` files beside a `.gltf`.
+fn buffers<'a>(gltf: &gltf::Gltf, bin: Option<&'a [u8]>, path: &Path) -> Result<Vec<Cow<'a, [u8]>>, FormatError> {
     gltf.buffers()
         .map(|b| {
             let at = format!("at $.buffers[{}]", b.index());
             let data = match b.source() {
-                gltf::buffer::Source::Bin => gltf.blob.clone().ok_or_else(|| {
+                gltf::buffer::Source::Bin => Cow::Borrowed(bin.ok_or_else(|| {
                     FormatError::other(path, format!("{at}: expected the GLB's binary chunk, found none"))
-                })?,
+                })?),
                 gltf::buffer::Source::Uri(uri) if uri.starts_with("data:") => {
                     return Err(FormatError::other(
                         path,
@@ -518,7 +520,7 @@ fn buffers(gltf: &gltf::Gltf, path: &Path) -> Result<Vec<Vec<u8>>, FormatError> 
                 gltf::buffer::Source::Uri(uri) => {
                     let read = super::uri::beside_uri(path, uri)
                         .and_then(|file| super::error::read_file(&file).map_err(|e| e.to_string()));
-                    read.map_err(|e| FormatError::other(path, format!("{at}.uri: {e}")))?
+                    Cow::Owned(read.map_err(|e| FormatError::other(path, format!("{at}.uri: {e}")))?)
                 }
             };
             if data.len() < b.length() {
