@@ -6,7 +6,7 @@ use glam::{Mat4, Vec3};
 use crate::rig::dqs::SkinningMethod;
 use crate::rig::fk::{RestOverride, posed_palette_with_rest};
 use crate::rig::lbs::skin;
-use crate::rig::node_clip::NodeClip;
+use crate::rig::node_clip::{NodeClip, NodePose};
 use crate::rig::{CharacterAsset, JointRotation, Skeleton};
 
 /// What is wrong with a `JOINT=rx,ry,rz` spec.
@@ -115,8 +115,8 @@ pub fn find_clip<'a>(clips: &'a [NodeClip], spec: &str) -> Option<&'a NodeClip> 
     })
 }
 
-/// Every character of a glTF file, shaped by the morph weights the file sets, each posed
-/// by its clip `clip` at `time` seconds (by its file's node transforms without one) and
+/// Every character of a glTF file, shaped by the morph weights the file sets (or its clip
+/// keys), each posed by its clip `clip` at `time` seconds (by its file's node transforms without one) and
 /// then by `poses` where it has the joints:
 /// the vertices and triangles of all of them, in file order. Fails when no character has
 /// the clip.
@@ -140,17 +140,19 @@ pub fn posed_gltf(
     let (mut positions, mut triangles) = (Vec::new(), Vec::new());
     for c in characters {
         let skeleton = &c.asset.skeleton;
-        let sampled = clip.and_then(|spec| find_clip(&c.clips, spec)).map(|clip| clip.sample(skeleton, time));
-        let node_pose = sampled.unwrap_or_else(|| crate::rig::node_clip::NodePose::of(skeleton));
+        let playing = clip.and_then(|spec| find_clip(&c.clips, spec));
+        let node_pose = playing.map_or_else(|| NodePose::of(skeleton), |clip| clip.sample(skeleton, time));
+        // The morph weights the file sets are part of its pose; a clip may key them.
+        let weights =
+            playing.map_or_else(|| c.morph_weights.clone(), |clip| clip.sample_weights(&c.morph_weights, time));
         let mut pose = node_pose.pose();
         let mine: Vec<PoseSpec> = poses.iter().filter(|p| skeleton.resolve(&p.joint).is_some()).cloned().collect();
         apply_pose_specs(skeleton, &mut pose, &mine).map_err(|e| e.to_string())?;
         let rest = RestOverride { offsets: Some(&node_pose.offsets), scales: Some(&node_pose.scales) };
         let first = positions.len() as u32;
-        // The morph weights the file sets are part of its pose.
         let mut shaped = std::borrow::Cow::Borrowed(&c.asset);
-        if c.morph_weights.iter().any(|&w| w != 0.0) {
-            shaped.to_mut().skin.bind_positions = c.asset.morphed_positions(&c.morph_weights);
+        if weights.iter().any(|&w| w != 0.0) {
+            shaped.to_mut().skin.bind_positions = c.asset.morphed_positions(&weights);
         }
         positions.extend(posed_positions_with_rest(&shaped, &pose, rest, Mat4::IDENTITY, method));
         triangles.extend(c.asset.skin.triangles.iter().map(|t| t.map(|i| i + first)));
@@ -184,6 +186,7 @@ pub fn describe(asset: &CharacterAsset) -> String {
     let kind = match asset.skin_kind {
         crate::rig::character::SkinKind::Mesh => "mesh",
         crate::rig::character::SkinKind::BoneBoxes => "bone boxes (no mesh in the source)",
+        crate::rig::character::SkinKind::Rigid => "meshes carried by their nodes (a prop: nothing skinned)",
     };
     out += &format!("skin: {kind}\n");
     out += &format!("vertices: {}\n", asset.vertex_count());

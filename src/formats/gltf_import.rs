@@ -1,10 +1,16 @@
-//! glTF 2.0 import (`.glb`, `.gltf` with its `.bin` files), read with the `gltf` crate:
-//! every skin with a mesh becomes a character. Its joints (names, hierarchy, each node's
-//! translation as the rest offset, its scale as the rest scale, its rotation as the
-//! joint's pose from the file), the file's inverse bind matrices, every primitive of the
-//! meshes that use the skin (merged, in file order) with all `JOINTS_n`/`WEIGHTS_n` sets,
-//! normalised; morph targets; the base colour factor and texture; and the file's animations of the
-//! skin's joints as clips. Transforms of nodes above the skeleton are folded into its root.
+//! glTF 2.0 import (`.glb`, `.gltf` with its `.bin` files or `data:` URIs), read with the
+//! `gltf` crate. The node tree is the truth: each tree of nodes that carries meshes becomes
+//! one part (a character, or a prop when none of its meshes is skinned). Its skeleton is
+//! every node of the tree that a mesh depends on: the skins' joints, the nodes above and
+//! between them (so a skeleton may hang under another skin's joint), and the nodes of
+//! unskinned meshes, which ride rigidly on their node. Static nodes above the tree's first
+//! branching node are folded into it. Each node's translation is its rest offset, its
+//! rotation its pose, its scale its rest scale; the skins' inverse bind matrices bind the
+//! joints (a joint bound differently by two skins gets a second, fixed joint for the
+//! second binding). Every primitive of the part's meshes, merged in file order, with all
+//! `JOINTS_n`/`WEIGHTS_n` sets, normalised; morph targets per mesh node; the base colour
+//! factor and texture; and the file's animations of the part's nodes and morph weights as
+//! clips.
 
 use std::borrow::Cow;
 use std::path::Path;
@@ -17,14 +23,15 @@ use crate::rig::{
     CharacterAsset, JointRotation, MorphTarget, Picture, RawJoint, Skeleton, Skin, SkinTexture, SkinWeights,
 };
 
-/// One character of a glTF file: its asset, the file's animations of its joints, and the
-/// base colour of its first primitive's material (none: the file gives no material).
+/// One part of a glTF file: its asset, the file's animations of its nodes, and the base
+/// colour of its first primitive's material (none: the file gives no material).
 #[derive(Debug, Clone)]
 pub struct ImportedCharacter {
     pub asset: CharacterAsset,
     pub clips: Vec<NodeClip>,
     pub base_color: Option<[f32; 4]>,
-    /// The morph targets' weights as the file sets them (`mesh.weights`; 0 where unset).
+    /// The morph targets' weights as the file sets them (`node.weights`, else
+    /// `mesh.weights`; 0 where unset).
     pub morph_weights: Vec<f32>,
 }
 
@@ -35,52 +42,106 @@ pub fn is_gltf(path: &Path) -> bool {
         .is_some_and(|e| e.eq_ignore_ascii_case("glb") || e.eq_ignore_ascii_case("gltf"))
 }
 
-/// Loads every skinned character of a glTF file, in the order of its skins.
+/// Loads every part (character or prop) of a glTF file.
 pub fn load_gltf(path: &Path) -> Result<Vec<ImportedCharacter>, FormatError> {
     let bytes = super::error::read_file(path)?;
     parse_gltf(&bytes, path)
 }
 
-/// The skinned characters of a glTF file's bytes (`.bin` files are looked for beside
-/// `path`), one per skin that a mesh uses, in the order of the skins.
+/// The parts of a glTF file's bytes (`.bin` files are looked for beside `path`): one per
+/// tree of nodes that carries a mesh, in the order of their first mesh node.
 pub fn parse_gltf(bytes: &[u8], path: &Path) -> Result<Vec<ImportedCharacter>, FormatError> {
     let (gltf, bin) = validated(bytes).map_err(|e| FormatError::other(path, e))?;
     if let Some(ext) = gltf.extensions_required().next() {
         return Err(FormatError::other(path, format!("at $.extensionsRequired: needs `{ext}`, which is not read")));
     }
     let buffers = buffers(&gltf, bin, path)?;
-    let file = File { gltf: &gltf, buffers: &buffers, path, parent: parents(&gltf) };
-    let mut characters = Vec::new();
-    for skin in gltf.skins() {
-        let meshes: Vec<gltf::Mesh> = gltf
-            .nodes()
-            .filter(|n| n.skin().is_some_and(|s| s.index() == skin.index()))
-            .filter_map(|n| n.mesh())
-            .collect();
-        if !meshes.is_empty() {
-            characters.push(file.character(&skin, &meshes, gltf.skins().len())?);
-        }
+    let file = File::new(&gltf, &buffers, path);
+    let parts = file.parts();
+    if parts.is_empty() {
+        return Err(file.error("at $.nodes: expected a node with a mesh, found none".into()));
     }
-    if characters.is_empty() {
-        let what = if gltf.skins().len() == 0 {
-            "at $.skins[0]: expected a skinned mesh"
-        } else {
-            "at $.skins: expected a skin that a mesh node uses"
-        };
-        return Err(FormatError::other(path, format!("{what}, found none")));
-    }
-    Ok(characters)
+    let mut vertices = 0usize;
+    parts
+        .iter()
+        .enumerate()
+        .map(|(n, part)| {
+            let imported = file.part(part, n, parts.len())?;
+            vertices += imported.asset.vertex_count();
+            if vertices > super::limits::MAX_VERTICES {
+                return Err(file.error(format!(
+                    "at $.nodes: the meshes hold more than the {} vertices a file may (MAX_VERTICES)",
+                    super::limits::MAX_VERTICES
+                )));
+            }
+            Ok(imported)
+        })
+        .collect()
 }
 
-/// A parsed file: its JSON, its buffers and each node's parent.
+/// A parsed file: its JSON, its buffers, each node's parent and what its animations key.
 struct File<'a> {
     gltf: &'a gltf::Gltf,
     buffers: &'a [Cow<'a, [u8]>],
     path: &'a Path,
     parent: Vec<Option<usize>>,
+    /// Whether an animation keys the node's translation, rotation or scale.
+    animated: Vec<bool>,
+    /// Whether a mesh depends on the node (a skin's joint, an unskinned mesh's node).
+    seed: Vec<bool>,
+    /// Whether the node is one of `seed`'s or above one.
+    relevant: Vec<bool>,
 }
 
-impl File<'_> {
+/// The nodes of one part: its roots, and its mesh nodes in file order.
+struct PartNodes {
+    roots: Vec<usize>,
+    meshes: Vec<usize>,
+}
+
+/// A skin's joints as raw joints of its part, with their inverse bind matrices.
+struct SkinSlots {
+    skin: usize,
+    joints: Vec<(usize, Mat4)>,
+}
+
+/// How a primitive's vertices follow the joints.
+enum Bound<'m> {
+    /// By their `JOINTS_n`/`WEIGHTS_n`, skin joint k being joint `joints[k]`.
+    Skinned(&'m [usize]),
+    /// Rigidly on `joint`, the vertices taken into its bind frame by `to_bind`.
+    Rigid { joint: usize, to_bind: Mat4 },
+}
+
+impl<'a> File<'a> {
+    fn new(gltf: &'a gltf::Gltf, buffers: &'a [Cow<'a, [u8]>], path: &'a Path) -> Self {
+        let n = gltf.nodes().len();
+        let parent = parents(gltf);
+        let mut animated = vec![false; n];
+        for channel in gltf.animations().flat_map(|a| a.channels().collect::<Vec<_>>()) {
+            if channel.target().property() != gltf::animation::Property::MorphTargetWeights {
+                animated[channel.target().node().index()] = true;
+            }
+        }
+        let mut seed = vec![false; n];
+        for node in gltf.nodes().filter(|n| n.mesh().is_some()) {
+            match node.skin() {
+                Some(skin) => skin.joints().for_each(|j| seed[j.index()] = true),
+                None => seed[node.index()] = true,
+            }
+        }
+        let mut relevant = vec![false; n];
+        for s in (0..n).filter(|&s| seed[s]) {
+            let mut at = Some(s);
+            // The nodes are a forest (checked): the walk ends at a root or a marked node.
+            while let Some(node) = at.filter(|&node| !relevant[node]) {
+                relevant[node] = true;
+                at = parent[node];
+            }
+        }
+        Self { gltf, buffers, path, parent, animated, seed, relevant }
+    }
+
     fn error(&self, message: String) -> FormatError {
         FormatError::other(self.path, message)
     }
@@ -89,36 +150,126 @@ impl File<'_> {
         |b: gltf::Buffer| self.buffers.get(b.index()).map(|data| &**data)
     }
 
-    /// The character of `skin`, drawn by `meshes`.
-    fn character(
-        &self,
-        skin: &gltf::Skin,
-        meshes: &[gltf::Mesh],
-        skin_count: usize,
-    ) -> Result<ImportedCharacter, FormatError> {
-        let mut warnings = Vec::new();
-        let joints: Vec<gltf::Node> = skin.joints().collect();
-        let (skeleton, new_index, root_parent) = self.skeleton(skin, &joints)?;
-        let mut inverse = vec![Mat4::IDENTITY; skeleton.len()];
-        if let Some(ibm) = skin.reader(self.data()).read_inverse_bind_matrices() {
-            for (j, m) in ibm.enumerate().take(skeleton.len()) {
-                let m = Mat4::from_cols_array_2d(&m);
-                if !m.is_finite() || m.determinant().abs() < 1e-12 || !m.inverse().is_finite() {
-                    let what = if m.is_finite() { "a singular matrix" } else { "numbers that are not finite" };
-                    return Err(self.error(format!(
-                        "at $.skins[{}].inverseBindMatrices: expected an invertible matrix for joint {j}, found {what}",
-                        skin.index()
-                    )));
+    fn node(&self, index: usize) -> gltf::Node<'a> {
+        self.gltf.nodes().nth(index).expect("node indices were checked")
+    }
+
+    fn root_of(&self, mut node: usize) -> usize {
+        while let Some(up) = self.parent[node] {
+            node = up;
+        }
+        node
+    }
+
+    /// The node's relevant children, in file order.
+    fn relevant_children(&self, node: usize) -> Vec<usize> {
+        self.node(node).children().map(|c| c.index()).filter(|&c| self.relevant[c]).collect()
+    }
+
+    /// The file's parts: the node trees that carry meshes, a skin whose joints lie in
+    /// several trees joining them, in the order of their first mesh node.
+    fn parts(&self) -> Vec<PartNodes> {
+        let n = self.parent.len();
+        // Union-find over the roots.
+        let mut group: Vec<usize> = (0..n).collect();
+        fn find(group: &mut [usize], mut x: usize) -> usize {
+            while group[x] != x {
+                group[x] = group[group[x]];
+                x = group[x];
+            }
+            x
+        }
+        let mesh_root = |node: &gltf::Node| match node.skin() {
+            Some(skin) => skin.joints().next().map(|j| self.root_of(j.index())),
+            None => Some(self.root_of(node.index())),
+        };
+        for node in self.gltf.nodes().filter(|n| n.mesh().is_some()) {
+            if let Some(skin) = node.skin() {
+                let mut roots = skin.joints().map(|j| self.root_of(j.index()));
+                if let Some(first) = roots.next() {
+                    for other in roots {
+                        let (a, b) = (find(&mut group, first), find(&mut group, other));
+                        group[b] = a;
+                    }
                 }
-                inverse[new_index[j]] = m;
             }
         }
+        let mut parts: Vec<(usize, PartNodes)> = Vec::new();
+        for node in self.gltf.nodes().filter(|n| n.mesh().is_some()) {
+            let Some(root) = mesh_root(&node) else { continue };
+            let id = find(&mut group, root);
+            match parts.iter_mut().find(|(g, _)| *g == id) {
+                Some((_, part)) => part.meshes.push(node.index()),
+                None => parts.push((id, PartNodes { roots: Vec::new(), meshes: vec![node.index()] })),
+            }
+        }
+        for root in (0..n).filter(|&r| self.parent[r].is_none() && self.relevant[r]) {
+            let id = find(&mut group, root);
+            if let Some((_, part)) = parts.iter_mut().find(|(g, _)| *g == id) {
+                part.roots.push(root);
+            }
+        }
+        parts.into_iter().map(|(_, part)| part).collect()
+    }
+
+    /// The part's name: the file's stem when it is the only one, else its first mesh
+    /// node's mesh name, its root node's name, or the stem and its number.
+    fn part_name(&self, part: &PartNodes, n: usize, count: usize) -> String {
+        let stem = self.path.file_stem().and_then(|s| s.to_str()).unwrap_or("gltf");
+        if count == 1 {
+            return stem.to_string();
+        }
+        let mesh = part.meshes.iter().find_map(|&m| self.node(m).mesh()?.name().map(str::to_string));
+        let root = || (part.roots.len() == 1).then(|| self.node(part.roots[0]).name().map(str::to_string)).flatten();
+        mesh.or_else(root).unwrap_or_else(|| format!("{stem} {}", n + 1))
+    }
+
+    /// One part: its skeleton, bindings, meshes, morphs and clips.
+    fn part(&self, part: &PartNodes, n: usize, count: usize) -> Result<ImportedCharacter, FormatError> {
+        let mut warnings = Vec::new();
+        let name = self.part_name(part, n, count);
+        let (top, root_parent) = self.folded_top(part);
+        let (mut raw, raw_of_node) = self.raw_joints(part, top, root_parent, &name)?;
+        let skins = self.skin_slots(part, &raw_of_node, &mut raw)?;
+        let (skeleton, new_index) = Skeleton::build_reordered(raw)
+            .map_err(|e| self.error(format!("at $.nodes (the tree of node {}): {e}", part.roots[0])))?;
+        let joint_of_node: Vec<Option<usize>> = raw_of_node.iter().map(|r| r.map(|r| new_index[r])).collect();
+        let mut bind = vec![None; skeleton.len()];
+        for slots in &skins {
+            for &(raw_joint, ibm) in &slots.joints {
+                bind[new_index[raw_joint]].get_or_insert(ibm);
+            }
+        }
+        let mut rest = vec![Mat4::IDENTITY; skeleton.len()];
+        crate::rig::fk::forward_kinematics(&skeleton, &skeleton.initial_pose(), Mat4::IDENTITY, &mut rest);
+        let bind: Vec<Mat4> = bind.iter().zip(&rest).map(|(b, world)| b.unwrap_or_else(|| world.inverse())).collect();
+
         let mut skin_data = Skin::default();
         let mut rows = Vec::new();
         let mut morphs = Vec::new();
+        let mut morph_weights = Vec::new();
+        let mut morph_of = Vec::new();
         let mut base_color = None;
         let (mut texture, mut texcoords) = (None, Vec::new());
-        for mesh in meshes {
+        let mut skinned = false;
+        for &node_index in &part.meshes {
+            let node = self.node(node_index);
+            let Some(mesh) = node.mesh() else { continue };
+            let slot_joints: Vec<usize>;
+            let bound = match node.skin() {
+                Some(skin) => {
+                    skinned = true;
+                    let slots =
+                        skins.iter().find(|s| s.skin == skin.index()).expect("every skin of the part has slots");
+                    slot_joints = slots.joints.iter().map(|&(r, _)| new_index[r]).collect();
+                    Bound::Skinned(&slot_joints)
+                }
+                None => {
+                    let joint = joint_of_node[node_index].expect("a mesh node is a joint");
+                    Bound::Rigid { joint, to_bind: bind[joint].inverse() }
+                }
+            };
+            let first_morph = morphs.len();
             for (p, primitive) in mesh.primitives().enumerate() {
                 let at = format!("at $.meshes[{}].primitives[{p}]", mesh.index());
                 if primitive.mode() != gltf::mesh::Mode::Triangles {
@@ -131,7 +282,7 @@ impl File<'_> {
                     base_color.get_or_insert(pbr.base_color_factor());
                 }
                 let first = skin_data.bind_positions.len();
-                self.primitive(&primitive, &at, &new_index, &mut skin_data, &mut rows)?;
+                self.primitive(&primitive, &at, &bound, &mut skin_data, &mut rows)?;
                 if let Some(info) = pbr.base_color_texture() {
                     texture = texture.or_else(|| self.texture(&info.texture(), &mut warnings));
                     let uv = primitive.reader(self.data()).read_tex_coords(info.tex_coord());
@@ -145,69 +296,155 @@ impl File<'_> {
                         )));
                     }
                 }
-                self.morph_targets(mesh, &primitive, &at, first, &mut morphs)?;
+                self.morph_targets(&node, &mesh, &primitive, &at, first, &bound, first_morph, &mut morphs)?;
             }
+            // This node's targets, in order, and the weights the file sets for them.
+            let targets = morphs.len() - first_morph;
+            let set = node.weights().or_else(|| mesh.weights()).unwrap_or(&[]);
+            morph_weights.extend((0..targets).map(|k| set.get(k).copied().filter(|w| w.is_finite()).unwrap_or(0.0)));
+            morph_of.push((node_index, first_morph, targets));
         }
         let (weights, normalised) = SkinWeights::from_rows(rows, skeleton.len())
-            .map_err(|e| self.error(format!("at $.skins[{}] meshes (JOINTS_n, WEIGHTS_n): {e}", skin.index())))?;
+            .map_err(|e| self.error(format!("at $.nodes (the meshes of part `{name}`, JOINTS_n, WEIGHTS_n): {e}")))?;
         warnings.extend(super::weight_warnings::normalised_warnings(self.path, &normalised));
         skin_data.weights = weights;
         if texture.is_some() {
             texcoords.resize(skin_data.bind_positions.len(), Vec2::ZERO);
             skin_data.texcoords = texcoords;
         }
-        let clips = self.clips(&joints, &new_index, root_parent, &mut warnings)?;
-        let stem = self.path.file_stem().and_then(|s| s.to_str()).unwrap_or("gltf");
-        let name = match (skin_count, meshes[0].name()) {
-            (1, _) => stem.to_string(),
-            (_, Some(mesh)) => mesh.to_string(),
-            _ => format!("{stem} {}", skin.index()),
-        };
-        let mut asset = CharacterAsset::with_inverse_binds(name, skeleton, skin_data, inverse, warnings)
+        let clips = self.clips(&joint_of_node, skeleton.len(), &morph_of, morphs.len(), root_parent)?;
+        let mut asset = CharacterAsset::with_inverse_binds(name, skeleton, skin_data, bind, warnings)
             .map_err(|e| FormatError::rig(self.path, e))?;
-        // Each morph's weight from the first mesh that names it.
-        let morph_weights = morphs
-            .iter()
-            .map(|m| {
-                meshes.iter().find_map(|mesh| {
-                    let k = target_names(mesh).iter().position(|n| *n == m.name)?;
-                    mesh.weights()?.get(k).copied()
-                })
-            })
-            .map(|w| w.filter(|w| w.is_finite()).unwrap_or(0.0))
-            .collect();
+        if !skinned {
+            asset.skin_kind = crate::rig::character::SkinKind::Rigid;
+        }
         asset.morphs = morphs;
         asset.texture = texture;
         Ok(ImportedCharacter { asset, clips, base_color, morph_weights })
     }
 
-    /// The skin's joints as a skeleton (reordered parents first: `new_index[file joint]`)
-    /// and the transform of the nodes above its root.
-    fn skeleton(&self, skin: &gltf::Skin, joints: &[gltf::Node]) -> Result<(Skeleton, Vec<usize>, Mat4), FormatError> {
-        let joint_of = joint_of_node(self.gltf, joints);
-        let joint_of = |node: usize| joint_of[node];
-        let mut raw = Vec::with_capacity(joints.len());
-        let mut root_parent = Mat4::IDENTITY;
-        for (j, node) in joints.iter().enumerate() {
-            let up = self.parent[node.index()];
-            let mut local = Mat4::from_cols_array_2d(&node.transform().matrix());
-            if up.and_then(joint_of).is_none() {
-                // A skeleton root: the nodes above it place it.
-                root_parent = self.global(up);
-                local = root_parent * local;
+    /// The node the part's skeleton starts at and the transform of the static nodes above
+    /// it folded into it: from a single root, down while a node is not keyed, carries no
+    /// mesh, is no joint and has one relevant child (and the fold keeps its transform
+    /// exactly a translation, rotation and scale).
+    fn folded_top(&self, part: &PartNodes) -> (Option<usize>, Mat4) {
+        let [root] = part.roots[..] else { return (None, Mat4::IDENTITY) };
+        let (mut top, mut fold) = (root, Mat4::IDENTITY);
+        loop {
+            let children = self.relevant_children(top);
+            let [next] = children[..] else { break };
+            if self.animated[top] || self.seed[top] {
+                break;
             }
-            let (scale, rotation, translation) = local.to_scale_rotation_translation();
-            let name = node.name().map_or_else(|| format!("joint {j}"), str::to_string);
-            let mut joint = RawJoint::new(name, up.and_then(joint_of), translation);
+            let folded = fold * local_matrix(&self.node(top));
+            if !is_trs(folded * local_matrix(&self.node(next))) {
+                break;
+            }
+            (top, fold) = (next, folded);
+        }
+        (Some(top), fold)
+    }
+
+    /// The part's joints in depth-first order (a common root first when it has several
+    /// root nodes) and each node's raw joint.
+    fn raw_joints(
+        &self,
+        part: &PartNodes,
+        top: Option<usize>,
+        root_parent: Mat4,
+        name: &str,
+    ) -> Result<(Vec<RawJoint>, Vec<Option<usize>>), FormatError> {
+        let mut raw = Vec::new();
+        let mut raw_of_node = vec![None; self.parent.len()];
+        let mut todo: Vec<(usize, Option<usize>)> = match top {
+            Some(top) => vec![(top, None)],
+            None => {
+                raw.push(RawJoint::new(name, None, Vec3::ZERO));
+                part.roots.iter().rev().map(|&r| (r, Some(0))).collect()
+            }
+        };
+        while let Some((index, parent)) = todo.pop() {
+            let node = self.node(index);
+            let folded = (parent.is_none() && root_parent != Mat4::IDENTITY).then(|| root_parent * local_matrix(&node));
+            let (translation, rotation, scale) = match (folded, node.transform()) {
+                (None, gltf::scene::Transform::Decomposed { translation, rotation, scale }) => {
+                    (Vec3::from(translation), Quat::from_array(rotation), Vec3::from(scale))
+                }
+                (folded, _) => {
+                    let local = folded.unwrap_or_else(|| local_matrix(&node));
+                    if !is_trs(local) {
+                        return Err(self.error(format!(
+                            "at $.nodes[{index}].matrix: expected a translation, rotation and scale, found a shear"
+                        )));
+                    }
+                    let (scale, rotation, translation) = local.to_scale_rotation_translation();
+                    (translation, rotation, scale)
+                }
+            };
+            let name = node.name().map_or_else(|| format!("node {index}"), str::to_string);
+            let mut joint = RawJoint::new(name, parent, translation);
             joint.initial_rotation = JointRotation::Quat(rotation.normalize());
             if (scale - Vec3::ONE).abs().max_element() > 1e-6 {
                 joint.rest_scale = scale;
             }
+            raw_of_node[index] = Some(raw.len());
+            let me = raw.len();
             raw.push(joint);
+            todo.extend(self.relevant_children(index).into_iter().rev().map(|c| (c, Some(me))));
         }
-        let (skeleton, new_index) = Skeleton::build_reordered(raw)
-            .map_err(|e| self.error(format!("at $.skins[{}].joints: {e}", skin.index())))?;
-        Ok((skeleton, new_index, root_parent))
+        Ok((raw, raw_of_node))
+    }
+
+    /// Each skin of the part's meshes: its joints as raw joints, with their inverse bind
+    /// matrices. A joint that an earlier skin binds differently gets a fixed child joint
+    /// (added to `raw`) that carries this skin's binding.
+    fn skin_slots(
+        &self,
+        part: &PartNodes,
+        raw_of_node: &[Option<usize>],
+        raw: &mut Vec<RawJoint>,
+    ) -> Result<Vec<SkinSlots>, FormatError> {
+        let mut bound: Vec<Option<Mat4>> = vec![None; raw.len()];
+        let mut skins: Vec<SkinSlots> = Vec::new();
+        for skin in part.meshes.iter().filter_map(|&m| self.node(m).skin()) {
+            if skins.iter().any(|s| s.skin == skin.index()) {
+                continue;
+            }
+            let mut ibms: Vec<Mat4> = vec![Mat4::IDENTITY; skin.joints().len()];
+            if let Some(read) = skin.reader(self.data()).read_inverse_bind_matrices() {
+                for (k, m) in read.enumerate().take(ibms.len()) {
+                    let m = Mat4::from_cols_array_2d(&m);
+                    if !m.is_finite() || m.determinant().abs() < 1e-12 || !m.inverse().is_finite() {
+                        let what = if m.is_finite() { "a singular matrix" } else { "numbers that are not finite" };
+                        return Err(self.error(format!(
+                            "at $.skins[{}].inverseBindMatrices: expected an invertible matrix for joint {k}, found {what}",
+                            skin.index()
+                        )));
+                    }
+                    ibms[k] = m;
+                }
+            }
+            let mut joints = Vec::with_capacity(ibms.len());
+            for (node, ibm) in skin.joints().zip(ibms) {
+                let r = raw_of_node[node.index()].expect("a skin's joints are relevant");
+                let slot = match bound[r] {
+                    None => {
+                        bound[r] = Some(ibm);
+                        r
+                    }
+                    Some(first) if same_matrix(first, ibm) => r,
+                    Some(_) => {
+                        let name = format!("{} (skin {})", raw[r].name, skin.index());
+                        raw.push(RawJoint::new(name, Some(r), Vec3::ZERO));
+                        bound.push(Some(ibm));
+                        raw.len() - 1
+                    }
+                };
+                joints.push((slot, ibm));
+            }
+            skins.push(SkinSlots { skin: skin.index(), joints });
+        }
+        Ok(skins)
     }
 
     /// Appends one triangle primitive: its positions, triangles and influence rows.
@@ -215,7 +452,7 @@ impl File<'_> {
         &self,
         primitive: &gltf::Primitive,
         at: &str,
-        new_index: &[usize],
+        bound: &Bound,
         skin: &mut Skin,
         rows: &mut Vec<Vec<(usize, f32)>>,
     ) -> Result<(), FormatError> {
@@ -233,7 +470,6 @@ impl File<'_> {
             )));
         }
         let count = points.len();
-        skin.bind_positions.extend(points);
         let indices: Vec<u32> = match reader.read_indices() {
             Some(i) => i.into_u32().collect(),
             None => (0..count as u32).collect(),
@@ -242,6 +478,15 @@ impl File<'_> {
             return Err(self.error(format!("{at}.indices: index {bad} is beyond its {count} vertices")));
         }
         skin.triangles.extend(indices.chunks_exact(3).map(|t| [first + t[0], first + t[1], first + t[2]]));
+        match *bound {
+            Bound::Rigid { joint, to_bind } => {
+                skin.bind_positions.extend(points.iter().map(|&p| to_bind.transform_point3(p)));
+                rows.extend(std::iter::repeat_n(vec![(joint, 1.0)], count));
+                return Ok(());
+            }
+            Bound::Skinned(_) => skin.bind_positions.extend(points),
+        }
+        let Bound::Skinned(joints) = *bound else { unreachable!("rigid primitives returned") };
         let mut influences: Vec<Vec<(usize, f32)>> = vec![Vec::new(); count];
         let mut set = 0;
         while let (Some(js), Some(ws)) = (reader.read_joints(set), reader.read_weights(set)) {
@@ -253,11 +498,11 @@ impl File<'_> {
                 }
                 for k in 0..4 {
                     if w[k] > 0.0 {
-                        let joint = *new_index.get(j[k] as usize).ok_or_else(|| {
+                        let joint = *joints.get(j[k] as usize).ok_or_else(|| {
                             self.error(format!(
                                 "{at}.attributes.JOINTS_{set}: vertex {v} names joint {} of {}",
                                 j[k],
-                                new_index.len()
+                                joints.len()
                             ))
                         })?;
                         influences[v].push((joint, w[k]));
@@ -274,26 +519,35 @@ impl File<'_> {
     }
 
     /// Adds the primitive's morph targets (position deltas of its vertices, which start
-    /// at `first`) to `morphs`, target k of every primitive of a mesh into one morph.
+    /// at `first`) to `morphs`: target k of the node's mesh is morph `first_morph + k`, for
+    /// every primitive of the mesh. A name that an earlier node's target has gets the
+    /// node's name after it.
+    #[allow(clippy::too_many_arguments)]
     fn morph_targets(
         &self,
+        node: &gltf::Node,
         mesh: &gltf::Mesh,
         primitive: &gltf::Primitive,
         at_primitive: &str,
         first: usize,
+        bound: &Bound,
+        first_morph: usize,
         morphs: &mut Vec<MorphTarget>,
     ) -> Result<(), FormatError> {
         let names = target_names(mesh);
         let reader = primitive.reader(self.data());
         for (k, (positions, _, _)) in reader.read_morph_targets().enumerate() {
-            let name = names.get(k).cloned().unwrap_or_else(|| format!("{} target {k}", mesh.name().unwrap_or("mesh")));
-            let index = match morphs.iter().position(|m| m.name == name) {
-                Some(index) => index,
-                None => {
-                    morphs.push(MorphTarget { name, deltas: Vec::new() });
-                    morphs.len() - 1
+            if morphs.len() <= first_morph + k {
+                let mut name =
+                    names.get(k).cloned().unwrap_or_else(|| format!("{} target {k}", mesh.name().unwrap_or("mesh")));
+                if morphs[..first_morph].iter().any(|m| m.name == name) {
+                    name = format!(
+                        "{name} ({})",
+                        node.name().map_or_else(|| format!("node {}", node.index()), str::to_string)
+                    );
                 }
-            };
+                morphs.push(MorphTarget { name, deltas: Vec::new() });
+            }
             let deltas: Vec<(usize, [f32; 3])> =
                 positions.into_iter().flatten().enumerate().filter(|(_, d)| *d != [0.0; 3]).collect();
             if let Some((v, _)) = deltas.iter().find(|(_, d)| !d.iter().all(|x| x.is_finite())) {
@@ -301,7 +555,13 @@ impl File<'_> {
                     "{at_primitive}.targets[{k}].POSITION: expected finite numbers, found a move of vertex {v} that is not"
                 )));
             }
-            morphs[index].deltas.extend(deltas.into_iter().map(|(v, d)| ((first + v) as u32, Vec3::from(d))));
+            let to_bind = match *bound {
+                Bound::Rigid { to_bind, .. } => to_bind,
+                Bound::Skinned(_) => Mat4::IDENTITY,
+            };
+            morphs[first_morph + k].deltas.extend(
+                deltas.into_iter().map(|(v, d)| ((first + v) as u32, to_bind.transform_vector3(Vec3::from(d)))),
+            );
         }
         Ok(())
     }
@@ -316,18 +576,13 @@ impl File<'_> {
                 let buffer = self.buffers.get(view.buffer().index())?;
                 buffer.get(view.offset()..view.offset() + view.length()).map(<[u8]>::to_vec)
             }
-            gltf::image::Source::Uri { uri, .. } if !uri.starts_with("data:") => {
-                match super::uri::beside_uri(self.path, uri)
-                    .and_then(|f| super::error::read_file(&f).map_err(|e| e.to_string()))
-                {
-                    Ok(bytes) => Some(bytes),
-                    Err(e) => {
-                        warnings.push(format!("{at}.uri: the base colour texture is not shown ({e})"));
-                        return None;
-                    }
+            gltf::image::Source::Uri { uri, .. } => match uri_bytes(self.path, uri) {
+                Ok(bytes) => Some(bytes),
+                Err(e) => {
+                    warnings.push(format!("{at}.uri: the base colour texture is not shown ({e})"));
+                    return None;
                 }
-            }
-            gltf::image::Source::Uri { .. } => None,
+            },
         };
         let decoded = bytes
             .ok_or_else(|| "its bytes cannot be read".to_string())
@@ -345,40 +600,32 @@ impl File<'_> {
         }
     }
 
-    /// The file's animations that move the skin's joints, as clips by joint index.
+    /// The file's animations that move the part's nodes or morph weights, as clips by
+    /// joint index and morph index (`morph_of`: each mesh node's first morph and count).
     fn clips(
         &self,
-        joints: &[gltf::Node],
-        new_index: &[usize],
+        joint_of_node: &[Option<usize>],
+        joint_count: usize,
+        morph_of: &[(usize, usize, usize)],
+        morph_count: usize,
         root_parent: Mat4,
-        warnings: &mut Vec<String>,
     ) -> Result<Vec<NodeClip>, FormatError> {
         let mut clips = Vec::new();
-        let joint_of = joint_of_node(self.gltf, joints);
         for animation in self.gltf.animations() {
-            let mut tracks = vec![JointTracks::default(); joints.len()];
+            let mut tracks = vec![JointTracks::default(); joint_count];
+            let mut weights = vec![None; morph_count];
             let mut moved = false;
-            for (c, channel) in animation.channels().enumerate() {
+            for channel in animation.channels() {
                 let node = channel.target().node().index();
-                let Some(j) = joint_of[node] else { continue };
-                let at = format!("at $.animations[{}].channels[{c}]", animation.index());
+                let morphs = morph_of.iter().find(|m| m.0 == node).filter(|m| m.2 > 0);
+                let joint = joint_of_node[node];
+                let keys_weights = channel.target().property() == gltf::animation::Property::MorphTargetWeights;
+                if (keys_weights && morphs.is_none()) || (!keys_weights && joint.is_none()) {
+                    continue;
+                }
                 let sampler = format!("at $.animations[{}].samplers[{}]", animation.index(), channel.sampler().index());
                 let reader = channel.reader(self.data());
-                let times: Vec<f32> = reader
-                    .read_inputs()
-                    .ok_or_else(|| self.error(format!("{sampler}.input: expected key times, found none")))?
-                    .collect();
-                if let Some(k) = times.iter().position(|t| !t.is_finite()) {
-                    return Err(self
-                        .error(format!("{sampler}.input: expected finite key times, found {} at key {k}", times[k])));
-                }
-                if let Some(k) = times.windows(2).position(|w| w[0].partial_cmp(&w[1]).is_none_or(|o| o.is_gt())) {
-                    return Err(self.error(format!(
-                        "{sampler}.input: key time {} follows {} (times must increase and be numbers)",
-                        times[k + 1],
-                        times[k]
-                    )));
-                }
+                let times = self.key_times(reader.read_inputs(), &sampler)?;
                 let interpolation = match channel.sampler().interpolation() {
                     gltf::animation::Interpolation::Step => Interpolation::Step,
                     gltf::animation::Interpolation::Linear => Interpolation::Linear,
@@ -387,19 +634,17 @@ impl File<'_> {
                 let outputs = reader
                     .read_outputs()
                     .ok_or_else(|| self.error(format!("{sampler}.output: expected key values, found none")))?;
-                let joint = &mut tracks[new_index[j]];
                 let incomplete = || {
                     self.error(format!("{sampler}: expected a value per key time (three for CUBICSPLINE) and a key, found {} key times", times.len()))
                 };
                 use gltf::animation::util::ReadOutputs;
-                match outputs {
-                    ReadOutputs::Translations(v) => {
+                match (outputs, joint, morphs) {
+                    (ReadOutputs::Translations(v), Some(j), _) => {
                         let values: Vec<Vec3> = v.map(Vec3::from).collect();
                         finite_keys(values.iter().map(|v| v.is_finite()), &sampler).map_err(|e| self.error(e))?;
-                        let track = Track { times: times.clone(), values, interpolation };
-                        joint.translation = Some(track).filter(Track::is_complete).ok_or_else(incomplete).map(Some)?;
+                        tracks[j].translation = Some(complete(&times, values, interpolation).ok_or_else(incomplete)?);
                     }
-                    ReadOutputs::Rotations(v) => {
+                    (ReadOutputs::Rotations(v), Some(j), _) => {
                         let values: Vec<Quat> = v.into_f32().map(Quat::from_array).collect();
                         // CUBICSPLINE tangents may be zero; values must be rotations.
                         let rotation = |k: usize, q: &Quat| {
@@ -409,33 +654,56 @@ impl File<'_> {
                         };
                         finite_keys(values.iter().enumerate().map(|(k, q)| rotation(k, q)), &sampler)
                             .map_err(|e| self.error(format!("{e} (a rotation that is not zero)")))?;
-                        let track = Track { times: times.clone(), values, interpolation };
-                        joint.rotation = Some(track).filter(Track::is_complete).ok_or_else(incomplete).map(Some)?;
+                        tracks[j].rotation = Some(complete(&times, values, interpolation).ok_or_else(incomplete)?);
                     }
-                    ReadOutputs::Scales(v) => {
+                    (ReadOutputs::Scales(v), Some(j), _) => {
                         let values: Vec<Vec3> = v.map(Vec3::from).collect();
                         finite_keys(values.iter().map(|v| v.is_finite()), &sampler).map_err(|e| self.error(e))?;
-                        let track = Track { times: times.clone(), values, interpolation };
-                        joint.scale = Some(track).filter(Track::is_complete).ok_or_else(incomplete).map(Some)?;
+                        tracks[j].scale = Some(complete(&times, values, interpolation).ok_or_else(incomplete)?);
                     }
-                    ReadOutputs::MorphTargetWeights(_) => {
-                        warnings.push(format!("{}: {at} keys morph weights, which do not play", self.path.display()));
-                        continue;
+                    (ReadOutputs::MorphTargetWeights(v), _, Some(&(_, first, count))) => {
+                        let flat: Vec<f32> = v.into_f32().collect();
+                        finite_keys(flat.iter().map(|w| w.is_finite()), &sampler).map_err(|e| self.error(e))?;
+                        if flat.len() % count != 0 {
+                            return Err(self.error(format!(
+                                "{sampler}.output: expected a weight for each of the {count} morph targets per value, found {} weights",
+                                flat.len()
+                            )));
+                        }
+                        for k in 0..count {
+                            let values: Vec<f32> = flat.iter().skip(k).step_by(count).copied().collect();
+                            weights[first + k] = Some(complete(&times, values, interpolation).ok_or_else(incomplete)?);
+                        }
                     }
+                    _ => continue,
                 }
                 moved = true;
             }
             if moved {
                 let name = animation.name().map_or_else(|| format!("animation {}", animation.index()), str::to_string);
-                clips.push(NodeClip { name, index: animation.index(), tracks, root_parent });
+                clips.push(NodeClip { name, index: animation.index(), tracks, weights, root_parent });
             }
         }
         Ok(clips)
     }
 
-    /// The global transform of `node` (identity for none), from its parents.
-    fn global(&self, node: Option<usize>) -> Mat4 {
-        global(self.gltf, &self.parent, node)
+    /// A sampler's key times: finite and increasing.
+    fn key_times(&self, read: Option<gltf::accessor::Iter<f32>>, sampler: &str) -> Result<Vec<f32>, FormatError> {
+        let times: Vec<f32> =
+            read.ok_or_else(|| self.error(format!("{sampler}.input: expected key times, found none")))?.collect();
+        if let Some(k) = times.iter().position(|t| !t.is_finite()) {
+            return Err(
+                self.error(format!("{sampler}.input: expected finite key times, found {} at key {k}", times[k]))
+            );
+        }
+        if let Some(k) = times.windows(2).position(|w| w[0].partial_cmp(&w[1]).is_none_or(|o| o.is_gt())) {
+            return Err(self.error(format!(
+                "{sampler}.input: key time {} follows {} (times must increase and be numbers)",
+                times[k + 1],
+                times[k]
+            )));
+        }
+        Ok(times)
     }
 }
 
@@ -460,15 +728,6 @@ fn finite_keys(mut good: impl Iterator<Item = bool>, sampler: &str) -> Result<()
     }
 }
 
-/// Each node's joint of the skin `joints` (none for the nodes that are not its joints).
-fn joint_of_node(gltf: &gltf::Gltf, joints: &[gltf::Node]) -> Vec<Option<usize>> {
-    let mut joint = vec![None; gltf.nodes().len()];
-    for (j, node) in joints.iter().enumerate() {
-        joint[node.index()] = Some(j);
-    }
-    joint
-}
-
 /// Each node's parent (none for a scene root).
 fn parents(gltf: &gltf::Gltf) -> Vec<Option<usize>> {
     let mut parent = vec![None; gltf.nodes().len()];
@@ -489,17 +748,33 @@ fn target_names(mesh: &gltf::Mesh) -> Vec<String> {
         .unwrap_or_default()
 }
 
-/// The global transform of `node` (identity for none), from its parents.
-fn global(gltf: &gltf::Gltf, parent: &[Option<usize>], node: Option<usize>) -> Mat4 {
-    let mut m = Mat4::IDENTITY;
-    let mut at = node;
-    while let Some(n) = at {
-        // The nodes are a forest (checked): the walk ends at a root.
-        let Some(node) = gltf.document.nodes().nth(n) else { break };
-        m = Mat4::from_cols_array_2d(&node.transform().matrix()) * m;
-        at = parent[n];
-    }
-    m
+/// A track of `values` at `times`, when there are as many as its interpolation needs.
+fn complete<T: crate::rig::node_clip::Keyed>(
+    times: &[f32],
+    values: Vec<T>,
+    interpolation: Interpolation,
+) -> Option<Track<T>> {
+    Some(Track { times: times.to_vec(), values, interpolation }).filter(Track::is_complete)
+}
+
+/// A node's transform in its parent's frame.
+fn local_matrix(node: &gltf::Node) -> Mat4 {
+    Mat4::from_cols_array_2d(&node.transform().matrix())
+}
+
+/// Whether `m` is a translation, rotation and scale (recomposed within 1e-5 of its size:
+/// a file's rotations are unit only to single precision).
+fn is_trs(m: Mat4) -> bool {
+    let (s, r, t) = m.to_scale_rotation_translation();
+    let back = Mat4::from_scale_rotation_translation(s, r, t);
+    let size = m.to_cols_array().iter().fold(1.0f32, |a, x| a.max(x.abs()));
+    back.abs_diff_eq(m, 1e-5 * size)
+}
+
+/// Whether two inverse bind matrices are the same binding (within 1e-6 of their size).
+fn same_matrix(a: Mat4, b: Mat4) -> bool {
+    let size = a.to_cols_array().iter().fold(1.0f32, |m, x| m.max(x.abs()));
+    a.abs_diff_eq(b, 1e-6 * size)
 }
 
 /// The file's buffers: the GLB's binary chunk (borrowed), or `.bin` files beside a `.gltf`.
@@ -511,16 +786,8 @@ fn buffers<'a>(gltf: &gltf::Gltf, bin: Option<&'a [u8]>, path: &Path) -> Result<
                 gltf::buffer::Source::Bin => Cow::Borrowed(bin.ok_or_else(|| {
                     FormatError::other(path, format!("{at}: expected the GLB's binary chunk, found none"))
                 })?),
-                gltf::buffer::Source::Uri(uri) if uri.starts_with("data:") => {
-                    return Err(FormatError::other(
-                        path,
-                        format!("{at}: embedded data URIs are not read; use .glb or a .bin file"),
-                    ));
-                }
                 gltf::buffer::Source::Uri(uri) => {
-                    let read = super::uri::beside_uri(path, uri)
-                        .and_then(|file| super::error::read_file(&file).map_err(|e| e.to_string()));
-                    Cow::Owned(read.map_err(|e| FormatError::other(path, format!("{at}.uri: {e}")))?)
+                    Cow::Owned(uri_bytes(path, uri).map_err(|e| FormatError::other(path, format!("{at}.uri: {e}")))?)
                 }
             };
             if data.len() < b.length() {
@@ -532,4 +799,13 @@ fn buffers<'a>(gltf: &gltf::Gltf, bin: Option<&'a [u8]>, path: &Path) -> Result<
             Ok(data)
         })
         .collect()
+}
+
+/// The bytes a buffer's or image's URI holds (`data:`) or names (a file beside the model).
+fn uri_bytes(model: &Path, uri: &str) -> Result<Vec<u8>, String> {
+    match super::uri::data_uri(uri) {
+        Some(bytes) => bytes,
+        None => super::uri::beside_uri(model, uri)
+            .and_then(|file| super::error::read_file(&file).map_err(|e| e.to_string())),
+    }
 }

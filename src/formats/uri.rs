@@ -74,3 +74,21 @@ fn percent_decoded(uri: &str) -> Option<String> {
     }
     String::from_utf8(out).ok()
 }
+
+/// The bytes of a `data:` URI (`data:[media type];base64,…`), or none when `uri` is not
+/// one. glTF embeds buffers and images this way; only base64 payloads are read.
+pub fn data_uri(uri: &str) -> Option<Result<Vec<u8>, String>> {
+    use base64::Engine;
+    let rest = uri.strip_prefix("data:")?;
+    let Some((media, payload)) = rest.split_once(',') else {
+        return Some(Err(format!("expected `data:…,` and the data, found `{}`", excerpt(uri))));
+    };
+    if !media.ends_with(";base64") {
+        return Some(Err(format!("expected a base64 data URI, found `data:{}`", excerpt(media))));
+    }
+    Some(
+        base64::engine::general_purpose::STANDARD
+            .decode(payload.trim_end())
+            .map_err(|e| format!("expected base64 data after `data:{}`, {e}", excerpt(media))),
+    )
+}

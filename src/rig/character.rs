@@ -44,6 +44,8 @@ pub enum SkinKind {
     Mesh,
     /// No mesh in the source: one box per joint, rigidly attached.
     BoneBoxes,
+    /// Meshes carried rigidly by their nodes, none skinned: a prop.
+    Rigid,
 }
 
 /// Everything loaded for one character.

@@ -42,6 +42,21 @@ impl Keyed for Vec3 {
     }
 }
 
+impl Keyed for f32 {
+    fn lerp_to(self, other: Self, u: f32) -> Self {
+        self + (other - self) * u
+    }
+    fn scaled(self, s: f32) -> Self {
+        self * s
+    }
+    fn plus(self, other: Self) -> Self {
+        self + other
+    }
+    fn tidy(self) -> Self {
+        self
+    }
+}
+
 impl Keyed for Quat {
     fn lerp_to(self, other: Self, u: f32) -> Self {
         self.slerp(other, u)
@@ -128,8 +143,9 @@ pub struct JointTracks {
     pub scale: Option<Track<Vec3>>,
 }
 
-/// A clip: tracks by joint index. `root_parent` is the transform of the nodes above the
-/// root joint (folded into the root's rest), applied to the root's keyed transform too.
+/// A clip: tracks by joint index and by morph target. `root_parent` is the transform of
+/// the nodes above the root joint (folded into the root's rest), applied to the root's keyed
+/// transform too.
 #[derive(Debug, Clone, PartialEq)]
 pub struct NodeClip {
     pub name: String,
@@ -137,6 +153,8 @@ pub struct NodeClip {
     pub index: usize,
     /// `tracks[j]` moves joint j (one entry per joint of the skeleton).
     pub tracks: Vec<JointTracks>,
+    /// `weights[m]` keys the weight of morph target m (one entry per target, or none).
+    pub weights: Vec<Option<Track<f32>>>,
     pub root_parent: Mat4,
 }
 
@@ -199,7 +217,25 @@ impl NodeClip {
                 t.scale.as_ref().map(Track::end),
             ]
         });
-        ends.flatten().fold(0.0, f32::max)
+        let weight_ends = self.weights.iter().flatten().map(Track::end);
+        ends.flatten().chain(weight_ends).fold(0.0, f32::max)
+    }
+
+    /// Whether it keys any morph target's weight.
+    pub fn keys_weights(&self) -> bool {
+        self.weights.iter().any(Option::is_some)
+    }
+
+    /// The morph weights at `t` seconds: keyed ones sampled, the others from `base`.
+    pub fn sample_weights(&self, base: &[f32], t: f32) -> Vec<f32> {
+        let mut weights = base.to_vec();
+        weights.resize(self.weights.len().max(base.len()), 0.0);
+        for (w, track) in weights.iter_mut().zip(&self.weights) {
+            if let Some(track) = track {
+                *w = track.sample(t);
+            }
+        }
+        weights
     }
 
     /// The root joint's own rest transform in its node's parent frame (its rest with the

@@ -417,14 +417,24 @@ fn bad_gltf_files_say_what_and_where() {
     std::fs::write(&not, b"glTF nonsense").unwrap();
     let e = marionette::formats::load_character(&not).unwrap_err().to_string();
     assert!(e.contains("not.glb") && e.contains("glTF"), "{e}");
-    // A valid file without a skin: the baked export.
+}
+
+/// A file without a skin (our baked export) loads as a prop: its mesh rides on its node,
+/// vertex for vertex where the file puts it.
+#[test]
+fn a_file_without_a_skin_loads_as_a_prop() {
+    let dir = crate::common::scratch("gltf-prop");
     let puppet = marionette::formats::puppet::embedded_puppet();
     let pose = puppet.skeleton.initial_pose();
     let character = GltfCharacter::new("p", &puppet, &pose);
     let baked = dir.join("baked.glb");
     std::fs::write(&baked, write_glb(&[character], GltfMesh::Baked).unwrap()).unwrap();
-    let e = marionette::formats::load_character(&baked).unwrap_err().to_string();
-    assert!(e.contains("baked.glb") && e.contains("skins[0]"), "{e}");
+    let prop = marionette::formats::load_character(&baked).unwrap();
+    assert_eq!(prop.skin_kind, marionette::rig::character::SkinKind::Rigid);
+    let expected = marionette::document::posing::posed_positions(&puppet, &pose, Mat4::IDENTITY);
+    let ours = marionette::document::posing::posed_positions(&prop, &prop.skeleton.initial_pose(), Mat4::IDENTITY);
+    assert_eq!(ours.len(), expected.len());
+    assert!(largest_distance(&ours, &expected) <= 1e-5);
 }
 
 /// `export FILE.glb --clip 0 --time 1 --out x.obj` writes both characters of the Blender
