@@ -34,8 +34,8 @@ pub fn sampled(
     Ok(motion)
 }
 
-/// A character's asset as the document shapes it: an SMPL body by its β, a mesh with morph
-/// targets by their weights.
+/// A character's asset as the document shapes it: an SMPL body by its β. (Morph targets go
+/// out as targets, with the document's weights.)
 fn shaped(
     library: &mut super::AssetLibrary,
     c: &crate::formats::scene::CharacterDoc,
@@ -47,11 +47,6 @@ fn shaped(
         let set = library.smpl(dir)?;
         asset = std::sync::Arc::new(set.model.asset(&c.name, &smpl.betas).map_err(|e| FormatError::rig(dir, e))?);
     }
-    if !c.morphs.is_empty() && !asset.morphs.is_empty() {
-        let mut morphed = (*asset).clone();
-        morphed.skin.bind_positions = asset.morphed_positions(&c.morphs);
-        asset = std::sync::Arc::new(morphed);
-    }
     Ok(asset)
 }
 
@@ -62,6 +57,10 @@ struct Posed {
     /// Rest offsets and scales a clip keys (the root's offset is `root`).
     rest: Option<(Vec<glam::Vec3>, Vec<glam::Vec3>)>,
     motion: Option<Motion>,
+    /// The name of `motion`'s animation.
+    motion_name: String,
+    /// The source's own clips, written key for key (with `animated`).
+    clips: std::sync::Arc<[crate::rig::node_clip::NodeClip]>,
 }
 
 /// Every character of a scene document as glTF: its shape, its pose, its clip (keyframes,
@@ -91,6 +90,9 @@ pub fn scene_glb(doc: &SceneDoc, mesh: GltfMesh, animated: bool) -> Result<Vec<u
             scale: c.placement.scale,
             tint: c.view.tint,
             motion: posed.motion.clone(),
+            motion_name: posed.motion_name.clone(),
+            clips: &posed.clips,
+            morph_weights: &c.morphs,
         })
         .collect();
     write_glb(&characters, mesh).map_err(|e| FormatError::other(std::path::Path::new("the exported scene"), e))
@@ -107,7 +109,14 @@ fn posed(
     let skeleton = &asset.skeleton;
     let (pose, notes) = super::scenes::pose_from_doc(asset, c);
     notes.iter().for_each(|n| eprintln!("warning: {n}"));
-    let mut posed = Posed { pose, root: skeleton.joint(0).rest_offset, rest: None, motion: None };
+    let mut posed = Posed {
+        pose,
+        root: skeleton.joint(0).rest_offset,
+        rest: None,
+        motion: None,
+        motion_name: String::new(),
+        clips: std::sync::Arc::new([]),
+    };
     if let Some(anim) = &c.anim {
         let clip = match &anim.keys {
             Some(keys) => keys.clone(),
@@ -117,67 +126,46 @@ fn posed(
         if animated {
             let clip_file = if anim.file.as_os_str().is_empty() { std::path::Path::new(&c.name) } else { &anim.file };
             posed.motion = Some(sampled(&clip, skeleton, &posed.pose).map_err(|e| FormatError::other(clip_file, e))?);
+            posed.motion_name =
+                clip_file.file_stem().map_or_else(|| c.name.clone(), |s| s.to_string_lossy().into_owned());
         }
         (posed.root, posed.pose) = clip.pose_at(skeleton, anim.time, &posed.pose);
     }
-    if let Some(playback) = &c.playback
-        && let Some(part) = library.gltf_source(&c.source)
-    {
-        play_node_clip(&mut posed, skeleton, &part.clips, playback, animated)
-            .map_err(|e| FormatError::other(c.source.path().unwrap_or(std::path::Path::new(&c.name)), e))?;
+    if let Some(part) = library.gltf_source(&c.source) {
+        if let Some(playback) = &c.playback {
+            play_node_clip(&mut posed, skeleton, &part.clips, playback)
+                .map_err(|e| FormatError::other(c.source.path().unwrap_or(std::path::Path::new(&c.name)), e))?;
+        }
+        if animated {
+            posed.clips = part.clips.clone();
+        }
     }
-    if animated && let Some(motion) = smpl_motion(library, c, asset)? {
-        posed.motion = Some(motion);
+    if animated && let Some((name, motion)) = smpl_motion(library, c, asset)? {
+        (posed.motion_name, posed.motion) = (name, Some(motion));
     }
     Ok(posed)
 }
 
-/// A glTF clip's pose at the playback's time on `posed` (its keyed joints, root and rest),
-/// and with `animated` the clip sampled at [`EXPORT_FPS`] over its length (or why it
-/// cannot be).
+/// A glTF clip's pose at the playback's time on `posed` (its keyed joints, root and rest).
 fn play_node_clip(
     posed: &mut Posed,
     skeleton: &crate::rig::Skeleton,
     clips: &[crate::rig::node_clip::NodeClip],
     playback: &crate::formats::scene::PlaybackDoc,
-    animated: bool,
 ) -> Result<(), String> {
     let find = |name: &Option<String>| clips.iter().find(|k| Some(&k.name) == name.as_ref());
     let Some(clip) = find(&playback.clip) else { return Ok(()) };
     let blend = find(&playback.blend_clip).map(|k| (k, playback.blend));
-    let at = |t: f32| sample_mix(skeleton, clip, blend, t);
-    let keyed = |pose: &mut Vec<crate::rig::JointRotation>, sample: &NodePose| {
-        for (j, q) in sample.rotations.iter().enumerate() {
-            if clip.turns(j) || blend.is_some_and(|(k, _)| k.turns(j)) {
-                pose[j] = crate::rig::JointRotation::Quat(*q);
-            }
+    let now = sample_mix(skeleton, clip, blend, playback.time);
+    for (j, q) in now.rotations.iter().enumerate() {
+        if clip.turns(j) || blend.is_some_and(|(k, _)| k.turns(j)) {
+            posed.pose[j] = crate::rig::JointRotation::Quat(*q);
         }
-    };
-    let moves_rest = clip.moves_rest() || blend.is_some_and(|(k, _)| k.moves_rest());
-    let now = at(playback.time);
-    keyed(&mut posed.pose, &now);
+    }
     posed.root = now.offsets[0];
-    if moves_rest {
+    if clip.moves_rest() || blend.is_some_and(|(k, _)| k.moves_rest()) {
         posed.rest = Some(rest_of(skeleton, &now));
     }
-    if !animated {
-        return Ok(());
-    }
-    let frames = sampled_frames(clip.duration(), EXPORT_FPS)?;
-    let mut motion = Motion::default();
-    for f in 0..=frames {
-        let t = (f as f32 / EXPORT_FPS).min(clip.duration());
-        let sample = at(t);
-        let mut pose = posed.pose.clone();
-        keyed(&mut pose, &sample);
-        motion.times.push(t);
-        motion.poses.push(pose);
-        motion.roots.push(sample.offsets[0]);
-        if moves_rest {
-            motion.rests.push(rest_of(skeleton, &sample));
-        }
-    }
-    posed.motion = Some(motion);
     Ok(())
 }
 
@@ -190,12 +178,12 @@ fn rest_of(skeleton: &crate::rig::Skeleton, sample: &NodePose) -> (Vec<glam::Vec
 }
 
 /// An SMPL body's playing clip, every frame (at its 30 frames per second), with the body's
-/// own root and the clip's rotations.
+/// own root and the clip's rotations, and the clip's name.
 fn smpl_motion(
     library: &mut super::AssetLibrary,
     c: &crate::formats::scene::CharacterDoc,
     asset: &crate::rig::CharacterAsset,
-) -> Result<Option<Motion>, FormatError> {
+) -> Result<Option<(String, Motion)>, FormatError> {
     let (Some(smpl), crate::formats::scene::SourceDoc::File(dir)) = (&c.smpl, &c.source) else { return Ok(None) };
     let Some(name) = &smpl.clip else { return Ok(None) };
     let set = library.smpl(dir)?;
@@ -207,5 +195,6 @@ fn smpl_motion(
         motion.poses.push(clip.frame(f).iter().map(|&q| crate::rig::JointRotation::Quat(q)).collect());
         motion.roots.push(root);
     }
-    Ok(Some(motion))
+    let stem = name.strip_suffix(".txt").unwrap_or(name);
+    Ok(Some((stem.to_string(), motion)))
 }

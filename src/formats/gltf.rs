@@ -7,6 +7,7 @@
 use glam::{Mat4, Quat, Vec3};
 use serde_json::{Value, json};
 
+use crate::rig::node_clip::{Interpolation, NodeClip, Track};
 use crate::rig::{CharacterAsset, JointRotation};
 
 /// One character to write.
@@ -24,8 +25,15 @@ pub struct GltfCharacter<'a> {
     pub yaw: f32,
     pub scale: f32,
     pub tint: [f32; 3],
-    /// Poses over time, written as a glTF animation of the joints (skinned meshes only).
+    /// Poses over time, written as a glTF animation of the joints (skinned meshes only),
+    /// under `motion_name` (the character's name when empty).
     pub motion: Option<Motion>,
+    pub motion_name: String,
+    /// Clips of the joints and morph weights, each written key for key as its own
+    /// animation (skinned meshes only).
+    pub clips: &'a [NodeClip],
+    /// The morph targets' weights (the mesh's `weights`; missing ones are 0).
+    pub morph_weights: &'a [f32],
 }
 
 impl<'a> GltfCharacter<'a> {
@@ -44,6 +52,9 @@ impl<'a> GltfCharacter<'a> {
             scale: 1.0,
             tint: [0.85, 0.75, 0.62],
             motion: None,
+            motion_name: String::new(),
+            clips: &[],
+            morph_weights: &[],
         }
     }
 }
@@ -178,8 +189,8 @@ pub fn write_glb(characters: &[GltfCharacter], mesh: GltfMesh) -> Result<Vec<u8>
                     attributes.insert(format!("JOINTS_{set}"), json!(j));
                     attributes.insert(format!("WEIGHTS_{set}"), json!(w));
                 }
-                let joints = skeleton_nodes(&mut b, c);
-                children.push(joints[0]);
+                let (top, joints) = skeleton_nodes(&mut b, c);
+                children.push(top);
                 let inverse: Vec<u8> = c
                     .asset
                     .bind_world_to_joint
@@ -193,7 +204,12 @@ pub fn write_glb(characters: &[GltfCharacter], mesh: GltfMesh) -> Result<Vec<u8>
                     json!({ "componentType": FLOAT, "count": joints.len(), "type": "MAT4" }),
                 );
                 if let Some(motion) = c.motion.as_ref().filter(|m| !m.times.is_empty()) {
-                    animations.push(animation(&mut b, c.name, motion, &joints));
+                    let name = if c.motion_name.is_empty() { c.name } else { &c.motion_name };
+                    animations.push(animation(&mut b, name, motion, &joints));
+                }
+                let mesh_node_index = b.nodes.len();
+                for clip in c.clips {
+                    animations.push(clip_animation(&mut b, clip, &joints, mesh_node_index, c.morph_weights));
                 }
                 mesh_node["skin"] = json!(skins.len());
                 skins.push(
@@ -201,10 +217,18 @@ pub fn write_glb(characters: &[GltfCharacter], mesh: GltfMesh) -> Result<Vec<u8>
                 );
             }
         }
-        meshes.push(json!({
-            "name": c.name,
-            "primitives": [{ "attributes": attributes, "indices": index_accessor, "material": materials.len() - 1 }],
-        }));
+        let mut primitive =
+            json!({ "attributes": attributes, "indices": index_accessor, "material": materials.len() - 1 });
+        let mut mesh_json = json!({ "name": c.name });
+        if mesh == GltfMesh::Skinned && !c.asset.morphs.is_empty() {
+            primitive["targets"] = json!(morph_targets(&mut b, c.asset));
+            let mut weights = c.morph_weights.to_vec();
+            weights.resize(c.asset.morphs.len(), 0.0);
+            mesh_json["weights"] = json!(weights);
+            mesh_json["extras"] = json!({ "targetNames": c.asset.morphs.iter().map(|m| &m.name).collect::<Vec<_>>() });
+        }
+        mesh_json["primitives"] = json!([primitive]);
+        meshes.push(mesh_json);
         // A skinned mesh's node sits at the scene's root (its skeleton places it); a baked
         // one under the placement.
         let mesh_index = b.node(mesh_node);
@@ -302,14 +326,30 @@ fn root_origin(c: &GltfCharacter) -> Mat4 {
 }
 
 /// The joints as nodes (translation: the rest offset, the root's at `root`; rotation: the
-/// pose; scale: the rest scale; a clip's keyed rest in their place), linked parent to child; their node indices in joint order.
-fn skeleton_nodes(b: &mut Builder, c: &GltfCharacter) -> Vec<usize> {
+/// pose; scale: the rest scale; a clip's keyed rest in their place), linked parent to
+/// child: the node at their top and their node indices in joint order. Where the clips key
+/// the root in a frame of nodes folded into it on import (`NodeClip::root_parent`), that
+/// frame goes out as a node above the root, so its keys go out as they are.
+fn skeleton_nodes(b: &mut Builder, c: &GltfCharacter) -> (usize, Vec<usize>) {
     let skeleton = &c.asset.skeleton;
-    let first = b.nodes.len();
+    let frame = c.clips.first().map_or(Mat4::IDENTITY, |k| k.root_parent);
+    let framed = frame != Mat4::IDENTITY;
+    let first = b.nodes.len() + usize::from(framed);
+    if framed {
+        let (s, r, t) = frame.to_scale_rotation_translation();
+        b.node(json!({ "name": format!("{} frame", c.name), "translation": t.to_array(),
+            "rotation": r.to_array(), "scale": s.to_array(), "children": [first] }));
+    }
     for (j, def) in skeleton.joints().iter().enumerate() {
         let translation = if j == 0 { c.root } else { c.rest.offsets.map_or(def.rest_offset, |o| o[j]) };
         let scale = c.rest.scales.map_or(def.rest_scale, |s| s[j]);
         let rotation = c.pose.get(j).map_or(Quat::IDENTITY, JointRotation::to_quat);
+        let (scale, rotation, translation) = if j == 0 && framed {
+            let local = Mat4::from_scale_rotation_translation(scale, rotation, translation);
+            (frame.inverse() * local).to_scale_rotation_translation()
+        } else {
+            (scale, rotation, translation)
+        };
         let mut node =
             json!({ "name": def.name, "translation": translation.to_array(), "rotation": rotation.to_array() });
         if scale != Vec3::ONE {
@@ -321,7 +361,134 @@ fn skeleton_nodes(b: &mut Builder, c: &GltfCharacter) -> Vec<usize> {
         }
         b.node(node);
     }
-    (first..first + skeleton.len()).collect()
+    (first - usize::from(framed), (first..first + skeleton.len()).collect())
+}
+
+/// The morph targets as glTF targets: each one's position deltas for every vertex.
+fn morph_targets(b: &mut Builder, asset: &CharacterAsset) -> Vec<Value> {
+    asset
+        .morphs
+        .iter()
+        .map(|m| {
+            let mut deltas = vec![Vec3::ZERO; asset.vertex_count()];
+            m.deltas.iter().for_each(|&(v, d)| deltas[v as usize] = d);
+            json!({ "POSITION": b.positions(&deltas) })
+        })
+        .collect()
+}
+
+/// A clip as a glTF animation, key for key: each track with its own key times and
+/// interpolation; the morph weights as one channel of the mesh node (their tracks
+/// combined: each keyed at the union of their key times, the unkeyed at `weights`).
+fn clip_animation(b: &mut Builder, clip: &NodeClip, joints: &[usize], mesh_node: usize, weights: &[f32]) -> Value {
+    let mut samplers = Vec::new();
+    let mut channels = Vec::new();
+    let mut add =
+        |b: &mut Builder, node: usize, path: &str, times: &[f32], values: Vec<f32>, kind: &str, i: Interpolation| {
+            let (first, last) = (times[0], times[times.len() - 1]);
+            let input = b.accessor(
+            &times.iter().flat_map(|t| t.to_le_bytes()).collect::<Vec<u8>>(),
+            None,
+            json!({ "componentType": FLOAT, "count": times.len(), "type": "SCALAR", "min": [first], "max": [last] }),
+        );
+            let width = if kind == "VEC4" {
+                4
+            } else if kind == "VEC3" {
+                3
+            } else {
+                1
+            };
+            let count = if kind == "SCALAR" { values.len() } else { values.len() / width };
+            let output = b.accessor(
+                &values.iter().flat_map(|v| v.to_le_bytes()).collect::<Vec<u8>>(),
+                None,
+                json!({ "componentType": FLOAT, "count": count, "type": kind }),
+            );
+            samplers.push(json!({ "input": input, "output": output, "interpolation": interpolation_name(i) }));
+            channels.push(json!({ "sampler": samplers.len() - 1, "target": { "node": node, "path": path } }));
+        };
+    for (tracks, &node) in clip.tracks.iter().zip(joints) {
+        if let Some(t) = &tracks.translation {
+            add(
+                b,
+                node,
+                "translation",
+                &t.times,
+                t.values.iter().flat_map(|v| v.to_array()).collect(),
+                "VEC3",
+                t.interpolation,
+            );
+        }
+        if let Some(t) = &tracks.rotation {
+            add(
+                b,
+                node,
+                "rotation",
+                &t.times,
+                t.values.iter().flat_map(|v| v.to_array()).collect(),
+                "VEC4",
+                t.interpolation,
+            );
+        }
+        if let Some(t) = &tracks.scale {
+            add(
+                b,
+                node,
+                "scale",
+                &t.times,
+                t.values.iter().flat_map(|v| v.to_array()).collect(),
+                "VEC3",
+                t.interpolation,
+            );
+        }
+    }
+    if let Some((times, values, interpolation)) = combined_weights(&clip.weights, weights) {
+        add(b, mesh_node, "weights", &times, values, "SCALAR", interpolation);
+    }
+    json!({ "name": clip.name, "samplers": samplers, "channels": channels })
+}
+
+/// The morph weight tracks as one glTF sampler (times, values target by target within
+/// each key, interpolation): as they are when the keyed ones share their times and
+/// interpolation (the unkeyed held at `base`, with flat tangents), else sampled linearly at
+/// the union of their key times. None when no weight is keyed.
+fn combined_weights(tracks: &[Option<Track<f32>>], base: &[f32]) -> Option<(Vec<f32>, Vec<f32>, Interpolation)> {
+    let keyed: Vec<&Track<f32>> = tracks.iter().flatten().collect();
+    let first = keyed.first()?;
+    let shared = keyed.iter().all(|t| t.times == first.times && t.interpolation == first.interpolation);
+    let (times, interpolation) = if shared {
+        (first.times.clone(), first.interpolation)
+    } else {
+        let mut times: Vec<f32> = keyed.iter().flat_map(|t| t.times.iter().copied()).collect();
+        times.sort_by(f32::total_cmp);
+        times.dedup();
+        (times, Interpolation::Linear)
+    };
+    let per_key = if interpolation == Interpolation::CubicSpline { 3 } else { 1 };
+    let mut values = Vec::with_capacity(times.len() * per_key * tracks.len());
+    for (k, &t) in times.iter().enumerate() {
+        for part in 0..per_key {
+            for (m, track) in tracks.iter().enumerate() {
+                let held = base.get(m).copied().unwrap_or(0.0);
+                values.push(match track {
+                    Some(track) if shared => track.values[k * per_key + part],
+                    Some(track) => track.sample(t),
+                    // A tangent of a weight held still is 0.
+                    None if per_key == 3 && part != 1 => 0.0,
+                    None => held,
+                });
+            }
+        }
+    }
+    Some((times, values, interpolation))
+}
+
+fn interpolation_name(i: Interpolation) -> &'static str {
+    match i {
+        Interpolation::Step => "STEP",
+        Interpolation::Linear => "LINEAR",
+        Interpolation::CubicSpline => "CUBICSPLINE",
+    }
 }
 
 /// Every vertex's influences, four to a set, zero-padded: the bytes of `JOINTS_n` (u16)

@@ -20,8 +20,9 @@ pub struct MorphPlugin;
 
 impl Plugin for MorphPlugin {
     fn build(&self, app: &mut App) {
-        // Before playback, so the playing systems never see a character mid-swap.
-        app.add_systems(PostUpdate, blend_morphs.in_set(MarionetteSystems::Animate).before(super::smpl::SmplPlayback));
+        // After the clips that key weights (`NodeClipPlayback` says so), so a shape never
+        // lags its pose by a frame.
+        app.add_systems(PostUpdate, blend_morphs.in_set(MarionetteSystems::Animate));
     }
 }
 

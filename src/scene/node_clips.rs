@@ -10,6 +10,7 @@ use bevy::prelude::*;
 use crate::formats::scene::PlaybackDoc;
 use crate::rig::JointRotation;
 use crate::rig::node_clip::{NodeClip, NodePose, sample_mix};
+use crate::scene::morphs::Morphs;
 use crate::scene::{Character, JointPose, MarionetteSystems, RestOverrides};
 
 /// The source's clips and their playback (the scene file's own `PlaybackDoc`).
@@ -51,15 +52,21 @@ impl NodeClipPlayer {
 /// Playback of the sources' own clips, within `Animate`.
 pub struct NodeClipPlugin;
 
+/// The systems that play the sources' own clips (after keyframes; morphs blend after).
+#[derive(SystemSet, Debug, Clone, PartialEq, Eq, Hash)]
+pub struct NodeClipPlayback;
+
 impl Plugin for NodeClipPlugin {
     fn build(&self, app: &mut App) {
         app.add_systems(
             PostUpdate,
-            (advance_node_clips, pose_from_node_clips)
+            (advance_node_clips, pose_from_node_clips, weights_from_node_clips)
                 .chain()
+                .in_set(NodeClipPlayback)
                 .in_set(MarionetteSystems::Animate)
                 .after(super::keyframes::KeyframePlayback),
-        );
+        )
+        .configure_sets(PostUpdate, NodeClipPlayback.before(super::morphs::blend_morphs));
     }
 }
 
@@ -110,5 +117,25 @@ fn pose_from_node_clips(
             RestOverrides::default()
         };
         rest.set_if_neq(wanted);
+    }
+}
+
+/// Sets the morph weights the clips key, when the player changed (writes `Morphs`; the
+/// clip blended in mixes its weights in by its weight).
+fn weights_from_node_clips(mut players: Query<(&NodeClipPlayer, &mut Morphs), Changed<NodeClipPlayer>>) {
+    for (player, mut morphs) in &mut players {
+        let Some(clip) = player.clip().filter(|c| c.keys_weights()) else { continue };
+        let state = &player.state;
+        let mut weights = clip.sample_weights(&morphs.weights, state.time);
+        if let Some(other) = player.blend_clip().filter(|c| c.keys_weights() && state.blend > 0.0) {
+            let length = other.duration();
+            let t = if length > 0.0 { state.time.rem_euclid(length) } else { state.time };
+            let theirs = other.sample_weights(&weights, t);
+            weights.iter_mut().zip(theirs).for_each(|(w, o)| *w += (o - *w) * state.blend);
+        }
+        weights.truncate(morphs.weights.len());
+        if morphs.weights != weights {
+            morphs.weights = weights;
+        }
     }
 }
