@@ -15,17 +15,41 @@ use anyhow::{Context, Result};
 use crate::document::posing::describe;
 use crate::formats::load_character;
 
-/// `info`: what a character file loads as (every character of a glTF file, with its
-/// animations).
+/// `info`: what a character file loads as: every part (character or prop) of a glTF file
+/// with its material's colour and its clips (channels, keys, length, interpolation); a
+/// BVH's motion; an SMPL folder's clips.
 pub fn info(path: &Path) -> Result<()> {
     if !crate::formats::gltf_import::is_gltf(path) {
         print!("{}", describe(&load_character(path)?));
+        if path.extension().is_some_and(|e| e.eq_ignore_ascii_case("bvh")) {
+            let bvh = crate::formats::bvh::parse_bvh(crate::formats::error::open(path)?, path)?;
+            let (start, end) = bvh.clip.range;
+            let frames = ((end - start) / bvh.frame_time).round() as usize + 1;
+            println!(
+                "motion: {frames} frames every {:.4} s, {:.3} s, {} channels, LINEAR (sampled)",
+                bvh.frame_time,
+                end - start,
+                bvh.clip.channels.len()
+            );
+        }
+        if crate::formats::smpl::is_smpl_dir(path) {
+            let mut library = crate::document::AssetLibrary::default();
+            for (name, clip) in library.smpl(path)?.clips {
+                let frames = clip.frame_count();
+                let seconds = frames.saturating_sub(1) as f32 / crate::rig::smpl::CLIP_FPS;
+                println!("clip `{name}`: {frames} frames at {} per second, {seconds:.3} s", crate::rig::smpl::CLIP_FPS);
+            }
+        }
         return Ok(());
     }
     for c in crate::formats::gltf_import::load_gltf(path)? {
         print!("{}", describe(&c.asset));
+        if let Some([r, g, b, a]) = c.base_color {
+            let texture = if c.asset.texture.is_some() { ", a base colour texture" } else { "" };
+            println!("material: base colour ({r:.3}, {g:.3}, {b:.3}, {a:.3}){texture}");
+        }
         for clip in &c.clips {
-            println!("animation {} `{}`: {:.3} s", clip.index, clip.name, clip.duration());
+            println!("{}", crate::document::posing::describe_clip(clip));
         }
     }
     Ok(())

@@ -262,3 +262,41 @@ pub fn describe_ik(skeleton: &Skeleton, r: &crate::rig::ik::IkReport) -> String 
         if r.limited { ", stopped by joint limits" } else { "" }
     )
 }
+
+/// One line on a glTF clip: its index and name, length, channels, keys and interpolations.
+pub fn describe_clip(clip: &NodeClip) -> String {
+    use crate::rig::node_clip::Interpolation;
+    let mut channels = 0;
+    let mut keys = 0;
+    let mut kinds = Vec::new();
+    let mut count = |times: usize, interpolation: Interpolation| {
+        channels += 1;
+        keys += times;
+        if !kinds.contains(&interpolation) {
+            kinds.push(interpolation);
+        }
+    };
+    for t in &clip.tracks {
+        t.translation.iter().for_each(|k| count(k.times.len(), k.interpolation));
+        t.rotation.iter().for_each(|k| count(k.times.len(), k.interpolation));
+        t.scale.iter().for_each(|k| count(k.times.len(), k.interpolation));
+    }
+    let weights = clip.weights.iter().flatten().count();
+    clip.weights.iter().flatten().for_each(|k| count(k.times.len(), k.interpolation));
+    let kinds: Vec<&str> = kinds
+        .iter()
+        .map(|k| match k {
+            Interpolation::Step => "STEP",
+            Interpolation::Linear => "LINEAR",
+            Interpolation::CubicSpline => "CUBICSPLINE",
+        })
+        .collect();
+    let morphs = if weights > 0 { format!(" ({weights} morph weights)") } else { String::new() };
+    format!(
+        "animation {} `{}`: {:.3} s, {channels} channels{morphs}, {keys} keys, {}",
+        clip.index,
+        clip.name,
+        clip.duration(),
+        kinds.join(" + ")
+    )
+}

@@ -664,7 +664,7 @@ impl<'a> File<'a> {
                     (ReadOutputs::MorphTargetWeights(v), _, Some(&(_, first, count))) => {
                         let flat: Vec<f32> = v.into_f32().collect();
                         finite_keys(flat.iter().map(|w| w.is_finite()), &sampler).map_err(|e| self.error(e))?;
-                        if flat.len() % count != 0 {
+                        if !flat.len().is_multiple_of(count) {
                             return Err(self.error(format!(
                                 "{sampler}.output: expected a weight for each of the {count} morph targets per value, found {} weights",
                                 flat.len()

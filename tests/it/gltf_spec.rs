@@ -8,6 +8,9 @@
 use glam::{DMat4, DQuat, DVec3};
 use serde_json::Value;
 
+/// An accessor's elements, each its components.
+type Elements = Vec<Vec<f64>>;
+
 /// A glTF file: its JSON and its buffers.
 pub struct SpecFile {
     pub json: Value,
@@ -185,7 +188,7 @@ impl SpecFile {
                 match &joints {
                     Some(joints) => {
                         let (js, ws) = (attribute("JOINTS_0").unwrap(), attribute("WEIGHTS_0").unwrap());
-                        let sets: Vec<(Vec<Vec<f64>>, Vec<Vec<f64>>)> = std::iter::once((js, ws))
+                        let sets: Vec<(Elements, Elements)> = std::iter::once((js, ws))
                             .chain((1..).map_while(|s| {
                                 Some((attribute(&format!("JOINTS_{s}"))?, attribute(&format!("WEIGHTS_{s}"))?))
                             }))

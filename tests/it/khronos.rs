@@ -17,7 +17,9 @@ pub fn worst_against_spec(path: &std::path::Path) -> (f64, f64, usize) {
     let rest = spec.posed(None);
     let (lo, hi) = rest.iter().fold((DVec3::MAX, DVec3::MIN), |(lo, hi), p| (lo.min(*p), hi.max(*p)));
     let size = (hi - lo).length();
-    let mut cases: Vec<(Option<(usize, f64)>, Option<String>)> = vec![(None, None)];
+    // (animation and time for the reference, clip for us): at rest, then each clip twice.
+    type Case = (Option<(usize, f64)>, Option<String>);
+    let mut cases: Vec<Case> = vec![(None, None)];
     for a in 0..spec.animations().len() {
         for u in [0.3, 0.7] {
             cases.push((Some((a, u * spec.duration(a))), Some(a.to_string())));
