@@ -16,7 +16,7 @@ use crate::document::posing::describe;
 use crate::formats::load_character;
 
 /// `info`: what a character file loads as: every part (character or prop) of a glTF file
-/// with its material's colour and its clips (channels, keys, length, interpolation); a
+/// with its materials and its clips (channels, keys, length, interpolation); a
 /// BVH's motion; an SMPL folder's clips.
 pub fn info(path: &Path) -> Result<()> {
     if !crate::formats::gltf_import::is_gltf(path) {
@@ -44,9 +44,8 @@ pub fn info(path: &Path) -> Result<()> {
     }
     for c in crate::formats::gltf_import::load_gltf(path)? {
         print!("{}", describe(&c.asset));
-        if let Some([r, g, b, a]) = c.base_color {
-            let texture = if c.asset.texture.is_some() { ", a base colour texture" } else { "" };
-            println!("material: base colour ({r:.3}, {g:.3}, {b:.3}, {a:.3}){texture}");
+        for m in &c.asset.materials {
+            println!("{}", crate::document::posing::describe_material(m));
         }
         for clip in &c.clips {
             println!("{}", crate::document::posing::describe_clip(clip));

@@ -21,12 +21,11 @@ pub struct AssetLibrary {
     gltf: HashMap<PathBuf, Vec<GltfPart>>,
 }
 
-/// One character of a glTF file, loaded: its asset, its clips and its base colour.
+/// One part of a glTF file, loaded: its asset, its clips and its morph weights.
 #[derive(Clone)]
 pub struct GltfPart {
     pub asset: Arc<CharacterAsset>,
     pub clips: Arc<[crate::rig::node_clip::NodeClip]>,
-    pub base_color: Option<[f32; 4]>,
     pub morph_weights: Vec<f32>,
 }
 
@@ -105,12 +104,7 @@ impl AssetLibrary {
         if !self.gltf.contains_key(path) {
             let parts = crate::formats::gltf_import::load_gltf(path)?
                 .into_iter()
-                .map(|c| GltfPart {
-                    asset: Arc::new(c.asset),
-                    clips: c.clips.into(),
-                    base_color: c.base_color,
-                    morph_weights: c.morph_weights,
-                })
+                .map(|c| GltfPart { asset: Arc::new(c.asset), clips: c.clips.into(), morph_weights: c.morph_weights })
                 .collect();
             self.gltf.insert(path.to_path_buf(), parts);
         }
@@ -128,14 +122,14 @@ impl AssetLibrary {
         std::iter::once(file).chain((1..count).map(|n| SourceDoc::Part(path.to_path_buf(), n))).collect()
     }
 
-    /// A new character's document for `source`: its name, the motion a BVH brings, the
-    /// base colour a glTF material gives as its tint and the morph weights its mesh sets.
+    /// A new character's document for `source`: its name, the motion a BVH brings, a white
+    /// tint where its own materials colour it, and the morph weights its file sets.
     pub fn new_character_doc(&mut self, source: SourceDoc, asset: &CharacterAsset) -> CharacterDoc {
         let mut doc = CharacterDoc { anim: own_motion(&source), ..CharacterDoc::new(source, asset.name.clone()) };
+        if asset.surfaces().iter().all(|s| s.material.is_some()) {
+            doc.view.tint = [1.0; 3];
+        }
         if let Some(part) = self.gltf_source(&doc.source) {
-            if let Some([r, g, b, _]) = part.base_color {
-                doc.view.tint = [r, g, b];
-            }
             if part.morph_weights.iter().any(|&w| w != 0.0) {
                 doc.morphs = part.morph_weights;
             }

@@ -300,3 +300,20 @@ pub fn describe_clip(clip: &NodeClip) -> String {
         kinds.join(" + ")
     )
 }
+
+/// One line on a material: its name, factors, textures, alpha and sidedness.
+pub fn describe_material(m: &crate::rig::material::Material) -> String {
+    let [r, g, b, a] = m.base_color;
+    let textures: Vec<&str> = m.textures().map(|(what, _)| what).collect();
+    let textures = if textures.is_empty() { String::new() } else { format!(", textures: {}", textures.join(", ")) };
+    let alpha = match m.alpha {
+        crate::rig::material::AlphaMode::Opaque => "opaque".to_string(),
+        crate::rig::material::AlphaMode::Mask(cutoff) => format!("alpha mask at {cutoff}"),
+        crate::rig::material::AlphaMode::Blend => "alpha blended".to_string(),
+    };
+    let sides = if m.double_sided { ", double-sided" } else { "" };
+    format!(
+        "material `{}`: base colour ({r:.3}, {g:.3}, {b:.3}, {a:.3}), metallic {:.2}, roughness {:.2}{textures}, {alpha}{sides}",
+        m.name, m.metallic, m.roughness
+    )
+}

@@ -187,10 +187,15 @@ fn load_cse169_skin(name: String, skeleton: Skeleton, path: &Path) -> Result<Cha
         Some(_) => file.texcoords.iter().map(|t| glam::Vec2::new(t.x, 1.0 - t.y)).collect(),
         None => Vec::new(),
     };
-    let skin = Skin { bind_positions: file.positions, triangles: file.triangles, weights, texcoords };
+    let skin =
+        Skin { bind_positions: file.positions, triangles: file.triangles, weights, texcoords, colors: Vec::new() };
     let asset = CharacterAsset::with_inverse_binds(name, skeleton, skin, inverse_binds, warnings)
         .map_err(|e| FormatError::rig(path, e))?;
-    Ok(CharacterAsset { morphs, texture: texture.map(crate::rig::SkinTexture::File), ..asset })
+    let materials = texture
+        .map(|t| crate::rig::material::Material::textured("texture", crate::rig::SkinTexture::File(t)))
+        .into_iter()
+        .collect();
+    Ok(CharacterAsset { morphs, materials, ..asset })
 }
 
 /// The `.morph` files beside a skin whose names start with the skin's (`head1.morph` and
@@ -229,6 +234,12 @@ fn load_6837_skin(
     let (weights, normalised) =
         mit6837::parse_attach(open(attach_path)?, attach_path, skeleton.len(), mesh.positions.len())?;
     let warnings = super::weight_warnings::normalised_warnings(attach_path, &normalised);
-    let skin = Skin { bind_positions: mesh.positions, triangles: mesh.triangles, weights, texcoords: Vec::new() };
+    let skin = Skin {
+        bind_positions: mesh.positions,
+        triangles: mesh.triangles,
+        weights,
+        texcoords: Vec::new(),
+        colors: Vec::new(),
+    };
     CharacterAsset::new(name, skeleton, skin, warnings).map_err(|e| FormatError::rig(obj_path, e))
 }

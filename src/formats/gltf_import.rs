@@ -8,28 +8,25 @@
 //! rotation its pose, its scale its rest scale; the skins' inverse bind matrices bind the
 //! joints (a joint bound differently by two skins gets a second, fixed joint for the
 //! second binding). Every primitive of the part's meshes, merged in file order, with all
-//! `JOINTS_n`/`WEIGHTS_n` sets, normalised; morph targets per mesh node; the base colour
-//! factor and texture; and the file's animations of the part's nodes and morph weights as
+//! `JOINTS_n`/`WEIGHTS_n` sets, normalised; morph targets per mesh node; each primitive's
+//! material and surface ([`gltf_materials`](super::gltf_materials)); and the file's animations of the part's nodes and morph weights as
 //! clips.
 
 use std::borrow::Cow;
 use std::path::Path;
 
-use glam::{Mat4, Quat, Vec2, Vec3};
+use glam::{Mat4, Quat, Vec3};
 
 use super::error::FormatError;
 use crate::rig::node_clip::{Interpolation, JointTracks, NodeClip, Track};
-use crate::rig::{
-    CharacterAsset, JointRotation, MorphTarget, Picture, RawJoint, Skeleton, Skin, SkinTexture, SkinWeights,
-};
+use crate::rig::{CharacterAsset, JointRotation, MorphTarget, RawJoint, Skeleton, Skin, SkinWeights};
 
-/// One part of a glTF file: its asset, the file's animations of its nodes, and the base
-/// colour of its first primitive's material (none: the file gives no material).
+/// One part of a glTF file: its asset (with its materials) and the file's animations of
+/// its nodes.
 #[derive(Debug, Clone)]
 pub struct ImportedCharacter {
     pub asset: CharacterAsset,
     pub clips: Vec<NodeClip>,
-    pub base_color: Option<[f32; 4]>,
     /// The morph targets' weights as the file sets them (`node.weights`, else
     /// `mesh.weights`; 0 where unset).
     pub morph_weights: Vec<f32>,
@@ -91,6 +88,8 @@ struct File<'a> {
     seed: Vec<bool>,
     /// Whether the node is one of `seed`'s or above one.
     relevant: Vec<bool>,
+    /// The images decoded so far.
+    images: std::cell::RefCell<super::gltf_materials::Images>,
 }
 
 /// The nodes of one part: its roots, and its mesh nodes in file order.
@@ -139,7 +138,7 @@ impl<'a> File<'a> {
                 at = parent[node];
             }
         }
-        Self { gltf, buffers, path, parent, animated, seed, relevant }
+        Self { gltf, buffers, path, parent, animated, seed, relevant, images: Default::default() }
     }
 
     fn error(&self, message: String) -> FormatError {
@@ -249,8 +248,8 @@ impl<'a> File<'a> {
         let mut morphs = Vec::new();
         let mut morph_weights = Vec::new();
         let mut morph_of = Vec::new();
-        let mut base_color = None;
-        let (mut texture, mut texcoords) = (None, Vec::new());
+        let mut looks = super::gltf_materials::Looks::default();
+        let source = super::gltf_materials::Source { buffers: self.buffers, path: self.path };
         let mut skinned = false;
         for &node_index in &part.meshes {
             let node = self.node(node_index);
@@ -276,26 +275,23 @@ impl<'a> File<'a> {
                     warnings.push(format!("{}: {at} is not triangles and was skipped", self.path.display()));
                     continue;
                 }
-                let pbr = primitive.material().pbr_metallic_roughness();
-                if primitive.material().index().is_some() {
-                    // A primitive without a material has glTF's default (white): no tint.
-                    base_color.get_or_insert(pbr.base_color_factor());
-                }
                 let first = skin_data.bind_positions.len();
+                let first_triangle = skin_data.triangles.len() as u32;
                 self.primitive(&primitive, &at, &bound, &mut skin_data, &mut rows)?;
-                if let Some(info) = pbr.base_color_texture() {
-                    texture = texture.or_else(|| self.texture(&info.texture(), &mut warnings));
-                    let uv = primitive.reader(self.data()).read_tex_coords(info.tex_coord());
-                    texcoords.resize(first, Vec2::ZERO);
-                    texcoords.extend(uv.into_iter().flat_map(|t| t.into_f32()).map(Vec2::from));
-                    if let Some(v) = texcoords[first..].iter().position(|t| !t.is_finite()) {
-                        return Err(self.error(format!(
-                            "{at}.attributes.TEXCOORD_{}: expected finite numbers, found vertex {v}'s {}",
-                            info.tex_coord(),
-                            texcoords[first + v]
-                        )));
-                    }
-                }
+                let count = skin_data.bind_positions.len() - first;
+                let triangles = first_triangle..skin_data.triangles.len() as u32;
+                looks
+                    .add(
+                        &source,
+                        &mut self.images.borrow_mut(),
+                        &primitive,
+                        &at,
+                        first,
+                        count,
+                        triangles,
+                        &mut warnings,
+                    )
+                    .map_err(|e| self.error(e))?;
                 self.morph_targets(&node, &mesh, &primitive, &at, first, &bound, first_morph, &mut morphs)?;
             }
             // This node's targets, in order, and the weights the file sets for them.
@@ -308,10 +304,7 @@ impl<'a> File<'a> {
             .map_err(|e| self.error(format!("at $.nodes (the meshes of part `{name}`, JOINTS_n, WEIGHTS_n): {e}")))?;
         warnings.extend(super::weight_warnings::normalised_warnings(self.path, &normalised));
         skin_data.weights = weights;
-        if texture.is_some() {
-            texcoords.resize(skin_data.bind_positions.len(), Vec2::ZERO);
-            skin_data.texcoords = texcoords;
-        }
+        looks.finish(&mut skin_data);
         let clips = self.clips(&joint_of_node, skeleton.len(), &morph_of, morphs.len(), root_parent)?;
         let mut asset = CharacterAsset::with_inverse_binds(name, skeleton, skin_data, bind, warnings)
             .map_err(|e| FormatError::rig(self.path, e))?;
@@ -319,8 +312,9 @@ impl<'a> File<'a> {
             asset.skin_kind = crate::rig::character::SkinKind::Rigid;
         }
         asset.morphs = morphs;
-        asset.texture = texture;
-        Ok(ImportedCharacter { asset, clips, base_color, morph_weights })
+        asset.materials = looks.materials;
+        asset.surfaces = looks.surfaces;
+        Ok(ImportedCharacter { asset, clips, morph_weights })
     }
 
     /// The node the part's skeleton starts at and the transform of the static nodes above
@@ -566,40 +560,6 @@ impl<'a> File<'a> {
         Ok(())
     }
 
-    /// A texture's image, decoded (PNG or JPEG, from the file's buffers or a file beside
-    /// it); a warning and none when it cannot be read.
-    fn texture(&self, texture: &gltf::Texture, warnings: &mut Vec<String>) -> Option<SkinTexture> {
-        let image = texture.source();
-        let at = format!("{}: at $.images[{}]", self.path.display(), image.index());
-        let bytes = match image.source() {
-            gltf::image::Source::View { view, .. } => {
-                let buffer = self.buffers.get(view.buffer().index())?;
-                buffer.get(view.offset()..view.offset() + view.length()).map(<[u8]>::to_vec)
-            }
-            gltf::image::Source::Uri { uri, .. } => match uri_bytes(self.path, uri) {
-                Ok(bytes) => Some(bytes),
-                Err(e) => {
-                    warnings.push(format!("{at}.uri: the base colour texture is not shown ({e})"));
-                    return None;
-                }
-            },
-        };
-        let decoded = bytes
-            .ok_or_else(|| "its bytes cannot be read".to_string())
-            .and_then(|b| image::load_from_memory(&b).map_err(|e| e.to_string()));
-        match decoded {
-            Ok(decoded) => {
-                let rgba = decoded.to_rgba8();
-                let picture = Picture { width: rgba.width(), height: rgba.height(), pixels: rgba.into_raw() };
-                Some(SkinTexture::Picture { key: at, picture: std::sync::Arc::new(picture) })
-            }
-            Err(e) => {
-                warnings.push(format!("{at}: the base colour texture is not shown ({e})"));
-                None
-            }
-        }
-    }
-
     /// The file's animations that move the part's nodes or morph weights, as clips by
     /// joint index and morph index (`morph_of`: each mesh node's first morph and count).
     fn clips(
@@ -786,9 +746,9 @@ fn buffers<'a>(gltf: &gltf::Gltf, bin: Option<&'a [u8]>, path: &Path) -> Result<
                 gltf::buffer::Source::Bin => Cow::Borrowed(bin.ok_or_else(|| {
                     FormatError::other(path, format!("{at}: expected the GLB's binary chunk, found none"))
                 })?),
-                gltf::buffer::Source::Uri(uri) => {
-                    Cow::Owned(uri_bytes(path, uri).map_err(|e| FormatError::other(path, format!("{at}.uri: {e}")))?)
-                }
+                gltf::buffer::Source::Uri(uri) => Cow::Owned(
+                    super::uri::bytes(path, uri).map_err(|e| FormatError::other(path, format!("{at}.uri: {e}")))?,
+                ),
             };
             if data.len() < b.length() {
                 return Err(FormatError::other(
@@ -799,13 +759,4 @@ fn buffers<'a>(gltf: &gltf::Gltf, bin: Option<&'a [u8]>, path: &Path) -> Result<
             Ok(data)
         })
         .collect()
-}
-
-/// The bytes a buffer's or image's URI holds (`data:`) or names (a file beside the model).
-fn uri_bytes(model: &Path, uri: &str) -> Result<Vec<u8>, String> {
-    match super::uri::data_uri(uri) {
-        Some(bytes) => bytes,
-        None => super::uri::beside_uri(model, uri)
-            .and_then(|file| super::error::read_file(&file).map_err(|e| e.to_string())),
-    }
 }

@@ -11,6 +11,7 @@ pub mod error;
 pub mod gltf;
 pub mod gltf_check;
 pub mod gltf_import;
+pub mod gltf_materials;
 pub mod homer;
 pub mod limits;
 pub mod mit6837;

@@ -178,6 +178,7 @@ pub fn embedded_puppet() -> crate::rig::CharacterAsset {
             triangles: mesh.triangles,
             weights,
             texcoords: Vec::new(),
+            colors: Vec::new(),
         };
         crate::rig::CharacterAsset::new("puppet", skeleton, skin, Vec::new())
             .map_err(|e| crate::formats::FormatError::rig(Path::new("assets/puppet.obj"), e))

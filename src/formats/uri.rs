@@ -92,3 +92,11 @@ pub fn data_uri(uri: &str) -> Option<Result<Vec<u8>, String>> {
             .map_err(|e| format!("expected base64 data after `data:{}`, {e}", excerpt(media))),
     )
 }
+
+/// The bytes a model's URI holds (`data:`) or names (a file beside the model).
+pub fn bytes(model: &Path, uri: &str) -> Result<Vec<u8>, String> {
+    match data_uri(uri) {
+        Some(bytes) => bytes,
+        None => beside_uri(model, uri).and_then(|file| super::error::read_file(&file).map_err(|e| e.to_string())),
+    }
+}

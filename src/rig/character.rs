@@ -5,6 +5,7 @@ use glam::{Mat4, Vec3};
 
 use super::RigError;
 use super::fk::{bind_world_to_joint, forward_kinematics};
+use super::material::{Material, SkinTexture, Surface};
 use super::skeleton::{BoneBox, Skeleton};
 use super::skinning::SkinWeights;
 
@@ -19,6 +20,8 @@ pub struct Skin {
     pub weights: SkinWeights,
     /// Texture coordinates, one per vertex (empty: none).
     pub texcoords: Vec<glam::Vec2>,
+    /// Vertex colours (linear RGBA, glTF's `COLOR_0`), one per vertex (empty: white).
+    pub colors: Vec<[f32; 4]>,
 }
 
 impl Skin {
@@ -61,26 +64,11 @@ pub struct CharacterAsset {
     pub warnings: Vec<String>,
     /// Shapes the bind mesh can blend towards before skinning (CSE169 `.morph`).
     pub morphs: Vec<MorphTarget>,
-    /// The image the skin's texture coordinates index (CSE169 `material { texture }`, a
-    /// glTF base colour texture).
-    pub texture: Option<SkinTexture>,
-}
-
-/// A skin's base colour image.
-#[derive(Debug, Clone, PartialEq)]
-pub enum SkinTexture {
-    /// A file beside the character's (read when it is shown).
-    File(std::path::PathBuf),
-    /// An image the character's file holds, decoded; `key` names it (file and image index).
-    Picture { key: String, picture: std::sync::Arc<Picture> },
-}
-
-/// An image as RGBA8 (sRGB) rows, top row first.
-#[derive(Debug, Clone, PartialEq)]
-pub struct Picture {
-    pub width: u32,
-    pub height: u32,
-    pub pixels: Vec<u8>,
+    /// The materials the surfaces use (a glTF file's, a CSE169 skin's texture).
+    pub materials: Vec<Material>,
+    /// The runs of the mesh drawn with one material each (empty: one run, drawn with the
+    /// first material if there is one, else the character's tint).
+    pub surfaces: Vec<Surface>,
 }
 
 /// A morph target: how far some vertices move (bind space) at full weight.
@@ -108,7 +96,8 @@ impl CharacterAsset {
             bind_world_to_joint,
             warnings,
             morphs: Vec::new(),
-            texture: None,
+            materials: Vec::new(),
+            surfaces: Vec::new(),
         })
     }
 
@@ -138,7 +127,8 @@ impl CharacterAsset {
             bind_world_to_joint,
             warnings,
             morphs: Vec::new(),
-            texture: None,
+            materials: Vec::new(),
+            surfaces: Vec::new(),
         }
     }
 
@@ -157,6 +147,24 @@ impl CharacterAsset {
             }
         }
         positions
+    }
+
+    /// The surfaces to draw: its own, or one over the whole mesh.
+    pub fn surfaces(&self) -> std::borrow::Cow<'_, [Surface]> {
+        if !self.surfaces.is_empty() {
+            return std::borrow::Cow::Borrowed(&self.surfaces);
+        }
+        let whole = Surface {
+            vertices: 0..self.vertex_count() as u32,
+            triangles: 0..self.triangle_count() as u32,
+            material: (!self.materials.is_empty()).then_some(0),
+        };
+        std::borrow::Cow::Owned(vec![whole])
+    }
+
+    /// The first base colour texture of its materials.
+    pub fn base_color_texture(&self) -> Option<&SkinTexture> {
+        self.materials.iter().find_map(|m| m.base_color_texture.as_ref()).map(|t| &t.image)
     }
 
     pub fn vertex_count(&self) -> usize {

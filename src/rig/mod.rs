@@ -11,6 +11,7 @@ pub mod heat;
 pub mod ik;
 pub mod influences;
 pub mod lbs;
+pub mod material;
 pub mod matrix_stack;
 pub mod mirror;
 pub mod node_clip;
@@ -21,8 +22,9 @@ pub mod smpl;
 pub mod triangle_tree;
 pub mod turn;
 
-pub use character::{CharacterAsset, MorphTarget, Picture, Skin, SkinTexture};
+pub use character::{CharacterAsset, MorphTarget, Skin};
 pub use fk::{bind_world_to_joint, forward_kinematics, skinning_palette};
+pub use material::{Picture, SkinTexture};
 pub use matrix_stack::MatrixStack;
 pub use pose::{DofLimits, EulerOrder, JointRotation};
 pub use skeleton::{BoneBox, JointDef, RawJoint, Skeleton};

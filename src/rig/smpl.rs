@@ -74,6 +74,7 @@ impl SmplModel {
             triangles: self.triangles.clone(),
             weights: self.weights.clone(),
             texcoords: Vec::new(),
+            colors: Vec::new(),
         };
         CharacterAsset::new(name, skeleton, skin, Vec::new())
     }

@@ -27,9 +27,19 @@ pub struct Character {
     pub asset: Arc<CharacterAsset>,
     /// `joints[i]` is the entity of joint `i` of `asset.skeleton`.
     pub joints: Vec<Entity>,
-    /// The child entity with the skinned render mesh.
-    pub skin_entity: Entity,
+    /// The child entities that draw its skin: one per surface of the asset.
+    pub skins: Vec<SkinPart>,
+}
+
+/// One surface of a character's skin as drawn: its entity, its render mesh (the
+/// surface's own vertices) and the range of the skin's vertices it shows.
+#[derive(Clone, Debug)]
+pub struct SkinPart {
+    pub entity: Entity,
     pub mesh: Handle<Mesh>,
+    pub vertices: std::ops::Range<u32>,
+    /// The asset's material it is drawn with (none: the character's tint alone).
+    pub material: Option<usize>,
 }
 
 /// Where a character stands in the world (the scene file's own `PlacementDoc`: model
@@ -171,6 +181,8 @@ impl CurrentJointToWorld {
 #[derive(Component, Clone, Copy, Debug)]
 pub struct SkinMesh {
     pub character: Entity,
+    /// Its index in the character's `skins`.
+    pub part: usize,
 }
 
 /// The matrix-stack pass's output and scratch, by joint index (no allocation per frame):

@@ -86,11 +86,13 @@ impl Plugin for GpuSkinningPlugin {
 /// (reads `SkinOnGpu`; writes `NoFrustumCulling` on skin entities).
 fn cull_only_cpu_skins(mut commands: Commands, characters: Query<(&Character, &SkinOnGpu), Changed<SkinOnGpu>>) {
     for (character, on_gpu) in &characters {
-        let Ok(mut skin) = commands.get_entity(character.skin_entity) else { continue };
-        if on_gpu.0 {
-            skin.insert(NoFrustumCulling);
-        } else {
-            skin.remove::<NoFrustumCulling>();
+        for part in &character.skins {
+            let Ok(mut skin) = commands.get_entity(part.entity) else { continue };
+            if on_gpu.0 && character.skins.len() == 1 {
+                skin.insert(NoFrustumCulling);
+            } else {
+                skin.remove::<NoFrustumCulling>();
+            }
         }
     }
 }
@@ -132,7 +134,7 @@ fn extract_gpu_skin_jobs(jobs: Extract<Query<(Entity, &Character, Ref<GpuSkinJob
     gpu.pending.retain(|e, _| jobs.get(*e).is_ok_and(|(_, _, job)| job.0.is_some()));
     for (entity, character, job) in &jobs {
         if let Some(input) = job.0.as_ref().filter(|_| job.is_changed()) {
-            gpu.pending.insert(entity, (character.mesh.id(), input.clone(), 0));
+            gpu.pending.insert(entity, (character.skins[0].mesh.id(), input.clone(), 0));
         }
     }
 }

@@ -55,26 +55,46 @@ pub fn spawn_character_posed(
             .id();
         joints.push(joint);
     }
-    let mesh = meshes.add(empty_skin_mesh(&asset.skin.triangles, asset.vertex_count(), &asset.skin.texcoords));
-    let skin_entity = commands
-        // The skinning system keeps the bounds right as the mesh deforms (model space).
-        .spawn((
-            SkinMesh { character },
-            Mesh3d(mesh.clone()),
-            Transform::IDENTITY,
-            Aabb::default(),
-            NoAutoAabb,
-            ChildOf(character),
-        ))
-        .id();
+    let skins = asset
+        .surfaces()
+        .iter()
+        .enumerate()
+        .map(|(part, surface)| {
+            let mesh = meshes.add(surface_mesh(&asset.skin, surface));
+            let entity = commands
+                // The skinning system keeps the bounds right as the mesh deforms (model space).
+                .spawn((
+                    SkinMesh { character, part },
+                    Mesh3d(mesh.clone()),
+                    Transform::IDENTITY,
+                    Aabb::default(),
+                    NoAutoAabb,
+                    ChildOf(character),
+                ))
+                .id();
+            SkinPart { entity, mesh, vertices: surface.vertices.clone(), material: surface.material }
+        })
+        .collect();
     commands.entity(character).insert((
-        Character { asset, joints, skin_entity, mesh },
+        Character { asset, joints, skins },
         super::keyframes::RootTranslation::default(),
         SkinScratch::default(),
         JointScratch::default(),
         PoseDirty { matrices: true, bind: false, colors: true },
     ));
     character
+}
+
+/// The render mesh of one surface of a skin: its vertices, and its triangles with their
+/// indices counted from its first vertex.
+fn surface_mesh(skin: &crate::rig::Skin, surface: &crate::rig::material::Surface) -> Mesh {
+    let (first, end) = (surface.vertices.start, surface.vertices.end);
+    let triangles: Vec<[u32; 3]> = skin.triangles[surface.triangles.start as usize..surface.triangles.end as usize]
+        .iter()
+        .map(|t| t.map(|i| i - first))
+        .collect();
+    let texcoords = skin.texcoords.get(first as usize..end as usize).unwrap_or(&[]);
+    empty_skin_mesh(&triangles, (end - first) as usize, texcoords)
 }
 
 /// A render mesh of the skin's own vertices and triangles: positions and colours, no

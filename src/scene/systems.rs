@@ -151,7 +151,9 @@ pub fn skin_changed_characters(
             if recolored {
                 vertex_colors(character, view, heat.0, &mut scratch.colors);
             }
-            if on_gpu.0 {
+            // The compute shader writes one mesh's slot: characters drawn in several
+            // surfaces are skinned here.
+            if on_gpu.0 && character.skins.len() == 1 {
                 // The first skin is done here as well: its positions frame the scene and
                 // stand the characters on the floor when it opens.
                 if never_skinned {
@@ -214,9 +216,11 @@ pub fn finish_skinned_characters(
         if *dirty == PoseDirty::default() {
             continue;
         }
-        if let Ok(mut aabb) = skin_bounds.get_mut(character.skin_entity) {
-            let (lo, hi) = scratch.bounds;
-            aabb.set_if_neq(Aabb::from_min_max(lo, hi));
+        for part in &character.skins {
+            if let Ok(mut aabb) = skin_bounds.get_mut(part.entity) {
+                let (lo, hi) = scratch.bounds;
+                aabb.set_if_neq(Aabb::from_min_max(lo, hi));
+            }
         }
         scratch.colored_with = Some(Coloring::of(view, heat));
         *dirty = PoseDirty::default();
@@ -234,4 +238,8 @@ fn vertex_colors(character: &Character, view: &CharacterView, heat_joint: Option
     }
     out.clear();
     out.extend(per_vertex.into_iter().map(|[r, g, b]| [r, g, b, 1.0]));
+    // The file's own vertex colours, under the tint (not under weights or heat).
+    if heat_joint.is_none() && !view.weight_colors && skin.colors.len() == out.len() {
+        out.iter_mut().zip(&skin.colors).for_each(|(c, v)| *c = std::array::from_fn(|k| c[k] * v[k]));
+    }
 }

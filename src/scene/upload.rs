@@ -34,10 +34,19 @@ fn count_handed_on(
     handed.0 = changed.iter().map(|u| u.bytes().len()).sum::<usize>() + palettes;
 }
 
+/// An upload waiting for its mesh's slot: the character's packed vertices, the floats per
+/// vertex, the range of vertices that mesh shows, and the frames waited.
+struct Pending {
+    vertices: Arc<Vec<f32>>,
+    floats: usize,
+    range: std::ops::Range<u32>,
+    waited: u32,
+}
+
 /// Uploads waiting in the render world: by mesh, the newest bytes (kept until the mesh has
-/// its slot on the GPU), with the frames waited.
+/// its slot on the GPU).
 #[derive(Resource, Default)]
-struct PendingUploads(HashMap<AssetId<Mesh>, (Arc<Vec<f32>>, usize, u32)>);
+struct PendingUploads(HashMap<AssetId<Mesh>, Pending>);
 
 /// Frames an upload waits for its mesh's slot before it is dropped (the mesh is gone).
 const MAX_WAIT_FRAMES: u32 = 600;
@@ -64,8 +73,12 @@ fn extract_skin_uploads(
     mut pending: ResMut<PendingUploads>,
 ) {
     for (character, upload) in &skins {
-        if !upload.vertices.is_empty() {
-            pending.0.insert(character.mesh.id(), (upload.vertices.clone(), upload.floats, 0));
+        if upload.vertices.is_empty() {
+            continue;
+        }
+        for part in &character.skins {
+            let (vertices, floats, range) = (upload.vertices.clone(), upload.floats, part.vertices.clone());
+            pending.0.insert(part.mesh.id(), Pending { vertices, floats, range, waited: 0 });
         }
     }
 }
@@ -78,14 +91,16 @@ fn write_skin_uploads(
     queue: Res<RenderQueue>,
 ) {
     let Some(allocator) = allocator else { return };
-    pending.0.retain(|id, (vertices, floats, waited)| {
+    pending.0.retain(|id, upload| {
         let Some(slice) = allocator.mesh_vertex_slice(id) else {
-            *waited += 1;
-            return *waited < MAX_WAIT_FRAMES;
+            upload.waited += 1;
+            return upload.waited < MAX_WAIT_FRAMES;
         };
-        if (slice.range.end - slice.range.start) as usize * *floats == vertices.len() {
-            let offset = (slice.range.start as usize * *floats * 4) as u64;
-            queue.write_buffer(slice.buffer, offset, bytemuck::cast_slice(vertices));
+        let floats = upload.floats;
+        let part = upload.vertices.get(upload.range.start as usize * floats..upload.range.end as usize * floats);
+        if let Some(part) = part.filter(|p| (slice.range.end - slice.range.start) as usize * floats == p.len()) {
+            let offset = (slice.range.start as usize * floats * 4) as u64;
+            queue.write_buffer(slice.buffer, offset, bytemuck::cast_slice(part));
         }
         false
     });

@@ -512,7 +512,9 @@ fn bitmaps_decode_top_row_first_and_others_are_refused() {
 fn the_head_is_textured_with_its_bitmap() {
     let data = data_dir().join("cse169/extras");
     let head = load_character(&data.join("head.skel")).unwrap();
-    assert!(matches!(&head.texture, Some(marionette::rig::SkinTexture::File(t)) if t.ends_with("head.bmp")));
+    assert!(
+        matches!(head.base_color_texture(), Some(marionette::rig::SkinTexture::File(t)) if t.ends_with("head.bmp"))
+    );
     assert_eq!(head.skin.texcoords.len(), head.vertex_count());
     let bytes = std::fs::read(data.join("head.bmp")).unwrap();
     let image = marionette::formats::bmp::decode_bmp(&bytes, Path::new("head.bmp")).unwrap();

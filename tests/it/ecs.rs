@@ -134,7 +134,7 @@ fn mesh_triangles_and_weight_colours_match_the_kernels() {
     let skinned: Vec<[f32; 3]> = posed_positions(&asset, &pose, Mat4::IDENTITY).iter().map(|p| p.to_array()).collect();
     let mut per_vertex = vec![[0.0; 3]; asset.vertex_count()];
     weight_colors(&asset.skin.weights, &joint_colors(asset.skeleton.len()), &mut per_vertex);
-    let handle = app.world().get::<Character>(character).unwrap().mesh.clone();
+    let handle = app.world().get::<Character>(character).unwrap().skins[0].mesh.clone();
     let mesh = app.world().resource::<Assets<Mesh>>().get(&handle).unwrap();
     let (positions, colors) = uploaded_vertices(&app, character);
     assert_positions_close(&positions, &skinned, 1e-5);

@@ -70,7 +70,8 @@ fn state(app: &mut App) -> (SceneDoc, usize) {
 fn commands_then_undo_all_return_the_ecs_to_its_start_and_redo_to_its_end() {
     let mut app = scene_app();
     open_puppets(&mut app, &[Some(1), Some(2)]);
-    let (first, first_mesh) = (entity(&app, 1), app.world().get::<Character>(entity(&app, 1)).unwrap().mesh.id());
+    let (first, first_mesh) =
+        (entity(&app, 1), app.world().get::<Character>(entity(&app, 1)).unwrap().skins[0].mesh.id());
     let elbow = joint(&app, 1, "l_elbow");
     let selection = Selection { character: Some(CharacterId(1)), joints: vec![elbow] };
     *app.world_mut().resource_mut::<Selection>() = selection.clone();
@@ -110,7 +111,7 @@ fn commands_then_undo_all_return_the_ecs_to_its_start_and_redo_to_its_end() {
     }
     assert_eq!(state(&mut app), start, "undo all returns to the exact start");
     assert_eq!(entity(&app, 1), first, "the character that stayed keeps its entity");
-    assert_eq!(app.world().get::<Character>(first).unwrap().mesh.id(), first_mesh, "and its mesh");
+    assert_eq!(app.world().get::<Character>(first).unwrap().skins[0].mesh.id(), first_mesh, "and its mesh");
     assert_eq!(*app.world().resource::<Selection>(), selection, "the selection survives");
     assert!(!app.world().resource::<History>().can_undo());
 

@@ -474,13 +474,13 @@ fn exporting_a_glb_to_obj_writes_every_character_as_blender_poses_it() {
 
 /// The Blender pair's walker wears Blender's 8 x 8 red and blue checker: the PNG inside
 /// the .glb is decoded to its pixels, every vertex has texture coordinates, and the
-/// material's base colour (white under a texture) is the tint.
+/// material's base colour is white under the texture.
 #[test]
 fn a_base_colour_texture_comes_with_its_coordinates() {
     let data = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data");
     let characters = marionette::formats::gltf_import::load_gltf(&data.join("blender_pair.glb")).unwrap();
     let walker = &characters[0];
-    let Some(marionette::rig::SkinTexture::Picture { picture, .. }) = &walker.asset.texture else {
+    let Some(marionette::rig::SkinTexture::Picture { picture, .. }) = walker.asset.base_color_texture() else {
         panic!("no texture: {:?}", walker.asset.warnings)
     };
     assert_eq!((picture.width, picture.height), (8, 8));
@@ -492,7 +492,7 @@ fn a_base_colour_texture_comes_with_its_coordinates() {
     }
     assert_eq!(walker.asset.skin.texcoords.len(), walker.asset.vertex_count());
     assert!(walker.asset.skin.texcoords.iter().all(|t| (0.0..=1.0).contains(&t.x) && (0.0..=1.0).contains(&t.y)));
-    assert_eq!(walker.base_color, Some([1.0; 4]));
+    assert_eq!(walker.asset.materials[0].base_color, [1.0; 4]);
     let waver = &characters[1];
-    assert!(waver.asset.texture.is_none() && waver.asset.skin.texcoords.is_empty());
+    assert!(waver.asset.base_color_texture().is_none() && waver.asset.skin.texcoords.is_empty());
 }

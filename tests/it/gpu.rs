@@ -102,7 +102,7 @@ fn spawn_posed(app: &mut App, asset: Arc<CharacterAsset>, pose: &[JointRotation]
 /// template's.
 fn largest_error(app: &App, entity: Entity, asset: &CharacterAsset, expected: &[Vec3]) -> Option<f32> {
     let job = app.world().get::<GpuSkinJob>(entity)?.0.as_ref()?;
-    let mesh = app.world().get::<Character>(entity)?.mesh.id();
+    let mesh = app.world().get::<Character>(entity)?.skins[0].mesh.id();
     let vertices = read_back_mesh_vertices(app.sub_app(RenderApp).world(), mesh, job.floats)?;
     assert_eq!(vertices.len(), job.template.len(), "{}: the mesh's slot holds its vertices", asset.name);
     let size = expected.iter().fold(1.0f32, |m, p| m.max(p.abs().max_element()));

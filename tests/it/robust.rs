@@ -75,6 +75,7 @@ fn chain_character(n: usize) -> Arc<CharacterAsset> {
         triangles: vec![[0, 1, 2]],
         weights,
         texcoords: Vec::new(),
+        colors: Vec::new(),
     };
     Arc::new(CharacterAsset::new("chain", skeleton, skin, Vec::new()).unwrap())
 }

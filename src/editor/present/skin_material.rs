@@ -10,6 +10,8 @@ use bevy::prelude::*;
 use bevy::render::render_resource::AsBindGroup;
 use bevy::shader::ShaderRef;
 
+use crate::rig::material::Sampler;
+
 /// The extension: no data of its own, only the flat-normal fragment shader.
 #[derive(Asset, AsBindGroup, Reflect, Debug, Clone, Default)]
 pub struct FlatNormals {}
@@ -27,33 +29,98 @@ pub type SkinMaterialAsset = ExtendedMaterial<StandardMaterial, FlatNormals>;
 #[derive(Resource)]
 pub struct SkinMaterial(pub Handle<SkinMaterialAsset>);
 
-/// The materials of textured skins, by texture (a file's path, or the key of an image a
-/// character's file holds; loaded once).
+/// The skin textures on the GPU, by texture (a file's path, or the key of an image a
+/// character's file holds), colour space and sampler: each uploaded once.
 #[derive(Resource, Default)]
-pub struct TexturedSkinMaterials(pub std::collections::HashMap<String, Handle<SkinMaterialAsset>>);
+pub struct SkinTextures(std::collections::HashMap<(String, bool, Sampler), Handle<Image>>);
 
-/// The skin material with `image` as its base colour texture.
-pub fn textured_material(
-    image: &crate::formats::bmp::Rgba,
-    images: &mut Assets<Image>,
-    materials: &mut Assets<SkinMaterialAsset>,
-) -> Handle<SkinMaterialAsset> {
-    let size =
-        bevy::render::render_resource::Extent3d { width: image.width, height: image.height, depth_or_array_layers: 1 };
-    let texture = Image::new(
-        size,
-        bevy::render::render_resource::TextureDimension::D2,
-        image.pixels.clone(),
-        bevy::render::render_resource::TextureFormat::Rgba8UnormSrgb,
-        bevy::asset::RenderAssetUsages::RENDER_WORLD,
-    );
+impl SkinTextures {
+    /// The image of `texture` (whose pixels are `picture`), sRGB or linear, sampled by
+    /// `sampler`.
+    pub fn image(
+        &mut self,
+        texture: &crate::rig::SkinTexture,
+        picture: &crate::rig::Picture,
+        srgb: bool,
+        sampler: Sampler,
+        images: &mut Assets<Image>,
+    ) -> Handle<Image> {
+        let key = match texture {
+            crate::rig::SkinTexture::File(path) => path.display().to_string(),
+            crate::rig::SkinTexture::Picture { key, .. } => key.clone(),
+        };
+        self.0.entry((key, srgb, sampler)).or_insert_with(|| images.add(image_of(picture, srgb, sampler))).clone()
+    }
+}
+
+/// A picture as an image the GPU samples (sRGB for colours, linear for data) as
+/// `sampler` says.
+fn image_of(picture: &crate::rig::Picture, srgb: bool, sampler: Sampler) -> Image {
+    use crate::rig::material::Wrap;
+    use bevy::image::{ImageAddressMode, ImageFilterMode, ImageSampler, ImageSamplerDescriptor};
+    use bevy::render::render_resource::{Extent3d, TextureDimension, TextureFormat};
+    let size = Extent3d { width: picture.width, height: picture.height, depth_or_array_layers: 1 };
+    let format = if srgb { TextureFormat::Rgba8UnormSrgb } else { TextureFormat::Rgba8Unorm };
+    let dimension = TextureDimension::D2;
+    let mut image =
+        Image::new(size, dimension, picture.pixels.clone(), format, bevy::asset::RenderAssetUsages::RENDER_WORLD);
+    let wrap = |w| match w {
+        Wrap::Repeat => ImageAddressMode::Repeat,
+        Wrap::Mirror => ImageAddressMode::MirrorRepeat,
+        Wrap::Clamp => ImageAddressMode::ClampToEdge,
+    };
+    let filter = |nearest| if nearest { ImageFilterMode::Nearest } else { ImageFilterMode::Linear };
+    image.sampler = ImageSampler::Descriptor(ImageSamplerDescriptor {
+        address_mode_u: wrap(sampler.wrap_u),
+        address_mode_v: wrap(sampler.wrap_v),
+        mag_filter: filter(sampler.nearest_mag),
+        min_filter: filter(sampler.nearest_min),
+        ..default()
+    });
+    image
+}
+
+/// The skin material of one of an asset's materials; `image` gives a texture's image
+/// (sRGB or not), or none when it cannot be read. The normal map is kept in the asset
+/// but not drawn: skins have no tangents (their normals come from the shader).
+pub fn skin_material_of(
+    m: &crate::rig::material::Material,
+    image: &mut impl FnMut(&crate::rig::SkinTexture, bool, Sampler) -> Option<Handle<Image>>,
+) -> SkinMaterialAsset {
+    use crate::rig::material::AlphaMode as Alpha;
+    let mut texture = |t: &Option<crate::rig::material::TextureRef>, srgb: bool| {
+        let t = t.as_ref()?;
+        image(&t.image, srgb, t.sampler)
+    };
+    let base_color_texture = texture(&m.base_color_texture, true);
+    let metallic_roughness = texture(&m.metallic_roughness_texture, false);
+    let emissive = texture(&m.emissive_texture, true);
+    let transform = m.base_color_texture.as_ref().map(|t| t.transform).unwrap_or_default();
+    let [r, g, b, a] = m.base_color;
+    let [er, eg, eb] = m.emissive;
     let base = StandardMaterial {
-        base_color: Color::WHITE,
-        base_color_texture: Some(images.add(texture)),
-        perceptual_roughness: 0.75,
+        base_color: Color::linear_rgba(r, g, b, a),
+        base_color_texture,
+        metallic: m.metallic,
+        perceptual_roughness: m.roughness,
+        metallic_roughness_texture: metallic_roughness,
+        emissive: LinearRgba::rgb(er, eg, eb),
+        emissive_texture: emissive,
+        alpha_mode: match m.alpha {
+            Alpha::Opaque => AlphaMode::Opaque,
+            Alpha::Mask(cutoff) => AlphaMode::Mask(cutoff),
+            Alpha::Blend => AlphaMode::Blend,
+        },
+        double_sided: m.double_sided,
+        cull_mode: if m.double_sided { None } else { Some(bevy::render::render_resource::Face::Back) },
+        uv_transform: bevy::math::Affine2::from_scale_angle_translation(
+            transform.scale,
+            transform.rotation,
+            transform.offset,
+        ),
         ..default()
     };
-    materials.add(ExtendedMaterial { base, extension: FlatNormals {} })
+    ExtendedMaterial { base, extension: FlatNormals {} }
 }
 
 pub struct SkinMaterialPlugin;
@@ -61,7 +128,7 @@ pub struct SkinMaterialPlugin;
 impl Plugin for SkinMaterialPlugin {
     fn build(&self, app: &mut App) {
         embedded_asset!(app, "flat_normals.wgsl");
-        app.init_resource::<TexturedSkinMaterials>()
+        app.init_resource::<SkinTextures>()
             .add_plugins(MaterialPlugin::<SkinMaterialAsset>::default())
             .add_systems(Startup, setup_skin_material);
     }

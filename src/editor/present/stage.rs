@@ -58,7 +58,7 @@ pub fn fit_stage_to_scene(
     let reach = characters
         .iter()
         .filter_map(|(character, placement)| {
-            let aabb = bounds.get(character.skin_entity).ok()?;
+            let aabb = bounds.get(character.skins.first()?.entity).ok()?;
             let m = placement.to_mat4();
             let (a, b) = (Vec3::from(aabb.min()), Vec3::from(aabb.max()));
             Some(

@@ -71,6 +71,7 @@ impl Plugin for ViewPlugin {
                 PostUpdate,
                 (
                     attach_skin_material,
+                    show_weights_in_plain_material,
                     apply_display_mode,
                     apply_stage_settings,
                     frame_when_skinned,
@@ -335,12 +336,13 @@ pub fn sync_character_views(
     }
 }
 
-/// Gives new skin meshes the shared material (writes `MeshMaterial3d`).
+/// Gives new skin meshes their material: the asset's for their surface (its textures
+/// decoded once), or the shared one (writes `MeshMaterial3d`, `OwnMaterial`).
 #[allow(clippy::too_many_arguments)]
 fn attach_skin_material(
     mut commands: Commands,
     material: Res<SkinMaterial>,
-    mut textured: ResMut<crate::editor::present::skin_material::TexturedSkinMaterials>,
+    mut textures: ResMut<crate::editor::present::skin_material::SkinTextures>,
     mut images: ResMut<Assets<Image>>,
     mut materials: ResMut<Assets<crate::editor::present::skin_material::SkinMaterialAsset>>,
     mut messages: ResMut<Messages>,
@@ -348,35 +350,48 @@ fn attach_skin_material(
     new_skins: Query<(Entity, &SkinMesh), Added<SkinMesh>>,
 ) {
     for (entity, skin) in &new_skins {
-        let texture = characters.get(skin.character).ok().and_then(|c| c.asset.texture.clone());
-        let handle = match texture {
-            Some(texture) => {
-                let key = match &texture {
-                    SkinTexture::File(path) => path.display().to_string(),
-                    SkinTexture::Picture { key, .. } => key.clone(),
+        let Ok(character) = characters.get(skin.character) else { continue };
+        let own =
+            character.skins.get(skin.part).and_then(|p| p.material).and_then(|m| character.asset.materials.get(m));
+        let handle = match own {
+            Some(m) => {
+                let mut image = |texture: &SkinTexture, srgb: bool, sampler| match picture_of(texture) {
+                    Ok(picture) => Some(textures.image(texture, &picture, srgb, sampler, &mut images)),
+                    Err(e) => {
+                        messages.push(format!("{e} (the skin is drawn without it)"));
+                        None
+                    }
                 };
-                match textured.0.get(&key) {
-                    Some(handle) => handle.clone(),
-                    None => match picture_of(&texture) {
-                        Ok(image) => {
-                            let handle = crate::editor::present::skin_material::textured_material(
-                                &image,
-                                &mut images,
-                                &mut materials,
-                            );
-                            textured.0.insert(key, handle.clone());
-                            handle
-                        }
-                        Err(e) => {
-                            messages.push(format!("{e} (the skin is drawn without it)"));
-                            material.0.clone()
-                        }
-                    },
-                }
+                materials.add(crate::editor::present::skin_material::skin_material_of(m, &mut image))
             }
             None => material.0.clone(),
         };
-        commands.entity(entity).insert(MeshMaterial3d(handle));
+        commands.entity(entity).insert((MeshMaterial3d(handle.clone()), OwnMaterial(handle)));
+    }
+}
+
+/// A skin mesh's own material, which weight colours and heat maps set aside for the
+/// shared one (so that only the vertex colours show).
+#[derive(Component)]
+pub struct OwnMaterial(pub Handle<crate::editor::present::skin_material::SkinMaterialAsset>);
+
+/// Draws skins in the shared material while they show weights or heat, else in their own
+/// (reads `CharacterView`, `HeatJoint`; writes `MeshMaterial3d`).
+fn show_weights_in_plain_material(
+    characters: Query<(&Character, &CharacterView, &HeatJoint), Or<(Changed<CharacterView>, Changed<HeatJoint>)>>,
+    material: Res<SkinMaterial>,
+    mut skins: Query<(&OwnMaterial, &mut MeshMaterial3d<crate::editor::present::skin_material::SkinMaterialAsset>)>,
+) {
+    for (character, view, heat) in &characters {
+        let plain = view.weight_colors || heat.0.is_some();
+        for part in &character.skins {
+            if let Ok((own, mut drawn)) = skins.get_mut(part.entity) {
+                let wanted = if plain { &material.0 } else { &own.0 };
+                if drawn.0 != *wanted {
+                    drawn.0 = wanted.clone();
+                }
+            }
+        }
     }
 }
 
@@ -396,8 +411,14 @@ fn apply_display_mode(
     mut visibility: Query<&mut Visibility, With<SkinMesh>>,
 ) {
     for (character, view) in &characters {
-        if let Ok(mut v) = visibility.get_mut(character.skin_entity) {
-            v.set_if_neq(if view.display == DisplayDoc::Skeleton { Visibility::Hidden } else { Visibility::Inherited });
+        for part in &character.skins {
+            if let Ok(mut v) = visibility.get_mut(part.entity) {
+                v.set_if_neq(if view.display == DisplayDoc::Skeleton {
+                    Visibility::Hidden
+                } else {
+                    Visibility::Inherited
+                });
+            }
         }
     }
 }
