@@ -129,10 +129,10 @@ impl AssetLibrary {
         if asset.surfaces().iter().all(|s| s.material.is_some()) {
             doc.view.tint = [1.0; 3];
         }
-        if let Some(part) = self.gltf_source(&doc.source) {
-            if part.morph_weights.iter().any(|&w| w != 0.0) {
-                doc.morphs = part.morph_weights;
-            }
+        if let Some(part) = self.gltf_source(&doc.source)
+            && part.morph_weights.iter().any(|&w| w != 0.0)
+        {
+            doc.morphs = part.morph_weights;
         }
         doc
     }

@@ -120,7 +120,8 @@ pub enum Wrap {
     Clamp,
 }
 
-/// `KHR_texture_transform`: `uv' = T(offset) · R(rotation) · S(scale) · uv`.
+/// `KHR_texture_transform`: `uv' = T(offset) · R(rotation) · S(scale) · uv` (see
+/// [`TextureTransform::apply`]).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct TextureTransform {
     pub offset: Vec2,
@@ -136,12 +137,14 @@ impl Default for TextureTransform {
 }
 
 impl TextureTransform {
-    /// The transformed coordinates of `uv` (the extension's GLSL matrix, whose rotation's
-    /// columns are `(cos, sin)` and `(-sin, cos)`, written out).
+    /// The transformed coordinates of `uv`. The rotation turns the image counter-clockwise
+    /// as it is seen (v runs down), as the extension's example has it: offset (0, 1),
+    /// rotation π/2 and scale ½ show the lower left quadrant turned a quarter clockwise
+    /// (three.js reads it so).
     pub fn apply(&self, uv: Vec2) -> Vec2 {
         let (s, c) = self.rotation.sin_cos();
         let scaled = uv * self.scale;
-        Vec2::new(c * scaled.x - s * scaled.y, s * scaled.x + c * scaled.y) + self.offset
+        Vec2::new(c * scaled.x + s * scaled.y, -s * scaled.x + c * scaled.y) + self.offset
     }
 }
 

@@ -186,3 +186,47 @@ fn an_exported_glb_reads_back_key_for_key() {
         }
     }
 }
+
+/// `KHR_texture_transform`'s own example: offset (0, 1), rotation π/2, scale ½ maps the
+/// unit square onto the image's lower left quadrant (v runs down), turned; Bevy's affine
+/// transform of the same numbers (as the editor builds it) agrees.
+#[test]
+fn a_texture_transform_reads_as_the_extensions_example() {
+    use marionette::rig::material::TextureTransform;
+    let t = TextureTransform {
+        offset: glam::Vec2::new(0.0, 1.0),
+        rotation: std::f32::consts::FRAC_PI_2,
+        scale: glam::Vec2::splat(0.5),
+    };
+    let corners = [(0.0, 0.0, 0.0, 1.0), (1.0, 0.0, 0.0, 0.5), (1.0, 1.0, 0.5, 0.5), (0.0, 1.0, 0.5, 1.0)];
+    let bevy = bevy::math::Affine2::from_scale_angle_translation(t.scale, -t.rotation, t.offset);
+    for (u, v, x, y) in corners {
+        let uv = glam::Vec2::new(u, v);
+        assert!(t.apply(uv).abs_diff_eq(glam::Vec2::new(x, y), 1e-6), "{uv} -> {}", t.apply(uv));
+        assert!(bevy.transform_point2(uv).abs_diff_eq(t.apply(uv), 1e-6), "{uv}");
+    }
+}
+
+/// The Blender fixture's body has two materials (red below, blue above): it loads as two
+/// surfaces that split its vertices and triangles, each with its material's name and
+/// colour; the hand and the hat, which have none, are one surface of the tint.
+#[test]
+fn each_primitive_keeps_its_material() {
+    let data = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data");
+    let part = marionette::formats::gltf_import::load_gltf(&data.join("blender_nested.glb")).unwrap().swap_remove(0);
+    let asset = &part.asset;
+    let names: Vec<&str> = asset.materials.iter().map(|m| m.name.as_str()).collect();
+    assert_eq!(names, ["red", "blue"]);
+    assert!((asset.materials[0].base_color[0] - 0.8).abs() < 1e-6 && asset.materials[0].double_sided);
+    let surfaces = asset.surfaces();
+    let used: Vec<Option<usize>> = surfaces.iter().map(|s| s.material).collect();
+    assert_eq!(used, [None, Some(0), Some(1)], "in node order: the hand and the hat (one run), the body's red, blue");
+    let mut next = (0, 0);
+    for s in surfaces.iter() {
+        assert_eq!((s.vertices.start, s.triangles.start), next, "surfaces tile the mesh");
+        next = (s.vertices.end, s.triangles.end);
+        let tris = &asset.skin.triangles[s.triangles.start as usize..s.triangles.end as usize];
+        assert!(tris.iter().flatten().all(|i| s.vertices.contains(i)), "a surface's triangles use its vertices");
+    }
+    assert_eq!(next, (asset.vertex_count() as u32, asset.triangle_count() as u32));
+}
