@@ -14,7 +14,7 @@ use crate::formats::{load_character, obj};
 
 /// Runs `export`: a glTF file's characters, a scene as glTF, or a character as OBJ or glTF.
 pub fn run(a: &ExportArgs) -> Result<()> {
-    if crate::formats::gltf_import::is_gltf(&a.path) {
+    if crate::formats::has_parts(&a.path) {
         return export_gltf_file(&a.path, &a.out, &a.poses, a.skinning.into(), &a.clip, a.bake, a.animation);
     }
     if is_glb(&a.out) && is_scene(&a.path) {
@@ -104,7 +104,7 @@ fn export_gltf_file(
         println!("wrote {} ({} characters)", out.display(), doc.characters.len());
         return Ok(());
     }
-    let characters = crate::formats::gltf_import::load_gltf(path)?;
+    let characters = crate::formats::load_parts(path)?;
     characters.iter().flat_map(|c| &c.asset.warnings).for_each(|w| eprintln!("warning: {w}"));
     let (positions, triangles) =
         crate::document::posing::posed_gltf(&characters, clip.clip.as_deref(), time, poses, method)

@@ -19,7 +19,7 @@ use crate::formats::load_character;
 /// with its materials and its clips (channels, keys, length, interpolation); a
 /// BVH's motion; an SMPL folder's clips.
 pub fn info(path: &Path) -> Result<()> {
-    if !crate::formats::gltf_import::is_gltf(path) {
+    if !crate::formats::has_parts(path) {
         print!("{}", describe(&load_character(path)?));
         if path.extension().is_some_and(|e| e.eq_ignore_ascii_case("bvh")) {
             let bvh = crate::formats::bvh::parse_bvh(crate::formats::error::open(path)?, path)?;
@@ -42,7 +42,7 @@ pub fn info(path: &Path) -> Result<()> {
         }
         return Ok(());
     }
-    for c in crate::formats::gltf_import::load_gltf(path)? {
+    for c in crate::formats::load_parts(path)? {
         print!("{}", describe(&c.asset));
         for m in &c.asset.materials {
             println!("{}", crate::document::posing::describe_material(m));

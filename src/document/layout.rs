@@ -68,7 +68,7 @@ pub fn union(boxes: impl IntoIterator<Item = (Vec3, Vec3)>) -> (Vec3, Vec3) {
 
 /// The glTF file a source is one character of (none for any other source).
 pub fn gltf_file(source: &crate::formats::scene::SourceDoc) -> Option<&std::path::Path> {
-    source.path().filter(|p| crate::formats::gltf_import::is_gltf(p))
+    source.path().filter(|p| crate::formats::has_parts(p))
 }
 
 /// The translation that puts a model box's left side at x = `left`, on the floor,

@@ -78,7 +78,7 @@ impl AssetLibrary {
                 asset.warnings = set.warnings;
                 asset
             }
-            SourceDoc::File(path) if crate::formats::gltf_import::is_gltf(path) => {
+            SourceDoc::File(path) if crate::formats::has_parts(path) => {
                 return Ok(self.gltf_part(path, 0)?.asset);
             }
             SourceDoc::Part(path, n) => return Ok(self.gltf_part(path, *n)?.asset),
@@ -102,7 +102,7 @@ impl AssetLibrary {
     /// Every character of the glTF file at `path` (the file read once).
     pub fn gltf_parts(&mut self, path: &Path) -> Result<&[GltfPart], FormatError> {
         if !self.gltf.contains_key(path) {
-            let parts = crate::formats::gltf_import::load_gltf(path)?
+            let parts = crate::formats::load_parts(path)?
                 .into_iter()
                 .map(|c| GltfPart { asset: Arc::new(c.asset), clips: c.clips.into(), morph_weights: c.morph_weights })
                 .collect();
@@ -115,7 +115,7 @@ impl AssetLibrary {
     /// others as `Part`), or the path itself.
     pub fn sources_of(&mut self, path: &Path) -> Vec<SourceDoc> {
         let file = SourceDoc::File(path.to_path_buf());
-        if !crate::formats::gltf_import::is_gltf(path) {
+        if !crate::formats::has_parts(path) {
             return vec![file];
         }
         let count = self.gltf_parts(path).map_or(1, <[GltfPart]>::len);
@@ -140,7 +140,7 @@ impl AssetLibrary {
     /// The glTF character a source names, if it is one.
     pub fn gltf_source(&mut self, source: &SourceDoc) -> Option<GltfPart> {
         match source {
-            SourceDoc::File(p) if crate::formats::gltf_import::is_gltf(p) => self.gltf_part(p, 0).ok(),
+            SourceDoc::File(p) if crate::formats::has_parts(p) => self.gltf_part(p, 0).ok(),
             SourceDoc::Part(p, n) => self.gltf_part(p, *n).ok(),
             _ => None,
         }

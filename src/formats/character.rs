@@ -21,8 +21,9 @@ pub enum CharacterSource {
     Homer { json: PathBuf },
     /// A BVH motion capture file: its skeleton as bone boxes.
     Bvh { path: PathBuf },
-    /// A glTF 2.0 file (`.glb`, `.gltf`): its skinned characters.
-    Gltf { path: PathBuf },
+    /// A file of parts, characters and props with their own clips: glTF 2.0 (`.glb`,
+    /// `.gltf`) or FBX.
+    Parts { path: PathBuf },
 }
 
 impl CharacterSource {
@@ -41,7 +42,7 @@ impl CharacterSource {
             }
             Some("json") => Ok(Self::Homer { json: path.to_path_buf() }),
             Some("bvh") => Ok(Self::Bvh { path: path.to_path_buf() }),
-            Some("glb" | "gltf") => Ok(Self::Gltf { path: path.to_path_buf() }),
+            Some("glb" | "gltf" | "fbx") => Ok(Self::Parts { path: path.to_path_buf() }),
             Some("skin") => {
                 let skel = path.with_extension("skel");
                 if !skel.is_file() {
@@ -93,14 +94,24 @@ pub fn load_skeleton(path: &Path) -> Result<Skeleton, FormatError> {
         CharacterSource::Homer { json } => Ok(super::homer::parse_rig(open(&json)?, &json)?.skeleton),
         CharacterSource::Smpl { dir } => Ok(super::smpl::load_smpl_dir(&dir)?.0.skeleton),
         CharacterSource::Bvh { path } => Ok(super::bvh::parse_bvh(open(&path)?, &path)?.skeleton),
-        CharacterSource::Gltf { path } => Ok(first_gltf_character(&path)?.skeleton),
+        CharacterSource::Parts { path } => Ok(first_part(&path)?.skeleton),
     }
 }
 
-/// The first character of a glTF file (its first skin that a mesh uses).
-fn first_gltf_character(path: &Path) -> Result<CharacterAsset, FormatError> {
-    let mut characters = super::gltf_import::load_gltf(path)?;
-    Ok(characters.swap_remove(0).asset)
+/// The first part of a glTF or FBX file.
+fn first_part(path: &Path) -> Result<CharacterAsset, FormatError> {
+    let mut parts = load_parts(path)?;
+    Ok(parts.swap_remove(0).asset)
+}
+
+/// Whether a file holds parts (characters and props with their own clips): glTF or FBX.
+pub fn has_parts(path: &Path) -> bool {
+    super::gltf_import::is_gltf(path) || super::fbx::is_fbx(path)
+}
+
+/// Every part of a glTF or FBX file (at least one).
+pub fn load_parts(path: &Path) -> Result<Vec<super::gltf_import::ImportedCharacter>, FormatError> {
+    if super::fbx::is_fbx(path) { super::fbx::load_fbx(path) } else { super::gltf_import::load_gltf(path) }
 }
 
 /// Loads whatever character `path` names (the first, where a glTF file holds several).
@@ -120,7 +131,7 @@ pub fn load_character(path: &Path) -> Result<CharacterAsset, FormatError> {
             let skeleton = super::bvh::parse_bvh(open(&path)?, &path)?.skeleton;
             Ok(CharacterAsset::with_bone_boxes(name, skeleton, Vec::new()))
         }
-        CharacterSource::Gltf { path } => first_gltf_character(&path),
+        CharacterSource::Parts { path } => first_part(&path),
         CharacterSource::Smpl { dir } => {
             let (model, warnings) = super::smpl::load_smpl_dir(&dir)?;
             let mut asset = model.asset(&name, &[]).map_err(|e| FormatError::rig(&dir, e))?;

@@ -8,6 +8,7 @@ pub mod character;
 pub mod cse169;
 pub mod cse169_skin;
 pub mod error;
+pub mod fbx;
 pub mod gltf;
 pub mod gltf_check;
 pub mod gltf_import;
@@ -23,7 +24,7 @@ pub mod smpl;
 pub mod uri;
 pub mod weight_warnings;
 
-pub use character::{CharacterSource, load_character};
+pub use character::{CharacterSource, has_parts, load_character, load_parts};
 
 /// A keyframed clip from a file: a CSE169 `.anim`, or the motion of a `.bvh`.
 pub fn load_clip(path: &std::path::Path) -> Result<crate::rig::anim::Clip, FormatError> {

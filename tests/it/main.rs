@@ -10,6 +10,7 @@ mod dqs;
 mod ecs;
 mod editor;
 mod edits;
+mod fbx;
 mod formats;
 mod fuzz;
 mod gizmo;
