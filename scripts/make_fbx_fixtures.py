@@ -42,6 +42,8 @@ for source in sources:
         axis_forward="-Z",
         axis_up="Y",
         mesh_smooth_type="OFF",
+        path_mode="COPY",
+        embed_textures=True,
     )
     bpy.ops.export_scene.gltf(
         filepath=str(out / f"{stem}_twin.glb"),

@@ -230,3 +230,32 @@ fn each_primitive_keeps_its_material() {
     }
     assert_eq!(next, (asset.vertex_count() as u32, asset.triangle_count() as u32));
 }
+
+/// A `.gltf` whose buffer is a `data:` URI (base64) and one whose `.bin` name needs
+/// percent-decoding load as the `.glb` they were made from.
+#[test]
+fn data_uris_and_percent_encoded_names_load() {
+    use base64::Engine;
+    let data = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data");
+    let glb = std::fs::read(data.join("blender_arm.glb")).unwrap();
+    let u32_at = |at: usize| u32::from_le_bytes(glb[at..at + 4].try_into().unwrap()) as usize;
+    let json_len = u32_at(12);
+    let mut json: serde_json::Value = serde_json::from_slice(&glb[20..20 + json_len]).unwrap();
+    let bin = &glb[28 + json_len..28 + json_len + u32_at(20 + json_len)];
+    let dir = crate::common::scratch("gltf-uris");
+    let encoded = base64::engine::general_purpose::STANDARD.encode(bin);
+    json["buffers"][0]["uri"] = serde_json::json!(format!("data:application/octet-stream;base64,{encoded}"));
+    std::fs::write(dir.join("embedded.gltf"), serde_json::to_vec(&json).unwrap()).unwrap();
+    json["buffers"][0]["uri"] = serde_json::json!("arm%20data.bin");
+    std::fs::write(dir.join("arm data.bin"), bin).unwrap();
+    std::fs::write(dir.join("named.gltf"), serde_json::to_vec(&json).unwrap()).unwrap();
+    let expected = marionette::formats::load_character(&data.join("blender_arm.glb")).unwrap();
+    for file in ["embedded.gltf", "named.gltf"] {
+        let loaded = marionette::formats::load_character(&dir.join(file)).unwrap_or_else(|e| panic!("{e}"));
+        assert!(loaded.skin == expected.skin && loaded.skeleton == expected.skeleton, "{file}");
+    }
+    json["buffers"][0]["uri"] = serde_json::json!("data:application/octet-stream;base64,@@@@");
+    std::fs::write(dir.join("bad.gltf"), serde_json::to_vec(&json).unwrap()).unwrap();
+    let e = marionette::formats::load_character(&dir.join("bad.gltf")).unwrap_err().to_string();
+    assert!(e.contains("bad.gltf") && e.contains("buffers[0].uri") && e.contains("base64"), "{e}");
+}
