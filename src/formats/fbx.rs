@@ -156,7 +156,9 @@ impl Fbx<'_> {
                 let r = raw_of_node[bone.element.typed_id as usize].expect("a bone is relevant");
                 // The mesh's vertices go into the model's space (`mesh`), so its binds
                 // start from there.
-                let bind = mat4(&cluster.geometry_to_bone) * mat4(&self.node(m).geometry_to_world).inverse();
+                let mut bind = mat4(&cluster.geometry_to_bone) * mat4(&self.node(m).geometry_to_world).inverse();
+                // Affine by construction: its last row exactly so.
+                (bind.x_axis.w, bind.y_axis.w, bind.z_axis.w, bind.w_axis.w) = (0.0, 0.0, 0.0, 1.0);
                 let slot = match bound[r] {
                     None => {
                         bound[r] = Some(bind);
@@ -208,7 +210,8 @@ impl Fbx<'_> {
             textured,
             ..
         } = geometry;
-        if textured {
+        // Coordinates matter where a material shows a texture (as glTF import keeps them).
+        if textured && materials.iter().any(|m| m.textures().next().is_some()) {
             skin.texcoords = texcoords;
         }
         let (weights, normalised) =
@@ -313,7 +316,7 @@ impl Fbx<'_> {
             }
             let vertices = v0..out.skin.bind_positions.len() as u32;
             let triangles = t0..out.skin.triangles.len() as u32;
-            out.surfaces.push(Surface { vertices, triangles, material: ours });
+            crate::rig::material::push_surface(&mut out.surfaces, Surface { vertices, triangles, material: ours });
         }
         let count = out.skin.bind_positions.len() - first;
         let mut rows: Vec<Vec<(usize, f32)>> = vec![Vec::new(); count];
@@ -360,6 +363,7 @@ impl Fbx<'_> {
                         deltas.extend(corners.get(point as usize).into_iter().flatten().map(|&v| (v, d)));
                     }
                 }
+                deltas.sort_by_key(|&(v, _)| v);
                 out.morph_channels.push((channel.element.element_id, out.morphs.len()));
                 out.morphs.push(MorphTarget { name: channel.element.name.to_string(), deltas });
                 let w = channel.weight as f32;

@@ -121,6 +121,17 @@ impl Builder {
         self.accessors.len() - 1
     }
 
+    /// Appends `bytes` as a buffer view (4-byte aligned, no accessor: an image); returns
+    /// its index.
+    fn view(&mut self, bytes: &[u8]) -> usize {
+        while !self.bin.len().is_multiple_of(4) {
+            self.bin.push(0);
+        }
+        self.views.push(json!({ "buffer": 0, "byteOffset": self.bin.len(), "byteLength": bytes.len() }));
+        self.bin.extend_from_slice(bytes);
+        self.views.len() - 1
+    }
+
     fn positions(&mut self, points: &[Vec3]) -> usize {
         let (lo, hi) = crate::rig::skinning::bounds(points);
         let bytes: Vec<u8> = points.iter().flat_map(|p| p.to_array()).flat_map(f32::to_le_bytes).collect();
@@ -139,7 +150,8 @@ impl Builder {
 /// finite (a NaN pose or position: nothing is written then).
 pub fn write_glb(characters: &[GltfCharacter], mesh: GltfMesh) -> Result<Vec<u8>, String> {
     let mut b = Builder::default();
-    let (mut meshes, mut skins, mut materials, mut roots) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
+    let (mut meshes, mut skins, mut roots) = (Vec::new(), Vec::new(), Vec::new());
+    let mut looks = super::gltf_out_materials::Materials::default();
     let mut animations = Vec::new();
     for c in characters {
         let placement = b.node(json!({
@@ -149,55 +161,24 @@ pub fn write_glb(characters: &[GltfCharacter], mesh: GltfMesh) -> Result<Vec<u8>
             "scale": [c.scale, c.scale, c.scale],
         }));
         roots.push(placement);
-        materials.push(json!({
-            "name": c.name,
-            "pbrMetallicRoughness": { "baseColorFactor": [c.tint[0], c.tint[1], c.tint[2], 1.0],
-                "metallicFactor": 0.0, "roughnessFactor": 0.75 },
-        }));
         let skin = &c.asset.skin;
-        let indices: Vec<u8> = skin.triangles.iter().flatten().flat_map(|i| i.to_le_bytes()).collect();
-        let index_accessor = b.accessor(
-            &indices,
-            Some(ELEMENT_ARRAY_BUFFER),
-            json!({ "componentType": UNSIGNED_INT, "count": skin.triangles.len() * 3, "type": "SCALAR" }),
-        );
         let mut children = Vec::new();
-        let mut attributes = serde_json::Map::new();
         let mut mesh_node = json!({ "name": format!("{} mesh", c.name), "mesh": meshes.len() });
-        match mesh {
+        let positions = match mesh {
             GltfMesh::Baked => {
                 let (skeleton, binds) = (&c.asset.skeleton, &c.asset.bind_world_to_joint);
                 let palette = crate::rig::fk::posed_palette_with_rest(skeleton, binds, c.pose, c.rest, root_origin(c));
                 let mut posed = vec![Vec3::ZERO; skin.bind_positions.len()];
                 crate::rig::lbs::skin(&skin.bind_positions, &skin.weights, &palette, &mut posed);
-                attributes.insert("POSITION".into(), json!(b.positions(&posed)));
+                posed
             }
             GltfMesh::Skinned => {
-                attributes.insert("POSITION".into(), json!(b.positions(&skin.bind_positions)));
-                for (set, (joints, weights)) in influence_sets(c.asset).into_iter().enumerate() {
-                    let count = skin.bind_positions.len();
-                    let j = b.accessor(
-                        &joints,
-                        Some(ARRAY_BUFFER),
-                        json!({ "componentType": UNSIGNED_SHORT, "count": count, "type": "VEC4" }),
-                    );
-                    let w = b.accessor(
-                        &weights,
-                        Some(ARRAY_BUFFER),
-                        json!({ "componentType": FLOAT, "count": count, "type": "VEC4" }),
-                    );
-                    attributes.insert(format!("JOINTS_{set}"), json!(j));
-                    attributes.insert(format!("WEIGHTS_{set}"), json!(w));
-                }
                 let (top, joints) = skeleton_nodes(&mut b, c);
                 children.push(top);
-                let inverse: Vec<u8> = c
-                    .asset
-                    .bind_world_to_joint
-                    .iter()
-                    .flat_map(Mat4::to_cols_array)
-                    .flat_map(f32::to_le_bytes)
-                    .collect();
+                // Inverse binds are affine: their last row goes out exactly (0, 0, 0, 1).
+                let affine = |m: &Mat4| Mat4::from(glam::Affine3A::from_mat4(*m)).to_cols_array();
+                let inverse: Vec<u8> =
+                    c.asset.bind_world_to_joint.iter().flat_map(affine).flat_map(f32::to_le_bytes).collect();
                 let ibm = b.accessor(
                     &inverse,
                     None,
@@ -207,6 +188,7 @@ pub fn write_glb(characters: &[GltfCharacter], mesh: GltfMesh) -> Result<Vec<u8>
                     let name = if c.motion_name.is_empty() { c.name } else { &c.motion_name };
                     animations.push(animation(&mut b, name, motion, &joints));
                 }
+                // The mesh node is the next node written.
                 let mesh_node_index = b.nodes.len();
                 for clip in c.clips {
                     animations.push(clip_animation(&mut b, clip, &joints, mesh_node_index, c.morph_weights));
@@ -215,19 +197,17 @@ pub fn write_glb(characters: &[GltfCharacter], mesh: GltfMesh) -> Result<Vec<u8>
                 skins.push(
                     json!({ "name": c.name, "joints": joints, "skeleton": joints[0], "inverseBindMatrices": ibm }),
                 );
+                skin.bind_positions.clone()
             }
-        }
-        let mut primitive =
-            json!({ "attributes": attributes, "indices": index_accessor, "material": materials.len() - 1 });
-        let mut mesh_json = json!({ "name": c.name });
+        };
+        let primitives = surface_primitives(&mut b, &mut looks, c, &positions, mesh);
+        let mut mesh_json = json!({ "name": c.name, "primitives": primitives });
         if mesh == GltfMesh::Skinned && !c.asset.morphs.is_empty() {
-            primitive["targets"] = json!(morph_targets(&mut b, c.asset));
             let mut weights = c.morph_weights.to_vec();
             weights.resize(c.asset.morphs.len(), 0.0);
             mesh_json["weights"] = json!(weights);
             mesh_json["extras"] = json!({ "targetNames": c.asset.morphs.iter().map(|m| &m.name).collect::<Vec<_>>() });
         }
-        mesh_json["primitives"] = json!([primitive]);
         meshes.push(mesh_json);
         // A skinned mesh's node sits at the scene's root (its skeleton places it); a baked
         // one under the placement.
@@ -246,7 +226,7 @@ pub fn write_glb(characters: &[GltfCharacter], mesh: GltfMesh) -> Result<Vec<u8>
         "scenes": [{ "nodes": roots }],
         "nodes": b.nodes,
         "meshes": meshes,
-        "materials": materials,
+        "materials": looks.materials,
         "accessors": b.accessors,
         "bufferViews": b.views,
         "buffers": [{ "byteLength": b.bin.len() }],
@@ -256,6 +236,14 @@ pub fn write_glb(characters: &[GltfCharacter], mesh: GltfMesh) -> Result<Vec<u8>
     }
     if !animations.is_empty() {
         doc["animations"] = json!(animations);
+    }
+    for (key, list) in [("textures", looks.textures), ("images", looks.images), ("samplers", looks.samplers)] {
+        if !list.is_empty() {
+            doc[key] = json!(list);
+        }
+    }
+    if looks.transformed {
+        doc["extensionsUsed"] = json!(["KHR_texture_transform"]);
     }
     if let Some(a) = b.non_finite {
         return Err(format!("at $.accessors[{a}]: the glTF would hold a number that is not finite"));
@@ -364,14 +352,92 @@ fn skeleton_nodes(b: &mut Builder, c: &GltfCharacter) -> (usize, Vec<usize>) {
     (first - usize::from(framed), (first..first + skeleton.len()).collect())
 }
 
-/// The morph targets as glTF targets: each one's position deltas for every vertex.
-fn morph_targets(b: &mut Builder, asset: &CharacterAsset) -> Vec<Value> {
+/// One primitive per surface of the character: its own vertices (`positions`, with
+/// weights, coordinates, colours and morph deltas for a skinned mesh), its triangles
+/// counted from its first vertex, and its material (the asset's, or the tint).
+fn surface_primitives(
+    b: &mut Builder,
+    looks: &mut super::gltf_out_materials::Materials,
+    c: &GltfCharacter,
+    positions: &[Vec3],
+    mesh: GltfMesh,
+) -> Vec<Value> {
+    let skin = &c.asset.skin;
+    let sets = if mesh == GltfMesh::Skinned { influence_sets(c.asset) } else { Vec::new() };
+    let mut ours: std::collections::HashMap<Option<usize>, usize> = std::collections::HashMap::new();
+    let mut primitives = Vec::new();
+    // A surface without triangles draws nothing (and glTF has no empty accessors).
+    for surface in c.asset.surfaces().iter().filter(|s| !s.triangles.is_empty() && !s.vertices.is_empty()) {
+        let (first, end) = (surface.vertices.start as usize, surface.vertices.end as usize);
+        let count = end - first;
+        let mut attributes = serde_json::Map::new();
+        attributes.insert("POSITION".into(), json!(b.positions(&positions[first..end])));
+        for (set, (joints, weights)) in sets.iter().enumerate() {
+            let j = b.accessor(
+                &joints[first * 8..end * 8],
+                Some(ARRAY_BUFFER),
+                json!({ "componentType": UNSIGNED_SHORT, "count": count, "type": "VEC4" }),
+            );
+            let w = b.accessor(
+                &weights[first * 16..end * 16],
+                Some(ARRAY_BUFFER),
+                json!({ "componentType": FLOAT, "count": count, "type": "VEC4" }),
+            );
+            attributes.insert(format!("JOINTS_{set}"), json!(j));
+            attributes.insert(format!("WEIGHTS_{set}"), json!(w));
+        }
+        if let Some(uv) = skin.texcoords.get(first..end) {
+            let bytes: Vec<u8> = uv.iter().flat_map(|t| t.to_array()).flat_map(f32::to_le_bytes).collect();
+            let a = b.accessor(
+                &bytes,
+                Some(ARRAY_BUFFER),
+                json!({ "componentType": FLOAT, "count": count, "type": "VEC2" }),
+            );
+            attributes.insert("TEXCOORD_0".into(), json!(a));
+        }
+        if let Some(colors) = skin.colors.get(first..end) {
+            let bytes: Vec<u8> = colors.iter().flatten().flat_map(|x| x.to_le_bytes()).collect();
+            let a = b.accessor(
+                &bytes,
+                Some(ARRAY_BUFFER),
+                json!({ "componentType": FLOAT, "count": count, "type": "VEC4" }),
+            );
+            attributes.insert("COLOR_0".into(), json!(a));
+        }
+        let triangles = &skin.triangles[surface.triangles.start as usize..surface.triangles.end as usize];
+        let indices: Vec<u8> =
+            triangles.iter().flatten().flat_map(|&i| (i - surface.vertices.start).to_le_bytes()).collect();
+        let index_accessor = b.accessor(
+            &indices,
+            Some(ELEMENT_ARRAY_BUFFER),
+            json!({ "componentType": UNSIGNED_INT, "count": triangles.len() * 3, "type": "SCALAR" }),
+        );
+        let material = *ours.entry(surface.material).or_insert_with(|| {
+            match surface.material.and_then(|m| c.asset.materials.get(m)) {
+                Some(m) => looks.material(m, &mut |bytes| b.view(bytes)),
+                None => looks.tint(c.name, c.tint),
+            }
+        });
+        let mut primitive = json!({ "attributes": attributes, "indices": index_accessor, "material": material });
+        if mesh == GltfMesh::Skinned && !c.asset.morphs.is_empty() {
+            primitive["targets"] = json!(morph_targets(b, c.asset, first..end));
+        }
+        primitives.push(primitive);
+    }
+    primitives
+}
+
+/// The morph targets as glTF targets: each one's position deltas for the vertices `range`.
+fn morph_targets(b: &mut Builder, asset: &CharacterAsset, range: std::ops::Range<usize>) -> Vec<Value> {
     asset
         .morphs
         .iter()
         .map(|m| {
-            let mut deltas = vec![Vec3::ZERO; asset.vertex_count()];
-            m.deltas.iter().for_each(|&(v, d)| deltas[v as usize] = d);
+            let mut deltas = vec![Vec3::ZERO; range.len()];
+            m.deltas
+                .iter()
+                .filter(|(v, _)| range.contains(&(*v as usize)))
+                .for_each(|&(v, d)| deltas[v as usize - range.start] = d);
             json!({ "POSITION": b.positions(&deltas) })
         })
         .collect()

@@ -55,6 +55,8 @@ impl Looks {
     ) -> Result<(), String> {
         let material = match primitive.material().index() {
             None => None,
+            // Our own export's tint: a surface without a material of its own.
+            Some(_) if is_tint(&primitive.material()) => None,
             Some(index) => Some(match self.ours.get(&index) {
                 Some(&ours) => ours,
                 None => {
@@ -67,13 +69,7 @@ impl Looks {
             }),
         };
         let vertices = first as u32..(first + count) as u32;
-        match self.surfaces.last_mut() {
-            Some(last) if last.material == material && last.vertices.end == vertices.start => {
-                last.vertices.end = vertices.end;
-                last.triangles.end = triangles.end;
-            }
-            _ => self.surfaces.push(Surface { vertices, triangles, material }),
-        }
+        crate::rig::material::push_surface(&mut self.surfaces, Surface { vertices, triangles, material });
         let reader = primitive.reader(|b| source.buffers.get(b.index()).map(|d| &**d));
         self.texcoords.resize(first, Vec2::ZERO);
         if let Some(uv) = reader.read_tex_coords(0) {
@@ -221,4 +217,12 @@ fn info(i: gltf::texture::Info<'_>) -> (gltf::Texture<'_>, u32, Option<TextureTr
     });
     let set = i.texture_transform().and_then(|t| t.tex_coord()).unwrap_or(i.tex_coord());
     (i.texture(), set, transform.filter(|t| t.offset.is_finite() && t.rotation.is_finite() && t.scale.is_finite()))
+}
+
+/// Whether a material is the tint Marionette's export gives a surface without a material.
+fn is_tint(m: &gltf::Material) -> bool {
+    m.extras()
+        .as_ref()
+        .and_then(|raw| serde_json::from_str::<serde_json::Value>(raw.get()).ok())
+        .is_some_and(|v| v.get(super::gltf_out_materials::TINT_MARK) == Some(&serde_json::Value::Bool(true)))
 }

@@ -13,6 +13,7 @@ pub mod gltf;
 pub mod gltf_check;
 pub mod gltf_import;
 pub mod gltf_materials;
+pub mod gltf_out_materials;
 pub mod homer;
 pub mod limits;
 pub mod mit6837;

@@ -148,6 +148,22 @@ impl TextureTransform {
     }
 }
 
+/// Appends `surface`, merged into the last one when it goes on from it in the same
+/// material.
+pub fn push_surface(surfaces: &mut Vec<Surface>, surface: Surface) {
+    match surfaces.last_mut() {
+        Some(last)
+            if last.material == surface.material
+                && last.vertices.end == surface.vertices.start
+                && last.triangles.end == surface.triangles.start =>
+        {
+            last.vertices.end = surface.vertices.end;
+            last.triangles.end = surface.triangles.end;
+        }
+        _ => surfaces.push(surface),
+    }
+}
+
 /// A run of the mesh drawn with one material: its vertices and triangles (indices into
 /// the skin's), and the material (none: the character's own tint).
 #[derive(Debug, Clone, PartialEq)]

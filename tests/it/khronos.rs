@@ -118,14 +118,17 @@ fn a_skeleton_under_another_skins_joint_moves_with_it() {
     eprintln!("nested: spec {worst:.2e}, Blender {worst_blender:.2e}, size {size:.3}");
 }
 
-/// `export F.glb --animation --out x.glb` and reading `x.glb` back gives the file's parts
+/// `export F.glb|F.fbx --animation --out x.glb` and reading `x.glb` back gives the file's parts
 /// again: the same joints (names, parents, rest), vertices, triangles, weights, morph
-/// targets, and every clip under its own name, key for key (times, values,
+/// targets, surfaces, materials with their images (embedded as PNG), texture coordinates
+/// and colours, and every clip under its own name, key for key (times, values,
 /// interpolation), so it poses the same at any time.
 #[test]
 fn an_exported_glb_reads_back_key_for_key() {
     let data = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data");
-    let mut files = vec![data.join("blender_nested.glb"), data.join("blender_pair.glb")];
+    let mut files = ["blender_nested.glb", "blender_pair.glb", "blender_nested.fbx", "blender_pair.fbx"]
+        .map(|f| data.join(f))
+        .to_vec();
     if let Some(dir) = crate::common::optional_data_dir() {
         files.extend(
             ["Fox", "CesiumMan", "BrainStem", "AnimatedMorphCube"].map(|m| dir.join(format!("khronos/{m}.glb"))),
@@ -133,13 +136,13 @@ fn an_exported_glb_reads_back_key_for_key() {
     }
     let dir = crate::common::scratch("gltf-round-trip");
     for path in &files {
-        let out = dir.join(path.file_name().unwrap());
+        let out = dir.join(path.file_name().unwrap()).with_extension("glb");
         let run = std::process::Command::new(env!("CARGO_BIN_EXE_marionette"))
             .args(["export", path.to_str().unwrap(), "--animation", "--out", out.to_str().unwrap()])
             .output()
             .unwrap();
         assert!(run.status.success(), "{}", String::from_utf8_lossy(&run.stderr));
-        let before = marionette::formats::gltf_import::load_gltf(path).unwrap();
+        let before = marionette::formats::load_parts(path).unwrap();
         let after = marionette::formats::gltf_import::load_gltf(&out).unwrap();
         let name = path.display();
         assert_eq!(before.len(), after.len(), "{name}");
@@ -165,6 +168,43 @@ fn an_exported_glb_reads_back_key_for_key() {
                 assert!(same, "{name}: vertex {v}'s weights {ra:?} and {rb:?}");
             }
             assert!(a.asset.morphs == b.asset.morphs, "{name}: morphs");
+            assert!(a.asset.surfaces() == b.asset.surfaces(), "{name}: surfaces");
+            assert_eq!(a.asset.skin.texcoords, b.asset.skin.texcoords, "{name}: texture coordinates");
+            assert_eq!(a.asset.skin.colors, b.asset.skin.colors, "{name}: colours");
+            assert_eq!(a.asset.materials.len(), b.asset.materials.len(), "{name}: materials");
+            for (ma, mb) in a.asset.materials.iter().zip(&b.asset.materials) {
+                // The same but for where the images came from (their keys name the file).
+                let pixels = |m: &marionette::rig::material::Material| -> Vec<Vec<u8>> {
+                    m.textures()
+                        .map(|(_, t)| match &t.image {
+                            marionette::rig::SkinTexture::Picture { picture, .. } => picture.pixels.clone(),
+                            marionette::rig::SkinTexture::File(_) => Vec::new(),
+                        })
+                        .collect()
+                };
+                assert_eq!(pixels(ma), pixels(mb), "{name}: {}'s images", ma.name);
+                let bare = |m: &marionette::rig::material::Material| {
+                    let strip = |t: &Option<marionette::rig::material::TextureRef>| {
+                        t.as_ref().map(|t| (t.sampler, t.transform))
+                    };
+                    (
+                        m.name.clone(),
+                        m.base_color,
+                        m.metallic,
+                        m.roughness,
+                        m.emissive,
+                        m.alpha,
+                        m.double_sided,
+                        [
+                            strip(&m.base_color_texture),
+                            strip(&m.metallic_roughness_texture),
+                            strip(&m.normal_texture),
+                            strip(&m.emissive_texture),
+                        ],
+                    )
+                };
+                assert_eq!(bare(ma), bare(mb), "{name}: material {}", ma.name);
+            }
             assert_eq!(a.morph_weights, b.morph_weights, "{name}");
             assert_eq!(a.clips.len(), b.clips.len(), "{name}");
             for (ca, cb) in a.clips.iter().zip(&b.clips) {
