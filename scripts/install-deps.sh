@@ -3,7 +3,7 @@
 # wayland headers), and to render without a GPU (Vulkan on Mesa's llvmpipe, Xvfb).
 # Run as root or with sudo available.
 set -euo pipefail
-packages=(pkg-config libudev-dev libx11-dev libxkbcommon-dev libxkbcommon-x11-0 libwayland-dev
+packages=(gcc pkg-config libudev-dev libx11-dev libxkbcommon-dev libxkbcommon-x11-0 libwayland-dev
           mesa-vulkan-drivers libvulkan1 xvfb xauth)
 missing=()
 for p in "${packages[@]}"; do

@@ -91,7 +91,7 @@ fn export_gltf_file(
         for source in library.sources_of(path) {
             let asset = library.load(&source)?;
             let mut c = library.new_character_doc(source.clone(), &asset);
-            let part = library.gltf_source(&source);
+            let part = library.part_of_source(&source);
             let found =
                 clip.clip.as_deref().and_then(|spec| crate::document::posing::find_clip(&part?.clips, spec).cloned());
             c.playback =

@@ -131,7 +131,7 @@ fn posed(
         }
         (posed.root, posed.pose) = clip.pose_at(skeleton, anim.time, &posed.pose);
     }
-    if let Some(part) = library.gltf_source(&c.source) {
+    if let Some(part) = library.part_of_source(&c.source) {
         if let Some(playback) = &c.playback {
             play_node_clip(&mut posed, skeleton, &part.clips, playback)
                 .map_err(|e| FormatError::other(c.source.path().unwrap_or(std::path::Path::new(&c.name)), e))?;

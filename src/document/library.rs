@@ -1,4 +1,4 @@
-//! The asset library: characters (and their clips, SMPL bodies, glTF parts) loaded by
+//! The asset library: characters (and their clips, SMPL bodies, glTF and FBX parts) loaded by
 //! source, once, and shared by every scene character made from them. No Bevy: the editor
 //! keeps one as a resource, `export` and `render` make their own.
 
@@ -18,12 +18,12 @@ pub struct AssetLibrary {
     smpl: HashMap<PathBuf, SmplSet>,
     bound: HashMap<(SourceDoc, BindingDoc), Arc<CharacterAsset>>,
     keyframe_clips: HashMap<PathBuf, Arc<crate::rig::anim::Clip>>,
-    gltf: HashMap<PathBuf, Vec<GltfPart>>,
+    parts: HashMap<PathBuf, Vec<LoadedPart>>,
 }
 
-/// One part of a glTF file, loaded: its asset, its clips and its morph weights.
+/// One part of a glTF or FBX file, loaded: its asset, its clips and its morph weights.
 #[derive(Clone)]
-pub struct GltfPart {
+pub struct LoadedPart {
     pub asset: Arc<CharacterAsset>,
     pub clips: Arc<[crate::rig::node_clip::NodeClip]>,
     pub morph_weights: Vec<f32>,
@@ -79,18 +79,18 @@ impl AssetLibrary {
                 asset
             }
             SourceDoc::File(path) if crate::formats::has_parts(path) => {
-                return Ok(self.gltf_part(path, 0)?.asset);
+                return Ok(self.file_part(path, 0)?.asset);
             }
-            SourceDoc::Part(path, n) => return Ok(self.gltf_part(path, *n)?.asset),
+            SourceDoc::Part(path, n) => return Ok(self.file_part(path, *n)?.asset),
             SourceDoc::File(path) => load_character(path)?,
         });
         self.cache.insert(source.clone(), asset.clone());
         Ok(asset)
     }
 
-    /// Character `n` of the glTF file at `path` (the file read once).
-    pub fn gltf_part(&mut self, path: &Path, n: usize) -> Result<GltfPart, FormatError> {
-        let parts = self.gltf_parts(path)?;
+    /// Part `n` of the glTF or FBX file at `path` (the file read once).
+    pub fn file_part(&mut self, path: &Path, n: usize) -> Result<LoadedPart, FormatError> {
+        let parts = self.file_parts(path)?;
         parts.get(n).cloned().ok_or_else(|| {
             FormatError::other(
                 path,
@@ -99,26 +99,26 @@ impl AssetLibrary {
         })
     }
 
-    /// Every character of the glTF file at `path` (the file read once).
-    pub fn gltf_parts(&mut self, path: &Path) -> Result<&[GltfPart], FormatError> {
-        if !self.gltf.contains_key(path) {
+    /// Every part of the glTF or FBX file at `path` (the file read once).
+    pub fn file_parts(&mut self, path: &Path) -> Result<&[LoadedPart], FormatError> {
+        if !self.parts.contains_key(path) {
             let parts = crate::formats::load_parts(path)?
                 .into_iter()
-                .map(|c| GltfPart { asset: Arc::new(c.asset), clips: c.clips.into(), morph_weights: c.morph_weights })
+                .map(|c| LoadedPart { asset: Arc::new(c.asset), clips: c.clips.into(), morph_weights: c.morph_weights })
                 .collect();
-            self.gltf.insert(path.to_path_buf(), parts);
+            self.parts.insert(path.to_path_buf(), parts);
         }
-        Ok(&self.gltf[path])
+        Ok(&self.parts[path])
     }
 
-    /// The sources of a path: one per character of a glTF file (its first as `File`, the
+    /// The sources of a path: one per part of a glTF or FBX file (its first as `File`, the
     /// others as `Part`), or the path itself.
     pub fn sources_of(&mut self, path: &Path) -> Vec<SourceDoc> {
         let file = SourceDoc::File(path.to_path_buf());
         if !crate::formats::has_parts(path) {
             return vec![file];
         }
-        let count = self.gltf_parts(path).map_or(1, <[GltfPart]>::len);
+        let count = self.file_parts(path).map_or(1, <[LoadedPart]>::len);
         std::iter::once(file).chain((1..count).map(|n| SourceDoc::Part(path.to_path_buf(), n))).collect()
     }
 
@@ -129,7 +129,7 @@ impl AssetLibrary {
         if asset.surfaces().iter().all(|s| s.material.is_some()) {
             doc.view.tint = [1.0; 3];
         }
-        if let Some(part) = self.gltf_source(&doc.source)
+        if let Some(part) = self.part_of_source(&doc.source)
             && part.morph_weights.iter().any(|&w| w != 0.0)
         {
             doc.morphs = part.morph_weights;
@@ -137,11 +137,11 @@ impl AssetLibrary {
         doc
     }
 
-    /// The glTF character a source names, if it is one.
-    pub fn gltf_source(&mut self, source: &SourceDoc) -> Option<GltfPart> {
+    /// The glTF or FBX part a source names, if it is one.
+    pub fn part_of_source(&mut self, source: &SourceDoc) -> Option<LoadedPart> {
         match source {
-            SourceDoc::File(p) if crate::formats::has_parts(p) => self.gltf_part(p, 0).ok(),
-            SourceDoc::Part(p, n) => self.gltf_part(p, *n).ok(),
+            SourceDoc::File(p) if crate::formats::has_parts(p) => self.file_part(p, 0).ok(),
+            SourceDoc::Part(p, n) => self.file_part(p, *n).ok(),
             _ => None,
         }
     }

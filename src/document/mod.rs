@@ -12,4 +12,4 @@ pub mod library;
 pub mod posing;
 pub mod scenes;
 
-pub use library::{AssetLibrary, GltfPart, SmplSet, own_motion, rebind};
+pub use library::{AssetLibrary, LoadedPart, SmplSet, own_motion, rebind};

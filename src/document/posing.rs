@@ -121,7 +121,7 @@ pub fn find_clip<'a>(clips: &'a [NodeClip], spec: &str) -> Option<&'a NodeClip> 
 /// the vertices and triangles of all of them, in file order. Fails when no character has
 /// the clip.
 pub fn posed_gltf(
-    characters: &[crate::formats::gltf_import::ImportedCharacter],
+    characters: &[crate::formats::part::Part],
     clip: Option<&str>,
     time: f32,
     poses: &[PoseSpec],

@@ -110,7 +110,7 @@ pub fn has_parts(path: &Path) -> bool {
 }
 
 /// Every part of a glTF or FBX file (at least one).
-pub fn load_parts(path: &Path) -> Result<Vec<super::gltf_import::ImportedCharacter>, FormatError> {
+pub fn load_parts(path: &Path) -> Result<Vec<super::part::Part>, FormatError> {
     if super::fbx::is_fbx(path) { super::fbx::load_fbx(path) } else { super::gltf_import::load_gltf(path) }
 }
 
@@ -245,12 +245,6 @@ fn load_6837_skin(
     let (weights, normalised) =
         mit6837::parse_attach(open(attach_path)?, attach_path, skeleton.len(), mesh.positions.len())?;
     let warnings = super::weight_warnings::normalised_warnings(attach_path, &normalised);
-    let skin = Skin {
-        bind_positions: mesh.positions,
-        triangles: mesh.triangles,
-        weights,
-        texcoords: Vec::new(),
-        colors: Vec::new(),
-    };
+    let skin = Skin::untextured(mesh.positions, mesh.triangles, weights);
     CharacterAsset::new(name, skeleton, skin, warnings).map_err(|e| FormatError::rig(obj_path, e))
 }

@@ -14,7 +14,7 @@ use std::path::Path;
 use glam::{Mat4, Quat, Vec2, Vec3};
 
 use super::error::FormatError;
-use super::gltf_import::ImportedCharacter;
+use super::part::Part;
 use crate::rig::material::{Material, Surface, TextureRef};
 use crate::rig::node_clip::{Interpolation, JointTracks, NodeClip, Track};
 use crate::rig::{
@@ -27,13 +27,13 @@ pub fn is_fbx(path: &Path) -> bool {
 }
 
 /// Loads an FBX file's character (or prop).
-pub fn load_fbx(path: &Path) -> Result<Vec<ImportedCharacter>, FormatError> {
+pub fn load_fbx(path: &Path) -> Result<Vec<Part>, FormatError> {
     let bytes = super::error::read_file(path)?;
     parse_fbx(&bytes, path)
 }
 
 /// The character of an FBX file's bytes (textures are looked for beside `path`).
-pub fn parse_fbx(bytes: &[u8], path: &Path) -> Result<Vec<ImportedCharacter>, FormatError> {
+pub fn parse_fbx(bytes: &[u8], path: &Path) -> Result<Vec<Part>, FormatError> {
     let opts = ufbx::LoadOpts {
         target_axes: ufbx::CoordinateAxes::right_handed_y_up(),
         target_unit_meters: 1.0,
@@ -118,7 +118,7 @@ impl Fbx<'_> {
         node.parent.as_ref().filter(|p| !p.is_root).map(|p| p.element.typed_id)
     }
 
-    fn part(&self) -> Result<ImportedCharacter, FormatError> {
+    fn part(&self) -> Result<Part, FormatError> {
         let n = self.scene.nodes.len();
         let mesh_nodes: Vec<u32> =
             self.scene.nodes.iter().filter(|n| n.mesh.is_some() && !n.is_root).map(|n| n.element.typed_id).collect();
@@ -227,7 +227,7 @@ impl Fbx<'_> {
         asset.morphs = morphs;
         asset.materials = materials;
         asset.surfaces = surfaces;
-        Ok(ImportedCharacter { asset, clips, morph_weights })
+        Ok(Part { asset, clips, morph_weights })
     }
 
     /// The relevant nodes as raw joints, depth first (a common root named `name` when

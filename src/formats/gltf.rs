@@ -474,38 +474,26 @@ fn clip_animation(b: &mut Builder, clip: &NodeClip, joints: &[usize], mesh_node:
             channels.push(json!({ "sampler": samplers.len() - 1, "target": { "node": node, "path": path } }));
         };
     for (tracks, &node) in clip.tracks.iter().zip(joints) {
-        if let Some(t) = &tracks.translation {
-            add(
-                b,
-                node,
-                "translation",
-                &t.times,
-                t.values.iter().flat_map(|v| v.to_array()).collect(),
-                "VEC3",
-                t.interpolation,
-            );
-        }
-        if let Some(t) = &tracks.rotation {
-            add(
-                b,
-                node,
-                "rotation",
-                &t.times,
-                t.values.iter().flat_map(|v| v.to_array()).collect(),
-                "VEC4",
-                t.interpolation,
-            );
-        }
-        if let Some(t) = &tracks.scale {
-            add(
-                b,
-                node,
-                "scale",
-                &t.times,
-                t.values.iter().flat_map(|v| v.to_array()).collect(),
-                "VEC3",
-                t.interpolation,
-            );
+        let flat = |values: &mut dyn Iterator<Item = f32>| values.collect::<Vec<f32>>();
+        let keyed = [
+            tracks.translation.as_ref().map(|t| {
+                (
+                    "translation",
+                    &t.times,
+                    flat(&mut t.values.iter().flat_map(|v| v.to_array())),
+                    "VEC3",
+                    t.interpolation,
+                )
+            }),
+            tracks.rotation.as_ref().map(|t| {
+                ("rotation", &t.times, flat(&mut t.values.iter().flat_map(|q| q.to_array())), "VEC4", t.interpolation)
+            }),
+            tracks.scale.as_ref().map(|t| {
+                ("scale", &t.times, flat(&mut t.values.iter().flat_map(|v| v.to_array())), "VEC3", t.interpolation)
+            }),
+        ];
+        for (path, times, values, kind, interpolation) in keyed.into_iter().flatten() {
+            add(b, node, path, times, values, kind, interpolation);
         }
     }
     if let Some((times, values, interpolation)) = combined_weights(&clip.weights, weights) {

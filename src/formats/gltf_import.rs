@@ -18,19 +18,9 @@ use std::path::Path;
 use glam::{Mat4, Quat, Vec3};
 
 use super::error::FormatError;
+use super::part::Part;
 use crate::rig::node_clip::{Interpolation, JointTracks, NodeClip, Track};
 use crate::rig::{CharacterAsset, JointRotation, MorphTarget, RawJoint, Skeleton, Skin, SkinWeights};
-
-/// One part of a glTF file: its asset (with its materials) and the file's animations of
-/// its nodes.
-#[derive(Debug, Clone)]
-pub struct ImportedCharacter {
-    pub asset: CharacterAsset,
-    pub clips: Vec<NodeClip>,
-    /// The morph targets' weights as the file sets them (`node.weights`, else
-    /// `mesh.weights`; 0 where unset).
-    pub morph_weights: Vec<f32>,
-}
 
 /// Whether `path` names a glTF file (`.glb`, `.gltf`).
 pub fn is_gltf(path: &Path) -> bool {
@@ -40,14 +30,14 @@ pub fn is_gltf(path: &Path) -> bool {
 }
 
 /// Loads every part (character or prop) of a glTF file.
-pub fn load_gltf(path: &Path) -> Result<Vec<ImportedCharacter>, FormatError> {
+pub fn load_gltf(path: &Path) -> Result<Vec<Part>, FormatError> {
     let bytes = super::error::read_file(path)?;
     parse_gltf(&bytes, path)
 }
 
 /// The parts of a glTF file's bytes (`.bin` files are looked for beside `path`): one per
 /// tree of nodes that carries a mesh, in the order of their first mesh node.
-pub fn parse_gltf(bytes: &[u8], path: &Path) -> Result<Vec<ImportedCharacter>, FormatError> {
+pub fn parse_gltf(bytes: &[u8], path: &Path) -> Result<Vec<Part>, FormatError> {
     let (gltf, bin) = validated(bytes).map_err(|e| FormatError::other(path, e))?;
     if let Some(ext) = gltf.extensions_required().next() {
         return Err(FormatError::other(path, format!("at $.extensionsRequired: needs `{ext}`, which is not read")));
@@ -224,7 +214,7 @@ impl<'a> File<'a> {
     }
 
     /// One part: its skeleton, bindings, meshes, morphs and clips.
-    fn part(&self, part: &PartNodes, n: usize, count: usize) -> Result<ImportedCharacter, FormatError> {
+    fn part(&self, part: &PartNodes, n: usize, count: usize) -> Result<Part, FormatError> {
         let mut warnings = Vec::new();
         let name = self.part_name(part, n, count);
         let (top, root_parent) = self.folded_top(part);
@@ -314,7 +304,7 @@ impl<'a> File<'a> {
         asset.morphs = morphs;
         asset.materials = looks.materials;
         asset.surfaces = looks.surfaces;
-        Ok(ImportedCharacter { asset, clips, morph_weights })
+        Ok(Part { asset, clips, morph_weights })
     }
 
     /// The node the part's skeleton starts at and the transform of the static nodes above

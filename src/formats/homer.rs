@@ -183,12 +183,6 @@ pub fn homer_character(
             bind_to_bones(&mesh.positions, &bones(&rig.skeleton, &rig.positions), rig.skeleton.len(), Binding::Smooth)
         }
     };
-    let skin = Skin {
-        bind_positions: mesh.positions,
-        triangles: mesh.triangles,
-        weights,
-        texcoords: Vec::new(),
-        colors: Vec::new(),
-    };
+    let skin = Skin::untextured(mesh.positions, mesh.triangles, weights);
     CharacterAsset::new(name, rig.skeleton, skin, warnings).map_err(|e| json_error(rig_path, "$", e))
 }

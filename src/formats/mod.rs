@@ -19,6 +19,7 @@ pub mod limits;
 pub mod mit6837;
 pub mod obj;
 pub mod off;
+pub mod part;
 pub mod puppet;
 pub mod scene;
 pub mod smpl;

@@ -173,13 +173,7 @@ pub fn embedded_puppet() -> crate::rig::CharacterAsset {
             skeleton.len(),
             mesh.positions.len(),
         )?;
-        let skin = crate::rig::Skin {
-            bind_positions: mesh.positions,
-            triangles: mesh.triangles,
-            weights,
-            texcoords: Vec::new(),
-            colors: Vec::new(),
-        };
+        let skin = crate::rig::Skin::untextured(mesh.positions, mesh.triangles, weights);
         crate::rig::CharacterAsset::new("puppet", skeleton, skin, Vec::new())
             .map_err(|e| crate::formats::FormatError::rig(Path::new("assets/puppet.obj"), e))
     };

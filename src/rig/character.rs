@@ -25,6 +25,11 @@ pub struct Skin {
 }
 
 impl Skin {
+    /// A skin of positions, triangles and weights, without texture coordinates or colours.
+    pub fn untextured(bind_positions: Vec<Vec3>, triangles: Vec<[u32; 3]>, weights: SkinWeights) -> Self {
+        Self { bind_positions, triangles, weights, texcoords: Vec::new(), colors: Vec::new() }
+    }
+
     /// Checks that weights and triangles fit the vertices.
     pub fn validate(&self) -> Result<(), RigError> {
         let count = self.bind_positions.len();

@@ -27,35 +27,27 @@ pub trait Keyed: Copy {
     fn tidy(self) -> Self;
 }
 
-impl Keyed for Vec3 {
-    fn lerp_to(self, other: Self, u: f32) -> Self {
-        self.lerp(other, u)
-    }
-    fn scaled(self, s: f32) -> Self {
-        self * s
-    }
-    fn plus(self, other: Self) -> Self {
-        self + other
-    }
-    fn tidy(self) -> Self {
-        self
-    }
+/// Values that blend linearly (vectors, morph weights).
+macro_rules! linear_keyed {
+    ($($t:ty),*) => {$(
+        impl Keyed for $t {
+            fn lerp_to(self, other: Self, u: f32) -> Self {
+                self + (other - self) * u
+            }
+            fn scaled(self, s: f32) -> Self {
+                self * s
+            }
+            fn plus(self, other: Self) -> Self {
+                self + other
+            }
+            fn tidy(self) -> Self {
+                self
+            }
+        }
+    )*};
 }
 
-impl Keyed for f32 {
-    fn lerp_to(self, other: Self, u: f32) -> Self {
-        self + (other - self) * u
-    }
-    fn scaled(self, s: f32) -> Self {
-        self * s
-    }
-    fn plus(self, other: Self) -> Self {
-        self + other
-    }
-    fn tidy(self) -> Self {
-        self
-    }
-}
+linear_keyed!(f32, Vec3);
 
 impl Keyed for Quat {
     fn lerp_to(self, other: Self, u: f32) -> Self {

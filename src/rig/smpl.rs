@@ -69,13 +69,7 @@ impl SmplModel {
         skeleton.set_rest_offsets(&self.rest_offsets(&self.shaped_joints(betas)));
         let mut positions = Vec::new();
         self.shaped_positions(betas, &mut positions);
-        let skin = Skin {
-            bind_positions: positions,
-            triangles: self.triangles.clone(),
-            weights: self.weights.clone(),
-            texcoords: Vec::new(),
-            colors: Vec::new(),
-        };
+        let skin = Skin::untextured(positions, self.triangles.clone(), self.weights.clone());
         CharacterAsset::new(name, skeleton, skin, Vec::new())
     }
 }

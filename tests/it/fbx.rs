@@ -51,7 +51,7 @@ fn fbx_fixtures_pose_as_their_gltf_twins() {
     for name in ["blender_arm", "blender_pair", "blender_nested"] {
         let fbx = marionette::formats::load_parts(&data.join(format!("{name}.fbx"))).unwrap();
         let twin = marionette::formats::load_parts(&data.join(format!("{name}_twin.glb"))).unwrap();
-        let morphs = |parts: &[marionette::formats::gltf_import::ImportedCharacter]| -> Vec<(String, f32)> {
+        let morphs = |parts: &[marionette::formats::part::Part]| -> Vec<(String, f32)> {
             let mut m: Vec<(String, f32)> = parts
                 .iter()
                 .flat_map(|p| p.asset.morphs.iter().map(|m| m.name.clone()).zip(p.morph_weights.iter().copied()))

@@ -70,13 +70,8 @@ fn chain_character(n: usize) -> Arc<CharacterAsset> {
     let skeleton = mit6837::parse_skel(Cursor::new(chain_6837(n)), path("chain.skel")).unwrap();
     let tip = 0.01 * (n - 1) as f32;
     let (weights, _) = SkinWeights::from_rows(vec![vec![(n - 1, 1.0)]; 3], n).unwrap();
-    let skin = Skin {
-        bind_positions: vec![Vec3::new(0.0, tip, 0.0), Vec3::new(0.1, tip, 0.0), Vec3::new(0.0, tip, 0.1)],
-        triangles: vec![[0, 1, 2]],
-        weights,
-        texcoords: Vec::new(),
-        colors: Vec::new(),
-    };
+    let corners = vec![Vec3::new(0.0, tip, 0.0), Vec3::new(0.1, tip, 0.0), Vec3::new(0.0, tip, 0.1)];
+    let skin = Skin::untextured(corners, vec![[0, 1, 2]], weights);
     Arc::new(CharacterAsset::new("chain", skeleton, skin, Vec::new()).unwrap())
 }
 

@@ -177,7 +177,7 @@ fn play_gltf_clip(
 ) {
     let mut played = 0;
     for c in &mut doc.characters {
-        let Some(part) = library.gltf_source(&c.source) else { continue };
+        let Some(part) = library.part_of_source(&c.source) else { continue };
         if let Some(clip) = crate::document::posing::find_clip(&part.clips, spec) {
             let state =
                 c.playback.take().unwrap_or(crate::formats::scene::PlaybackDoc { playing: true, ..Default::default() });

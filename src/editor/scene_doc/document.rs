@@ -201,7 +201,7 @@ pub fn spawn_from_doc(
             None
         }
     });
-    let node_clips = library.gltf_source(&doc.source).map(|part| part.clips).filter(|c| !c.is_empty());
+    let node_clips = library.part_of_source(&doc.source).map(|part| part.clips).filter(|c| !c.is_empty());
     let morphs = (!asset.morphs.is_empty()).then(|| {
         let mut weights = doc.morphs.clone();
         weights.resize(asset.morphs.len(), 0.0);
