@@ -371,3 +371,49 @@ fn recent_files_are_kept_newest_first_and_read_back() {
     write_recent(&file, &recent).unwrap();
     assert_eq!(read_recent(&file), recent);
 }
+
+/// Materials reach the picture: the Blender pair's walker drawn with its checker also as
+/// its normal map (the file changed here) differs from the plain walker where the walker
+/// is, and nowhere else (the normal map bends the flat normals; the waver, the floor and the
+/// sky stay as they were).
+#[test]
+fn a_normal_map_bends_the_light_on_its_surface_only() {
+    let dir = scratch("render-normal-map");
+    let pair = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/blender_pair.glb");
+    let glb = std::fs::read(&pair).unwrap();
+    let u32_at = |at: usize| u32::from_le_bytes(glb[at..at + 4].try_into().unwrap()) as usize;
+    let json_len = u32_at(12);
+    let mut json: serde_json::Value = serde_json::from_slice(&glb[20..20 + json_len]).unwrap();
+    json["materials"][0]["normalTexture"] = serde_json::json!({ "index": 0 });
+    let mut text = serde_json::to_vec(&json).unwrap();
+    text.resize(text.len().div_ceil(4) * 4, b' ');
+    let rest = &glb[20 + json_len..];
+    let mut bumpy = b"glTF".to_vec();
+    bumpy.extend(2u32.to_le_bytes());
+    bumpy.extend(((20 + text.len() + rest.len()) as u32).to_le_bytes());
+    bumpy.extend((text.len() as u32).to_le_bytes());
+    bumpy.extend(b"JSON");
+    bumpy.extend(&text);
+    bumpy.extend(rest);
+    std::fs::write(dir.join("bumpy.glb"), bumpy).unwrap();
+    let render = |input: &std::path::Path, name: &str| {
+        let out = dir.join(name);
+        let output = Command::new(env!("CARGO_BIN_EXE_marionette"))
+            .args(["render", "--width", "160", "--height", "120", "--out"])
+            .arg(&out)
+            .arg(input)
+            .output()
+            .unwrap();
+        assert!(output.status.success(), "{}", String::from_utf8_lossy(&output.stderr));
+        image::open(&out).unwrap().to_rgb8()
+    };
+    let (plain, bumpy) = (render(&pair, "plain.png"), render(&dir.join("bumpy.glb"), "bumpy.png"));
+    let changed: Vec<(u32, u32)> = plain
+        .enumerate_pixels()
+        .filter(|(x, y, p)| p.0.iter().zip(bumpy.get_pixel(*x, *y).0).any(|(a, b)| a.abs_diff(b) > 8))
+        .map(|(x, y, _)| (x, y))
+        .collect();
+    assert!(changed.len() > 100, "the normal map changed {} pixels", changed.len());
+    // The walker stands on the left half of the picture; the waver on the right.
+    assert!(changed.iter().all(|&(x, _)| x < 80), "changed beyond the walker: {:?}", changed.iter().max());
+}

@@ -1,6 +1,7 @@
 // The skin's fragment shader: StandardMaterial lighting with each triangle's own normal,
 // taken from the screen-space derivatives of the world position (flat shading without a
-// normal attribute: the CPU writes only shared vertex positions).
+// normal attribute: the CPU writes only shared vertex positions), bent by the material's
+// normal map where it has one.
 #import bevy_pbr::{
     pbr_fragment::pbr_input_from_standard_material,
     pbr_functions::alpha_discard,
@@ -27,8 +28,31 @@ fn fragment(
     // Screen x runs along dpdx, screen y (downwards) along dpdy: their cross product
     // in this order faces the camera on a front face.
     let p = in.world_position.xyz;
-    let n = normalize(cross(dpdy(p), dpdx(p)));
-    pbr_input.world_normal = n;
+    let flat = normalize(cross(dpdy(p), dpdx(p)));
+    pbr_input.world_normal = flat;
+    var n = flat;
+#ifdef STANDARD_MATERIAL_NORMAL_MAP
+#ifdef VERTEX_UVS_A
+#ifndef BINDLESS
+    // A normal map without tangents: the tangent frame from the derivatives of the
+    // position and the texture coordinates (a cotangent frame). glTF's maps point +y
+    // towards decreasing v (up the image), so the bitangent is -dp/dv.
+    let uv = (pbr_input.material.uv_transform * vec3(in.uv, 1.0)).xy;
+    let dp1 = dpdx(p);
+    let dp2 = dpdy(p);
+    let duv1 = dpdx(uv);
+    let duv2 = dpdy(uv);
+    let dp2perp = cross(dp2, flat);
+    let dp1perp = cross(flat, dp1);
+    let t = dp2perp * duv1.x + dp1perp * duv2.x;
+    let b = dp2perp * duv1.y + dp1perp * duv2.y;
+    let scale = inverseSqrt(max(max(dot(t, t), dot(b, b)), 1e-20));
+    let sampled = textureSample(bevy_pbr::pbr_bindings::normal_map_texture, bevy_pbr::pbr_bindings::normal_map_sampler, uv).rgb;
+    let tangent_space = sampled * 2.0 - 1.0;
+    n = normalize(tangent_space.x * t * scale - tangent_space.y * b * scale + tangent_space.z * flat);
+#endif
+#endif
+#endif
     pbr_input.N = n;
     pbr_input.material.base_color = alpha_discard(pbr_input.material, pbr_input.material.base_color);
 

@@ -81,8 +81,9 @@ fn image_of(picture: &crate::rig::Picture, srgb: bool, sampler: Sampler) -> Imag
 }
 
 /// The skin material of one of an asset's materials; `image` gives a texture's image
-/// (sRGB or not), or none when it cannot be read. The normal map is kept in the asset
-/// but not drawn: skins have no tangents (their normals come from the shader).
+/// (sRGB or not), or none when it cannot be read. Skins have no tangents: the shader
+/// bends its flat normals by the normal map in a frame from the derivatives (the map's
+/// scale is not applied).
 pub fn skin_material_of(
     m: &crate::rig::material::Material,
     image: &mut impl FnMut(&crate::rig::SkinTexture, bool, Sampler) -> Option<Handle<Image>>,
@@ -95,6 +96,7 @@ pub fn skin_material_of(
     let base_color_texture = texture(&m.base_color_texture, true);
     let metallic_roughness = texture(&m.metallic_roughness_texture, false);
     let emissive = texture(&m.emissive_texture, true);
+    let normal_map = texture(&m.normal_texture, false);
     let transform = m.base_color_texture.as_ref().map(|t| t.transform).unwrap_or_default();
     let [r, g, b, a] = m.base_color;
     let [er, eg, eb] = m.emissive;
@@ -106,6 +108,7 @@ pub fn skin_material_of(
         metallic_roughness_texture: metallic_roughness,
         emissive: LinearRgba::rgb(er, eg, eb),
         emissive_texture: emissive,
+        normal_map_texture: normal_map,
         alpha_mode: match m.alpha {
             Alpha::Opaque => AlphaMode::Opaque,
             Alpha::Mask(cutoff) => AlphaMode::Mask(cutoff),
