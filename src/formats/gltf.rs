@@ -172,6 +172,16 @@ pub fn write_glb(characters: &[GltfCharacter], mesh: GltfMesh) -> Result<Vec<u8>
                 crate::rig::lbs::skin(&skin.bind_positions, &skin.weights, &palette, &mut posed);
                 posed
             }
+            GltfMesh::Skinned if is_prop(c.asset) => {
+                let (top, joints) = skeleton_nodes(&mut b, c);
+                children.push(top);
+                let morph_nodes = prop_meshes(&mut b, &mut looks, c, &joints, &mut meshes);
+                for clip in c.clips {
+                    animations.push(clip_animation(&mut b, clip, &joints, &morph_nodes, c.morph_weights));
+                }
+                b.nodes[placement]["children"] = json!(children);
+                continue;
+            }
             GltfMesh::Skinned => {
                 let (top, joints) = skeleton_nodes(&mut b, c);
                 children.push(top);
@@ -189,9 +199,9 @@ pub fn write_glb(characters: &[GltfCharacter], mesh: GltfMesh) -> Result<Vec<u8>
                     animations.push(animation(&mut b, name, motion, &joints));
                 }
                 // The mesh node is the next node written.
-                let mesh_node_index = b.nodes.len();
+                let morph_nodes = [MorphNode { node: b.nodes.len(), morphs: (0..c.asset.morphs.len()).collect() }];
                 for clip in c.clips {
-                    animations.push(clip_animation(&mut b, clip, &joints, mesh_node_index, c.morph_weights));
+                    animations.push(clip_animation(&mut b, clip, &joints, &morph_nodes, c.morph_weights));
                 }
                 mesh_node["skin"] = json!(skins.len());
                 skins.push(
@@ -200,15 +210,15 @@ pub fn write_glb(characters: &[GltfCharacter], mesh: GltfMesh) -> Result<Vec<u8>
                 skin.bind_positions.clone()
             }
         };
-        let primitives = surface_primitives(&mut b, &mut looks, c, &positions, mesh);
-        let mut mesh_json = json!({ "name": c.name, "primitives": primitives });
-        if mesh == GltfMesh::Skinned && !c.asset.morphs.is_empty() {
-            let mut weights = c.morph_weights.to_vec();
-            weights.resize(c.asset.morphs.len(), 0.0);
-            mesh_json["weights"] = json!(weights);
-            mesh_json["extras"] = json!({ "targetNames": c.asset.morphs.iter().map(|m| &m.name).collect::<Vec<_>>() });
-        }
-        meshes.push(mesh_json);
+        let all = Piece {
+            vertices: 0..positions.len(),
+            to_node: Mat4::IDENTITY,
+            morphs: (0..c.asset.morphs.len()).collect(),
+        };
+        let morphs = if mesh == GltfMesh::Skinned { &all.morphs[..] } else { &[] };
+        let primitives =
+            surface_primitives(&mut b, &mut looks, c, &positions, mesh, &Piece { morphs: morphs.to_vec(), ..all });
+        meshes.push(mesh_json(c, primitives, morphs));
         // A skinned mesh's node sits at the scene's root (its skeleton places it); a baked
         // one under the placement.
         let mesh_index = b.node(mesh_node);
@@ -361,17 +371,24 @@ fn surface_primitives(
     c: &GltfCharacter,
     positions: &[Vec3],
     mesh: GltfMesh,
+    piece: &Piece,
 ) -> Vec<Value> {
     let skin = &c.asset.skin;
-    let sets = if mesh == GltfMesh::Skinned { influence_sets(c.asset) } else { Vec::new() };
+    let skinned = mesh == GltfMesh::Skinned && !is_prop(c.asset);
+    let sets = if skinned { influence_sets(c.asset) } else { Vec::new() };
     let mut ours: std::collections::HashMap<Option<usize>, usize> = std::collections::HashMap::new();
     let mut primitives = Vec::new();
     // A surface without triangles draws nothing (and glTF has no empty accessors).
     for surface in c.asset.surfaces().iter().filter(|s| !s.triangles.is_empty() && !s.vertices.is_empty()) {
-        let (first, end) = (surface.vertices.start as usize, surface.vertices.end as usize);
+        let first = (surface.vertices.start as usize).max(piece.vertices.start);
+        let end = (surface.vertices.end as usize).min(piece.vertices.end);
+        if first >= end {
+            continue;
+        }
         let count = end - first;
         let mut attributes = serde_json::Map::new();
-        attributes.insert("POSITION".into(), json!(b.positions(&positions[first..end])));
+        let local: Vec<Vec3> = positions[first..end].iter().map(|&p| piece.to_node.transform_point3(p)).collect();
+        attributes.insert("POSITION".into(), json!(b.positions(&local)));
         for (set, (joints, weights)) in sets.iter().enumerate() {
             let j = b.accessor(
                 &joints[first * 8..end * 8],
@@ -404,9 +421,17 @@ fn surface_primitives(
             );
             attributes.insert("COLOR_0".into(), json!(a));
         }
-        let triangles = &skin.triangles[surface.triangles.start as usize..surface.triangles.end as usize];
+        // The surface's triangles among this piece's vertices.
+        let triangles: Vec<&[u32; 3]> = skin.triangles
+            [surface.triangles.start as usize..surface.triangles.end as usize]
+            .iter()
+            .filter(|t| (first..end).contains(&(t[0] as usize)))
+            .collect();
+        if triangles.is_empty() {
+            continue;
+        }
         let indices: Vec<u8> =
-            triangles.iter().flatten().flat_map(|&i| (i - surface.vertices.start).to_le_bytes()).collect();
+            triangles.iter().flat_map(|t| t.iter()).flat_map(|&i| (i - first as u32).to_le_bytes()).collect();
         let index_accessor = b.accessor(
             &indices,
             Some(ELEMENT_ARRAY_BUFFER),
@@ -419,34 +444,121 @@ fn surface_primitives(
             }
         });
         let mut primitive = json!({ "attributes": attributes, "indices": index_accessor, "material": material });
-        if mesh == GltfMesh::Skinned && !c.asset.morphs.is_empty() {
-            primitive["targets"] = json!(morph_targets(b, c.asset, first..end));
+        if !piece.morphs.is_empty() {
+            primitive["targets"] = json!(morph_targets(b, c.asset, piece, first..end));
         }
         primitives.push(primitive);
     }
     primitives
 }
 
-/// The morph targets as glTF targets: each one's position deltas for the vertices `range`.
-fn morph_targets(b: &mut Builder, asset: &CharacterAsset, range: std::ops::Range<usize>) -> Vec<Value> {
-    asset
+/// The piece's morph targets as glTF targets: each one's position deltas for the vertices
+/// `range`, in the piece's node frame.
+fn morph_targets(b: &mut Builder, asset: &CharacterAsset, piece: &Piece, range: std::ops::Range<usize>) -> Vec<Value> {
+    piece
         .morphs
         .iter()
-        .map(|m| {
+        .map(|&m| {
             let mut deltas = vec![Vec3::ZERO; range.len()];
-            m.deltas
-                .iter()
-                .filter(|(v, _)| range.contains(&(*v as usize)))
-                .for_each(|&(v, d)| deltas[v as usize - range.start] = d);
+            for &(v, d) in asset.morphs[m].deltas.iter().filter(|(v, _)| range.contains(&(*v as usize))) {
+                deltas[v as usize - range.start] = piece.to_node.transform_vector3(d);
+            }
             json!({ "POSITION": b.positions(&deltas) })
         })
         .collect()
 }
 
+/// Vertices of an asset that go out as one glTF mesh: their range, the transform from the
+/// asset's bind space into the frame of the node that carries them, and the morphs they have.
+struct Piece {
+    vertices: std::ops::Range<usize>,
+    to_node: Mat4,
+    morphs: Vec<usize>,
+}
+
+/// A mesh of `primitives` with the morphs' weights and names (`extras.targetNames`).
+fn mesh_json(c: &GltfCharacter, primitives: Vec<Value>, morphs: &[usize]) -> Value {
+    let mut mesh = json!({ "name": c.name, "primitives": primitives });
+    if !morphs.is_empty() {
+        let weights: Vec<f32> = morphs.iter().map(|&m| c.morph_weights.get(m).copied().unwrap_or(0.0)).collect();
+        mesh["weights"] = json!(weights);
+        mesh["extras"] = json!({ "targetNames": morphs.iter().map(|&m| &c.asset.morphs[m].name).collect::<Vec<_>>() });
+    }
+    mesh
+}
+
+/// Whether `asset` is a prop: meshes carried rigidly by their nodes (one influence of
+/// weight 1 per vertex; a prop rebound by bone heat is skinned).
+fn is_prop(asset: &CharacterAsset) -> bool {
+    asset.skin_kind == crate::rig::character::SkinKind::Rigid && asset.skin.weights.max_influences() <= 1
+}
+
+/// A prop's meshes, unskinned, each on the node of the joint that carries its vertices (in
+/// that joint's frame: its inverse bind applied), as the file it came from had them; the
+/// nodes whose meshes have morph targets.
+fn prop_meshes(
+    b: &mut Builder,
+    looks: &mut super::gltf_out_materials::Materials,
+    c: &GltfCharacter,
+    joints: &[usize],
+    meshes: &mut Vec<Value>,
+) -> Vec<MorphNode> {
+    let asset = c.asset;
+    let joint_of = |v: usize| asset.skin.weights.of_vertex(v).first().map_or(0, |i| i.joint as usize);
+    // Each joint's runs of vertices, joints in the order their vertices come.
+    let mut runs: Vec<(usize, Vec<std::ops::Range<usize>>)> = Vec::new();
+    let mut start = 0;
+    while start < asset.vertex_count() {
+        let joint = joint_of(start);
+        let end = (start..asset.vertex_count()).find(|&v| joint_of(v) != joint).unwrap_or(asset.vertex_count());
+        match runs.iter_mut().find(|(j, _)| *j == joint) {
+            Some((_, ranges)) => ranges.push(start..end),
+            None => runs.push((joint, std::iter::once(start..end).collect())),
+        }
+        start = end;
+    }
+    let mut morph_nodes = Vec::new();
+    for (joint, ranges) in runs {
+        let within = |v: u32| ranges.iter().any(|r| r.contains(&(v as usize)));
+        let morphs: Vec<usize> = (0..asset.morphs.len())
+            .filter(|&m| asset.morphs[m].deltas.first().is_some_and(|(v, _)| within(*v)))
+            .collect();
+        let to_node = asset.bind_world_to_joint[joint];
+        let primitives: Vec<Value> = ranges
+            .iter()
+            .flat_map(|r| {
+                let piece = Piece { vertices: r.clone(), to_node, morphs: morphs.clone() };
+                surface_primitives(b, looks, c, &asset.skin.bind_positions, GltfMesh::Skinned, &piece)
+            })
+            .collect();
+        if primitives.is_empty() {
+            continue;
+        }
+        b.nodes[joints[joint]]["mesh"] = json!(meshes.len());
+        meshes.push(mesh_json(c, primitives, &morphs));
+        if !morphs.is_empty() {
+            morph_nodes.push(MorphNode { node: joints[joint], morphs });
+        }
+    }
+    morph_nodes
+}
+
+/// A node that carries a mesh with morph targets, and the asset's morphs its mesh has.
+struct MorphNode {
+    node: usize,
+    morphs: Vec<usize>,
+}
+
 /// A clip as a glTF animation, key for key: each track with its own key times and
-/// interpolation; the morph weights as one channel of the mesh node (their tracks
-/// combined: each keyed at the union of their key times, the unkeyed at `weights`).
-fn clip_animation(b: &mut Builder, clip: &NodeClip, joints: &[usize], mesh_node: usize, weights: &[f32]) -> Value {
+/// interpolation; the morph weights as one channel per node whose mesh has them (their
+/// tracks combined: each keyed at the union of their key times, the unkeyed at `weights`).
+fn clip_animation(
+    b: &mut Builder,
+    clip: &NodeClip,
+    joints: &[usize],
+    morph_nodes: &[MorphNode],
+    weights: &[f32],
+) -> Value {
     let mut samplers = Vec::new();
     let mut channels = Vec::new();
     let mut add =
@@ -496,8 +608,13 @@ fn clip_animation(b: &mut Builder, clip: &NodeClip, joints: &[usize], mesh_node:
             add(b, node, path, times, values, kind, interpolation);
         }
     }
-    if let Some((times, values, interpolation)) = combined_weights(&clip.weights, weights) {
-        add(b, mesh_node, "weights", &times, values, "SCALAR", interpolation);
+    for group in morph_nodes {
+        let tracks: Vec<Option<Track<f32>>> =
+            group.morphs.iter().map(|&m| clip.weights.get(m).cloned().flatten()).collect();
+        let base: Vec<f32> = group.morphs.iter().map(|&m| weights.get(m).copied().unwrap_or(0.0)).collect();
+        if let Some((times, values, interpolation)) = combined_weights(&tracks, &base) {
+            add(b, group.node, "weights", &times, values, "SCALAR", interpolation);
+        }
     }
     json!({ "name": clip.name, "samplers": samplers, "channels": channels })
 }
