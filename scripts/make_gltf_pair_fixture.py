@@ -26,10 +26,13 @@ Needs `pip install bpy`.
 import json
 import struct
 import sys
-from math import atan2, cos, pi, radians, sin
+from math import atan2, pi, radians
 from pathlib import Path
 
 import bpy
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from blender_kit import armature, bind, tube  # noqa: E402
 
 out = Path(sys.argv[1])
 FPS = 24
@@ -39,54 +42,10 @@ scene.render.fps = FPS
 scene.frame_start, scene.frame_end = 0, 24
 
 
-def tube(name, rings, height, radius):
-    segments = 12
-    verts = [
-        (radius * cos(2 * pi * s / segments), radius * sin(2 * pi * s / segments), height * r / (rings - 1))
-        for r in range(rings)
-        for s in range(segments)
-    ]
-    faces = [
-        (r * segments + s, r * segments + (s + 1) % segments, (r + 1) * segments + (s + 1) % segments, (r + 1) * segments + s)
-        for r in range(rings - 1)
-        for s in range(segments)
-    ]
-    data = bpy.data.meshes.new(name)
-    data.from_pydata(verts, [], faces)
-    obj = bpy.data.objects.new(name, data)
-    scene.collection.objects.link(obj)
-    return obj
-
-
-def armature(name, bones):
-    data = bpy.data.armatures.new(name + "_rig")
-    obj = bpy.data.objects.new(name + "_rig", data)
-    scene.collection.objects.link(obj)
-    bpy.context.view_layer.objects.active = obj
-    bpy.ops.object.mode_set(mode="EDIT")
-    made = []
-    for bone_name, head, tail in bones:
-        b = data.edit_bones.new(bone_name)
-        b.head, b.tail = head, tail
-        if made:
-            b.parent = made[-1]
-            b.use_connect = True
-        made.append(b)
-    bpy.ops.object.mode_set(mode="OBJECT")
-    return obj
-
-
-def bind(mesh, rig):
-    bpy.ops.object.select_all(action="DESELECT")
-    mesh.select_set(True)
-    rig.select_set(True)
-    bpy.context.view_layer.objects.active = rig
-    bpy.ops.object.parent_set(type="ARMATURE_AUTO")
-
 
 # walker: three bones up z, a bulge in the middle.
 walker = tube("walker", 13, 3.0, 0.2)
-walker_rig = armature("walker", [("hip", (0, 0, 0), (0, 0, 1)), ("knee", (0, 0, 1), (0, 0.1, 2)), ("foot", (0, 0.1, 2), (0, 0, 3))])
+walker_rig = armature("walker_rig", [("hip", (0, 0, 0), (0, 0, 1)), ("knee", (0, 0, 1), (0, 0.1, 2)), ("foot", (0, 0.1, 2), (0, 0, 3))])
 bind(walker, walker_rig)
 walker.shape_key_add(name="Basis")
 bulge = walker.shape_key_add(name="bulge")
@@ -113,7 +72,7 @@ for loop in walker.data.loops:
 
 # waver: two bones, its armature object moved, turned and scaled.
 waver = tube("waver", 9, 2.0, 0.25)
-waver_rig = armature("waver", [("upper", (0, 0, 0), (0, 0, 1)), ("lower", (0, 0, 1), (0, 0, 2))])
+waver_rig = armature("waver_rig", [("upper", (0, 0, 0), (0, 0, 1)), ("lower", (0, 0, 1), (0, 0, 2))])
 bind(waver, waver_rig)
 waver_rig.location = (3.0, 0.5, 0.0)
 waver_rig.rotation_euler = (0, 0, radians(30))

@@ -20,10 +20,13 @@ material), so the test compares the two as point sets.
 Needs `pip install bpy`.
 """
 import sys
-from math import cos, pi, radians, sin
+from math import radians
 from pathlib import Path
 
 import bpy
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from blender_kit import armature, bind, tube  # noqa: E402
 
 out = Path(sys.argv[1])
 FPS = 24
@@ -32,51 +35,6 @@ scene = bpy.context.scene
 scene.render.fps = FPS
 scene.frame_start, scene.frame_end = 0, 24
 
-
-def tube(name, rings, height, radius, location=(0, 0, 0)):
-    segments = 10
-    x0, y0, z0 = location
-    verts = [
-        (x0 + radius * cos(2 * pi * s / segments), y0 + radius * sin(2 * pi * s / segments), z0 + height * r / (rings - 1))
-        for r in range(rings)
-        for s in range(segments)
-    ]
-    faces = [
-        (r * segments + s, r * segments + (s + 1) % segments, (r + 1) * segments + (s + 1) % segments, (r + 1) * segments + s)
-        for r in range(rings - 1)
-        for s in range(segments)
-    ]
-    data = bpy.data.meshes.new(name)
-    data.from_pydata(verts, [], faces)
-    obj = bpy.data.objects.new(name, data)
-    scene.collection.objects.link(obj)
-    return obj
-
-
-def armature(name, bones):
-    data = bpy.data.armatures.new(name)
-    obj = bpy.data.objects.new(name, data)
-    scene.collection.objects.link(obj)
-    bpy.context.view_layer.objects.active = obj
-    bpy.ops.object.mode_set(mode="EDIT")
-    made = []
-    for bone_name, head, tail in bones:
-        b = data.edit_bones.new(bone_name)
-        b.head, b.tail = head, tail
-        if made:
-            b.parent = made[-1]
-            b.use_connect = True
-        made.append(b)
-    bpy.ops.object.mode_set(mode="OBJECT")
-    return obj
-
-
-def bind(mesh, rig):
-    bpy.ops.object.select_all(action="DESELECT")
-    mesh.select_set(True)
-    rig.select_set(True)
-    bpy.context.view_layer.objects.active = rig
-    bpy.ops.object.parent_set(type="ARMATURE_AUTO")
 
 
 def parent_to_bone(obj, rig, bone):
@@ -96,7 +54,7 @@ def material(name, colour):
     return m
 
 
-body = tube("body", 9, 2.0, 0.25)
+body = tube("body", 9, 2.0, 0.25, segments=10)
 body_rig = armature("body_rig", [("spine", (0, 0, 0), (0, 0, 1)), ("arm", (0, 0, 1), (0, 0, 2))])
 bind(body, body_rig)
 body.data.materials.append(material("red", (0.8, 0.1, 0.1, 1)))
@@ -105,7 +63,7 @@ for face in body.data.polygons:
     face.material_index = 1 if face.center.z > 1.0 else 0
 
 hand_rig = armature("hand_rig", [("palm", (0, 0, 2), (0, 0, 2.5)), ("finger", (0, 0, 2.5), (0, 0, 3))])
-hand = tube("hand", 7, 1.0, 0.12, location=(0, 0, 2))
+hand = tube("hand", 7, 1.0, 0.12, segments=10, location=(0, 0, 2))
 bind(hand, hand_rig)
 parent_to_bone(hand_rig, body_rig, "arm")
 
