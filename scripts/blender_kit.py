@@ -6,6 +6,15 @@ from math import cos, pi, sin
 import bpy
 
 
+def fresh_scene(fps=24, frames=(0, 24)):
+    """Blender's empty factory scene at `fps` frames per second over `frames`."""
+    bpy.ops.wm.read_factory_settings(use_empty=True)
+    scene = bpy.context.scene
+    scene.render.fps = fps
+    scene.frame_start, scene.frame_end = frames
+    return scene
+
+
 def tube(name, rings, height, radius, segments=12, location=(0, 0, 0)):
     """A tube of `rings` rings of `segments` vertices, from `location` up `height` along z."""
     x0, y0, z0 = location

@@ -9,29 +9,18 @@ exported vertex order). The test loads the .glb with Marionette and compares.
 Needs `pip install bpy`.
 """
 import sys
-from math import cos, pi, radians, sin
+from math import radians
 from pathlib import Path
 
 import bpy
 
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from blender_kit import tube  # noqa: E402
+
 out = Path(sys.argv[1])
 bpy.ops.wm.read_factory_settings(use_empty=True)
 # A tube of 11 rings of 16 vertices from z = 0 to 2, so it bends where the bones meet.
-SEGMENTS, RINGS = 16, 11
-verts = [
-    (0.15 * cos(2 * pi * s / SEGMENTS), 0.15 * sin(2 * pi * s / SEGMENTS), 2.0 * r / (RINGS - 1))
-    for r in range(RINGS)
-    for s in range(SEGMENTS)
-]
-faces = [
-    (r * SEGMENTS + s, r * SEGMENTS + (s + 1) % SEGMENTS, (r + 1) * SEGMENTS + (s + 1) % SEGMENTS, (r + 1) * SEGMENTS + s)
-    for r in range(RINGS - 1)
-    for s in range(SEGMENTS)
-]
-mesh_data = bpy.data.meshes.new("arm")
-mesh_data.from_pydata(verts, [], faces)
-arm_mesh = bpy.data.objects.new("arm", mesh_data)
-bpy.context.scene.collection.objects.link(arm_mesh)
+arm_mesh = tube("arm", 11, 2.0, 0.15, segments=16)
 
 armature = bpy.data.armatures.new("rig")
 rig = bpy.data.objects.new("rig", armature)

@@ -26,14 +26,11 @@ from pathlib import Path
 import bpy
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from blender_kit import armature, bind, tube  # noqa: E402
+from blender_kit import armature, bind, fresh_scene, tube  # noqa: E402
 
 out = Path(sys.argv[1])
 FPS = 24
-bpy.ops.wm.read_factory_settings(use_empty=True)
-scene = bpy.context.scene
-scene.render.fps = FPS
-scene.frame_start, scene.frame_end = 0, 24
+scene = fresh_scene(FPS)
 
 
 

@@ -170,7 +170,7 @@ pub fn write_glb(characters: &[GltfCharacter], mesh: GltfMesh) -> Result<Vec<u8>
                 let palette = crate::rig::fk::posed_palette_with_rest(skeleton, binds, c.pose, c.rest, root_origin(c));
                 let mut posed = vec![Vec3::ZERO; skin.bind_positions.len()];
                 crate::rig::lbs::skin(&skin.bind_positions, &skin.weights, &palette, &mut posed);
-                posed
+                std::borrow::Cow::Owned(posed)
             }
             GltfMesh::Skinned if is_prop(c.asset) => {
                 let (top, joints) = skeleton_nodes(&mut b, c);
@@ -207,7 +207,7 @@ pub fn write_glb(characters: &[GltfCharacter], mesh: GltfMesh) -> Result<Vec<u8>
                 skins.push(
                     json!({ "name": c.name, "joints": joints, "skeleton": joints[0], "inverseBindMatrices": ibm }),
                 );
-                skin.bind_positions.clone()
+                std::borrow::Cow::Borrowed(&skin.bind_positions[..])
             }
         };
         let all = Piece {

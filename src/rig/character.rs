@@ -140,7 +140,15 @@ impl CharacterAsset {
     /// The bind positions with the morph targets blended in by `weights` (one per target;
     /// missing ones are 0).
     pub fn morphed_positions(&self, weights: &[f32]) -> Vec<Vec3> {
-        let mut positions = self.skin.bind_positions.clone();
+        let mut positions = Vec::new();
+        self.morph_into(weights, &mut positions);
+        positions
+    }
+
+    /// [`Self::morphed_positions`] written into `positions` (its allocation reused).
+    pub fn morph_into(&self, weights: &[f32], positions: &mut Vec<Vec3>) {
+        positions.clear();
+        positions.extend_from_slice(&self.skin.bind_positions);
         for (target, &w) in self.morphs.iter().zip(weights) {
             if w == 0.0 {
                 continue;
@@ -151,7 +159,6 @@ impl CharacterAsset {
                 }
             }
         }
-        positions
     }
 
     /// The surfaces to draw: its own, or one over the whole mesh.

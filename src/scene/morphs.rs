@@ -27,12 +27,13 @@ impl Plugin for MorphPlugin {
 }
 
 /// Rebuilds the bind mesh of characters whose weights changed (writes `Character`'s asset
-/// and `PoseDirty`; the skinning follows).
+/// and `PoseDirty`; the skinning follows). The character's asset is copied from the base
+/// the first time only (and again while the GPU skinning holds it); after that, a clip that
+/// keys weights every frame rewrites the positions in place.
 pub fn blend_morphs(mut characters: Query<(&Morphs, &mut Character, &mut PoseDirty), Changed<Morphs>>) {
     for (morphs, mut character, mut dirty) in &mut characters {
-        let mut asset = (*morphs.base).clone();
-        asset.skin.bind_positions = morphs.base.morphed_positions(&morphs.weights);
-        character.asset = Arc::new(asset);
+        let asset = Arc::make_mut(&mut character.asset);
+        morphs.base.morph_into(&morphs.weights, &mut asset.skin.bind_positions);
         dirty.matrices = true;
     }
 }
