@@ -197,8 +197,8 @@ pub struct ExportArgs {
     /// with its skeleton.
     #[arg(long)]
     pub bake: bool,
-    /// With `--out X.glb`: keyframed clips (a scene's, or `--anim`) go out as glTF
-    /// animations, sampled at 30 frames per second.
+    /// With `--out X.glb`: every clip goes out as a glTF animation (keyframed clips, a
+    /// scene's or `--anim`'s, as cubic splines keyed at their keys).
     #[arg(long)]
     pub animation: bool,
 }

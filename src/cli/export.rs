@@ -41,12 +41,13 @@ fn export_character(a: &ExportArgs) -> Result<()> {
     }
     let mut pose = asset.skeleton.initial_pose();
     let mut origin = Mat4::IDENTITY;
-    let mut motion = None;
+    let mut clips = Vec::new();
     if let Some(file) = &clip.anim {
         let anim = crate::formats::load_clip(file)?.retargeted(&asset.skeleton, &Default::default());
         if animation {
-            let sampled = crate::document::export::sampled(&anim, &asset.skeleton, &pose);
-            motion = Some(sampled.map_err(|e| anyhow::anyhow!("{}: {e}", file.display()))?);
+            let name = file.file_stem().map_or_else(|| asset.name.clone(), |s| s.to_string_lossy().into_owned());
+            let splines = crate::document::export::keyframes_as_splines(&anim, &asset.skeleton, &pose, &name);
+            clips.push(splines.map_err(|e| anyhow::anyhow!("{}: {e}", file.display()))?);
         }
         let (root, clip_pose) = anim.pose_at(&asset.skeleton, clip.time.unwrap_or(0.0), &pose);
         pose = clip_pose;
@@ -60,7 +61,7 @@ fn export_character(a: &ExportArgs) -> Result<()> {
     if is_glb(out) {
         let name = asset.name.clone();
         let root = origin.transform_point3(asset.skeleton.joint(0).rest_offset);
-        let character = GltfCharacter { root, motion, ..GltfCharacter::new(&name, &asset, &pose) };
+        let character = GltfCharacter { root, clips: &clips, ..GltfCharacter::new(&name, &asset, &pose) };
         let glb = write_glb(&[character], mesh_kind(bake)).map_err(|e| anyhow::anyhow!("{}: {e}", out.display()))?;
         write_file(out, |w| w.write_all(&glb))?;
         println!("wrote {} ({} joints, {} vertices)", out.display(), asset.skeleton.len(), asset.vertex_count());

@@ -4,34 +4,23 @@
 
 use crate::formats::FormatError;
 use crate::formats::gltf::{GltfCharacter, GltfMesh, Motion, write_glb};
-use crate::formats::limits::sampled_frames;
+use crate::formats::limits::MAX_SAMPLED_FRAMES;
 use crate::formats::scene::SceneDoc;
 use crate::rig::fk::RestOverride;
-use crate::rig::node_clip::{NodePose, sample_mix};
+use crate::rig::node_clip::{NodeClip, NodePose, sample_mix};
 
-/// Frames per second at which clips are sampled for glTF.
-pub const EXPORT_FPS: f32 = 30.0;
-
-/// A clip sampled over its range at [`EXPORT_FPS`] (its last time included): the poses
-/// and root translations a glTF animation holds. Joints without keys keep `rest`. A clip
-/// longer than [`MAX_SAMPLED_FRAMES`](crate::formats::limits::MAX_SAMPLED_FRAMES) frames
-/// is refused.
-pub fn sampled(
+/// A keyframed clip as glTF splines ([`spline_clip`](crate::rig::keyframe_splines::spline_clip)):
+/// key for key, times from its start, its joints without keys left at `rest`; refused
+/// where a track would need more than
+/// [`MAX_SAMPLED_FRAMES`](crate::formats::limits::MAX_SAMPLED_FRAMES) keys.
+pub fn keyframes_as_splines(
     clip: &crate::rig::anim::Clip,
     skeleton: &crate::rig::Skeleton,
     rest: &[crate::rig::JointRotation],
-) -> Result<Motion, String> {
-    let (start, end) = clip.range;
-    let frames = sampled_frames(end - start, EXPORT_FPS)?;
-    let mut motion = Motion::default();
-    for f in 0..=frames {
-        let t = (start + f as f32 / EXPORT_FPS).min(end);
-        let (root, pose) = clip.pose_at(skeleton, t, rest);
-        motion.times.push(t - start);
-        motion.poses.push(pose);
-        motion.roots.push(root);
-    }
-    Ok(motion)
+    name: &str,
+) -> Result<NodeClip, String> {
+    crate::rig::keyframe_splines::spline_clip(clip, skeleton, rest, name, MAX_SAMPLED_FRAMES)
+        .map_err(|e| format!("{e} (MAX_SAMPLED_FRAMES)"))
 }
 
 /// A character's asset as the document shapes it: an SMPL body by its β. (Morph targets go
@@ -125,9 +114,10 @@ fn posed(
         let clip = clip.retargeted(skeleton, &anim.names);
         if animated {
             let clip_file = if anim.file.as_os_str().is_empty() { std::path::Path::new(&c.name) } else { &anim.file };
-            posed.motion = Some(sampled(&clip, skeleton, &posed.pose).map_err(|e| FormatError::other(clip_file, e))?);
-            posed.motion_name =
-                clip_file.file_stem().map_or_else(|| c.name.clone(), |s| s.to_string_lossy().into_owned());
+            let name = clip_file.file_stem().map_or_else(|| c.name.clone(), |s| s.to_string_lossy().into_owned());
+            let splines = keyframes_as_splines(&clip, skeleton, &posed.pose, &name)
+                .map_err(|e| FormatError::other(clip_file, e))?;
+            posed.clips = std::sync::Arc::new([splines]);
         }
         (posed.root, posed.pose) = clip.pose_at(skeleton, anim.time, &posed.pose);
     }
@@ -137,7 +127,7 @@ fn posed(
                 .map_err(|e| FormatError::other(c.source.path().unwrap_or(std::path::Path::new(&c.name)), e))?;
         }
         if animated {
-            posed.clips = part.clips.clone();
+            posed.clips = part.clips.iter().chain(posed.clips.iter()).cloned().collect();
         }
     }
     if animated && let Some((name, motion)) = smpl_motion(library, c, asset)? {

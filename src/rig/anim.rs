@@ -173,6 +173,146 @@ impl Channel {
         }
     }
 
+    /// The channel's value and slope (per second) as `t` is approached from `side`. They
+    /// differ between the sides where the curve jumps (a step, the seam of a cycle) or
+    /// turns (a bounce, a key whose tangents differ); elsewhere the value is `value_at`'s.
+    pub fn sided(&self, t: f32, side: Side) -> (f32, f32) {
+        let (Some(first), Some(last)) = (self.keys.first(), self.keys.last()) else { return (0.0, 0.0) };
+        if t < first.time || (t == first.time && side == Side::Before) {
+            self.extrapolate_sided(self.before, t, side, true)
+        } else if t > last.time || (t == last.time && side == Side::After) {
+            self.extrapolate_sided(self.after, t, side, false)
+        } else {
+            self.inside_sided(t, side)
+        }
+    }
+
+    fn extrapolate_sided(&self, mode: Extrapolation, t: f32, side: Side, before: bool) -> (f32, f32) {
+        let (first, last) = (self.keys[0], self.keys[self.keys.len() - 1]);
+        let length = last.time - first.time;
+        let edge = if before { first } else { last };
+        if length <= 0.0 && !matches!(mode, Extrapolation::Linear) {
+            return (edge.value, 0.0);
+        }
+        match mode {
+            Extrapolation::Constant => (edge.value, 0.0),
+            Extrapolation::Linear => {
+                let slope = if before { self.slopes[0].0 } else { self.slopes[self.keys.len() - 1].1 };
+                (edge.value + slope * (t - edge.time), slope)
+            }
+            Extrapolation::Cycle | Extrapolation::CycleOffset => {
+                let mut cycles = ((t - first.time) / length).floor();
+                let mut local = t - cycles * length;
+                // At a seam, the side before is the end of the previous cycle.
+                if side == Side::Before && local <= first.time {
+                    (cycles, local) = (cycles - 1.0, local + length);
+                } else if side == Side::After && local >= last.time {
+                    (cycles, local) = (cycles + 1.0, local - length);
+                }
+                let (value, slope) = self.inside_sided(self.snapped(local), side);
+                let offset = if mode == Extrapolation::CycleOffset { cycles * (last.value - first.value) } else { 0.0 };
+                (value + offset, slope)
+            }
+            Extrapolation::Bounce => {
+                let phase = (t - first.time).rem_euclid(2.0 * length);
+                // At a turn, the side decides the direction: forwards after the first key's
+                // turn and before the last key's.
+                let forwards = if phase == 0.0 {
+                    side == Side::After
+                } else if phase == length {
+                    side == Side::Before
+                } else {
+                    phase < length
+                };
+                if forwards {
+                    self.inside_sided(self.snapped(first.time + phase), side)
+                } else {
+                    let local = if phase == 0.0 { 0.0 } else { 2.0 * length - phase };
+                    let (value, slope) = self.inside_sided(self.snapped(first.time + local), side.other());
+                    (value, -slope)
+                }
+            }
+        }
+    }
+
+    /// A time within the keys' range that a repetition brought there (`t − n·length`, with
+    /// its rounding), put on the key it is a few floats from: a repetition's seams are its
+    /// keys, and their sides must be the keys' sides.
+    fn snapped(&self, t: f32) -> f32 {
+        let (first, last) = (self.keys[0].time, self.keys[self.keys.len() - 1].time);
+        let near = 16.0 * f32::EPSILON * (first.abs().max(last.abs()) + (last - first));
+        let k = self.keys.partition_point(|key| key.time < t);
+        let nearest = [k.checked_sub(1), Some(k)]
+            .into_iter()
+            .flatten()
+            .filter_map(|k| self.keys.get(k))
+            .map(|key| key.time)
+            .find(|&time| (time - t).abs() <= near);
+        nearest.unwrap_or(t).clamp(first, last)
+    }
+
+    /// As [`sided`](Self::sided) within the keys' range: the span on `side` of `t`.
+    fn inside_sided(&self, t: f32, side: Side) -> (f32, f32) {
+        let keys = &self.keys;
+        if keys.len() == 1 {
+            return (keys[0].value, 0.0);
+        }
+        let starts_at_or_before = |key: &Key| match side {
+            Side::After => key.time <= t,
+            Side::Before => key.time < t,
+        };
+        let k = keys.partition_point(starts_at_or_before).saturating_sub(1).min(keys.len() - 2);
+        let (a, b) = (keys[k], keys[k + 1]);
+        let span = b.time - a.time;
+        if span <= 0.0 {
+            return (b.value, 0.0);
+        }
+        if a.tangent_out == Tangent::Step {
+            return (a.value, 0.0);
+        }
+        let u = ((t - a.time) / span).clamp(0.0, 1.0);
+        let (m0, m1) = (self.slopes[k].1 * span, self.slopes[k + 1].0 * span);
+        (hermite(a.value, m0, b.value, m1, u), hermite_slope(a.value, m0, b.value, m1, u) / span)
+    }
+
+    /// The times within `range` (its ends included, in order) between which the channel is
+    /// one cubic: its keys, and the keys of every repetition its extrapolation makes. Refused
+    /// when there would be more than `most`.
+    pub fn seams(&self, range: (f32, f32), most: usize) -> Result<Vec<f32>, String> {
+        let mut seams = vec![range.0, range.1];
+        let (Some(first), Some(last)) = (self.keys.first(), self.keys.last()) else { return Ok(seams) };
+        let length = last.time - first.time;
+        let repeats = |mode: Extrapolation| {
+            length > 0.0 && matches!(mode, Extrapolation::Cycle | Extrapolation::CycleOffset | Extrapolation::Bounce)
+        };
+        let repetition = |t: f32| ((f64::from(t) - f64::from(first.time)) / f64::from(length)).floor();
+        let from = if repeats(self.before) { repetition(range.0).min(0.0) } else { 0.0 };
+        let to = if repeats(self.after) { repetition(range.1).max(0.0) } else { 0.0 };
+        let count = (to - from + 1.0) * self.keys.len() as f64;
+        if count.is_nan() || count > most as f64 {
+            return Err(format!(
+                "a channel repeats its {} keys {} times within {:?}: more than the {most} keys a clip is written with",
+                self.keys.len(),
+                to - from + 1.0,
+                range
+            ));
+        }
+        for n in from as i64..=to as i64 {
+            let start = first.time + n as f32 * length;
+            let bounced = self.before == Extrapolation::Bounce && n < 0 || self.after == Extrapolation::Bounce && n > 0;
+            let backwards = bounced && n.rem_euclid(2) == 1;
+            for key in &self.keys {
+                let t = if backwards { start + (last.time - key.time) } else { start + (key.time - first.time) };
+                if range.0 <= t && t <= range.1 {
+                    seams.push(t);
+                }
+            }
+        }
+        seams.sort_by(f32::total_cmp);
+        seams.dedup();
+        Ok(seams)
+    }
+
     /// The value at `t` within the keys' range.
     fn inside(&self, t: f32) -> f32 {
         let keys = &self.keys;
@@ -183,7 +323,8 @@ impl Channel {
         }
         let (a, b) = (keys[k], keys[k + 1]);
         let span = b.time - a.time;
-        if span <= 0.0 {
+        // On the last key (or past a span of none): its value, even after a step.
+        if span <= 0.0 || t >= b.time {
             return b.value;
         }
         if a.tangent_out == Tangent::Step {
@@ -221,6 +362,28 @@ impl From<Channel> for ChannelKeys {
 pub fn hermite(p0: f32, m0: f32, p1: f32, m1: f32, u: f32) -> f32 {
     let (u2, u3) = (u * u, u * u * u);
     (2.0 * u3 - 3.0 * u2 + 1.0) * p0 + (u3 - 2.0 * u2 + u) * m0 + (-2.0 * u3 + 3.0 * u2) * p1 + (u3 - u2) * m1
+}
+
+/// The derivative in `u` of [`hermite`].
+pub fn hermite_slope(p0: f32, m0: f32, p1: f32, m1: f32, u: f32) -> f32 {
+    let u2 = u * u;
+    (6.0 * u2 - 6.0 * u) * (p0 - p1) + (3.0 * u2 - 4.0 * u + 1.0) * m0 + (3.0 * u2 - 2.0 * u) * m1
+}
+
+/// Which side of a time a one-sided limit comes from.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Side {
+    Before,
+    After,
+}
+
+impl Side {
+    pub fn other(self) -> Self {
+        match self {
+            Side::Before => Side::After,
+            Side::After => Side::Before,
+        }
+    }
 }
 
 /// The slope of key `k` by `rule`, on its incoming side (`incoming`) or outgoing side.

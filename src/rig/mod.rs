@@ -10,6 +10,7 @@ pub mod fk;
 pub mod heat;
 pub mod ik;
 pub mod influences;
+pub mod keyframe_splines;
 pub mod lbs;
 pub mod material;
 pub mod matrix_stack;

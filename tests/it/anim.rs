@@ -111,6 +111,65 @@ fn value_and_slope_are_continuous_where_the_rules_promise_it() {
     assert!((before - after).abs() < 1e-4, "cycle_offset at the seam: {before} {after}");
 }
 
+/// The pieces a clip goes out to glTF in: between two seams (keys, and the keys of every
+/// repetition the extrapolation makes) a channel is one cubic, so the Hermite spline made of
+/// the one-sided values and slopes at the seams is the channel itself; and the one-sided
+/// values are the limits `value_at` approaches from each side.
+#[test]
+fn between_its_seams_a_channel_is_the_cubic_its_sided_values_and_slopes_make() {
+    use marionette::rig::anim::{Extrapolation, Key, Side, Tangent, hermite};
+    let key = |time, value, tangent_in, tangent_out| Key { time, value, tangent_in, tangent_out };
+    let stepped = Channel::new(
+        vec![
+            key(0.0, 1.0, Tangent::Smooth, Tangent::Step),
+            key(0.7, -2.0, Tangent::Flat, Tangent::Smooth),
+            key(1.6, 0.5, Tangent::Fixed(3.0), Tangent::Linear),
+        ],
+        Extrapolation::Bounce,
+        Extrapolation::Cycle,
+    );
+    let mut channels = clip();
+    channels.push(stepped);
+    let range = (-3.3, 7.1);
+    for (c, channel) in channels.iter().enumerate() {
+        let seams = channel.seams(range, 1000).unwrap();
+        assert_eq!((seams[0], seams[seams.len() - 1]), range);
+        for pair in seams.windows(2) {
+            let (t0, t1) = (pair[0], pair[1]);
+            let (p0, m0) = channel.sided(t0, Side::After);
+            let (p1, m1) = channel.sided(t1, Side::Before);
+            let span = t1 - t0;
+            for u in [0.1, 0.37, 0.5, 0.83] {
+                let t = t0 + u * span;
+                let want = channel.value_at(t);
+                let got = hermite(p0, m0 * span, p1, m1 * span, u);
+                assert!((got - want).abs() < 2e-4, "channel {c} in [{t0}, {t1}] at {t}: {got} against {want}");
+            }
+            // One-sided limits: the value just inside each end, and the slope by differences.
+            let h = 1e-3;
+            let (inside0, inside1) = (channel.value_at(t0 + h), channel.value_at(t1 - h));
+            assert!((inside0 - (p0 + m0 * h)).abs() < 1e-3, "channel {c} after {t0}: {inside0} against {p0}, {m0}");
+            assert!((inside1 - (p1 - m1 * h)).abs() < 1e-3, "channel {c} before {t1}: {inside1} against {p1}, {m1}");
+        }
+    }
+    // The step jumps at 0.7 (and at its bounced and cycled copies); a smooth key does not.
+    let stepped = &channels[3];
+    assert_eq!(stepped.sided(0.7, Side::Before), (1.0, 0.0));
+    assert_eq!(stepped.sided(0.7, Side::After).0, -2.0);
+    assert_eq!(stepped.sided(1.6 + 0.7, Side::Before).0, 1.0, "one cycle on");
+    let smooth = &channels[1];
+    assert_eq!(smooth.sided(1.0, Side::Before), smooth.sided(1.0, Side::After));
+    // On a step's next key the curve has that key's value, the last key too.
+    let steps = Channel::new(
+        vec![key(0.0, 1.0, Tangent::Step, Tangent::Step), key(1.0, 2.0, Tangent::Step, Tangent::Step)],
+        Extrapolation::Constant,
+        Extrapolation::Constant,
+    );
+    assert_eq!((steps.value_at(0.999), steps.value_at(1.0)), (1.0, 2.0));
+    // Too many repetitions are refused rather than listed.
+    assert!(smooth.seams((0.0, 1e9), 1000).unwrap_err().contains("more than the 1000"));
+}
+
 #[test]
 fn bad_clips_name_the_file_and_line() {
     let cases = [
