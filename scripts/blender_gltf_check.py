@@ -9,7 +9,7 @@ z-up) with the OBJ's: for each OBJ vertex, the nearest deformed vertex.
     python3.11 scripts/blender_gltf_check.py ../shared/data target/debug/marionette
 
 Then the animation: the wasp's walk exported with `--animation`, played by Blender to
-t = 1 s and 2.5 s, against `export --anim ... --time T`; and Khronos samples, the nested
+t = 0 and 4 s (key times of every track), against `export --anim ... --time T`; and Khronos samples, the nested
 skeleton fixture and its FBX, every clip written key for key, Blender playing the first.
 
 Prints the largest distance per case. Needs `pip install bpy numpy`.
@@ -106,7 +106,9 @@ def main(data: Path, marionette: str):
             print(f"{name}: {len(ours)} vertices, Blender {len(theirs)}; largest distance {worst:.2e} ({worst / size:.1e} of the size {size:.3f})")
             worst_all = max(worst_all, worst / size)
         wasp, walk = str(data / "cse169/project3/wasp.skel"), str(data / "cse169/project3/wasp_walk.anim")
-        worst_all = max(worst_all, check_animation(marionette, tmp, "wasp walk animation", wasp, ["--anim", walk], (1.0, 2.5)))
+        # The walk goes out as CUBICSPLINE keyed at its keys (more where a joint turns fast);
+        # Blender drops the tangents, so only where every track has a key: 0 and 4 s.
+        worst_all = max(worst_all, check_animation(marionette, tmp, "wasp walk animation", wasp, ["--anim", walk], (0.0, 4.0)))
         # The pair's walker clip (CUBICSPLINE in the file, and so in ours): Blender drops the
         # tangents, so only at key times (frames 10 and 24).
         pair = str(REPO / "tests/data/blender_pair.glb")

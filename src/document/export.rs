@@ -127,7 +127,11 @@ fn posed(
                 .map_err(|e| FormatError::other(c.source.path().unwrap_or(std::path::Path::new(&c.name)), e))?;
         }
         if animated {
-            posed.clips = part.clips.iter().chain(posed.clips.iter()).cloned().collect();
+            // Keyframes on a part whose clips key its root under folded nodes go out in
+            // their frame, which the export writes above the root.
+            let frame = part.clips.first().map_or(glam::Mat4::IDENTITY, |k| k.root_parent);
+            let keyframes = posed.clips.iter().map(|k| crate::rig::keyframe_splines::reframed(k.clone(), frame));
+            posed.clips = part.clips.iter().cloned().chain(keyframes).collect();
         }
     }
     if animated && let Some((name, motion)) = smpl_motion(library, c, asset)? {

@@ -11,7 +11,7 @@
 //! joint turns fast, none where it turns slowly). Where a curve jumps (a step key, a
 //! cycle's seam) it is keyed twice, one float apart: the value before the jump, then after.
 
-use glam::{DVec3, DVec4, Quat, Vec3};
+use glam::{DVec3, DVec4, Mat4, Quat, Vec3};
 
 use super::anim::{Clip, Side};
 use super::node_clip::{Interpolation, JointTracks, NodeClip, Track};
@@ -52,7 +52,31 @@ pub fn spline_clip(
         let held = fallback.get(j).copied().unwrap_or_default().to_euler(EulerOrder::Xyz);
         tracks.rotation = rotation_track(clip, j, held, &skeleton.joint(j).limits, most)?;
     }
-    Ok(NodeClip { name: name.to_owned(), index: 0, tracks, weights: Vec::new(), root_parent: glam::Mat4::IDENTITY })
+    Ok(NodeClip { name: name.to_owned(), index: 0, tracks, weights: Vec::new(), root_parent: Mat4::IDENTITY })
+}
+
+/// `clip` with its root's keys in the frame of `frame`, the nodes above the root that a glTF
+/// import folded into it ([`NodeClip::root_parent`]): the export writes that frame as a node
+/// above the root, so the root's keys go out as `frame⁻¹ ·` the keyed transform. For a frame
+/// of uniform scale, the translation's values move by the inverse frame (its slopes by its
+/// linear part) and the rotation's values and slopes turn by its inverse rotation: both
+/// linear, so each spline stays the same curve.
+pub fn reframed(mut clip: NodeClip, frame: Mat4) -> NodeClip {
+    let inverse = frame.inverse();
+    let (_, turn, _) = inverse.to_scale_rotation_translation();
+    if let Some(root) = clip.tracks.first_mut() {
+        if let Some(track) = &mut root.translation {
+            for (i, v) in track.values.iter_mut().enumerate() {
+                // In-slope, value, out-slope: a value is a point, a slope a direction.
+                *v = if i % 3 == 1 { inverse.transform_point3(*v) } else { inverse.transform_vector3(*v) };
+            }
+        }
+        if let Some(track) = &mut root.rotation {
+            track.values.iter_mut().for_each(|q| *q = turn * *q);
+        }
+    }
+    clip.root_parent = frame;
+    clip
 }
 
 /// The channels of `indices` that have keys, and the seams of all of them (none keyed: None).

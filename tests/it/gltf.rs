@@ -577,3 +577,49 @@ fn a_base_colour_texture_comes_with_its_coordinates() {
     let waver = &characters[1];
     assert!(waver.asset.base_color_texture().is_none() && waver.asset.skin.texcoords.is_empty());
 }
+
+/// Keyframes on a glTF character whose import folded nodes above its root (CesiumMan's
+/// z-up frame) go out in that frame: the animated export played at t, read as the spec
+/// says, deforms as the still export of the scene at t does, its root keyed too.
+#[test]
+#[cfg_attr(not(marionette_data), ignore = "needs MARIONETTE_DATA (the course data)")]
+fn keyframes_on_a_folded_root_go_out_in_its_frame() {
+    use marionette::formats::scene::{AnimDoc, CharacterDoc, SceneDoc, SourceDoc};
+    use marionette::rig::anim::{Channel, Clip, Extrapolation, Key, Tangent};
+    let path = crate::common::data_dir().join("khronos/CesiumMan.glb");
+    let part = &marionette::formats::load_parts(&path).unwrap()[0];
+    assert_ne!(part.clips[0].root_parent, Mat4::IDENTITY, "CesiumMan's root sits under folded nodes");
+    let skeleton = &part.asset.skeleton;
+    let smooth = |time, value| Key { time, value, tangent_in: Tangent::Smooth, tangent_out: Tangent::Smooth };
+    let channel = |keys| Channel::new(keys, Extrapolation::Constant, Extrapolation::Constant);
+    let mut clip = Clip::empty(skeleton.len());
+    clip.range = (0.0, 2.0);
+    let rest = skeleton.joint(0).rest_offset;
+    clip.channels[1] = channel(vec![smooth(0.0, rest.y), smooth(1.0, rest.y + 0.3), smooth(2.0, rest.y)]);
+    clip.channels[Clip::joint_channel(0, 2)] = channel(vec![smooth(0.0, 0.0), smooth(2.0, 1.2)]);
+    clip.channels[Clip::joint_channel(3, 0)] = channel(vec![smooth(0.0, 0.0), smooth(1.0, 0.9), smooth(2.0, -0.4)]);
+    let doc_at = |time: f32| {
+        let anim = AnimDoc { keys: Some(clip.clone()), time, ..AnimDoc::default() };
+        let man = CharacterDoc { anim: Some(anim), ..CharacterDoc::new(SourceDoc::File(path.clone()), "man") };
+        SceneDoc { characters: vec![man], ..SceneDoc::default() }
+    };
+    let dir = crate::common::scratch("folded-keyframes");
+    let write = |name: &str, doc: &SceneDoc, animated: bool| {
+        let file = dir.join(name);
+        std::fs::write(&file, marionette::document::export::scene_glb(doc, GltfMesh::Skinned, animated).unwrap())
+            .unwrap();
+        super::gltf_spec::SpecFile::read(&file)
+    };
+    let animated = write("animated.glb", &doc_at(0.0), true);
+    let keyframes = animated.animations().iter().position(|a| a["name"] == "man").unwrap();
+    let mut worst = 0.0f64;
+    for t in [0.0, 0.37, 1.0, 1.61, 2.0] {
+        let still = write("still.glb", &doc_at(t), false).posed(None);
+        let played = animated.posed(Some((keyframes, f64::from(t))));
+        let (lo, hi) = still.iter().fold((glam::DVec3::MAX, glam::DVec3::MIN), |(lo, hi), v| (lo.min(*v), hi.max(*v)));
+        for (a, b) in still.iter().zip(&played) {
+            worst = worst.max((*a - *b).length() / (hi - lo).length());
+        }
+    }
+    assert!(worst < 1e-4, "worst {worst:e} of the size");
+}
