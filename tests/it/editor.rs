@@ -375,7 +375,7 @@ fn recent_files_are_kept_newest_first_and_read_back() {
 /// Materials reach the picture: the Blender pair's walker drawn with its checker also as
 /// its normal map (the file changed here) differs from the plain walker where the walker
 /// is, and nowhere else (the normal map bends the flat normals; the waver, the floor and the
-/// sky stay as they were).
+/// sky stay as they were); the same map at scale −1 bends it the other way.
 #[test]
 fn a_normal_map_bends_the_light_on_its_surface_only() {
     let dir = scratch("render-normal-map");
@@ -384,18 +384,22 @@ fn a_normal_map_bends_the_light_on_its_surface_only() {
     let u32_at = |at: usize| u32::from_le_bytes(glb[at..at + 4].try_into().unwrap()) as usize;
     let json_len = u32_at(12);
     let mut json: serde_json::Value = serde_json::from_slice(&glb[20..20 + json_len]).unwrap();
-    json["materials"][0]["normalTexture"] = serde_json::json!({ "index": 0 });
-    let mut text = serde_json::to_vec(&json).unwrap();
-    text.resize(text.len().div_ceil(4) * 4, b' ');
-    let rest = &glb[20 + json_len..];
-    let mut bumpy = b"glTF".to_vec();
-    bumpy.extend(2u32.to_le_bytes());
-    bumpy.extend(((20 + text.len() + rest.len()) as u32).to_le_bytes());
-    bumpy.extend((text.len() as u32).to_le_bytes());
-    bumpy.extend(b"JSON");
-    bumpy.extend(&text);
-    bumpy.extend(rest);
-    std::fs::write(dir.join("bumpy.glb"), bumpy).unwrap();
+    let mut with_normal_map = |scale: f32, name: &str| {
+        json["materials"][0]["normalTexture"] = serde_json::json!({ "index": 0, "scale": scale });
+        let mut text = serde_json::to_vec(&json).unwrap();
+        text.resize(text.len().div_ceil(4) * 4, b' ');
+        let rest = &glb[20 + json_len..];
+        let mut bumpy = b"glTF".to_vec();
+        bumpy.extend(2u32.to_le_bytes());
+        bumpy.extend(((20 + text.len() + rest.len()) as u32).to_le_bytes());
+        bumpy.extend((text.len() as u32).to_le_bytes());
+        bumpy.extend(b"JSON");
+        bumpy.extend(&text);
+        bumpy.extend(rest);
+        std::fs::write(dir.join(name), bumpy).unwrap();
+    };
+    with_normal_map(1.0, "bumpy.glb");
+    with_normal_map(-1.0, "turned.glb");
     let render = |input: &std::path::Path, name: &str| {
         let out = dir.join(name);
         let output = Command::new(env!("CARGO_BIN_EXE_marionette"))
@@ -416,4 +420,9 @@ fn a_normal_map_bends_the_light_on_its_surface_only() {
     assert!(changed.len() > 100, "the normal map changed {} pixels", changed.len());
     // The walker stands on the left half of the picture; the waver on the right.
     assert!(changed.iter().all(|&(x, _)| x < 80), "changed beyond the walker: {:?}", changed.iter().max());
+    // The map's scale multiplies its x and y: at -1 they turn the other way.
+    let turned = render(&dir.join("turned.glb"), "turned.png");
+    let differ =
+        bumpy.pixels().zip(turned.pixels()).filter(|(a, b)| a.0.iter().zip(b.0).any(|(a, b)| a.abs_diff(b) > 8));
+    assert!(differ.count() > 50, "the map's scale is not applied");
 }

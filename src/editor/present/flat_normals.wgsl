@@ -19,6 +19,9 @@
 }
 #endif
 
+// glTF's normalTexture.scale in x.
+@group(#{MATERIAL_BIND_GROUP}) @binding(100) var<uniform> normal_scale: vec4<f32>;
+
 @fragment
 fn fragment(
     in: VertexOutput,
@@ -48,7 +51,8 @@ fn fragment(
     let b = dp2perp * duv1.y + dp1perp * duv2.y;
     let scale = inverseSqrt(max(max(dot(t, t), dot(b, b)), 1e-20));
     let sampled = textureSample(bevy_pbr::pbr_bindings::normal_map_texture, bevy_pbr::pbr_bindings::normal_map_sampler, uv).rgb;
-    let tangent_space = sampled * 2.0 - 1.0;
+    // glTF: scaledNormal = normalize((sampled * 2 - 1) * vec3(scale, scale, 1)).
+    let tangent_space = (sampled * 2.0 - 1.0) * vec3(normal_scale.x, normal_scale.x, 1.0);
     n = normalize(tangent_space.x * t * scale - tangent_space.y * b * scale + tangent_space.z * flat);
 #endif
 #endif

@@ -12,9 +12,20 @@ use bevy::shader::ShaderRef;
 
 use crate::rig::material::Sampler;
 
-/// The extension: no data of its own, only the flat-normal fragment shader.
-#[derive(Asset, AsBindGroup, Reflect, Debug, Clone, Default)]
-pub struct FlatNormals {}
+/// The extension: the flat-normal fragment shader and the normal map's scale.
+#[derive(Asset, AsBindGroup, Reflect, Debug, Clone)]
+pub struct FlatNormals {
+    /// glTF's `normalTexture.scale` in x (the map's x and y are multiplied by it); y, z, w
+    /// unused (a uniform of 16 bytes).
+    #[uniform(100)]
+    pub normal_scale: Vec4,
+}
+
+impl Default for FlatNormals {
+    fn default() -> Self {
+        Self { normal_scale: Vec4::new(1.0, 0.0, 0.0, 0.0) }
+    }
+}
 
 impl MaterialExtension for FlatNormals {
     fn fragment_shader() -> ShaderRef {
@@ -82,8 +93,8 @@ fn image_of(picture: &crate::rig::Picture, srgb: bool, sampler: Sampler) -> Imag
 
 /// The skin material of one of an asset's materials; `image` gives a texture's image
 /// (sRGB or not), or none when it cannot be read. Skins have no tangents: the shader
-/// bends its flat normals by the normal map in a frame from the derivatives (the map's
-/// scale is not applied).
+/// bends its flat normals by the normal map (times its scale) in a frame from the
+/// derivatives.
 pub fn skin_material_of(
     m: &crate::rig::material::Material,
     image: &mut impl FnMut(&crate::rig::SkinTexture, bool, Sampler) -> Option<Handle<Image>>,
@@ -123,7 +134,7 @@ pub fn skin_material_of(
         ),
         ..default()
     };
-    ExtendedMaterial { base, extension: FlatNormals {} }
+    ExtendedMaterial { base, extension: FlatNormals { normal_scale: Vec4::new(m.normal_scale, 0.0, 0.0, 0.0) } }
 }
 
 pub struct SkinMaterialPlugin;
@@ -139,5 +150,5 @@ impl Plugin for SkinMaterialPlugin {
 
 fn setup_skin_material(mut commands: Commands, mut materials: ResMut<Assets<SkinMaterialAsset>>) {
     let base = StandardMaterial { base_color: Color::WHITE, perceptual_roughness: 0.75, ..default() };
-    commands.insert_resource(SkinMaterial(materials.add(ExtendedMaterial { base, extension: FlatNormals {} })));
+    commands.insert_resource(SkinMaterial(materials.add(ExtendedMaterial { base, extension: FlatNormals::default() })));
 }
