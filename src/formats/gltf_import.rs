@@ -74,6 +74,9 @@ struct File<'a> {
     parent: Vec<Option<usize>>,
     /// Whether an animation keys the node's translation, rotation or scale.
     animated: Vec<bool>,
+    /// Whether the node is in the scene the file shows (`scene`, else its first; every
+    /// node when it has no scenes).
+    shown: Vec<bool>,
     /// Whether a mesh depends on the node (a skin's joint, an unskinned mesh's node).
     seed: Vec<bool>,
     /// Whether the node is one of `seed`'s or above one.
@@ -112,8 +115,9 @@ impl<'a> File<'a> {
                 animated[channel.target().node().index()] = true;
             }
         }
+        let shown = shown_nodes(gltf, &parent);
         let mut seed = vec![false; n];
-        for node in gltf.nodes().filter(|n| n.mesh().is_some()) {
+        for node in gltf.nodes().filter(|n| n.mesh().is_some() && shown[n.index()]) {
             match node.skin() {
                 Some(skin) => skin.joints().for_each(|j| seed[j.index()] = true),
                 None => seed[node.index()] = true,
@@ -128,7 +132,12 @@ impl<'a> File<'a> {
                 at = parent[node];
             }
         }
-        Self { gltf, buffers, path, parent, animated, seed, relevant, images: Default::default() }
+        Self { gltf, buffers, path, parent, animated, shown, seed, relevant, images: Default::default() }
+    }
+
+    /// The nodes with a mesh in the scene shown, in file order.
+    fn mesh_nodes(&self) -> impl Iterator<Item = gltf::Node<'a>> + '_ {
+        self.gltf.nodes().filter(|n| n.mesh().is_some() && self.shown[n.index()])
     }
 
     fn error(&self, message: String) -> FormatError {
@@ -172,7 +181,7 @@ impl<'a> File<'a> {
             Some(skin) => skin.joints().next().map(|j| self.root_of(j.index())),
             None => Some(self.root_of(node.index())),
         };
-        for node in self.gltf.nodes().filter(|n| n.mesh().is_some()) {
+        for node in self.mesh_nodes() {
             if let Some(skin) = node.skin() {
                 let mut roots = skin.joints().map(|j| self.root_of(j.index()));
                 if let Some(first) = roots.next() {
@@ -184,7 +193,7 @@ impl<'a> File<'a> {
             }
         }
         let mut parts: Vec<(usize, PartNodes)> = Vec::new();
-        for node in self.gltf.nodes().filter(|n| n.mesh().is_some()) {
+        for node in self.mesh_nodes() {
             let Some(root) = mesh_root(&node) else { continue };
             let id = find(&mut group, root);
             match parts.iter_mut().find(|(g, _)| *g == id) {
@@ -676,6 +685,34 @@ fn finite_keys(mut good: impl Iterator<Item = bool>, sampler: &str) -> Result<()
         Some(k) => Err(format!("{sampler}.output: expected finite key values, found an unusable one at value {k}")),
         None => Ok(()),
     }
+}
+
+/// Whether each node is in the scene the file shows: under a root node of its `scene` (else
+/// its first scene); every node when the file has no scenes.
+fn shown_nodes(gltf: &gltf::Gltf, parent: &[Option<usize>]) -> Vec<bool> {
+    let Some(scene) = gltf.default_scene().or_else(|| gltf.scenes().next()) else {
+        return vec![true; parent.len()];
+    };
+    let mut shown: Vec<Option<bool>> = vec![None; parent.len()];
+    for root in (0..parent.len()).filter(|&n| parent[n].is_none()) {
+        shown[root] = Some(false);
+    }
+    for root in scene.nodes() {
+        shown[root.index()] = Some(parent[root.index()].is_none());
+    }
+    // Each node takes its root's answer: up to the first node that knows, then down the
+    // path (each node is walked once, however deep the tree).
+    let mut path = Vec::new();
+    for start in 0..parent.len() {
+        let mut node = start;
+        while shown[node].is_none() {
+            path.push(node);
+            node = parent[node].expect("a node without an answer has a parent");
+        }
+        let answer = shown[node];
+        path.drain(..).for_each(|n| shown[n] = answer);
+    }
+    shown.into_iter().map(|s| s == Some(true)).collect()
 }
 
 /// Each node's parent (none for a scene root).

@@ -381,21 +381,10 @@ fn a_normal_map_bends_the_light_on_its_surface_only() {
     let dir = scratch("render-normal-map");
     let pair = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/blender_pair.glb");
     let glb = std::fs::read(&pair).unwrap();
-    let u32_at = |at: usize| u32::from_le_bytes(glb[at..at + 4].try_into().unwrap()) as usize;
-    let json_len = u32_at(12);
-    let mut json: serde_json::Value = serde_json::from_slice(&glb[20..20 + json_len]).unwrap();
-    let mut with_normal_map = |scale: f32, name: &str| {
-        json["materials"][0]["normalTexture"] = serde_json::json!({ "index": 0, "scale": scale });
-        let mut text = serde_json::to_vec(&json).unwrap();
-        text.resize(text.len().div_ceil(4) * 4, b' ');
-        let rest = &glb[20 + json_len..];
-        let mut bumpy = b"glTF".to_vec();
-        bumpy.extend(2u32.to_le_bytes());
-        bumpy.extend(((20 + text.len() + rest.len()) as u32).to_le_bytes());
-        bumpy.extend((text.len() as u32).to_le_bytes());
-        bumpy.extend(b"JSON");
-        bumpy.extend(&text);
-        bumpy.extend(rest);
+    let with_normal_map = |scale: f32, name: &str| {
+        let bumpy = crate::common::glb_with_json(&glb, |json| {
+            json["materials"][0]["normalTexture"] = serde_json::json!({ "index": 0, "scale": scale });
+        });
         std::fs::write(dir.join(name), bumpy).unwrap();
     };
     with_normal_map(1.0, "bumpy.glb");

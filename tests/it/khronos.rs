@@ -312,3 +312,30 @@ fn data_uris_and_percent_encoded_names_load() {
     let e = marionette::formats::load_character(&dir.join("bad.gltf")).unwrap_err().to_string();
     assert!(e.contains("bad.gltf") && e.contains("buffers[0].uri") && e.contains("base64"), "{e}");
 }
+
+/// A file of several scenes loads the scene it shows (`scene`, else its first): the Blender
+/// pair with a second scene holding only the waver loads both when the first scene shows,
+/// and only the waver when the second does.
+#[test]
+fn only_the_scene_a_file_shows_loads() {
+    let pair =
+        std::fs::read(std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/blender_pair.glb")).unwrap();
+    let dir = crate::common::scratch("scenes");
+    let joints = |scene: u64| {
+        let glb = crate::common::glb_with_json(&pair, |json| {
+            json["scenes"].as_array_mut().unwrap().push(serde_json::json!({ "name": "waver alone", "nodes": [8] }));
+            json["scene"] = serde_json::json!(scene);
+        });
+        let path = dir.join(format!("scene{scene}.glb"));
+        std::fs::write(&path, glb).unwrap();
+        let parts = marionette::formats::load_parts(&path).unwrap();
+        parts
+            .iter()
+            .map(|p| p.asset.skeleton.joints().iter().map(|j| j.name.clone()).collect())
+            .collect::<Vec<Vec<_>>>()
+    };
+    let both = joints(0);
+    assert_eq!(both.len(), 2);
+    assert_eq!(joints(1), [both[1].clone()], "the waver's part alone");
+    assert!(both[1].iter().any(|j| j == "upper"));
+}
