@@ -212,7 +212,9 @@ fn frame_time_readout(ctx: &egui::Context, viewport: egui::Rect, diagnostics: &D
     else {
         return;
     };
-    egui::Area::new("frame_time".into()).fixed_pos(viewport.right_top() + egui::vec2(-200.0, 8.0)).show(ctx, |ui| {
+    // Pinned by its right edge, so a longer number grows leftwards, never under the panel.
+    let corner = viewport.right_top() + egui::vec2(-10.0, 8.0);
+    egui::Area::new("frame_time".into()).pivot(egui::Align2::RIGHT_TOP).fixed_pos(corner).show(ctx, |ui| {
         let text = egui::RichText::new(format!("{ms:.1} ms · {fps:.0} fps")).monospace().color(egui::Color32::WHITE);
         ui.add(egui::Label::new(text).wrap_mode(egui::TextWrapMode::Extend));
     });
