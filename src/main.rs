@@ -32,7 +32,7 @@ fn run(cli: Cli) -> Result<()> {
         }
         Some(Command::Info { path }) => marionette::cli::info(&path)?,
         Some(Command::Export(args)) => marionette::cli::export::run(&args)?,
-        Some(Command::Render { paths, out, width, height, poses, ik, skinning, match_height, clip }) => {
+        Some(Command::Render { paths, out, width, height, poses, ik, skinning, match_height, clip, frames }) => {
             let started = std::time::Instant::now();
             let edits = marionette::editor::StartupEdits {
                 poses,
@@ -43,12 +43,18 @@ fn run(cli: Cli) -> Result<()> {
                 time: clip.time,
                 clip: clip.clip.clone(),
             };
-            let notes = marionette::editor::present::render::render(paths, edits, out.clone(), width, height)
-                .map_err(anyhow::Error::msg)?;
+            let sequence = frames.sequence();
+            let notes =
+                marionette::editor::present::render::render(paths, edits, out.clone(), (width, height), sequence)
+                    .map_err(anyhow::Error::msg)?;
             for n in notes {
                 eprintln!("note: {n}");
             }
-            println!("wrote {} ({width}x{height}) in {:.2} s", out.display(), started.elapsed().as_secs_f64());
+            let what = match sequence.and_then(|s| s.times().ok()) {
+                Some(times) => format!("{} frames as {}", times.len(), out.display()),
+                None => out.display().to_string(),
+            };
+            println!("wrote {what} ({width}x{height}) in {:.2} s", started.elapsed().as_secs_f64());
         }
         Some(Command::Bind(args)) => marionette::cli::bind::run(&args)?,
         Some(Command::Smpl(args)) => marionette::cli::smpl::run(&args)?,

@@ -59,6 +59,8 @@ pub enum Command {
         match_height: bool,
         #[command(flatten)]
         clip: ClipArgs,
+        #[command(flatten)]
+        frames: FrameArgs,
     },
     /// The SMPL exercise: writes frame000.obj, frame001.obj, ... into --out.
     ///
@@ -144,8 +146,38 @@ impl From<BindMethod> for crate::rig::bind::Binding {
     }
 }
 
-/// `--anim FILE --time T`: pose characters from a keyframed clip.
+/// `--from A --to B --fps N`, `--turntable S`: a sequence of pictures.
 #[derive(clap::Args, Debug, Clone)]
+pub struct FrameArgs {
+    /// With `--to`: render the frames from this time (seconds) to `--to`, one picture per
+    /// frame of every clip of the scene, into the files `--out` numbers
+    /// (`dir/frame_%04d.png`).
+    #[arg(long, requires = "to", conflicts_with = "time", value_parser = finite_seconds)]
+    pub from: Option<f32>,
+    /// The last frame's time (seconds), with `--from`.
+    #[arg(long, requires = "from", value_parser = finite_seconds)]
+    pub to: Option<f32>,
+    /// Frames per second of `--from`/`--to` and `--turntable`.
+    #[arg(long, default_value_t = 24.0)]
+    pub fps: f32,
+    /// The camera goes once round the scene in this many seconds: the frames of one turn
+    /// (from `--from`, or 0), or the turn over `--from`/`--to`.
+    #[arg(long, value_name = "SECONDS", value_parser = finite_seconds)]
+    pub turntable: Option<f32>,
+}
+
+impl FrameArgs {
+    /// The frames to render, if a sequence was asked for.
+    pub fn sequence(&self) -> Option<crate::document::frames::FrameSequence> {
+        let from = self.from.unwrap_or(0.0);
+        // One turn without --to: every frame before the turn comes round to the first.
+        let to = self.to.or_else(|| self.turntable.map(|s| from + s - 1.0 / self.fps))?;
+        Some(crate::document::frames::FrameSequence { from, to, fps: self.fps, turntable: self.turntable })
+    }
+}
+
+/// `--anim FILE --time T`: pose characters from a keyframed clip.
+#[derive(Debug, Clone, clap::Args)]
 pub struct ClipArgs {
     /// A CSE169 `.anim` clip (channels 0-2 move the root, then x, y, z rotation per joint
     /// in the skeleton's order) or a `.bvh` (its joints by name), on every character whose

@@ -7,6 +7,7 @@
 pub mod crowd;
 pub mod default_scene;
 pub mod export;
+pub mod frames;
 pub mod layout;
 pub mod library;
 pub mod posing;

@@ -415,3 +415,53 @@ fn a_normal_map_bends_the_light_on_its_surface_only() {
         bumpy.pixels().zip(turned.pixels()).filter(|(a, b)| a.0.iter().zip(b.0).any(|(a, b)| a.abs_diff(b) > 8));
     assert!(differ.count() > 50, "the map's scale is not applied");
 }
+
+/// `render --from 0 --to 1 --fps 10` writes 11 numbered pictures, each of its time: the
+/// puppet raising an arm under a fixed camera, every picture differing from the one before,
+/// and frame 7 as `render --time 0.7` draws it.
+#[test]
+fn a_frame_sequence_writes_one_picture_per_frame_at_its_time() {
+    use marionette::formats::scene::{AnimDoc, CameraDoc, CharacterDoc, SceneDoc, SourceDoc};
+    use marionette::rig::anim::{Channel, Clip, Extrapolation, Key, Tangent};
+    let dir = scratch("render-frames");
+    let puppet = marionette::formats::puppet::embedded_puppet();
+    let shoulder = puppet.skeleton.find("r_shoulder").unwrap();
+    let key = |time, value| Key { time, value, tangent_in: Tangent::Linear, tangent_out: Tangent::Linear };
+    let mut clip = Clip::empty(puppet.skeleton.len());
+    clip.channels[Clip::joint_channel(shoulder, 2)] =
+        Channel::new(vec![key(0.0, 0.0), key(1.0, -2.0)], Extrapolation::Constant, Extrapolation::Constant);
+    let anim = AnimDoc { keys: Some(clip), ..AnimDoc::default() };
+    let character = CharacterDoc { anim: Some(anim), ..CharacterDoc::new(SourceDoc::Embedded("puppet".into()), "p") };
+    let camera = CameraDoc { focus: glam::Vec3::new(0.0, 0.7, 0.0), yaw: 0.0, pitch: -0.1, distance: 2.2 };
+    let doc = SceneDoc { characters: vec![character], camera: Some(camera), ..SceneDoc::default() };
+    let scene = dir.join("arm.ron");
+    marionette::document::scenes::write_scene(&scene, &doc).unwrap();
+    let render = |extra: &[&str], out: &std::path::Path| {
+        let output = Command::new(env!("CARGO_BIN_EXE_marionette"))
+            .args(["render", "--width", "64", "--height", "48"])
+            .args(extra)
+            .arg("--out")
+            .arg(out)
+            .arg(&scene)
+            .output()
+            .unwrap();
+        assert!(output.status.success(), "{}", String::from_utf8_lossy(&output.stderr));
+    };
+    render(&["--from", "0", "--to", "1", "--fps", "10"], &dir.join("frame_%04d.png"));
+    let mut names: Vec<String> =
+        std::fs::read_dir(&dir).unwrap().map(|e| e.unwrap().file_name().to_string_lossy().into_owned()).collect();
+    names.retain(|n| n.starts_with("frame_"));
+    names.sort();
+    let expected: Vec<String> = (0..=10).map(|k| format!("frame_{k:04}.png")).collect();
+    assert_eq!(names, expected);
+    let picture = |name: &str| image::open(dir.join(name)).unwrap().to_rgb8();
+    let differing = |a: &image::RgbImage, b: &image::RgbImage| {
+        a.pixels().zip(b.pixels()).filter(|(p, q)| p.0.iter().zip(q.0).any(|(x, y)| x.abs_diff(y) > 8)).count()
+    };
+    for pair in expected.windows(2) {
+        assert!(differing(&picture(&pair[0]), &picture(&pair[1])) > 0, "{} and {} are alike", pair[0], pair[1]);
+    }
+    render(&["--time", "0.7"], &dir.join("single.png"));
+    let at = differing(&picture("frame_0007.png"), &picture("single.png"));
+    assert!(at < 10, "frame 7 differs from the picture at 0.7 s in {at} pixels");
+}

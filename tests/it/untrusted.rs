@@ -454,8 +454,8 @@ fn render_of_a_scene_whose_clip_fails_to_load_fails_and_writes_nothing() {
     std::fs::write(&scene, "(characters:[(source:Embedded(\"puppet\"),name:\"p\",anim:Some((file:\"bad.anim\")))])")
         .unwrap();
     let out = dir.join("shot.png");
-    let e =
-        marionette::editor::present::render::render(vec![scene], Default::default(), out.clone(), 64, 64).unwrap_err();
+    let e = marionette::editor::present::render::render(vec![scene], Default::default(), out.clone(), (64, 64), None)
+        .unwrap_err();
     assert!(e.contains("bad.anim:1:") && e.contains("(character `p` of"), "{e}");
     assert!(!out.exists());
 }

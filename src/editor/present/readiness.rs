@@ -119,6 +119,12 @@ impl CaptureGate {
         self.last_frame = frame;
     }
 
+    /// Counts ready frames from none again: what is drawn changed (the next frame of a
+    /// sequence), and only frames after the change count.
+    pub fn restart(&mut self) {
+        self.ready_frames = 0;
+    }
+
     /// Whether enough ready frames passed in a row.
     pub fn is_ready(&self) -> bool {
         self.ready_frames >= READY_FRAMES && self.failed.is_none()

@@ -12,6 +12,7 @@ use bevy::render::render_resource::{TextureFormat, TextureUsages};
 use bevy::render::view::screenshot::{Screenshot, ScreenshotCaptured};
 
 use crate::document::AssetLibrary;
+use crate::document::frames::{FrameSequence, frame_path};
 use crate::document::scenes::{read_scene, scene_path};
 use crate::editor::interact::camera::OrbitCamera;
 use crate::editor::present::readiness::CaptureGate;
@@ -25,32 +26,53 @@ use crate::scene::{RigCorePlugin, SkinningPlugin};
 /// Seconds after which the render gives up, saying what was still pending.
 const GIVE_UP_SECONDS: u64 = 300;
 
-/// The render in progress: it waits for [`CaptureGate`] (every pipeline compiled, every
-/// mesh on the GPU, every character skinned), then captures once and saves.
+/// The render in progress: for each frame it waits for [`CaptureGate`] (every pipeline
+/// compiled, every mesh on the GPU, every character skinned), captures and saves; then
+/// puts the clips (and a turntable's camera) at the next frame's time.
 #[derive(Resource)]
 struct RenderJob {
-    out: PathBuf,
+    /// Each picture's time (none: the scene as it opens) and file.
+    frames: Vec<(Option<f32>, PathBuf)>,
+    /// The frame being rendered.
+    next: usize,
+    sequence: Option<FrameSequence>,
+    /// The camera's yaw at the first frame (a turntable turns from it).
+    first_yaw: Option<f32>,
     target: Handle<Image>,
     started: std::time::Instant,
-    /// The capture was requested.
+    /// The capture of `next` was requested.
     requested: bool,
-    /// The result of saving, once done.
+    /// The result of saving `next`, until the next frame is set up.
+    saved: Option<Result<(), String>>,
+    /// The result of the whole render, once done.
     done: Option<Result<(), String>>,
     /// Where the result and the messages are left for the caller.
     outcome: Arc<Mutex<(Option<Result<(), String>>, Vec<String>)>>,
 }
 
 /// Renders `paths` (a scene `.ron`, character files, or the default scene when empty) at
-/// `width`×`height` into `out`. Returns what went wrong, if anything.
+/// `width`×`height` into `out`, or with `sequence` one picture per frame into the files
+/// `out` numbers (`frame_%04d.png`). Returns the notes, or what went wrong.
 pub fn render(
     paths: Vec<PathBuf>,
-    edits: StartupEdits,
+    mut edits: StartupEdits,
     out: PathBuf,
-    width: u32,
-    height: u32,
+    (width, height): (u32, u32),
+    sequence: Option<FrameSequence>,
 ) -> Result<Vec<String>, String> {
+    let frames = match &sequence {
+        Some(sequence) => {
+            let times = sequence.times()?;
+            let paths = (0..times.len()).map(|n| frame_path(&out, n)).collect::<Result<Vec<_>, _>>()?;
+            edits.time = times.first().copied();
+            times.into_iter().map(Some).zip(paths).collect()
+        }
+        None => vec![(None, out)],
+    };
     let library = preload(&paths, &edits)?;
-    crate::formats::error::refuse_overwriting_input(&out).map_err(|e| e.to_string())?;
+    for (_, out) in &frames {
+        crate::formats::error::refuse_overwriting_input(out).map_err(|e| e.to_string())?;
+    }
     let mut app = App::new();
     app.add_plugins(crate::editor::windowless_plugins())
         .add_plugins(ScheduleRunnerPlugin::run_loop(Duration::from_millis(2)))
@@ -68,10 +90,14 @@ pub fn render(
     };
     let outcome = Arc::new(Mutex::new((None, Vec::new())));
     app.insert_resource(RenderJob {
-        out,
+        frames,
+        next: 0,
+        sequence,
+        first_yaw: None,
         target: target.clone(),
         started: std::time::Instant::now(),
         requested: false,
+        saved: None,
         done: None,
         outcome: outcome.clone(),
     });
@@ -79,7 +105,10 @@ pub fn render(
         let orbit = OrbitCamera::default();
         commands.spawn((Camera3d::default(), RenderTarget::Image(target.clone().into()), orbit, orbit.transform()));
     });
-    app.add_systems(Last, capture_when_ready.after(crate::editor::present::readiness::UpdateCaptureGate));
+    app.add_systems(
+        Last,
+        (next_frame, capture_when_ready).chain().after(crate::editor::present::readiness::UpdateCaptureGate),
+    );
     let exit = app.run();
     // `App::run` hands the world to the runner: the outcome comes back through `outcome`.
     let (done, messages) = outcome.lock().map(|o| o.clone()).unwrap_or_default();
@@ -148,14 +177,50 @@ fn capture_when_ready(
         job.done = Some(Err(format!("the render was not ready within {GIVE_UP_SECONDS} s; still pending: {pending}")));
         return;
     }
-    if job.requested || !gate.is_ready() {
+    if job.requested || job.saved.is_some() || !gate.is_ready() {
         return;
     }
     job.requested = true;
-    let out = job.out.clone();
+    let out = job.frames[job.next].1.clone();
     commands.spawn(Screenshot::image(job.target.clone())).observe(
         move |captured: On<ScreenshotCaptured>, mut job: ResMut<RenderJob>| {
-            job.done = Some(crate::editor::present::screenshot::save_png(&captured.image, &out));
+            job.saved = Some(crate::editor::present::screenshot::save_png(&captured.image, &out));
         },
     );
+}
+
+/// Once a frame is saved: the render is done after the last (or a failed save); else every
+/// clip is paused at the next frame's time, a turntable's camera turned to it, and the gate
+/// counts its ready frames afresh (writes `ClipPlayer`, `SmplCharacter`, `NodeClipPlayer`,
+/// `OrbitCamera`, `CaptureGate`).
+fn next_frame(
+    mut job: ResMut<RenderJob>,
+    mut gate: ResMut<CaptureGate>,
+    mut keyframes: Query<&mut crate::scene::keyframes::ClipPlayer>,
+    mut smpl: Query<&mut crate::scene::smpl::SmplCharacter>,
+    mut node_clips: Query<&mut crate::scene::node_clips::NodeClipPlayer>,
+    mut cameras: Query<&mut OrbitCamera>,
+) {
+    let Some(saved) = job.saved.take() else { return };
+    if saved.is_err() || job.next + 1 == job.frames.len() {
+        job.done = Some(saved);
+        return;
+    }
+    let first_yaw = *job.first_yaw.get_or_insert_with(|| cameras.iter().next().map_or(0.0, |c| c.0.yaw));
+    job.next += 1;
+    job.requested = false;
+    let Some(t) = job.frames[job.next].0 else { return };
+    for mut player in &mut keyframes {
+        (player.state.time, player.state.playing) = (t, false);
+    }
+    for mut body in smpl.iter_mut().filter(|b| b.state.clip.is_some()) {
+        (body.state.time, body.state.playing) = (t * crate::rig::smpl::CLIP_FPS, false);
+    }
+    for mut player in node_clips.iter_mut().filter(|p| p.state.clip.is_some()) {
+        (player.state.time, player.state.playing) = (t, false);
+    }
+    if let Some(sequence) = job.sequence.filter(|s| s.turntable.is_some()) {
+        cameras.iter_mut().for_each(|mut c| c.0.yaw = first_yaw + sequence.turn_at(t));
+    }
+    gate.restart();
 }
