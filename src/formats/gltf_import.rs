@@ -697,8 +697,9 @@ fn shown_nodes(gltf: &gltf::Gltf, parent: &[Option<usize>]) -> Vec<bool> {
     for root in (0..parent.len()).filter(|&n| parent[n].is_none()) {
         shown[root] = Some(false);
     }
-    for root in scene.nodes() {
-        shown[root.index()] = Some(parent[root.index()].is_none());
+    // A scene's nodes should be roots; one that is not marks nothing (its root decides).
+    for root in scene.nodes().filter(|n| parent[n.index()].is_none()) {
+        shown[root.index()] = Some(true);
     }
     // Each node takes its root's answer: up to the first node that knows, then down the
     // path (each node is walked once, however deep the tree).

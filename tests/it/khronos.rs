@@ -324,6 +324,11 @@ fn only_the_scene_a_file_shows_loads() {
     let joints = |scene: u64| {
         let glb = crate::common::glb_with_json(&pair, |json| {
             json["scenes"].as_array_mut().unwrap().push(serde_json::json!({ "name": "waver alone", "nodes": [8] }));
+            // Against the spec, a child (the waver's mesh) listed too: its root decides.
+            json["scenes"]
+                .as_array_mut()
+                .unwrap()
+                .push(serde_json::json!({ "name": "and a child", "nodes": [4, 8, 7] }));
             json["scene"] = serde_json::json!(scene);
         });
         let path = dir.join(format!("scene{scene}.glb"));
@@ -338,4 +343,5 @@ fn only_the_scene_a_file_shows_loads() {
     assert_eq!(both.len(), 2);
     assert_eq!(joints(1), [both[1].clone()], "the waver's part alone");
     assert!(both[1].iter().any(|j| j == "upper"));
+    assert_eq!(joints(2), both, "a child listed in the scene takes its root's place");
 }
