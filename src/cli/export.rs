@@ -45,7 +45,7 @@ fn export_character(a: &ExportArgs) -> Result<()> {
     if let Some(file) = &clip.anim {
         let anim = crate::formats::load_clip(file)?.retargeted(&asset.skeleton, &Default::default());
         if animation {
-            let name = file.file_stem().map_or_else(|| asset.name.clone(), |s| s.to_string_lossy().into_owned());
+            let name = crate::document::export::clip_name(file, &asset.name);
             let splines = crate::document::export::keyframes_as_splines(&anim, &asset.skeleton, &pose, &name);
             clips.push(splines.map_err(|e| anyhow::anyhow!("{}: {e}", file.display()))?);
         }

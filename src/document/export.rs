@@ -9,6 +9,11 @@ use crate::formats::scene::SceneDoc;
 use crate::rig::fk::RestOverride;
 use crate::rig::node_clip::{NodeClip, NodePose, sample_mix};
 
+/// The name a clip from `file` goes out under: the file's stem, else `otherwise`.
+pub fn clip_name(file: &std::path::Path, otherwise: &str) -> String {
+    file.file_stem().map_or_else(|| otherwise.to_owned(), |s| s.to_string_lossy().into_owned())
+}
+
 /// A keyframed clip as glTF splines ([`spline_clip`](crate::rig::keyframe_splines::spline_clip)):
 /// key for key, times from its start, its joints without keys left at `rest`; refused
 /// where a track would need more than
@@ -114,8 +119,7 @@ fn posed(
         let clip = clip.retargeted(skeleton, &anim.names);
         if animated {
             let clip_file = if anim.file.as_os_str().is_empty() { std::path::Path::new(&c.name) } else { &anim.file };
-            let name = clip_file.file_stem().map_or_else(|| c.name.clone(), |s| s.to_string_lossy().into_owned());
-            let splines = keyframes_as_splines(&clip, skeleton, &posed.pose, &name)
+            let splines = keyframes_as_splines(&clip, skeleton, &posed.pose, &clip_name(clip_file, &c.name))
                 .map_err(|e| FormatError::other(clip_file, e))?;
             posed.clips = std::sync::Arc::new([splines]);
         }
