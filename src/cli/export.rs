@@ -17,10 +17,15 @@ pub fn run(a: &ExportArgs) -> Result<()> {
     if crate::formats::has_parts(&a.path) {
         return export_gltf_file(&a.path, &a.out, &a.poses, a.skinning.into(), &a.clip, a.bake, a.animation);
     }
-    if is_glb(&a.out) && is_scene(&a.path) {
+    if is_scene(&a.path) {
         let doc = crate::document::scenes::read_scene(&a.path)?;
-        let glb = crate::document::export::scene_glb(&doc, mesh_kind(a.bake), a.animation)?;
-        write_file(&a.out, |w| w.write_all(&glb))?;
+        if is_glb(&a.out) {
+            let glb = crate::document::export::scene_glb(&doc, mesh_kind(a.bake), a.animation)?;
+            write_file(&a.out, |w| w.write_all(&glb))?;
+        } else {
+            let (positions, triangles) = crate::document::export::scene_mesh(&doc)?;
+            write_file(&a.out, |w| obj::write_obj(w, &positions, &triangles))?;
+        }
         println!("wrote {} ({} characters)", a.out.display(), doc.characters.len());
         return Ok(());
     }

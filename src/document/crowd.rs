@@ -18,7 +18,7 @@ fn grid(i: usize, n: usize, spacing: f32) -> Vec3 {
 
 fn crowd_member(i: usize, n: usize, source: SourceDoc, spacing: f32, lift: f32, smpl: Option<SmplDoc>) -> CharacterDoc {
     CharacterDoc {
-        placement: PlacementDoc { translation: grid(i, n, spacing) + Vec3::Y * lift, yaw: 0.0, scale: 1.0 },
+        placement: PlacementDoc::new(grid(i, n, spacing) + Vec3::Y * lift, 0.0, 1.0),
         smpl,
         ..CharacterDoc::new(source, format!("crowd {i}"))
     }

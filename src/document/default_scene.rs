@@ -21,7 +21,7 @@ fn puppet(
     view: ViewDoc,
 ) -> CharacterDoc {
     CharacterDoc {
-        placement: PlacementDoc { translation, yaw, scale: 1.0 },
+        placement: PlacementDoc::new(translation, yaw, 1.0),
         pose,
         view,
         ..CharacterDoc::new(SourceDoc::Embedded("puppet".into()), name)

@@ -5,7 +5,7 @@
 use crate::formats::FormatError;
 use crate::formats::gltf::{GltfCharacter, GltfMesh, Motion, write_glb};
 use crate::formats::limits::MAX_SAMPLED_FRAMES;
-use crate::formats::scene::SceneDoc;
+use crate::formats::scene::{CharacterDoc, SceneDoc};
 use crate::rig::fk::RestOverride;
 use crate::rig::node_clip::{NodeClip, NodePose, sample_mix};
 
@@ -46,6 +46,8 @@ fn shaped(
 
 /// A character's pose, motion and keyed rest for export.
 struct Posed {
+    /// Where it stands (its document's placement, or where its holder carries it).
+    placement: crate::formats::scene::PlacementDoc,
     pose: Vec<crate::rig::JointRotation>,
     root: glam::Vec3,
     /// Rest offsets and scales a clip keys (the root's offset is `root`).
@@ -61,13 +63,7 @@ struct Posed {
 /// its source's own animation, SMPL playback) at its time, its placement and tint; with
 /// `animated`, the clips as glTF animations.
 pub fn scene_glb(doc: &SceneDoc, mesh: GltfMesh, animated: bool) -> Result<Vec<u8>, FormatError> {
-    let mut library = super::AssetLibrary::default();
-    let mut loaded = Vec::new();
-    for c in &doc.characters {
-        let asset = shaped(&mut library, c)?;
-        let posed = posed(&mut library, c, &asset, animated)?;
-        loaded.push((c, asset, posed));
-    }
+    let loaded = load_posed(doc, animated)?;
     let characters: Vec<GltfCharacter> = loaded
         .iter()
         .map(|(c, asset, posed)| GltfCharacter {
@@ -75,13 +71,8 @@ pub fn scene_glb(doc: &SceneDoc, mesh: GltfMesh, animated: bool) -> Result<Vec<u
             asset,
             pose: &posed.pose,
             root: posed.root,
-            rest: posed
-                .rest
-                .as_ref()
-                .map_or_else(Default::default, |(o, s)| RestOverride { offsets: Some(o), scales: Some(s) }),
-            translation: c.placement.translation,
-            yaw: c.placement.yaw,
-            scale: c.placement.scale,
+            rest: posed.rest_override(),
+            placement: posed.placement,
             tint: c.view.tint,
             motion: posed.motion.clone(),
             motion_name: posed.motion_name.clone(),
@@ -90,6 +81,50 @@ pub fn scene_glb(doc: &SceneDoc, mesh: GltfMesh, animated: bool) -> Result<Vec<u
         })
         .collect();
     write_glb(&characters, mesh).map_err(|e| FormatError::other(std::path::Path::new("the exported scene"), e))
+}
+
+/// Every character of a scene document posed (as [`scene_glb`] poses it) and placed in the
+/// world, as one mesh: the characters' vertices in document order, their triangles
+/// renumbered to match.
+pub fn scene_mesh(doc: &SceneDoc) -> Result<(Vec<glam::Vec3>, Vec<[u32; 3]>), FormatError> {
+    let mut positions = Vec::new();
+    let mut triangles = Vec::new();
+    for (c, asset, posed) in load_posed(doc, false)? {
+        let first = positions.len() as u32;
+        let world = posed.placement.to_mat4() * posed.root_shift(&asset);
+        positions.extend(crate::document::posing::posed_positions_with_rest(
+            &asset,
+            &posed.pose,
+            posed.rest_override(),
+            world,
+            c.skinning,
+        ));
+        triangles.extend(asset.skin.triangles.iter().map(|t| t.map(|v| v + first)));
+    }
+    Ok((positions, triangles))
+}
+
+/// Every character of `doc` with its shaped asset and its pose; attached characters placed
+/// where their holding joints carry them.
+fn load_posed(
+    doc: &SceneDoc,
+    animated: bool,
+) -> Result<Vec<(&CharacterDoc, std::sync::Arc<crate::rig::CharacterAsset>, Posed)>, FormatError> {
+    let mut library = super::AssetLibrary::default();
+    let mut loaded = Vec::new();
+    for c in &doc.characters {
+        let asset = shaped(&mut library, c)?;
+        let posed = posed(&mut library, c, &asset, animated)?;
+        loaded.push((c, asset, posed));
+    }
+    for i in 0..loaded.len() {
+        let Some(attached) = &loaded[i].0.attached else { continue };
+        let holder = loaded.iter().find(|(h, ..)| h.id == Some(attached.to));
+        if let Some(joint_world) = holder.and_then(|(_, asset, posed)| posed.joint_world(asset, &attached.joint)) {
+            loaded[i].2.placement = attached.placement(joint_world);
+        }
+    }
+    Ok(loaded)
 }
 
 /// A character's pose from its document and clips at their times, and (with `animated`)
@@ -104,6 +139,7 @@ fn posed(
     let (pose, notes) = super::scenes::pose_from_doc(asset, c);
     notes.iter().for_each(|n| eprintln!("warning: {n}"));
     let mut posed = Posed {
+        placement: c.placement,
         pose,
         root: skeleton.joint(0).rest_offset,
         rest: None,
@@ -142,6 +178,28 @@ fn posed(
         (posed.motion_name, posed.motion) = (name, Some(motion));
     }
     Ok(posed)
+}
+
+impl Posed {
+    /// The rest offsets and scales its clip keys, for the matrix stack.
+    fn rest_override(&self) -> RestOverride<'_> {
+        self.rest.as_ref().map_or_else(Default::default, |(o, s)| RestOverride { offsets: Some(o), scales: Some(s) })
+    }
+
+    /// Model space as the root's translation moves it from its rest offset.
+    fn root_shift(&self, asset: &crate::rig::CharacterAsset) -> glam::Mat4 {
+        glam::Mat4::from_translation(self.root - asset.skeleton.joint(0).rest_offset)
+    }
+
+    /// The world transform of the joint `key` names (a pose key), posed.
+    fn joint_world(&self, asset: &crate::rig::CharacterAsset, key: &str) -> Option<glam::Mat4> {
+        let skeleton = &asset.skeleton;
+        let joint = crate::formats::scene::joint_of_pose_key(skeleton, key)?;
+        let mut matrices = vec![glam::Mat4::IDENTITY; skeleton.len()];
+        let origin = self.placement.to_mat4() * self.root_shift(asset);
+        crate::rig::fk::forward_kinematics_with_rest(skeleton, &self.pose, self.rest_override(), origin, &mut matrices);
+        Some(matrices[joint])
+    }
 }
 
 /// A glTF clip's pose at the playback's time on `posed` (its keyed joints, root and rest).

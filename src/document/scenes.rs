@@ -57,7 +57,7 @@ pub fn doc_side_by_side(library: &mut AssetLibrary, sources: Vec<SourceDoc>, mes
         .into_iter()
         .zip(translations)
         .map(|((source, asset), translation)| CharacterDoc {
-            placement: PlacementDoc { translation, yaw: 0.0, scale: 1.0 },
+            placement: PlacementDoc::new(translation, 0.0, 1.0),
             ..library.new_character_doc(source, &asset)
         })
         .collect();

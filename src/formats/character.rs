@@ -24,6 +24,8 @@ pub enum CharacterSource {
     /// A file of parts, characters and props with their own clips: glTF 2.0 (`.glb`,
     /// `.gltf`) or FBX.
     Parts { path: PathBuf },
+    /// An OBJ mesh with no skeleton beside it: a prop, carried rigidly by one joint.
+    Prop { obj: PathBuf },
 }
 
 impl CharacterSource {
@@ -53,6 +55,7 @@ impl CharacterSource {
                 }
                 Ok(Self::Cse169 { skel, skin: Some(path.to_path_buf()) })
             }
+            Some("obj") if !path.with_extension("skel").is_file() => Ok(Self::Prop { obj: path.to_path_buf() }),
             Some("obj") | Some("attach") => {
                 let skel = path.with_extension("skel");
                 if !skel.is_file() {
@@ -95,6 +98,7 @@ pub fn load_skeleton(path: &Path) -> Result<Skeleton, FormatError> {
         CharacterSource::Smpl { dir } => Ok(super::smpl::load_smpl_dir(&dir)?.0.skeleton),
         CharacterSource::Bvh { path } => Ok(super::bvh::parse_bvh(open(&path)?, &path)?.skeleton),
         CharacterSource::Parts { path } => Ok(first_part(&path)?.skeleton),
+        CharacterSource::Prop { obj } => Ok(load_prop(&obj)?.skeleton),
     }
 }
 
@@ -132,6 +136,7 @@ pub fn load_character(path: &Path) -> Result<CharacterAsset, FormatError> {
             Ok(CharacterAsset::with_bone_boxes(name, skeleton, Vec::new()))
         }
         CharacterSource::Parts { path } => first_part(&path),
+        CharacterSource::Prop { obj } => load_prop(&obj),
         CharacterSource::Smpl { dir } => {
             let (model, warnings) = super::smpl::load_smpl_dir(&dir)?;
             let mut asset = model.asset(&name, &[]).map_err(|e| FormatError::rig(&dir, e))?;
@@ -154,6 +159,16 @@ pub fn load_character(path: &Path) -> Result<CharacterAsset, FormatError> {
             }
         }
     }
+}
+
+/// An OBJ mesh as a prop: its vertices carried by one joint at the origin.
+fn load_prop(path: &Path) -> Result<CharacterAsset, FormatError> {
+    let mesh = obj::parse_obj(open(path)?, path)?;
+    if mesh.positions.is_empty() {
+        return Err(FormatError::other(path, "expected a mesh (`v` lines), found none"));
+    }
+    let name = path.file_stem().and_then(|s| s.to_str()).unwrap_or("prop");
+    CharacterAsset::rigid(name, mesh.positions, mesh.triangles).map_err(|e| FormatError::rig(path, e))
 }
 
 /// A CSE169 skeleton with its `.skin`: bound by the skin's own bind matrices.

@@ -20,10 +20,8 @@ pub struct GltfCharacter<'a> {
     /// Rest offsets and scales a clip keys, in place of the skeleton's (the root's offset
     /// is `root`).
     pub rest: crate::rig::fk::RestOverride<'a>,
-    /// Model space → world: translation, turn about y, uniform scale.
-    pub translation: Vec3,
-    pub yaw: f32,
-    pub scale: f32,
+    /// Model space → world.
+    pub placement: crate::formats::scene::PlacementDoc,
     pub tint: [f32; 3],
     /// Poses over time, written as a glTF animation of the joints (skinned meshes only),
     /// under `motion_name` (the character's name when empty).
@@ -47,9 +45,7 @@ impl<'a> GltfCharacter<'a> {
             pose,
             root,
             rest: Default::default(),
-            translation: Vec3::ZERO,
-            yaw: 0.0,
-            scale: 1.0,
+            placement: Default::default(),
             tint: [0.85, 0.75, 0.62],
             motion: None,
             motion_name: String::new(),
@@ -156,9 +152,9 @@ pub fn write_glb(characters: &[GltfCharacter], mesh: GltfMesh) -> Result<Vec<u8>
     for c in characters {
         let placement = b.node(json!({
             "name": c.name,
-            "translation": c.translation.to_array(),
-            "rotation": Quat::from_rotation_y(c.yaw).to_array(),
-            "scale": [c.scale, c.scale, c.scale],
+            "translation": c.placement.translation.to_array(),
+            "rotation": c.placement.rotation().to_array(),
+            "scale": Vec3::splat(c.placement.scale).to_array(),
         }));
         roots.push(placement);
         let skin = &c.asset.skin;

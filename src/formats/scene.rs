@@ -95,8 +95,10 @@ pub fn relative_path(path: &Path, dir: &Path) -> PathBuf {
     out
 }
 
-/// Where a character stands: model space → world is `T(translation) · Ry(yaw) · S(scale)`
-/// (the editor holds this very type on the character entity).
+/// Where a character or prop stands: model space → world is
+/// `T(translation) · Ry(yaw) · tilt · S(scale)` (the editor holds this very type on the
+/// character entity). Characters stand upright (`tilt` is the identity); a prop may lie in
+/// any orientation.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct PlacementDoc {
     pub translation: glam::Vec3,
@@ -104,22 +106,47 @@ pub struct PlacementDoc {
     pub yaw: f32,
     /// Uniform scale.
     pub scale: f32,
+    /// A turn before the yaw, off the vertical (files without it: upright).
+    #[serde(default, skip_serializing_if = "is_upright")]
+    pub tilt: glam::Quat,
+}
+
+fn is_upright(q: &glam::Quat) -> bool {
+    *q == glam::Quat::IDENTITY
 }
 
 impl Default for PlacementDoc {
     fn default() -> Self {
-        Self { translation: glam::Vec3::ZERO, yaw: 0.0, scale: 1.0 }
+        Self::new(glam::Vec3::ZERO, 0.0, 1.0)
     }
 }
 
 impl PlacementDoc {
+    /// Upright at `translation`, turned by `yaw` about the vertical, scaled by `scale`.
+    pub fn new(translation: glam::Vec3, yaw: f32, scale: f32) -> Self {
+        Self { translation, yaw, scale, tilt: glam::Quat::IDENTITY }
+    }
+
+    /// The orientation: the yaw after the tilt.
+    pub fn rotation(&self) -> glam::Quat {
+        glam::Quat::from_rotation_y(self.yaw) * self.tilt.normalize()
+    }
+
     /// The model-to-world matrix.
     pub fn to_mat4(&self) -> glam::Mat4 {
-        glam::Mat4::from_scale_rotation_translation(
-            glam::Vec3::splat(self.scale),
-            glam::Quat::from_rotation_y(self.yaw),
-            self.translation,
-        )
+        glam::Mat4::from_scale_rotation_translation(glam::Vec3::splat(self.scale), self.rotation(), self.translation)
+    }
+
+    /// The placement whose matrix is `m` (a rigid motion with uniform scale, as a placement
+    /// times a joint's transform gives): the turn about the vertical becomes the yaw, the
+    /// rest the tilt.
+    pub fn from_mat4(m: glam::Mat4) -> Self {
+        let (scale, rotation, translation) = m.to_scale_rotation_translation();
+        let rotation = rotation.normalize();
+        // Twist about y: the rotation's y and w parts.
+        let yaw = 2.0 * rotation.y.atan2(rotation.w);
+        let tilt = (glam::Quat::from_rotation_y(-yaw) * rotation).normalize();
+        Self { translation, yaw, scale: (scale.x + scale.y + scale.z) / 3.0, tilt }
     }
 }
 
@@ -234,6 +261,35 @@ pub struct CharacterDoc {
     /// Playback of the source's own clips (a glTF file's animations).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub playback: Option<PlaybackDoc>,
+    /// Held by a joint of another character (a sword in a hand): its placement follows
+    /// that joint.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub attached: Option<AttachDoc>,
+}
+
+/// A prop (or character) held by a joint of another character: it follows the joint,
+/// keeping the offset it had from it when it was attached.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct AttachDoc {
+    /// The character that holds it.
+    pub to: CharacterId,
+    /// The holding joint (its pose key: see [`pose_key`]).
+    pub joint: String,
+    /// Its model space → the joint's frame, as when it was attached.
+    pub offset: glam::Mat4,
+}
+
+impl AttachDoc {
+    /// Held by `joint` of `to`, whose world transform is `joint_world`, where it stands now
+    /// at `placement`.
+    pub fn holding(to: CharacterId, joint: String, joint_world: glam::Mat4, placement: &PlacementDoc) -> Self {
+        Self { to, joint, offset: joint_world.inverse() * placement.to_mat4() }
+    }
+
+    /// Where it stands while the holding joint's world transform is `joint_world`.
+    pub fn placement(&self, joint_world: glam::Mat4) -> PlacementDoc {
+        PlacementDoc::from_mat4(joint_world * self.offset)
+    }
 }
 
 /// Playback of a source's own clips (a glTF file's animations): which clip by name, the
@@ -322,6 +378,7 @@ impl CharacterDoc {
             anim: None,
             morphs: Vec::new(),
             playback: None,
+            attached: None,
         }
     }
 }
@@ -452,6 +509,16 @@ impl SceneDoc {
             }
             finite(&at("placement.translation"), &c.placement.translation.to_array())?;
             finite(&at("placement.yaw"), &[c.placement.yaw])?;
+            finite(&at("placement.tilt"), &c.placement.tilt.to_array())?;
+            if c.placement.tilt.length_squared() < 1e-12 {
+                return Err(format!("{}: expected a rotation, found a zero quaternion", at("placement.tilt")));
+            }
+            if let Some(attached) = &c.attached {
+                finite(&at("attached.offset"), &attached.offset.to_cols_array())?;
+                if attached.offset.determinant().abs() < 1e-12 {
+                    return Err(format!("{}: expected an invertible matrix", at("attached.offset")));
+                }
+            }
             positive(&at("placement.scale"), c.placement.scale)?;
             rotations(&at("pose"), &c.pose)?;
             finite(&at("view.tint"), &c.view.tint)?;

@@ -119,6 +119,15 @@ impl CharacterAsset {
         Self::new(name, skeleton, skin, warnings).map(|asset| Self { bind_world_to_joint, ..asset })
     }
 
+    /// A prop: one mesh carried rigidly by a single joint at the origin (named after the
+    /// prop), drawn with its tint.
+    pub fn rigid(name: &str, positions: Vec<Vec3>, triangles: Vec<[u32; 3]>) -> Result<Self, RigError> {
+        let skeleton = Skeleton::build(vec![super::skeleton::RawJoint::new(name, None, Vec3::ZERO)])?;
+        let weights = SkinWeights::rigid(&vec![0; positions.len()]);
+        let asset = Self::new(name, skeleton, Skin::untextured(positions, triangles, weights), Vec::new())?;
+        Ok(Self { skin_kind: SkinKind::Rigid, ..asset })
+    }
+
     /// A character without a mesh: each joint's bone box (its own, or ±0.1) rigidly
     /// bound to that joint.
     pub fn with_bone_boxes(name: impl Into<String>, skeleton: Skeleton, warnings: Vec<String>) -> Self {

@@ -49,7 +49,7 @@ pub struct Placement(pub PlacementDoc);
 
 impl Placement {
     pub fn new(translation: Vec3, yaw: f32, scale: f32) -> Self {
-        Self(PlacementDoc { translation, yaw, scale })
+        Self(PlacementDoc::new(translation, yaw, scale))
     }
 
     pub fn at(translation: Vec3) -> Self {
@@ -58,11 +58,7 @@ impl Placement {
 
     /// The character's `Transform`: what places its joints and skin in the world.
     pub fn to_transform(&self) -> Transform {
-        Transform {
-            translation: self.translation,
-            rotation: Quat::from_rotation_y(self.yaw),
-            scale: Vec3::splat(self.scale),
-        }
+        Transform { translation: self.translation, rotation: self.rotation(), scale: Vec3::splat(self.scale) }
     }
 }
 

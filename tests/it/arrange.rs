@@ -29,7 +29,7 @@ fn placed(boxes: &[(Vec3, Vec3)], scales: &[f32], translations: &[Vec3]) -> Vec<
         .iter()
         .zip(scales)
         .zip(translations)
-        .map(|(((lo, hi), &scale), &translation)| world_box(*lo, *hi, &PlacementDoc { translation, yaw: 0.0, scale }))
+        .map(|(((lo, hi), &scale), &translation)| world_box(*lo, *hi, &PlacementDoc::new(translation, 0.0, scale)))
         .collect()
 }
 
@@ -56,20 +56,19 @@ fn an_added_character_stands_beside_every_other_even_turned_ones() {
         .zip(&scales)
         .enumerate()
         .map(|(i, ((lo, hi), &scale))| {
-            let placement =
-                PlacementDoc { translation: Vec3::new(i as f32 * 0.7, 0.0, 0.0), yaw: 0.4 * i as f32, scale };
+            let placement = PlacementDoc::new(Vec3::new(i as f32 * 0.7, 0.0, 0.0), 0.4 * i as f32, scale);
             world_box(*lo, *hi, &placement)
         })
         .collect();
     for (k, ((lo, hi), &scale)) in boxes.iter().zip(&scales).enumerate() {
         let translation = beside(&world, *lo, *hi, scale);
-        let new = world_box(*lo, *hi, &PlacementDoc { translation, yaw: 0.0, scale });
+        let new = world_box(*lo, *hi, &PlacementDoc::new(translation, 0.0, scale));
         assert!(world.iter().all(|&w| disjoint_in_x(w, new)), "added {k} overlaps");
         assert!(new.0.y.abs() < 1e-5);
         world.push(new);
     }
     let first = beside(&[], boxes[0].0, boxes[0].1, 1.0);
-    let alone = world_box(boxes[0].0, boxes[0].1, &PlacementDoc { translation: first, yaw: 0.0, scale: 1.0 });
+    let alone = world_box(boxes[0].0, boxes[0].1, &PlacementDoc::new(first, 0.0, 1.0));
     assert!((alone.0.x + alone.1.x).abs() < 1e-5, "the first stands at the origin");
 }
 
@@ -82,10 +81,7 @@ fn match_height_makes_heights_equal_and_the_row_does_not_overlap() {
     let one = doc_with(SourceDoc::Embedded("puppet".into()), &[]).characters[0].clone();
     let characters = [0.7f32, 2.5, 0.2]
         .iter()
-        .map(|&scale| CharacterDoc {
-            placement: PlacementDoc { translation: Vec3::ZERO, yaw: 0.3, scale },
-            ..one.clone()
-        })
+        .map(|&scale| CharacterDoc { placement: PlacementDoc::new(Vec3::ZERO, 0.3, scale), ..one.clone() })
         .collect();
     let doc = SceneDoc { characters, ..SceneDoc::default() };
     *app.world_mut().resource_mut::<PendingScene>() = PendingScene { doc: Some(doc), frame: false };

@@ -17,7 +17,7 @@ use crate::common::{data_dir, scratch};
 pub fn doc_with(source: SourceDoc, pose: &[(&str, JointRotation)]) -> SceneDoc {
     SceneDoc {
         characters: vec![CharacterDoc {
-            placement: PlacementDoc { translation: glam::Vec3::new(0.5, 0.0, -1.0), yaw: 0.3, scale: 1.2 },
+            placement: PlacementDoc::new(glam::Vec3::new(0.5, 0.0, -1.0), 0.3, 1.2),
             pose: pose.iter().map(|(k, r)| (k.to_string(), *r)).collect::<BTreeMap<_, _>>(),
             view: ViewDoc { weight_colors: true, ..ViewDoc::default() },
             ..CharacterDoc::new(source, "c")

@@ -16,17 +16,17 @@ use marionette::scene::{Character, JointPose, Placement};
 use crate::editor::doc_with;
 
 #[derive(Resource, Default)]
-struct Captured(SceneDoc);
+pub struct Captured(pub SceneDoc);
 
 /// The ECS core and the live scene (no window, no rendering); after each update the scene
 /// is captured into `Captured`.
-fn scene_app() -> App {
+pub fn scene_app() -> App {
     let mut app = crate::ecs::app();
     app.add_plugins(ScenePlugin).init_resource::<Captured>().add_systems(Last, capture_scene);
     app
 }
 
-fn capture_scene(reader: SceneReader, mut out: ResMut<Captured>) {
+pub fn capture_scene(reader: SceneReader, mut out: ResMut<Captured>) {
     out.0 = reader.capture();
 }
 
@@ -40,27 +40,27 @@ fn open_puppets(app: &mut App, ids: &[Option<u64>]) {
     app.update();
 }
 
-fn edit(app: &mut App, edit: Edit) {
+pub fn edit(app: &mut App, edit: Edit) {
     app.world_mut().resource_mut::<EditQueue>().push(edit);
     app.update();
 }
 
-fn request(app: &mut App, request: HistoryRequest) {
+pub fn request(app: &mut App, request: HistoryRequest) {
     app.world_mut().resource_mut::<History>().request = Some(request);
     app.update();
 }
 
-fn entity(app: &App, id: u64) -> Entity {
+pub fn entity(app: &App, id: u64) -> Entity {
     app.world().resource::<CharacterIndex>().get(CharacterId(id)).expect("the character is in the scene")
 }
 
-fn joint(app: &App, id: u64, name: &str) -> usize {
+pub fn joint(app: &App, id: u64, name: &str) -> usize {
     app.world().get::<Character>(entity(app, id)).unwrap().asset.skeleton.find(name).unwrap()
 }
 
 /// Everything an edit can change: the scene document (poses, placements, views, names,
 /// weights, stage, ids) and the number of entities.
-fn state(app: &mut App) -> (SceneDoc, usize) {
+pub fn state(app: &mut App) -> (SceneDoc, usize) {
     let doc = app.world().resource::<Captured>().0.clone();
     let count = app.world_mut().query::<Entity>().iter(app.world()).count();
     (doc, count)

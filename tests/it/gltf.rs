@@ -82,9 +82,7 @@ fn an_exported_character_skins_back_to_our_vertices_with_its_names_and_weights()
     let root = skeleton.joint(0).rest_offset + Vec3::new(0.1, 0.05, -0.2);
     let character = GltfCharacter {
         root,
-        translation: Vec3::new(1.0, 0.0, -2.0),
-        yaw: 0.6,
-        scale: 1.5,
+        placement: marionette::formats::scene::PlacementDoc::new(Vec3::new(1.0, 0.0, -2.0), 0.6, 1.5),
         tint: [0.2, 0.4, 0.6],
         ..GltfCharacter::new("p", &puppet, &pose)
     };

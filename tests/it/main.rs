@@ -25,6 +25,7 @@ mod khronos;
 mod layers;
 mod order;
 mod poses;
+mod props;
 mod rig;
 mod robust;
 mod smpl;

@@ -123,9 +123,7 @@ fn no_obj_gltf_or_scene_written_from_a_valid_model_holds_a_non_finite_number() {
             rests: Vec::new(),
         };
         let character = GltfCharacter {
-            translation,
-            yaw,
-            scale,
+            placement: marionette::formats::scene::PlacementDoc::new(translation, yaw, scale),
             tint: [finite(&mut u).unwrap(), 0.5, 0.5],
             motion: Some(motion),
             ..GltfCharacter::new("c", asset, &pose)
@@ -141,7 +139,7 @@ fn no_obj_gltf_or_scene_written_from_a_valid_model_holds_a_non_finite_number() {
 
         // Scene: what is written reads back (reading refuses any non-finite number).
         let mut c = CharacterDoc::new(SourceDoc::Embedded("puppet".into()), "p");
-        c.placement = PlacementDoc { translation, yaw, scale };
+        c.placement = PlacementDoc::new(translation, yaw, scale);
         c.morphs = vec![finite(&mut u).unwrap()];
         c.pose.insert("l_elbow".into(), pose[0]);
         let doc = SceneDoc { characters: vec![c], ..SceneDoc::default() };

@@ -11,6 +11,7 @@ pub use crate::editor::edits::edit::{Edit, EditQueue, GestureHold};
 use crate::editor::edits::history::History;
 use crate::editor::edits::pose_library::PoseLibrary;
 use crate::editor::present::stage::StageSettings;
+use crate::editor::scene_doc::attach::Attached;
 use crate::editor::scene_doc::document::{
     CharacterIndex, Library, NextCharacterId, SceneCharacter, SceneReader, spawn_from_doc,
 };
@@ -177,6 +178,15 @@ pub fn inverse_of(world: &mut World, edit: &Edit) -> Result<Option<Edit>, String
             let old = component::<crate::scene::morphs::Morphs>(world, *character)?.weights.clone();
             unless(old == *weights, Edit::Morph { character: *character, weights: old })
         }
+        Edit::Attach { character, attached, placement } => {
+            let old = world.get::<Attached>(entity_of(world, *character)?).map(|a| a.0.clone());
+            let old_placement = component::<Placement>(world, *character)?.0;
+            let undo = Edit::Attach { character: *character, attached: old, placement: old_placement };
+            unless(
+                undo == Edit::Attach { character: *character, attached: attached.clone(), placement: *placement },
+                undo,
+            )
+        }
         Edit::Library { name, pose } => {
             let old = world.resource::<PoseLibrary>().0.get(name).cloned();
             unless(old == *pose, Edit::Library { name: name.clone(), pose: old })
@@ -236,6 +246,14 @@ fn write(world: &mut World, edit: Edit) -> Result<(), String> {
             match pose {
                 Some(pose) => library.0.insert(name, pose),
                 None => library.0.remove(&name),
+            };
+        }
+        Edit::Attach { character, attached, placement } => {
+            let entity = entity_of(world, character)?;
+            component_mut::<Placement>(world, character)?.0 = placement;
+            match attached {
+                Some(attached) => world.entity_mut(entity).insert(Attached(attached)),
+                None => world.entity_mut(entity).remove::<Attached>(),
             };
         }
         Edit::Stage(stage) => world.resource_mut::<StageSettings>().0 = stage,

@@ -5,8 +5,8 @@
 use bevy::prelude::*;
 
 use crate::formats::scene::{
-    AnimDoc, BindingDoc, CharacterDoc, CharacterId, LibraryPoseDoc, PlacementDoc, PlaybackDoc, SkinningDoc, SmplDoc,
-    StageDoc, ViewDoc,
+    AnimDoc, AttachDoc, BindingDoc, CharacterDoc, CharacterId, LibraryPoseDoc, PlacementDoc, PlaybackDoc, SkinningDoc,
+    SmplDoc, StageDoc, ViewDoc,
 };
 
 use crate::rig::JointRotation;
@@ -73,6 +73,13 @@ pub enum Edit {
         name: String,
         pose: Option<LibraryPoseDoc>,
     },
+    /// Held by a joint of another character (none: let go), standing at `placement` (where
+    /// it stands when attached or let go, so that undo puts it back exactly).
+    Attach {
+        character: CharacterId,
+        attached: Option<AttachDoc>,
+        placement: PlacementDoc,
+    },
     /// Floor, shadows, axes.
     Stage(StageDoc),
     /// A character from its document (a fresh id is given when it has none).
@@ -95,6 +102,7 @@ impl Edit {
             | Edit::Clip { character, .. }
             | Edit::Morph { character, .. }
             | Edit::Playback { character, .. }
+            | Edit::Attach { character, .. }
             | Edit::Remove(character) => Some(*character),
             Edit::Add(doc) => doc.id,
             Edit::Stage(_) | Edit::Library { .. } => None,

@@ -48,7 +48,11 @@ impl Plugin for ScenePlugin {
             )
             .add_systems(
                 PostUpdate,
-                crate::editor::scene_doc::arrange::arrange_when_skinned
+                (
+                    crate::editor::scene_doc::arrange::arrange_when_skinned,
+                    crate::editor::scene_doc::attach::follow_holders,
+                )
+                    .chain()
                     .in_set(crate::editor::order::EditorSystems::Arrange),
             );
     }

@@ -61,7 +61,7 @@ pub fn arrange_when_skinned(
         .collect();
     for (((_, placement, bounds), scale), translation) in characters.iter_mut().zip(scales).zip(translations) {
         placement.0 = if in_a_row {
-            PlacementDoc { translation, scale, yaw: 0.0 }
+            PlacementDoc::new(translation, 0.0, scale)
         } else {
             rescaled_keeping_feet(&placement.0, bounds.0.y, scale)
         };

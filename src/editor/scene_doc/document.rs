@@ -37,6 +37,11 @@ pub struct SceneCharacter {
     pub binding: Option<BindingDoc>,
 }
 
+/// Held by a joint of another character (on the held character's entity; followed by
+/// [`super::attach::follow_holders`]).
+#[derive(Component, Clone, Debug, PartialEq, Deref)]
+pub struct Attached(pub crate::formats::scene::AttachDoc);
+
 /// Each scene character's entity by id (kept by `SceneCharacter`'s hooks).
 #[derive(Resource, Default, Debug)]
 pub struct CharacterIndex(HashMap<CharacterId, Entity>);
@@ -110,6 +115,7 @@ pub struct SceneCharacterData {
     pub player: Option<&'static ClipPlayer>,
     pub morphs: Option<&'static crate::scene::morphs::Morphs>,
     pub node_clips: Option<&'static crate::scene::node_clips::NodeClipPlayer>,
+    pub attached: Option<&'static Attached>,
 }
 
 #[derive(SystemParam)]
@@ -168,6 +174,7 @@ impl SceneReader<'_, '_> {
             anim: c.player.map(|p| p.state.clone()),
             morphs: c.morphs.map(|m| m.weights.clone()).unwrap_or_default(),
             playback: c.node_clips.map(|p| p.state.clone()),
+            attached: c.attached.map(|a| a.0.clone()),
         })
     }
 }
@@ -225,6 +232,9 @@ pub fn spawn_from_doc(
         SkinOnGpu(doc.gpu_skinning),
         visibility_of(&doc.view),
     ));
+    if let Some(attached) = &doc.attached {
+        commands.entity(entity).insert(Attached(attached.clone()));
+    }
     if let Some((dir, set)) = smpl {
         let state = doc.smpl.clone().unwrap_or_default();
         commands.entity(entity).insert(SmplCharacter::new(set.model, dir.clone(), set.clips, state));

@@ -2,6 +2,7 @@
 //! panel inside the scene panel. They read the live scene and push [`Edit`]s; nothing here
 //! writes the scene itself.
 
+pub mod attach_panel;
 pub mod clip_panel;
 pub mod dialogs;
 pub mod joint_panel;

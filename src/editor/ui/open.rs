@@ -58,7 +58,7 @@ fn add_character(path: &str, state: &mut InspectorState, panels: &mut Panels) {
         let doc = panels.library.new_character_doc(source, &asset);
         panels.push(Edit::Add(Box::new(CharacterDoc {
             id: Some(id),
-            placement: PlacementDoc { translation, yaw: 0.0, scale: 1.0 },
+            placement: PlacementDoc::new(translation, 0.0, 1.0),
             ..doc
         })));
         *panels.selection = Selection { character: Some(id), joints: Vec::new() };

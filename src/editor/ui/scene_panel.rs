@@ -174,6 +174,7 @@ fn selected_character(ui: &mut egui::Ui, panels: &mut Panels, entity: Entity, id
     let mut match_height = false;
     let mut edits = Vec::new();
     let (mut duplicate, mut remove) = (false, false);
+    let mut held = None;
     egui::Frame::group(ui.style()).show(ui, |ui| {
         ui.horizontal(|ui| {
             ui.label("Name");
@@ -191,7 +192,10 @@ fn selected_character(ui: &mut egui::Ui, panels: &mut Panels, entity: Entity, id
                 .on_hover_text("scale every other character to this one's height (one undo step)")
                 .clicked();
         });
-        placement_rows(ui, &mut p);
+        if c.attached.is_none() {
+            placement_rows(ui, &mut p);
+        }
+        held = super::attach_panel::attach_rows(ui, panels, entity, id);
         ui.horizontal(|ui| {
             ui.radio_value(&mut v.display, DisplayDoc::Mesh, "mesh");
             ui.radio_value(&mut v.display, DisplayDoc::Skeleton, "skeleton");
@@ -206,6 +210,7 @@ fn selected_character(ui: &mut egui::Ui, panels: &mut Panels, entity: Entity, id
     if v != view.0 {
         edits.push(Edit::View { character: id, view: v });
     }
+    edits.extend(held);
     ui.horizontal_wrapped(|ui| {
         ui.label("Weights:");
         for (label, b) in [
@@ -263,6 +268,7 @@ fn selected_character(ui: &mut egui::Ui, panels: &mut Panels, entity: Entity, id
         let copy_id = panels.ids.take();
         copy.id = Some(copy_id);
         copy.name = format!("{} copy", copy.name);
+        copy.attached = None;
         if let Ok((lo, hi)) = panels.skins.get(entity).map(|s| s.bounds) {
             copy.placement.translation = beside(&panels.world_boxes(), lo, hi, copy.placement.scale);
             copy.placement.yaw = 0.0;
