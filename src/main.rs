@@ -32,7 +32,7 @@ fn run(cli: Cli) -> Result<()> {
         }
         Some(Command::Info { path }) => marionette::cli::info(&path)?,
         Some(Command::Export(args)) => marionette::cli::export::run(&args)?,
-        Some(Command::Render { paths, out, width, height, poses, ik, skinning, match_height, clip, frames }) => {
+        Some(Command::Render { paths, out, shot, poses, ik, skinning, match_height, clip, frames }) => {
             let started = std::time::Instant::now();
             let edits = marionette::editor::StartupEdits {
                 poses,
@@ -42,10 +42,13 @@ fn run(cli: Cli) -> Result<()> {
                 anim: clip.anim_doc(false),
                 time: clip.time,
                 clip: clip.clip.clone(),
+                view: shot.view,
+                ortho: shot.ortho,
+                transparent: shot.transparent,
             };
             let sequence = frames.sequence();
-            let notes =
-                marionette::editor::present::render::render(paths, edits, out.clone(), (width, height), sequence)
+            let (notes, picture) =
+                marionette::editor::present::render::render(paths, edits, out.clone(), shot.picture(), sequence)
                     .map_err(anyhow::Error::msg)?;
             for n in notes {
                 eprintln!("note: {n}");
@@ -54,6 +57,7 @@ fn run(cli: Cli) -> Result<()> {
                 Some(times) => format!("{} frames as {}", times.len(), out.display()),
                 None => out.display().to_string(),
             };
+            let (width, height) = (picture.width, picture.height);
             println!("wrote {what} ({width}x{height}) in {:.2} s", started.elapsed().as_secs_f64());
         }
         Some(Command::Bind(args)) => marionette::cli::bind::run(&args)?,

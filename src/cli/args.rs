@@ -39,10 +39,8 @@ pub enum Command {
         paths: Vec<PathBuf>,
         #[arg(long)]
         out: PathBuf,
-        #[arg(long, default_value_t = 1280, value_parser = clap::value_parser!(u32).range(1..=MAX_PICTURE_SIDE))]
-        width: u32,
-        #[arg(long, default_value_t = 720, value_parser = clap::value_parser!(u32).range(1..=MAX_PICTURE_SIDE))]
-        height: u32,
+        #[command(flatten)]
+        shot: ShotArgs,
         /// `JOINT=rx,ry,rz` applied to every character that has the joint. Repeatable.
         #[arg(long = "pose", value_name = "JOINT=rx,ry,rz")]
         poses: Vec<PoseSpec>,
@@ -143,6 +141,43 @@ impl From<BindMethod> for crate::rig::bind::Binding {
             BindMethod::Nearest => Self::Nearest,
             BindMethod::Smooth => Self::Smooth,
         }
+    }
+}
+
+/// The picture: its size and samples (default: the scene's shot, else 1280×720, 1 sample),
+/// background, view and lens.
+#[derive(clap::Args, Debug, Clone, Default)]
+pub struct ShotArgs {
+    /// Width in pixels.
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=MAX_PICTURE_SIDE))]
+    pub width: Option<u32>,
+    /// Height in pixels.
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=MAX_PICTURE_SIDE))]
+    pub height: Option<u32>,
+    /// Supersampling: each pixel the mean of N×N rendered ones (1 to 4; edges are
+    /// multisampled either way).
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=4))]
+    pub samples: Option<u32>,
+    /// No background and no floor: a PNG with alpha.
+    #[arg(long)]
+    pub transparent: bool,
+    /// Frame the characters from this side: front, back, right (or side), left, top,
+    /// bottom, three-quarter.
+    #[arg(long, value_parser = parse_view)]
+    pub view: Option<crate::formats::scene::ViewName>,
+    /// An orthographic lens, framed to the characters.
+    #[arg(long)]
+    pub ortho: bool,
+}
+
+fn parse_view(s: &str) -> Result<crate::formats::scene::ViewName, String> {
+    s.parse()
+}
+
+impl ShotArgs {
+    /// The size and samples asked for (each none: the scene's).
+    pub fn picture(&self) -> crate::document::frames::PictureRequest {
+        crate::document::frames::PictureRequest { width: self.width, height: self.height, samples: self.samples }
     }
 }
 

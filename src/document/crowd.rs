@@ -56,6 +56,8 @@ pub fn smpl_crowd(dir: &Path, n: usize) -> Result<SceneDoc, String> {
 pub fn shipped_crowd() -> SceneDoc {
     let mut doc = puppet_crowd(64);
     doc.camera = Some(crate::formats::scene::CameraDoc {
+        fov: 45.0,
+        ortho: None,
         focus: Vec3::new(0.0, 0.4, 0.0),
         yaw: 0.6,
         pitch: -0.45,

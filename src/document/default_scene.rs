@@ -74,8 +74,15 @@ pub fn generate() -> SceneDoc {
             puppet("Bo", glam::Vec3::new(0.4, 0.0, 0.05), -0.9, reaching, blue),
             puppet("Cy", glam::Vec3::new(0.0, -0.29, -0.95), 0.0, sitting, weights),
         ],
-        camera: Some(CameraDoc { focus: glam::Vec3::new(0.0, 0.42, -0.3), yaw: 0.0, pitch: -0.32, distance: 2.9 }),
+        camera: Some(CameraDoc {
+            focus: glam::Vec3::new(0.0, 0.42, -0.3),
+            yaw: 0.0,
+            pitch: -0.32,
+            distance: 2.9,
+            ..CameraDoc::default()
+        }),
         stage: StageDoc::default(),
         poses: Default::default(),
+        ..SceneDoc::default()
     }
 }

@@ -65,3 +65,24 @@ pub fn frame_path(pattern: &Path, n: usize) -> Result<PathBuf, String> {
     let width: usize = width.parse().unwrap_or(0);
     Ok(PathBuf::from(format!("{start}{n:0width$}{tail}")))
 }
+
+/// The picture's size and samples asked for on the command line (each none: the scene's).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct PictureRequest {
+    pub width: Option<u32>,
+    pub height: Option<u32>,
+    pub samples: Option<u32>,
+}
+
+impl PictureRequest {
+    /// The picture: what was asked for, the rest as the scene's `shot` says; refused beyond
+    /// the GPU's texture size.
+    pub fn resolved(self, shot: &crate::formats::scene::ShotDoc) -> Result<crate::formats::scene::ShotDoc, String> {
+        let picture = crate::formats::scene::ShotDoc {
+            width: self.width.unwrap_or(shot.width),
+            height: self.height.unwrap_or(shot.height),
+            samples: self.samples.unwrap_or(shot.samples),
+        };
+        picture.validate().map(|()| picture)
+    }
+}

@@ -39,7 +39,11 @@ pub struct InteractionPlugin;
 impl Plugin for InteractionPlugin {
     fn build(&self, app: &mut App) {
         order::add_editor_order(app);
-        app.add_plugins((interact::ik_drag::IkDragPlugin, interact::rotate_gizmo::RotateGizmoPlugin));
+        app.add_plugins((
+            interact::ik_drag::IkDragPlugin,
+            interact::rotate_gizmo::RotateGizmoPlugin,
+            interact::move_gizmo::MoveGizmoPlugin,
+        ));
         app.init_resource::<interact::pointer::ViewportHasPointer>()
             .init_resource::<interact::pointer::PointerOwner>()
             .init_resource::<interact::picking::PointerPress>()
@@ -54,9 +58,11 @@ impl Plugin for InteractionPlugin {
                 Update,
                 (
                     orbit_camera_input,
+                    interact::camera::apply_camera_request,
                     interact::picking::pick_joint_on_click,
                     interact::shortcuts::scene_shortcuts,
                     interact::shortcuts::frame_selection,
+                    interact::shortcuts::view_shortcuts,
                 )
                     .chain()
                     .in_set(order::EditorSystems::Viewport),

@@ -1,5 +1,5 @@
 //! The editor's system order, declared once. In `Update` the pointer's owners go first:
-//! who has it (panels or viewport), then the rotation gizmo, then IK drags, then the
+//! who has it (panels or viewport), then the rotation gizmo, the move gizmo, then IK drags, then the
 //! viewport's own input (orbit, picking, shortcuts). In `PostUpdate`, inside the scene's
 //! `Animate` (before SMPL playback): a pending scene replaces the world, then the queued
 //! edits apply, then the characters' views follow their documents (and morphs blend after
@@ -18,6 +18,8 @@ pub enum EditorSystems {
     Pointer,
     /// `Update`: the rotation gizmo's drags and typed turns.
     Gizmo,
+    /// `Update`: the move gizmo's drags and typed moves (after the rotation gizmo's).
+    MoveGizmo,
     /// `Update`: pins and IK drags of joints.
     Drag,
     /// `Update`: orbiting, picking, the viewport's shortcuts.
@@ -40,7 +42,7 @@ pub struct EditorOrderPlugin;
 impl Plugin for EditorOrderPlugin {
     fn build(&self, app: &mut App) {
         use EditorSystems::*;
-        app.configure_sets(Update, (Pointer, Gizmo, Drag, Viewport).chain())
+        app.configure_sets(Update, (Pointer, Gizmo, MoveGizmo, Drag, Viewport).chain())
             .configure_sets(
                 PostUpdate,
                 (OpenScene, Edits, SyncViews)

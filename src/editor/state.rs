@@ -28,6 +28,12 @@ pub struct StartupEdits {
     pub time: Option<f32>,
     /// `--clip`: a glTF file's animation (name or index) on the characters it moves.
     pub clip: Option<String>,
+    /// `--view`: the characters framed from this side.
+    pub view: Option<crate::formats::scene::ViewName>,
+    /// `--ortho`: an orthographic lens, framed to the characters.
+    pub ortho: bool,
+    /// `--transparent`: no background and no floor (a PNG with alpha).
+    pub transparent: bool,
 }
 
 /// Messages for the user (load errors, warnings, where files went), newest last.

@@ -5,6 +5,7 @@
 pub mod bmp;
 pub mod bvh;
 pub mod character;
+pub mod checks;
 pub mod cse169;
 pub mod cse169_skin;
 pub mod error;
@@ -23,6 +24,7 @@ pub mod part;
 pub mod puppet;
 pub mod scene;
 pub mod smpl;
+pub mod stage;
 pub mod uri;
 pub mod weight_warnings;
 

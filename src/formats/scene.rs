@@ -7,6 +7,7 @@ use std::path::{Path, PathBuf};
 
 use serde::{Deserialize, Serialize};
 
+use super::checks::{finite, positive};
 use super::error::FormatError;
 use crate::rig::{JointRotation, Skeleton};
 
@@ -389,41 +390,9 @@ pub use crate::rig::bind::Binding as BindingDoc;
 /// How a character's vertices follow its joints (stored as `Linear` or `DualQuaternion`).
 pub use crate::rig::dqs::SkinningMethod as SkinningDoc;
 
-/// The orbit camera: an orbit around `focus` (world space) at `distance`, with `yaw` and
-/// `pitch` in radians (the editor holds this very type on its camera).
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-pub struct CameraDoc {
-    pub focus: glam::Vec3,
-    pub yaw: f32,
-    pub pitch: f32,
-    pub distance: f32,
-}
-
-impl Default for CameraDoc {
-    fn default() -> Self {
-        Self { focus: glam::Vec3::new(0.0, 0.5, 0.0), yaw: 0.0, pitch: -0.25, distance: 3.0 }
-    }
-}
-
-/// Scene-wide view settings (the editor holds this very type as its stage resource).
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-#[serde(default)]
-pub struct StageDoc {
-    /// Draw the floor (and its grid).
-    pub floor: bool,
-    /// The sun casts shadows.
-    pub shadows: bool,
-    /// Draw the world axes.
-    pub axes: bool,
-    /// Height of the floor plane (world y).
-    pub floor_height: f32,
-}
-
-impl Default for StageDoc {
-    fn default() -> Self {
-        Self { floor: true, shadows: true, axes: false, floor_height: 0.0 }
-    }
-}
+pub use super::stage::{
+    AmbientDoc, BackgroundDoc, CameraDoc, LampDoc, MAX_LAMPS, ShotDoc, SpotDoc, StageDoc, SunDoc, ViewName,
+};
 
 #[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
 pub struct SceneDoc {
@@ -435,6 +404,12 @@ pub struct SceneDoc {
     /// The scene's pose library, by name.
     #[serde(default, skip_serializing_if = "BTreeMap::is_empty")]
     pub poses: BTreeMap<String, LibraryPoseDoc>,
+    /// Camera views kept by name.
+    #[serde(default, skip_serializing_if = "BTreeMap::is_empty")]
+    pub bookmarks: BTreeMap<String, CameraDoc>,
+    /// The picture `render` takes: its size and samples.
+    #[serde(default)]
+    pub shot: ShotDoc,
 }
 
 /// A pose kept in the scene's library: rotations by joint name (applied to any character
@@ -543,15 +518,18 @@ impl SceneDoc {
             }
         }
         if let Some(camera) = &self.camera {
-            finite("camera.focus", &camera.focus.to_array())?;
-            finite("camera.yaw", &[camera.yaw, camera.pitch])?;
-            positive("camera.distance", camera.distance)?;
+            camera.validate("camera")?;
         }
+        for (name, camera) in &self.bookmarks {
+            camera.validate(&format!("bookmarks[{name:?}]"))?;
+        }
+        self.stage.validate()?;
+        self.shot.validate()?;
         for (name, pose) in &self.poses {
             rotations(&format!("poses[{name:?}].joints"), &pose.joints)?;
             finite(&format!("poses[{name:?}].thumbnail"), pose.thumbnail.as_flattened())?;
         }
-        finite("stage.floor_height", &[self.stage.floor_height])
+        Ok(())
     }
 }
 
@@ -581,21 +559,6 @@ fn blend_weight(at: &str, value: f32) -> Result<(), String> {
         Ok(())
     } else {
         Err(format!("{at}: expected a blend weight in 0..=1, found {value}"))
-    }
-}
-
-fn finite(at: &str, values: &[f32]) -> Result<(), String> {
-    match values.iter().find(|v| !v.is_finite()) {
-        Some(v) => Err(format!("{at}: expected a finite number, found {v}")),
-        None => Ok(()),
-    }
-}
-
-fn positive(at: &str, value: f32) -> Result<(), String> {
-    if value.is_finite() && value > 0.0 {
-        Ok(())
-    } else {
-        Err(format!("{at}: expected a positive finite number, found {value}"))
     }
 }
 

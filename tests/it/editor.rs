@@ -24,7 +24,7 @@ pub fn doc_with(source: SourceDoc, pose: &[(&str, JointRotation)]) -> SceneDoc {
         }],
         camera: None,
         stage: Default::default(),
-        poses: Default::default(),
+        ..SceneDoc::default()
     }
 }
 
@@ -135,6 +135,7 @@ fn render_draws_characters_distinct_from_floor_and_sky_with_weight_hues() {
         yaw: 0.0,
         pitch: -0.2,
         distance: 1.6,
+        ..Default::default()
     });
     let scene = dir.join("scene.ron");
     write_scene(&scene, &doc).unwrap();
@@ -432,7 +433,13 @@ fn a_frame_sequence_writes_one_picture_per_frame_at_its_time() {
         Channel::new(vec![key(0.0, 0.0), key(1.0, -2.0)], Extrapolation::Constant, Extrapolation::Constant);
     let anim = AnimDoc { keys: Some(clip), ..AnimDoc::default() };
     let character = CharacterDoc { anim: Some(anim), ..CharacterDoc::new(SourceDoc::Embedded("puppet".into()), "p") };
-    let camera = CameraDoc { focus: glam::Vec3::new(0.0, 0.7, 0.0), yaw: 0.0, pitch: -0.1, distance: 2.2 };
+    let camera = CameraDoc {
+        focus: glam::Vec3::new(0.0, 0.7, 0.0),
+        yaw: 0.0,
+        pitch: -0.1,
+        distance: 2.2,
+        ..CameraDoc::default()
+    };
     let doc = SceneDoc { characters: vec![character], camera: Some(camera), ..SceneDoc::default() };
     let scene = dir.join("arm.ron");
     marionette::document::scenes::write_scene(&scene, &doc).unwrap();

@@ -162,3 +162,133 @@ fn a_ray_meets_a_ring_at_the_angle_of_the_point_it_hits() {
     let along = Ray3d::new(center + Vec3::Y, Dir3::X);
     assert_eq!(angle_on_ring(center, normal, across, along), None, "a ray along the plane meets it nowhere");
 }
+
+mod moving {
+    //! The move gizmo's math: a drag along an arrow or on the ground square moves by what
+    //! the cursor's rays say, the ring turns about the vertical, Ctrl snaps to the grid and
+    //! Shift to the floor, typed moves are exact; a drag's edits are one undo step.
+
+    use bevy::math::{Dir3, Ray3d};
+    use glam::Vec3;
+    use marionette::editor::interact::move_gizmo::{GRID_STEP, Move, MoveGrip, Snap, along_axis, on_ground};
+    use marionette::formats::scene::{CharacterId, PlacementDoc};
+
+    /// A ray from a camera-ish eye through `target`.
+    fn ray_to(target: Vec3) -> Ray3d {
+        let eye = Vec3::new(1.2, 2.5, 4.0);
+        Ray3d::new(eye, Dir3::new(target - eye).unwrap())
+    }
+
+    fn start() -> PlacementDoc {
+        PlacementDoc::new(Vec3::new(0.43, 0.0, -1.27), 0.3, 1.2)
+    }
+
+    #[test]
+    fn an_arrow_drag_moves_along_its_axis_by_the_cursor_s_travel() {
+        let s = start();
+        for axis in 0..3 {
+            let along = Vec3::AXES[axis];
+            let from = along_axis(s.translation, along, ray_to(s.translation + along * 0.2)).unwrap();
+            assert!((from - 0.2).abs() < 1e-5);
+            let mut drag = Move::new(CharacterId(1), s, MoveGrip::Axis { axis, from });
+            for k in 1..=3 {
+                drag.follow(ray_to(s.translation + along * (0.2 + 0.35 * k as f32)));
+            }
+            // A ray that runs along the axis moves nothing further.
+            drag.follow(Ray3d::new(s.translation + along * 9.0, Dir3::new(-along).unwrap()));
+            let moved = drag.placement(Snap::default()).translation - s.translation;
+            assert!((moved - along * 1.05).length() < 1e-4, "axis {axis}: {moved}");
+        }
+    }
+
+    #[test]
+    fn a_square_drag_moves_in_the_ground_plane() {
+        let s = start();
+        let from = on_ground(0.0, ray_to(Vec3::new(0.5, 0.0, -1.2))).unwrap();
+        let mut drag = Move::new(CharacterId(1), s, MoveGrip::Plane { height: 0.0, from });
+        drag.follow(ray_to(Vec3::new(1.7, 0.0, -0.4)));
+        let p = drag.placement(Snap::default());
+        assert!((p.translation - (s.translation + Vec3::new(1.2, 0.0, 0.8))).length() < 1e-4, "{}", p.translation);
+        assert_eq!((p.yaw, p.scale), (s.yaw, s.scale));
+    }
+
+    #[test]
+    fn ctrl_snaps_to_the_grid_and_shift_stands_it_on_the_floor() {
+        let s = start();
+        let from = on_ground(0.0, ray_to(Vec3::new(0.5, 0.0, -1.2))).unwrap();
+        let mut drag = Move::new(CharacterId(1), s, MoveGrip::Plane { height: 0.0, from });
+        drag.follow(ray_to(Vec3::new(1.737, 0.0, -0.449)));
+        let p = drag.placement(Snap { grid: true, floor: None });
+        for v in [p.translation.x, p.translation.z] {
+            assert!(((v / GRID_STEP).round() * GRID_STEP - v).abs() < 1e-5, "{v} is on the grid");
+        }
+        assert!((p.translation.x - 1.7).abs() < 1e-5 && (p.translation.z - (-0.5)).abs() < 1e-5, "{}", p.translation);
+        // The lowest point 0.08 below the model's origin, scaled 1.2, on a floor at 0.25.
+        let p = drag.placement(Snap { grid: false, floor: Some((0.25, -0.08)) });
+        assert!((p.translation.y - (0.25 + 0.08 * 1.2)).abs() < 1e-6);
+    }
+
+    #[test]
+    fn the_ring_turns_about_the_vertical_and_snaps_to_15_degrees() {
+        let s = start();
+        let at = |angle: f32| ray_to(s.translation + Vec3::new(angle.sin(), 0.0, angle.cos()) * 0.8);
+        let mut drag = Move::new(CharacterId(1), s, MoveGrip::Turn { last: 0.1 });
+        for k in 1..=10 {
+            drag.follow(at(0.1 + 0.07 * k as f32));
+        }
+        let p = drag.placement(Snap::default());
+        assert!((p.yaw - (s.yaw + 0.7)).abs() < 1e-4, "{}", p.yaw);
+        assert_eq!(p.translation, s.translation);
+        let snapped = drag.placement(Snap { grid: true, floor: None }).yaw.to_degrees();
+        assert!((snapped / 15.0 - (snapped / 15.0).round()).abs() < 1e-3, "{snapped}");
+    }
+
+    #[test]
+    fn typed_moves_and_turns_are_exact() {
+        let s = start();
+        let typed = |turn, axis, text: &str| {
+            Move::new(CharacterId(1), s, MoveGrip::Typed { turn, axis, text: text.into() }).placement(Snap::default())
+        };
+        assert_eq!(typed(false, Some(0), "1.5").translation, s.translation + Vec3::new(1.5, 0.0, 0.0));
+        assert_eq!(typed(false, Some(1), "-0.25").translation, s.translation + Vec3::new(0.0, -0.25, 0.0));
+        assert!((typed(true, None, "90").yaw - (s.yaw + std::f32::consts::FRAC_PI_2)).abs() < 1e-6);
+        assert_eq!(typed(false, Some(2), "").translation, s.translation, "nothing typed yet");
+    }
+
+    #[test]
+    fn a_drag_s_placements_are_one_undo_step_that_restores_the_start_exactly() {
+        use bevy::prelude::*;
+        use marionette::editor::edits::commands::Edit;
+        use marionette::editor::edits::history::{History, HistoryRequest};
+        use marionette::scene::Placement;
+        let mut app = crate::edits::scene_app();
+        let doc = crate::editor::doc_with(marionette::formats::scene::SourceDoc::Embedded("puppet".into()), &[]);
+        let mut doc = doc;
+        doc.characters[0].id = Some(CharacterId(1));
+        *app.world_mut().resource_mut::<marionette::editor::scene_doc::document::PendingScene>() =
+            marionette::editor::scene_doc::document::PendingScene { doc: Some(doc), frame: false };
+        app.update();
+        app.update();
+        let entity = crate::edits::entity(&app, 1);
+        let s = app.world().get::<Placement>(entity).unwrap().0;
+        let mut buttons = ButtonInput::<MouseButton>::default();
+        buttons.press(MouseButton::Left);
+        app.world_mut().insert_resource(buttons);
+        // What follow_move pushes each frame of a drag along x by the cursor.
+        let from = along_axis(s.translation, Vec3::X, ray_to(s.translation)).unwrap();
+        let mut drag = Move::new(CharacterId(1), s, MoveGrip::Axis { axis: 0, from });
+        for k in 1..=6 {
+            drag.follow(ray_to(s.translation + Vec3::X * 0.1 * k as f32));
+            let placement = drag.placement(Snap::default());
+            crate::edits::edit(&mut app, Edit::Place { character: CharacterId(1), placement });
+        }
+        let moved = app.world().get::<Placement>(entity).unwrap().translation - s.translation;
+        assert!((moved - Vec3::new(0.6, 0.0, 0.0)).length() < 1e-4, "{moved}");
+        app.world_mut().resource_mut::<ButtonInput<MouseButton>>().release(MouseButton::Left);
+        app.update();
+        app.update();
+        assert_eq!(app.world().resource::<History>().undo_steps(), 1, "the drag is one step");
+        crate::edits::request(&mut app, HistoryRequest::Undo);
+        assert_eq!(app.world().get::<Placement>(entity).unwrap().0, s, "undo: exactly where it stood");
+    }
+}

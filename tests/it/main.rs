@@ -28,6 +28,7 @@ mod poses;
 mod props;
 mod rig;
 mod robust;
+mod shot;
 mod smpl;
 mod untrusted;
 mod writers;

@@ -9,6 +9,7 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 use std::time::Duration;
 
+use marionette::document::frames::PictureRequest;
 use marionette::formats::limits::{MAX_EXCERPT_CHARS, MAX_FILE_BYTES, MAX_SAMPLED_FRAMES};
 use marionette::formats::{FormatError, bvh, gltf_import, load_character, load_clip, scene};
 
@@ -454,8 +455,14 @@ fn render_of_a_scene_whose_clip_fails_to_load_fails_and_writes_nothing() {
     std::fs::write(&scene, "(characters:[(source:Embedded(\"puppet\"),name:\"p\",anim:Some((file:\"bad.anim\")))])")
         .unwrap();
     let out = dir.join("shot.png");
-    let e = marionette::editor::present::render::render(vec![scene], Default::default(), out.clone(), (64, 64), None)
-        .unwrap_err();
+    let e = marionette::editor::present::render::render(
+        vec![scene],
+        Default::default(),
+        out.clone(),
+        PictureRequest { width: Some(64), height: Some(64), samples: None },
+        None,
+    )
+    .unwrap_err();
     assert!(e.contains("bad.anim:1:") && e.contains("(character `p` of"), "{e}");
     assert!(!out.exists());
 }

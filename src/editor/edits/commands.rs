@@ -10,7 +10,8 @@ use bevy::prelude::*;
 pub use crate::editor::edits::edit::{Edit, EditQueue, GestureHold};
 use crate::editor::edits::history::History;
 use crate::editor::edits::pose_library::PoseLibrary;
-use crate::editor::present::stage::StageSettings;
+use crate::editor::interact::camera::Bookmarks;
+use crate::editor::present::stage::{ShotSettings, StageSettings};
 use crate::editor::scene_doc::attach::Attached;
 use crate::editor::scene_doc::document::{
     CharacterIndex, Library, NextCharacterId, SceneCharacter, SceneReader, spawn_from_doc,
@@ -192,8 +193,16 @@ pub fn inverse_of(world: &mut World, edit: &Edit) -> Result<Option<Edit>, String
             unless(old == *pose, Edit::Library { name: name.clone(), pose: old })
         }
         Edit::Stage(stage) => {
-            let old = world.resource::<StageSettings>().0;
+            let old = world.resource::<StageSettings>().0.clone();
             unless(old == *stage, Edit::Stage(old))
+        }
+        Edit::Shot(shot) => {
+            let old = world.resource::<ShotSettings>().0;
+            unless(old == *shot, Edit::Shot(old))
+        }
+        Edit::Bookmark { name, camera } => {
+            let old = world.resource::<Bookmarks>().0.get(name).copied();
+            unless(old == *camera, Edit::Bookmark { name: name.clone(), camera: old })
         }
         Edit::Add(doc) => {
             let id = doc.id.ok_or("a character to add has an id")?;
@@ -257,6 +266,14 @@ fn write(world: &mut World, edit: Edit) -> Result<(), String> {
             };
         }
         Edit::Stage(stage) => world.resource_mut::<StageSettings>().0 = stage,
+        Edit::Shot(shot) => world.resource_mut::<ShotSettings>().0 = shot,
+        Edit::Bookmark { name, camera } => {
+            let mut bookmarks = world.resource_mut::<Bookmarks>();
+            match camera {
+                Some(camera) => bookmarks.0.insert(name, camera),
+                None => bookmarks.0.remove(&name),
+            };
+        }
         Edit::Add(doc) => add_character(world, &doc)?,
         Edit::Remove(id) => {
             let entity = entity_of(world, id)?;

@@ -5,8 +5,8 @@
 use bevy::prelude::*;
 
 use crate::formats::scene::{
-    AnimDoc, AttachDoc, BindingDoc, CharacterDoc, CharacterId, LibraryPoseDoc, PlacementDoc, PlaybackDoc, SkinningDoc,
-    SmplDoc, StageDoc, ViewDoc,
+    AnimDoc, AttachDoc, BindingDoc, CameraDoc, CharacterDoc, CharacterId, LibraryPoseDoc, PlacementDoc, PlaybackDoc,
+    ShotDoc, SkinningDoc, SmplDoc, StageDoc, ViewDoc,
 };
 
 use crate::rig::JointRotation;
@@ -80,8 +80,15 @@ pub enum Edit {
         attached: Option<AttachDoc>,
         placement: PlacementDoc,
     },
-    /// Floor, shadows, axes.
+    /// Floor, lights, background, axes.
     Stage(StageDoc),
+    /// The picture `render` takes.
+    Shot(ShotDoc),
+    /// A camera view kept under `name` (none: taken out).
+    Bookmark {
+        name: String,
+        camera: Option<CameraDoc>,
+    },
     /// A character from its document (a fresh id is given when it has none).
     Add(Box<CharacterDoc>),
     Remove(CharacterId),
@@ -105,7 +112,7 @@ impl Edit {
             | Edit::Attach { character, .. }
             | Edit::Remove(character) => Some(*character),
             Edit::Add(doc) => doc.id,
-            Edit::Stage(_) | Edit::Library { .. } => None,
+            Edit::Stage(_) | Edit::Shot(_) | Edit::Library { .. } | Edit::Bookmark { .. } => None,
         }
     }
 }
@@ -117,6 +124,7 @@ impl Edit {
     pub fn same_slot(&self, other: &Edit) -> bool {
         match (self, other) {
             (Edit::Library { name: a, .. }, Edit::Library { name: b, .. }) => a == b,
+            (Edit::Bookmark { name: a, .. }, Edit::Bookmark { name: b, .. }) => a == b,
             _ => std::mem::discriminant(self) == std::mem::discriminant(other) && self.character() == other.character(),
         }
     }

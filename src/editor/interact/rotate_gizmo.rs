@@ -133,7 +133,7 @@ impl RotateGizmo {
 }
 
 /// Tells the camera, picking and IK drags whether the gizmo has the pointer (reads
-/// `RotateGizmo`; writes `PointerOwner`).
+/// `RotateGizmo`; writes `PointerOwner`; the move gizmo adds its own after).
 fn publish_pointer_owner(gizmo: Res<RotateGizmo>, mut owner: ResMut<crate::editor::interact::pointer::PointerOwner>) {
     let now = crate::editor::interact::pointer::PointerOwner {
         gizmo_holds_pointer: gizmo.holds_pointer,
@@ -471,7 +471,7 @@ fn finish_typing(gizmo: &mut RotateGizmo, hold: &mut GestureHold) {
 }
 
 /// The character a key types into a number of degrees.
-fn typed_char(key: KeyCode) -> Option<char> {
+pub fn typed_char(key: KeyCode) -> Option<char> {
     use KeyCode::*;
     let digits = [Digit0, Digit1, Digit2, Digit3, Digit4, Digit5, Digit6, Digit7, Digit8, Digit9];
     let numpad = [Numpad0, Numpad1, Numpad2, Numpad3, Numpad4, Numpad5, Numpad6, Numpad7, Numpad8, Numpad9];

@@ -1,6 +1,7 @@
 //! Keyboard shortcuts in the viewport: S display mode, A axes, Ctrl+Z / Ctrl+Shift+Z undo
 //! and redo, Ctrl+S / Ctrl+O save and open, F12 screenshot (scene edits go out as `Edit`s);
-//! F frames the selection.
+//! F frames the selection; the numpad's views (as in Blender): 1 front, 3 right, 7 top, with
+//! Ctrl the opposite side, 9 three-quarter, 5 perspective / orthographic.
 
 use bevy::prelude::*;
 
@@ -11,7 +12,7 @@ use crate::editor::present::screenshot::ScreenshotRequest;
 use crate::editor::scene_doc::document::{PendingScene, SceneReader, open_scene_from, save_scene_to};
 use crate::editor::state::{Messages, Selection};
 use crate::editor::ui::InspectorState;
-use crate::formats::scene::ViewDoc;
+use crate::formats::scene::{ViewDoc, ViewName};
 use crate::scene::{Character, CurrentJointToWorld, Placement};
 
 /// Whether the keys are the viewport's (egui has no text field focused).
@@ -70,7 +71,7 @@ pub fn scene_shortcuts(
         edits.push(Edit::Clip { character: id, anim: Some(anim) });
     }
     if keys.just_pressed(KeyCode::KeyA) {
-        edits.push(Edit::Stage(crate::formats::scene::StageDoc { axes: !scene.stage.axes, ..scene.stage.0 }));
+        edits.push(Edit::Stage(crate::formats::scene::StageDoc { axes: !scene.stage.axes, ..scene.stage.0.clone() }));
     }
     if keys.just_pressed(KeyCode::KeyS) {
         // The selected character, or every character when none is selected.
@@ -121,5 +122,40 @@ pub fn frame_selection(
         let framed = OrbitCamera::framing(lo, hi + Vec3::splat(0.15), 1.6);
         orbit.focus = (lo + hi) / 2.0;
         orbit.distance = framed.distance.max(0.4);
+    }
+}
+
+/// The view a numpad key asks for (Ctrl: the opposite side).
+fn numpad_view(keys: &ButtonInput<KeyCode>) -> Option<ViewName> {
+    let opposite = ctrl_held(keys);
+    [
+        (KeyCode::Numpad1, ViewName::Front, ViewName::Back),
+        (KeyCode::Numpad3, ViewName::Right, ViewName::Left),
+        (KeyCode::Numpad7, ViewName::Top, ViewName::Bottom),
+        (KeyCode::Numpad9, ViewName::ThreeQuarter, ViewName::ThreeQuarter),
+    ]
+    .into_iter()
+    .find(|(key, ..)| keys.just_pressed(*key))
+    .map(|(_, view, other)| if opposite { other } else { view })
+}
+
+/// The numpad's views and lens switch (reads keys; writes `OrbitCamera`).
+pub fn view_shortcuts(
+    keys: Res<ButtonInput<KeyCode>>,
+    wants: Option<Res<bevy_egui::input::EguiWantsInput>>,
+    mut cameras: Query<&mut OrbitCamera>,
+) {
+    if !viewport_has_keys(&wants) {
+        return;
+    }
+    let view = numpad_view(&keys);
+    let toggle = keys.just_pressed(KeyCode::Numpad5);
+    for mut orbit in &mut cameras {
+        if let Some(view) = view {
+            orbit.0 = orbit.0.looking_from(view);
+        }
+        if toggle {
+            orbit.0 = orbit.0.toggled_ortho();
+        }
     }
 }

@@ -12,7 +12,8 @@ use bevy::render::render_resource::{TextureFormat, TextureUsages};
 use bevy::render::view::screenshot::{Screenshot, ScreenshotCaptured};
 
 use crate::document::AssetLibrary;
-use crate::document::frames::{FrameSequence, frame_path};
+use crate::document::frames::{FrameSequence, PictureRequest, frame_path};
+use crate::document::picture;
 use crate::document::scenes::{read_scene, scene_path};
 use crate::editor::interact::camera::OrbitCamera;
 use crate::editor::present::readiness::CaptureGate;
@@ -20,7 +21,7 @@ use crate::editor::present::stage;
 use crate::editor::present::view::ViewPlugin;
 use crate::editor::scene_doc::document::Library;
 use crate::editor::state::{Messages, StartupEdits, StartupPaths};
-use crate::formats::scene::{BindingDoc, SourceDoc};
+use crate::formats::scene::{BackgroundDoc, BindingDoc, ShotDoc, SourceDoc};
 use crate::scene::{RigCorePlugin, SkinningPlugin};
 
 /// Seconds after which the render gives up, saying what was still pending.
@@ -33,6 +34,8 @@ const GIVE_UP_SECONDS: u64 = 300;
 struct RenderJob {
     /// Each picture's time (none: the scene as it opens) and file.
     frames: Vec<(Option<f32>, PathBuf)>,
+    /// Rendered pixels a side of each saved one.
+    samples: u32,
     /// The frame being rendered.
     next: usize,
     sequence: Option<FrameSequence>,
@@ -50,16 +53,17 @@ struct RenderJob {
     outcome: Arc<Mutex<(Option<Result<(), String>>, Vec<String>)>>,
 }
 
-/// Renders `paths` (a scene `.ron`, character files, or the default scene when empty) at
-/// `width`×`height` into `out`, or with `sequence` one picture per frame into the files
-/// `out` numbers (`frame_%04d.png`). Returns the notes, or what went wrong.
+/// Renders `paths` (a scene `.ron`, character files, or the default scene when empty) into
+/// `out`, or with `sequence` one picture per frame into the files `out` numbers
+/// (`frame_%04d.png`), at the size and samples asked for (else the scene's shot). Returns
+/// the notes and the picture's size, or what went wrong.
 pub fn render(
     paths: Vec<PathBuf>,
     mut edits: StartupEdits,
     out: PathBuf,
-    (width, height): (u32, u32),
+    picture: PictureRequest,
     sequence: Option<FrameSequence>,
-) -> Result<Vec<String>, String> {
+) -> Result<(Vec<String>, ShotDoc), String> {
     let frames = match &sequence {
         Some(sequence) => {
             let times = sequence.times()?;
@@ -69,7 +73,9 @@ pub fn render(
         }
         None => vec![(None, out)],
     };
-    let library = preload(&paths, &edits)?;
+    let (library, shot) = preload(&paths, &edits)?;
+    let picture = picture.resolved(&shot)?;
+    let (width, height) = (picture.width, picture.height);
     for (_, out) in &frames {
         crate::formats::error::refuse_overwriting_input(out).map_err(|e| e.to_string())?;
     }
@@ -84,13 +90,15 @@ pub fn render(
         .add_plugins((RigCorePlugin, SkinningPlugin, ViewPlugin));
     let target = {
         let mut images = app.world_mut().resource_mut::<Assets<Image>>();
-        let mut image = Image::new_target_texture(width, height, TextureFormat::Rgba8UnormSrgb, None);
+        let (w, h) = (width * picture.samples, height * picture.samples);
+        let mut image = Image::new_target_texture(w, h, TextureFormat::Rgba8UnormSrgb, None);
         image.texture_descriptor.usage |= TextureUsages::COPY_SRC;
         images.add(image)
     };
     let outcome = Arc::new(Mutex::new((None, Vec::new())));
     app.insert_resource(RenderJob {
         frames,
+        samples: picture.samples,
         next: 0,
         sequence,
         first_yaw: None,
@@ -108,13 +116,14 @@ pub fn render(
     app.add_systems(
         Last,
         (next_frame, capture_when_ready).chain().after(crate::editor::present::readiness::UpdateCaptureGate),
-    );
+    )
+    .add_systems(PostUpdate, clear_behind_gradient.after(stage::apply_stage_settings));
     let exit = app.run();
     // `App::run` hands the world to the runner: the outcome comes back through `outcome`.
     let (done, messages) = outcome.lock().map(|o| o.clone()).unwrap_or_default();
 
     match (exit, done) {
-        (AppExit::Success, Some(Ok(()))) => Ok(messages),
+        (AppExit::Success, Some(Ok(()))) => Ok((messages, picture)),
         (_, Some(Err(e))) => Err(e),
         _ => Err("the render stopped before a picture was captured".to_string()),
     }
@@ -123,12 +132,14 @@ pub fn render(
 /// Loads everything the render will show before any window or GPU work, so that a missing
 /// file, an unparsable scene, a character or a clip that fails to load is an error (and no
 /// picture is written). Returns the loaded assets for the app to reuse.
-fn preload(paths: &[PathBuf], edits: &StartupEdits) -> Result<AssetLibrary, String> {
+fn preload(paths: &[PathBuf], edits: &StartupEdits) -> Result<(AssetLibrary, ShotDoc), String> {
     let mut library = AssetLibrary::default();
+    let mut shot = ShotDoc::default();
     // Each source and the clip file it plays, with what names it in a scene file (for the message).
     let mut sources: Vec<(SourceDoc, Option<BindingDoc>, Option<PathBuf>, String)> = match scene_path(paths) {
         Some(scene) => read_scene(scene)
-            .map_err(|e| e.to_string())?
+            .map_err(|e| e.to_string())
+            .inspect(|doc| shot = doc.shot)?
             .characters
             .into_iter()
             .map(|c| {
@@ -149,7 +160,7 @@ fn preload(paths: &[PathBuf], edits: &StartupEdits) -> Result<AssetLibrary, Stri
             loaded.and(clip).err().map(|e| format!("{e}{named_in}"))
         })
         .collect();
-    if errors.is_empty() { Ok(library) } else { Err(errors.join("\n")) }
+    if errors.is_empty() { Ok((library, shot)) } else { Err(errors.join("\n")) }
 }
 
 /// Once the gate opens, captures the target once, saves it and exits; gives up after
@@ -159,6 +170,7 @@ fn capture_when_ready(
     mut job: ResMut<RenderJob>,
     gate: Res<CaptureGate>,
     messages: Res<Messages>,
+    stage: Res<stage::StageSettings>,
     mut exit: MessageWriter<AppExit>,
 ) {
     if let Some(done) = job.done.clone() {
@@ -182,11 +194,30 @@ fn capture_when_ready(
     }
     job.requested = true;
     let out = job.frames[job.next].1.clone();
+    let (samples, background) = (job.samples, stage.background);
     commands.spawn(Screenshot::image(job.target.clone())).observe(
         move |captured: On<ScreenshotCaptured>, mut job: ResMut<RenderJob>| {
-            job.saved = Some(crate::editor::present::screenshot::save_png(&captured.image, &out));
+            job.saved = Some(save_picture(&captured.image, samples, &background, &out));
         },
     );
+}
+
+/// The captured pixels averaged down from their samples, over the background, as PNG.
+fn save_picture(image: &Image, samples: u32, background: &BackgroundDoc, out: &std::path::Path) -> Result<(), String> {
+    let rendered = image.clone().try_into_dynamic().map_err(|e| format!("unreadable capture: {e}"))?.to_rgba8();
+    let picture = picture::over_background(picture::downsampled(&rendered, samples), background);
+    let mut bytes = Vec::new();
+    picture.write_to(&mut std::io::Cursor::new(&mut bytes), image::ImageFormat::Png).map_err(|e| e.to_string())?;
+    crate::formats::write_atomically(out, |w| std::io::Write::write_all(w, &bytes))
+        .map_err(|e| format!("{}: {e}", out.display()))
+}
+
+/// A gradient goes behind the picture once captured: the render clears to nothing
+/// (reads `StageSettings`; writes `ClearColor`).
+fn clear_behind_gradient(settings: Res<stage::StageSettings>, mut clear: ResMut<ClearColor>) {
+    if settings.is_changed() && matches!(settings.background, BackgroundDoc::Gradient { .. }) {
+        clear.0 = Color::NONE;
+    }
 }
 
 /// Once a frame is saved: the render is done after the last (or a failed save); else every

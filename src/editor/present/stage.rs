@@ -1,15 +1,22 @@
-//! The stage: a floor with a subtle grid, a sun that casts shadows, ambient light.
+//! The stage: a floor with a subtle grid, a sun that casts shadows, an ambient fill, up to
+//! three lamps, the background; all as the scene's `StageDoc` says.
 
-use bevy::light::{DirectionalLightShadowMap, light_consts};
+use bevy::light::DirectionalLightShadowMap;
 use bevy::prelude::*;
 
 /// Scene-wide view settings: the scene file's own type (floor, shadows, axes, floor
 /// height), held as a resource.
-#[derive(Resource, Clone, Copy, Debug, Default, PartialEq, Deref, DerefMut)]
+#[derive(Resource, Clone, Debug, Default, PartialEq, Deref, DerefMut)]
 pub struct StageSettings(pub crate::formats::scene::StageDoc);
 
+/// The picture `render` takes (size, samples): the scene file's own type, held as a
+/// resource; the viewport's frame guide shows its shape.
+#[derive(Resource, Clone, Copy, Debug, Default, PartialEq, Deref, DerefMut)]
+pub struct ShotSettings(pub crate::formats::scene::ShotDoc);
+
 /// The sky (clear) colour.
-pub const SKY: Color = Color::srgb(0.62, 0.7, 0.78);
+pub const SKY: Color =
+    Color::srgb(crate::formats::stage::SKY[0], crate::formats::stage::SKY[1], crate::formats::stage::SKY[2]);
 
 #[derive(Component)]
 pub struct Floor;
@@ -51,8 +58,9 @@ pub fn fit_stage_to_scene(
     bounds: Query<&bevy::camera::primitives::Aabb>,
     mut extent: ResMut<StageExtent>,
     mut floors: Query<&mut Transform, With<Floor>>,
+    settings: Res<StageSettings>,
 ) {
-    if changed.is_empty() {
+    if changed.is_empty() && !settings.is_changed() {
         return;
     }
     let reach = characters
@@ -70,11 +78,15 @@ pub fn fit_stage_to_scene(
             )
         })
         .fold(0.0f32, f32::max);
-    let wanted = StageExtent::reaching(reach);
+    let wanted = match settings.floor_size {
+        Some(size) => StageExtent::reaching(size / 4.0),
+        None => StageExtent::reaching(reach),
+    };
     if *extent != wanted {
         *extent = wanted;
+        let side = settings.floor_size.unwrap_or(2.0 * wanted.half) / FLOOR_SIZE;
         for mut floor in &mut floors {
-            floor.scale = Vec3::new(2.0 * wanted.half / FLOOR_SIZE, 1.0, 2.0 * wanted.half / FLOOR_SIZE);
+            floor.scale = Vec3::new(side, 1.0, side);
         }
     }
 }
@@ -82,51 +94,105 @@ pub fn fit_stage_to_scene(
 #[derive(Component)]
 pub struct Sun;
 
-/// Spawns floor and lights (writes entities).
+/// A lamp of the stage (its index in `StageDoc::lamps`).
+#[derive(Component)]
+pub struct Lamp(pub usize);
+
+/// Spawns floor and sun; the stage's settings light them (writes entities).
 pub fn spawn_stage(
     mut commands: Commands,
     mut meshes: ResMut<Assets<Mesh>>,
     mut materials: ResMut<Assets<StandardMaterial>>,
-    settings: Res<StageSettings>,
 ) {
     commands.insert_resource(DirectionalLightShadowMap { size: 2048 });
-    commands.insert_resource(GlobalAmbientLight { color: Color::WHITE, brightness: 350.0, ..default() });
     commands.spawn((
         Floor,
         Mesh3d(meshes.add(Plane3d::default().mesh().size(FLOOR_SIZE, FLOOR_SIZE))),
-        MeshMaterial3d(materials.add(StandardMaterial {
-            base_color: Color::srgb(0.55, 0.57, 0.6),
-            perceptual_roughness: 0.95,
-            ..default()
-        })),
-        Transform::from_xyz(0.0, settings.floor_height, 0.0),
+        MeshMaterial3d(materials.add(StandardMaterial { perceptual_roughness: 0.95, ..default() })),
+        Transform::default(),
     ));
-    commands.spawn((
-        Sun,
-        DirectionalLight {
-            illuminance: light_consts::lux::OVERCAST_DAY * 4.0,
-            shadow_maps_enabled: settings.shadows,
-            ..default()
-        },
-        Transform::from_xyz(2.0, 4.0, 3.0).looking_at(Vec3::ZERO, Vec3::Y),
-    ));
+    commands.spawn((Sun, DirectionalLight::default(), Transform::default()));
 }
 
-/// Applies floor/shadow switches (reads `StageSettings`; writes floor visibility, sun).
+/// Linear RGB as a colour.
+fn linear([r, g, b]: [f32; 3]) -> Color {
+    Color::linear_rgb(r, g, b)
+}
+
+/// Applies the stage's settings whenever they change: the floor (shown, height, size,
+/// colour), the sun (direction, light, shadows), the ambient fill, the lamps (spawned
+/// afresh) and the background (reads `StageSettings`; writes floor, sun, lamps,
+/// `GlobalAmbientLight`, `ClearColor`).
+#[allow(clippy::too_many_arguments)]
 pub fn apply_stage_settings(
+    mut commands: Commands,
     settings: Res<StageSettings>,
-    mut floors: Query<(&mut Visibility, &mut Transform), With<Floor>>,
-    mut suns: Query<&mut DirectionalLight, With<Sun>>,
+    extent: Res<StageExtent>,
+    mut floors: Query<(&mut Visibility, &mut Transform, &MeshMaterial3d<StandardMaterial>), With<Floor>>,
+    mut materials: ResMut<Assets<StandardMaterial>>,
+    mut suns: Query<(&mut DirectionalLight, &mut Transform), (With<Sun>, Without<Floor>)>,
+    lamps: Query<Entity, With<Lamp>>,
+    mut ambient: ResMut<GlobalAmbientLight>,
+    mut clear: ResMut<ClearColor>,
 ) {
     if !settings.is_changed() {
         return;
     }
-    for (mut visibility, mut transform) in &mut floors {
-        *visibility = if settings.floor { Visibility::Inherited } else { Visibility::Hidden };
-        transform.translation.y = settings.floor_height;
+    let stage = &settings.0;
+    for (mut visibility, mut transform, material) in &mut floors {
+        *visibility = if stage.floor { Visibility::Inherited } else { Visibility::Hidden };
+        transform.translation.y = stage.floor_height;
+        let side = stage.floor_size.unwrap_or(2.0 * extent.half) / FLOOR_SIZE;
+        transform.scale = Vec3::new(side, 1.0, side);
+        if let Some(mut m) = materials.get_mut(&material.0) {
+            let [r, g, b] = stage.floor_color;
+            m.base_color = Color::srgb(r, g, b);
+        }
     }
-    for mut sun in &mut suns {
-        sun.shadow_maps_enabled = settings.shadows;
+    for (mut sun, mut transform) in &mut suns {
+        sun.illuminance = stage.sun.illuminance;
+        sun.color = linear(stage.sun.color);
+        sun.shadow_maps_enabled = stage.shadows;
+        *transform = Transform::from_translation(stage.sun.toward()).looking_at(Vec3::ZERO, sun_up(stage.sun.toward()));
+    }
+    *ambient =
+        GlobalAmbientLight { color: linear(stage.ambient.color), brightness: stage.ambient.brightness, ..default() };
+    lamps.iter().for_each(|e| commands.entity(e).despawn());
+    for (i, lamp) in stage.lamps.iter().take(crate::formats::scene::MAX_LAMPS).enumerate() {
+        spawn_lamp(&mut commands, i, lamp);
+    }
+    let ([r, g, b], alpha) = stage.background.at(0.5);
+    clear.0 = Color::srgba(r, g, b, alpha);
+}
+
+/// An up direction for a light looking along `toward` (any but `toward` itself).
+fn sun_up(toward: Vec3) -> Vec3 {
+    if toward.cross(Vec3::Y).length_squared() < 1e-6 { Vec3::Z } else { Vec3::Y }
+}
+
+/// Lamp `i`: a point light, or a spot light aimed at its point.
+fn spawn_lamp(commands: &mut Commands, i: usize, lamp: &crate::formats::scene::LampDoc) {
+    let (color, intensity, shadows_enabled) = (linear(lamp.color), lamp.intensity, lamp.shadows);
+    let at = Transform::from_translation(lamp.position);
+    match lamp.spot {
+        Some(spot) => {
+            let aim = if spot.aim.distance_squared(lamp.position) < 1e-8 { lamp.position - Vec3::Y } else { spot.aim };
+            let outer = spot.angle.to_radians();
+            let light = SpotLight {
+                color,
+                intensity,
+                shadow_maps_enabled: shadows_enabled,
+                range: 40.0,
+                outer_angle: outer,
+                inner_angle: outer * 0.8,
+                ..default()
+            };
+            commands.spawn((Lamp(i), light, at.looking_at(aim, sun_up(aim - lamp.position))));
+        }
+        None => {
+            let light = PointLight { color, intensity, shadow_maps_enabled: shadows_enabled, range: 40.0, ..default() };
+            commands.spawn((Lamp(i), light, at));
+        }
     }
 }
 

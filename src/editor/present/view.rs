@@ -16,7 +16,7 @@ use crate::editor::present::stage::{
 };
 use crate::editor::scene_doc::document::{Library, NextCharacterId, PendingScene, SceneCharacter, spawn_from_doc};
 use crate::editor::state::{Messages, Selection, StartupEdits, StartupPaths, UnloadedCharacters};
-use crate::formats::scene::{CharacterId, DisplayDoc};
+use crate::formats::scene::{CameraDoc, CharacterId, DisplayDoc};
 use crate::rig::SkinTexture;
 use crate::scene::{Character, CharacterView, HeatJoint, SkinMesh};
 
@@ -28,6 +28,9 @@ pub struct ScenePlugin;
 impl Plugin for ScenePlugin {
     fn build(&self, app: &mut App) {
         app.init_resource::<StageSettings>()
+            .init_resource::<crate::editor::present::stage::ShotSettings>()
+            .init_resource::<crate::editor::interact::camera::Bookmarks>()
+            .init_resource::<crate::editor::interact::camera::CameraRequest>()
             .init_resource::<Messages>()
             .init_resource::<Selection>()
             .init_resource::<UnloadedCharacters>()
@@ -36,6 +39,7 @@ impl Plugin for ScenePlugin {
             .init_resource::<Library>()
             .init_resource::<FramingAspect>()
             .init_resource::<FrameWhenSkinned>()
+            .init_resource::<FramingView>()
             .init_resource::<crate::editor::scene_doc::arrange::ArrangeWhenSkinned>()
             .init_resource::<crate::editor::edits::pose_library::PoseLibrary>()
             .add_plugins((crate::scene::PlaybackPlugin, crate::editor::edits::commands::CommandsPlugin))
@@ -98,6 +102,7 @@ fn queue_startup_scene(
     mut messages: ResMut<Messages>,
     mut pending: ResMut<PendingScene>,
     mut arrange: ResMut<crate::editor::scene_doc::arrange::ArrangeWhenSkinned>,
+    mut framing: ResMut<FramingView>,
 ) {
     let mut notes = Vec::new();
     let doc = startup_doc(&paths.0, &mut library, &mut notes);
@@ -108,8 +113,28 @@ fn queue_startup_scene(
     notes.into_iter().for_each(|m| messages.push(m));
     if let Some(mut doc) = doc {
         apply_startup_edits(&mut doc, &edits, &mut library, &mut messages);
+        if let Some(view) = startup_view(&mut doc, &edits) {
+            framing.0 = view;
+        }
         *pending = PendingScene { frame: doc.camera.is_none(), doc: Some(doc) };
     }
+}
+
+/// The view and lens `--view` and `--ortho` ask for (from the scene's camera, else the
+/// three-quarter view), which the characters are then framed from: the scene's own camera
+/// is left out.
+fn startup_view(doc: &mut crate::formats::scene::SceneDoc, edits: &StartupEdits) -> Option<CameraDoc> {
+    if edits.view.is_none() && !edits.ortho {
+        return None;
+    }
+    let mut view = doc.camera.take().unwrap_or(FramingView::default().0);
+    if let Some(name) = edits.view {
+        view = view.looking_from(name);
+    }
+    if edits.ortho && view.ortho.is_none() {
+        view = view.toggled_ortho();
+    }
+    Some(view)
 }
 
 /// Applies `--pose` and `--ik` to every character of `doc` that has the joints.
@@ -131,6 +156,10 @@ fn apply_startup_edits(
     }
     if let Some(t) = edits.time {
         pause_clips_at(doc, t);
+    }
+    if edits.transparent {
+        doc.stage.background = crate::formats::scene::BackgroundDoc::Transparent;
+        doc.stage.floor = false;
     }
     if edits.poses.is_empty() && edits.ik.is_empty() {
         return;
@@ -264,6 +293,8 @@ pub fn apply_pending_scene(
     }
     stage.0 = doc.stage;
     reset.pose_library.0 = doc.poses;
+    reset.shot.0 = doc.shot;
+    reset.bookmarks.0 = doc.bookmarks;
     if let Some(c) = doc.camera {
         cameras.iter_mut().for_each(|mut orbit| *orbit = OrbitCamera(c));
     }
@@ -274,12 +305,24 @@ pub fn apply_pending_scene(
 #[derive(Resource, Default)]
 pub struct FrameWhenSkinned(pub bool);
 
+/// The direction and lens framing starts from (the three-quarter view unless `--view` or
+/// `--ortho` said otherwise).
+#[derive(Resource, Clone, Copy, Debug)]
+pub struct FramingView(pub CameraDoc);
+
+impl Default for FramingView {
+    fn default() -> Self {
+        Self(CameraDoc::default().looking_from(crate::formats::scene::ViewName::ThreeQuarter))
+    }
+}
+
 /// Frames the characters as they stand, posed (their skinned vertices, placed), once all
 /// are skinned after a scene opened (reads `SkinScratch`; writes `OrbitCamera`).
 pub fn frame_when_skinned(
     mut frame: ResMut<FrameWhenSkinned>,
     characters: Query<(&crate::scene::Placement, &crate::scene::SkinScratch, &crate::scene::PoseDirty)>,
     aspect: Res<FramingAspect>,
+    view: Res<FramingView>,
     mut cameras: Query<&mut OrbitCamera>,
 ) {
     if !frame.0 || characters.iter().any(|c| *c.2 != crate::scene::PoseDirty::default()) {
@@ -291,7 +334,7 @@ pub fn frame_when_skinned(
         scratch.positions.iter().map(move |&p| m.transform_point3(p))
     });
     if points.clone().next().is_some() {
-        let framed = OrbitCamera::framing_points(points, aspect.0);
+        let framed = OrbitCamera::framing_from(points, aspect.0, view.0);
         cameras.iter_mut().for_each(|mut orbit| *orbit = framed);
     }
 }
@@ -314,6 +357,8 @@ pub struct SceneReset<'w> {
     history: ResMut<'w, history::History>,
     unloaded: ResMut<'w, UnloadedCharacters>,
     pose_library: ResMut<'w, crate::editor::edits::pose_library::PoseLibrary>,
+    shot: ResMut<'w, crate::editor::present::stage::ShotSettings>,
+    bookmarks: ResMut<'w, crate::editor::interact::camera::Bookmarks>,
 }
 
 impl SceneReset<'_> {

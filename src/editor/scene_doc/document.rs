@@ -126,6 +126,8 @@ pub struct SceneReader<'w, 's> {
     pub stage: Res<'w, StageSettings>,
     pub unloaded: Res<'w, crate::editor::state::UnloadedCharacters>,
     pub pose_library: Res<'w, crate::editor::edits::pose_library::PoseLibrary>,
+    pub shot: Res<'w, crate::editor::present::stage::ShotSettings>,
+    pub bookmarks: Res<'w, crate::editor::interact::camera::Bookmarks>,
 }
 
 impl SceneReader<'_, '_> {
@@ -139,8 +141,10 @@ impl SceneReader<'_, '_> {
             // Characters that failed to load stay in the document as they were.
             characters: characters.into_iter().chain(self.unloaded.0.iter().cloned()).collect(),
             camera: self.cameras.iter().next().map(|o| o.0),
-            stage: self.stage.0,
+            stage: self.stage.0.clone(),
             poses: self.pose_library.0.clone(),
+            bookmarks: self.bookmarks.0.clone(),
+            shot: self.shot.0,
         }
     }
 

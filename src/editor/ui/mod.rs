@@ -12,6 +12,7 @@ pub mod pose_panel;
 pub mod recent;
 pub mod scene_panel;
 pub mod smpl_panel;
+pub mod stage_panel;
 
 use bevy::diagnostic::{DiagnosticsStore, FrameTimeDiagnosticsPlugin};
 use bevy::ecs::system::SystemParam;
@@ -47,6 +48,10 @@ pub struct InspectorState {
     pub pose_name: String,
     /// The file dialog.
     pub dialogs: dialogs::FileDialogs,
+    /// The name "Keep view" keeps the camera under.
+    pub bookmark_name: String,
+    /// Show the shot's frame in the viewport.
+    pub frame_guide: bool,
 }
 
 impl Default for InspectorState {
@@ -63,6 +68,8 @@ impl Default for InspectorState {
             dialogs: Default::default(),
             active_dof: None,
             crowd_size: 16,
+            bookmark_name: "view 1".into(),
+            frame_guide: true,
         }
     }
 }
@@ -82,6 +89,8 @@ pub struct Panels<'w, 's> {
     pub library: ResMut<'w, Library>,
     pub ids: ResMut<'w, NextCharacterId>,
     pub pending: ResMut<'w, PendingScene>,
+    /// A camera the panels ask for.
+    pub camera_request: ResMut<'w, crate::editor::interact::camera::CameraRequest>,
     /// The recent files (none in an app without the inspector: nothing is remembered).
     pub recent: Option<ResMut<'w, crate::editor::ui::recent::RecentFiles>>,
 }
@@ -117,6 +126,7 @@ pub struct ViewportOverlays<'w> {
     diagnostics: Res<'w, DiagnosticsStore>,
     hovered: Res<'w, crate::editor::interact::picking::HoveredJoint>,
     gizmo: Res<'w, crate::editor::interact::rotate_gizmo::RotateGizmo>,
+    moving: Res<'w, crate::editor::interact::move_gizmo::MoveGizmo>,
 }
 
 pub struct InspectorPlugin;
@@ -173,8 +183,13 @@ fn inspector_ui(
     viewport_area.set_if_neq(area);
     dialogs::show(&ctx, &mut state, &mut panels, &mut shot);
     frame_time_readout(&ctx, central, &overlays.diagnostics);
+    if state.frame_guide {
+        frame_guide(&ctx, central, &panels.scene.shot.0);
+    }
     hovered_joint_tooltip(&ctx, &panels, &overlays.hovered);
-    if let Some(text) = state.active_dof.as_ref().or(overlays.gizmo.readout.as_ref()) {
+    if let Some(text) =
+        state.active_dof.as_ref().or(overlays.gizmo.readout.as_ref()).or(overlays.moving.readout.as_ref())
+    {
         egui::Area::new("active_dof".into()).anchor(egui::Align2::CENTER_TOP, [0.0, 36.0]).show(&ctx, |ui| {
             egui::Frame::popup(ui.style()).show(ui, |ui| {
                 ui.add(
@@ -219,6 +234,36 @@ fn frame_time_readout(ctx: &egui::Context, viewport: egui::Rect, diagnostics: &D
         let text = egui::RichText::new(format!("{ms:.1} ms · {fps:.0} fps")).monospace().color(egui::Color32::WHITE);
         ui.add(egui::Label::new(text).wrap_mode(egui::TextWrapMode::Extend));
     });
+}
+
+/// The shot's frame in the viewport: what `render` takes at the shot's aspect (the
+/// viewport's height or width, centred), the rest dimmed.
+fn frame_guide(ctx: &egui::Context, viewport: egui::Rect, shot: &crate::formats::scene::ShotDoc) {
+    let aspect = shot.width as f32 / shot.height.max(1) as f32;
+    let size = if viewport.width() / viewport.height().max(1.0) > aspect {
+        egui::vec2(viewport.height() * aspect, viewport.height())
+    } else {
+        egui::vec2(viewport.width(), viewport.width() / aspect)
+    };
+    let frame = egui::Rect::from_center_size(viewport.center(), size);
+    let painter = ctx.layer_painter(egui::LayerId::new(egui::Order::Background, "frame guide".into()));
+    let dim = egui::Color32::from_black_alpha(110);
+    for outside in [
+        egui::Rect::from_min_max(viewport.min, egui::pos2(frame.min.x, viewport.max.y)),
+        egui::Rect::from_min_max(egui::pos2(frame.max.x, viewport.min.y), viewport.max),
+        egui::Rect::from_min_max(egui::pos2(frame.min.x, viewport.min.y), egui::pos2(frame.max.x, frame.min.y)),
+        egui::Rect::from_min_max(egui::pos2(frame.min.x, frame.max.y), egui::pos2(frame.max.x, viewport.max.y)),
+    ] {
+        if outside.is_positive() {
+            painter.rect_filled(outside, 0.0, dim);
+        }
+    }
+    painter.rect_stroke(
+        frame,
+        0.0,
+        egui::Stroke::new(1.0, egui::Color32::from_white_alpha(160)),
+        egui::StrokeKind::Inside,
+    );
 }
 
 /// The joint under the cursor, named beside it: "character · joint (index)".

@@ -33,7 +33,9 @@ pub fn scene_panel(ui: &mut egui::Ui, state: &mut InspectorState, panels: &mut P
         }
     }
     ui.separator();
-    stage_rows(ui, panels);
+    ui.heading("View");
+    super::stage_panel::stage_panel(ui, state, panels);
+    ui.label("S cycles mesh / skeleton / both; F frames the selection; click a joint to select it.");
     ui.separator();
     screenshot_rows(ui, state, shot);
     ui.separator();
@@ -332,20 +334,6 @@ fn placement_rows(ui: &mut egui::Ui, p: &mut PlacementDoc) {
         ui.label("Scale");
         ui.add(egui::DragValue::new(&mut p.scale).speed(0.01).range(0.01..=100.0));
     });
-}
-
-fn stage_rows(ui: &mut egui::Ui, panels: &mut Panels) {
-    ui.heading("View");
-    let mut stage = panels.scene.stage.0;
-    ui.horizontal(|ui| {
-        ui.checkbox(&mut stage.floor, "floor");
-        ui.checkbox(&mut stage.shadows, "shadows");
-        ui.checkbox(&mut stage.axes, "axes (A)");
-    });
-    if stage != panels.scene.stage.0 {
-        panels.push(Edit::Stage(stage));
-    }
-    ui.label("S cycles mesh / skeleton / both; F frames the selection; click a joint to select it.");
 }
 
 fn screenshot_rows(ui: &mut egui::Ui, state: &mut InspectorState, shot: &mut ScreenshotRequest) {

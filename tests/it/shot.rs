@@ -1,0 +1,135 @@
+//! The picture: lights, background and lens as `render` draws them. The sun from the left
+//! lights the characters' left halves, from the right their right halves; a transparent
+//! picture is clear around the characters and opaque on them; an orthographic front view
+//! draws a character at one size whatever the camera's distance; supersampling averages.
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+use marionette::formats::scene::{BackgroundDoc, CameraDoc, CharacterDoc, SceneDoc, SourceDoc, StageDoc, SunDoc};
+
+use crate::common::{optional_data_dir, scratch};
+
+/// Renders `scene` with `flags` into `out` (64×96 unless the flags say).
+fn render(scene: &Path, flags: &[&str], out: &Path) -> image::RgbaImage {
+    let output = Command::new(env!("CARGO_BIN_EXE_marionette"))
+        .args(["render", "--width", "64", "--height", "96"])
+        .args(flags)
+        .arg("--out")
+        .arg(out)
+        .arg(scene)
+        .output()
+        .unwrap();
+    assert!(output.status.success(), "{}", String::from_utf8_lossy(&output.stderr));
+    image::open(out).unwrap().to_rgba8()
+}
+
+fn scene_file(dir: &Path, name: &str, doc: &SceneDoc) -> PathBuf {
+    std::fs::create_dir_all(dir).unwrap();
+    let path = dir.join(name);
+    marionette::document::scenes::write_scene(&path, doc).unwrap();
+    path
+}
+
+/// The puppet alone, lit by the sun alone from `azimuth` (a dim fill), no floor.
+fn puppet_lit_from(azimuth: f32) -> SceneDoc {
+    let puppet = CharacterDoc::new(SourceDoc::Embedded("puppet".into()), "p");
+    let stage = StageDoc {
+        floor: false,
+        shadows: false,
+        sun: SunDoc { azimuth, elevation: 5.0, illuminance: 8000.0, color: [1.0; 3] },
+        ambient: marionette::formats::scene::AmbientDoc { color: [1.0; 3], brightness: 20.0 },
+        background: BackgroundDoc::Transparent,
+        ..StageDoc::default()
+    };
+    SceneDoc { characters: vec![puppet], stage, ..SceneDoc::default() }
+}
+
+/// The columns and rows the opaque pixels span.
+fn silhouette(picture: &image::RgbaImage) -> (u32, u32, u32, u32) {
+    let opaque: Vec<(u32, u32)> = picture.enumerate_pixels().filter(|p| p.2.0[3] > 128).map(|p| (p.0, p.1)).collect();
+    assert!(!opaque.is_empty(), "nothing drawn");
+    let xs = opaque.iter().map(|p| p.0);
+    let ys = opaque.iter().map(|p| p.1);
+    (xs.clone().min().unwrap(), xs.max().unwrap(), ys.clone().min().unwrap(), ys.max().unwrap())
+}
+
+/// The mean brightness of the opaque pixels left and right of the silhouette's middle.
+fn halves(picture: &image::RgbaImage) -> (f64, f64) {
+    let (x0, x1, ..) = silhouette(picture);
+    let middle = (x0 + x1) as f64 / 2.0;
+    let (mut sums, mut counts) = ([0.0; 2], [0.0; 2]);
+    for (x, _, p) in picture.enumerate_pixels().filter(|p| p.2.0[3] == 255) {
+        let side = usize::from(x as f64 > middle);
+        sums[side] += p.0[..3].iter().map(|&c| c as f64).sum::<f64>() / 3.0;
+        counts[side] += 1.0;
+    }
+    (sums[0] / counts[0], sums[1] / counts[1])
+}
+
+#[test]
+fn the_sun_from_the_left_lights_the_left_halves_and_from_the_right_the_right() {
+    let dir = scratch("shot-sun");
+    // The front view looks along -z at the puppet: the picture's left is -x.
+    let left = render(&scene_file(&dir, "left.ron", &puppet_lit_from(-90.0)), &["--view", "front"], &dir.join("l.png"));
+    let right =
+        render(&scene_file(&dir, "right.ron", &puppet_lit_from(90.0)), &["--view", "front"], &dir.join("r.png"));
+    let ((ll, lr), (rl, rr)) = (halves(&left), halves(&right));
+    assert!(ll > lr * 1.3, "sun from the left: left half {ll:.1}, right half {lr:.1}");
+    assert!(rr > rl * 1.3, "sun from the right: left half {rl:.1}, right half {rr:.1}");
+}
+
+#[test]
+fn a_transparent_picture_is_clear_around_the_characters_and_opaque_on_them() {
+    let dir = scratch("shot-transparent");
+    let mut doc = puppet_lit_from(30.0);
+    doc.stage = StageDoc::default();
+    let picture = render(&scene_file(&dir, "p.ron", &doc), &["--transparent", "--samples", "2"], &dir.join("t.png"));
+    let (w, h) = picture.dimensions();
+    assert_eq!((w, h), (64, 96), "supersampled, then averaged to the size asked for");
+    for (x, y) in [(0, 0), (w - 1, 0), (0, h - 1), (w - 1, h - 1)] {
+        assert_eq!(picture.get_pixel(x, y).0[3], 0, "corner ({x}, {y})");
+    }
+    let (x0, x1, y0, y1) = silhouette(&picture);
+    let opaque = picture.pixels().filter(|p| p.0[3] == 255).count();
+    assert!(opaque > 200, "{opaque} opaque pixels");
+    // The chest, at the middle of the silhouette's width, a third of the way down.
+    assert_eq!(picture.get_pixel((x0 + x1) / 2, y0 + (y1 - y0) / 3).0[3], 255);
+}
+
+#[test]
+fn a_gradient_background_fills_behind_the_characters() {
+    let dir = scratch("shot-gradient");
+    let mut doc = puppet_lit_from(30.0);
+    doc.stage.background = BackgroundDoc::Gradient { top: [1.0, 0.0, 0.0], bottom: [0.0, 0.0, 1.0] };
+    let picture = render(&scene_file(&dir, "g.ron", &doc), &[], &dir.join("g.png"));
+    let (top, bottom) = (picture.get_pixel(0, 0).0, picture.get_pixel(0, 95).0);
+    assert_eq!((top[0], top[2], top[3]), (255, 0, 255), "red at the top");
+    assert_eq!((bottom[0], bottom[2]), (0, 255), "blue at the bottom");
+}
+
+#[test]
+fn an_orthographic_front_view_draws_model1_at_one_size_whatever_the_distance() {
+    let Some(data) = optional_data_dir() else { return };
+    let dir = scratch("shot-ortho");
+    let model = CharacterDoc::new(SourceDoc::File(data.join("mit6837/Model1.skel")), "m");
+    let stage = StageDoc { floor: false, background: BackgroundDoc::Transparent, ..StageDoc::default() };
+    let height_at = |distance: f32, ortho: Option<f32>| {
+        let camera =
+            CameraDoc { focus: glam::Vec3::ZERO, yaw: 0.0, pitch: 0.0, distance, ortho, ..CameraDoc::default() };
+        let doc = SceneDoc {
+            characters: vec![model.clone()],
+            camera: Some(camera),
+            stage: stage.clone(),
+            ..SceneDoc::default()
+        };
+        let name = format!("{distance}-{}", ortho.is_some());
+        let picture = render(&scene_file(&dir, &format!("{name}.ron"), &doc), &[], &dir.join(format!("{name}.png")));
+        let (.., y0, y1) = silhouette(&picture);
+        y1 - y0
+    };
+    let (near, far) = (height_at(4.0, Some(2.5)), height_at(8.0, Some(2.5)));
+    assert_eq!(near, far, "orthographic: the same pixel height at 4 m and 8 m");
+    let (near, far) = (height_at(4.0, None), height_at(8.0, None));
+    assert!(near > far + far / 2, "perspective: nearer is larger ({near} against {far} pixels)");
+}
