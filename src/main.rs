@@ -46,9 +46,9 @@ fn run(cli: Cli) -> Result<()> {
                 ortho: shot.ortho,
                 transparent: shot.transparent,
             };
-            let sequence = frames.sequence();
+            let (sequence, pictures) = (frames.sequence(), frames.pictures());
             let (notes, picture) =
-                marionette::editor::present::render::render(paths, edits, out.clone(), shot.picture(), sequence)
+                marionette::editor::present::render::render(paths, edits, out.clone(), shot.picture(), pictures)
                     .map_err(anyhow::Error::msg)?;
             for n in notes {
                 eprintln!("note: {n}");

@@ -199,9 +199,23 @@ pub struct FrameArgs {
     /// (from `--from`, or 0), or the turn over `--from`/`--to`.
     #[arg(long, value_name = "SECONDS", value_parser = finite_seconds)]
     pub turntable: Option<f32>,
+    /// A contact sheet into `--out`: every pose of the scene's library on its characters,
+    /// one cell each (of `--width`×`--height`), in a grid by name.
+    #[arg(long = "poses", id = "pose_sheet", conflicts_with_all = ["from", "turntable", "time"])]
+    pub pose_sheet: bool,
 }
 
 impl FrameArgs {
+    /// The pictures asked for: a sequence, a contact sheet of poses, or one.
+    pub fn pictures(&self) -> crate::document::frames::Pictures {
+        use crate::document::frames::Pictures;
+        match self.sequence() {
+            Some(sequence) => Pictures::Sequence(sequence),
+            None if self.pose_sheet => Pictures::PoseSheet,
+            None => Pictures::Still,
+        }
+    }
+
     /// The frames to render, if a sequence was asked for.
     pub fn sequence(&self) -> Option<crate::document::frames::FrameSequence> {
         let from = self.from.unwrap_or(0.0);

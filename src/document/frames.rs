@@ -86,3 +86,14 @@ impl PictureRequest {
         picture.validate().map(|()| picture)
     }
 }
+
+/// The pictures a render writes.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Pictures {
+    /// One picture of the scene as it opens.
+    Still,
+    /// One per frame, into the files `out` numbers (`frame_%04d.png`).
+    Sequence(FrameSequence),
+    /// A contact sheet: every pose of the scene's library on its characters, in a grid.
+    PoseSheet,
+}

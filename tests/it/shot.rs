@@ -133,3 +133,28 @@ fn an_orthographic_front_view_draws_model1_at_one_size_whatever_the_distance() {
     let (near, far) = (height_at(4.0, None), height_at(8.0, None));
     assert!(near > far + far / 2, "perspective: nearer is larger ({near} against {far} pixels)");
 }
+
+#[test]
+fn a_contact_sheet_shows_every_kept_pose_in_a_grid() {
+    use marionette::formats::scene::LibraryPoseDoc;
+    use marionette::rig::JointRotation;
+    let dir = scratch("shot-sheet");
+    let mut doc = puppet_lit_from(30.0);
+    doc.camera =
+        Some(CameraDoc { focus: glam::Vec3::new(0.0, 0.6, 0.0), pitch: 0.0, distance: 2.6, ..CameraDoc::default() });
+    for (name, angle) in [("a raised", -2.2), ("b level", -1.4), ("c lowered", 0.0)] {
+        let joints = [("r_shoulder".to_string(), JointRotation::euler_xyz(0.0, 0.0, angle))].into_iter().collect();
+        doc.poses.insert(name.into(), LibraryPoseDoc { joints, thumbnail: Vec::new() });
+    }
+    let scene = scene_file(&dir, "poses.ron", &doc);
+    let sheet = render(&scene, &["--poses"], &dir.join("sheet.png"));
+    assert_eq!(sheet.dimensions(), (128, 192), "three 64×96 cells in a 2×2 grid");
+    let cell = |k: u32| image::imageops::crop_imm(&sheet, (k % 2) * 64, (k / 2) * 96, 64, 96).to_image();
+    let differing =
+        |a: &image::RgbaImage, b: &image::RgbaImage| a.pixels().zip(b.pixels()).filter(|(p, q)| p != q).count();
+    for (a, b) in [(0, 1), (1, 2), (0, 2)] {
+        assert!(differing(&cell(a), &cell(b)) > 20, "cells {a} and {b} differ");
+    }
+    assert!(cell(3).pixels().all(|p| p.0[3] == 0), "the fourth cell is empty");
+    assert!(cell(0).pixels().any(|p| p.0[3] == 255), "a cell shows the puppet");
+}

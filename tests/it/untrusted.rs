@@ -9,7 +9,7 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 use std::time::Duration;
 
-use marionette::document::frames::PictureRequest;
+use marionette::document::frames::{PictureRequest, Pictures};
 use marionette::formats::limits::{MAX_EXCERPT_CHARS, MAX_FILE_BYTES, MAX_SAMPLED_FRAMES};
 use marionette::formats::{FormatError, bvh, gltf_import, load_character, load_clip, scene};
 
@@ -460,7 +460,7 @@ fn render_of_a_scene_whose_clip_fails_to_load_fails_and_writes_nothing() {
         Default::default(),
         out.clone(),
         PictureRequest { width: Some(64), height: Some(64), samples: None },
-        None,
+        Pictures::Still,
     )
     .unwrap_err();
     assert!(e.contains("bad.anim:1:") && e.contains("(character `p` of"), "{e}");

@@ -12,7 +12,7 @@ use bevy::render::render_resource::{TextureFormat, TextureUsages};
 use bevy::render::view::screenshot::{Screenshot, ScreenshotCaptured};
 
 use crate::document::AssetLibrary;
-use crate::document::frames::{FrameSequence, PictureRequest, frame_path};
+use crate::document::frames::{FrameSequence, PictureRequest, Pictures, frame_path};
 use crate::document::picture;
 use crate::document::scenes::{read_scene, scene_path};
 use crate::editor::interact::camera::OrbitCamera;
@@ -32,8 +32,10 @@ const GIVE_UP_SECONDS: u64 = 300;
 /// puts the clips (and a turntable's camera) at the next frame's time.
 #[derive(Resource)]
 struct RenderJob {
-    /// Each picture's time (none: the scene as it opens) and file.
-    frames: Vec<(Option<f32>, PathBuf)>,
+    /// What each picture shows and its file.
+    frames: Vec<(FrameAt, PathBuf)>,
+    /// The frame `next` shows what it should (its pose applied).
+    set_up: bool,
     /// Rendered pixels a side of each saved one.
     samples: u32,
     /// The frame being rendered.
@@ -53,32 +55,53 @@ struct RenderJob {
     outcome: Arc<Mutex<(Option<Result<(), String>>, Vec<String>)>>,
 }
 
+/// What one picture shows.
+#[derive(Debug, Clone, PartialEq)]
+enum FrameAt {
+    /// The scene as it opens.
+    AsOpened,
+    /// Every clip paused at this time (seconds).
+    Time(f32),
+    /// Every character in this pose of the scene's library.
+    Pose(String),
+}
+
 /// Renders `paths` (a scene `.ron`, character files, or the default scene when empty) into
-/// `out`, or with `sequence` one picture per frame into the files `out` numbers
-/// (`frame_%04d.png`), at the size and samples asked for (else the scene's shot). Returns
-/// the notes and the picture's size, or what went wrong.
+/// `out`: one picture, one per frame of a sequence, or a contact sheet of the scene's
+/// poses; at the size and samples asked for (else the scene's shot; a sheet's cells).
+/// Returns the notes and the picture's size, or what went wrong.
 pub fn render(
     paths: Vec<PathBuf>,
     mut edits: StartupEdits,
     out: PathBuf,
     picture: PictureRequest,
-    sequence: Option<FrameSequence>,
+    pictures: Pictures,
 ) -> Result<(Vec<String>, ShotDoc), String> {
-    let frames = match &sequence {
-        Some(sequence) => {
+    let (library, shot, poses) = preload(&paths, &edits)?;
+    let cells = std::env::temp_dir().join(format!("marionette-sheet-{}", std::process::id()));
+    let (frames, sequence): (Vec<(FrameAt, PathBuf)>, _) = match pictures {
+        Pictures::Sequence(sequence) => {
             let times = sequence.times()?;
             let paths = (0..times.len()).map(|n| frame_path(&out, n)).collect::<Result<Vec<_>, _>>()?;
             edits.time = times.first().copied();
-            times.into_iter().map(Some).zip(paths).collect()
+            (times.into_iter().map(FrameAt::Time).zip(paths).collect(), Some(sequence))
         }
-        None => vec![(None, out)],
+        Pictures::Still => (vec![(FrameAt::AsOpened, out.clone())], None),
+        Pictures::PoseSheet => {
+            if poses.is_empty() {
+                return Err("the scene keeps no poses to show (keep some with \"Keep pose\" in the editor)".into());
+            }
+            std::fs::create_dir_all(&cells).map_err(|e| format!("{}: {e}", cells.display()))?;
+            let at = |k: usize| cells.join(format!("pose_{k:04}.png"));
+            (poses.iter().enumerate().map(|(k, name)| (FrameAt::Pose(name.clone()), at(k))).collect(), None)
+        }
     };
-    let (library, shot) = preload(&paths, &edits)?;
     let picture = picture.resolved(&shot)?;
     let (width, height) = (picture.width, picture.height);
-    for (_, out) in &frames {
+    for out in frames.iter().map(|f| &f.1).chain([&out]) {
         crate::formats::error::refuse_overwriting_input(out).map_err(|e| e.to_string())?;
     }
+    let cell_files: Vec<PathBuf> = frames.iter().map(|f| f.1.clone()).collect();
     let mut app = App::new();
     app.add_plugins(crate::editor::windowless_plugins())
         .add_plugins(ScheduleRunnerPlugin::run_loop(Duration::from_millis(2)))
@@ -98,6 +121,7 @@ pub fn render(
     let outcome = Arc::new(Mutex::new((None, Vec::new())));
     app.insert_resource(RenderJob {
         frames,
+        set_up: false,
         samples: picture.samples,
         next: 0,
         sequence,
@@ -115,13 +139,22 @@ pub fn render(
     });
     app.add_systems(
         Last,
-        (next_frame, capture_when_ready).chain().after(crate::editor::present::readiness::UpdateCaptureGate),
+        (next_frame, pose_frame, capture_when_ready)
+            .chain()
+            .after(crate::editor::present::readiness::UpdateCaptureGate),
     )
     .add_systems(PostUpdate, clear_behind_gradient.after(stage::apply_stage_settings));
     let exit = app.run();
     // `App::run` hands the world to the runner: the outcome comes back through `outcome`.
     let (done, messages) = outcome.lock().map(|o| o.clone()).unwrap_or_default();
 
+    let done = match (pictures, done) {
+        (Pictures::PoseSheet, Some(Ok(()))) => Some(contact_sheet(&cell_files, &out)),
+        (_, done) => done,
+    };
+    if pictures == Pictures::PoseSheet {
+        let _ = std::fs::remove_dir_all(&cells);
+    }
     match (exit, done) {
         (AppExit::Success, Some(Ok(()))) => Ok((messages, picture)),
         (_, Some(Err(e))) => Err(e),
@@ -132,14 +165,15 @@ pub fn render(
 /// Loads everything the render will show before any window or GPU work, so that a missing
 /// file, an unparsable scene, a character or a clip that fails to load is an error (and no
 /// picture is written). Returns the loaded assets for the app to reuse.
-fn preload(paths: &[PathBuf], edits: &StartupEdits) -> Result<(AssetLibrary, ShotDoc), String> {
+fn preload(paths: &[PathBuf], edits: &StartupEdits) -> Result<(AssetLibrary, ShotDoc, Vec<String>), String> {
     let mut library = AssetLibrary::default();
     let mut shot = ShotDoc::default();
+    let mut poses = Vec::new();
     // Each source and the clip file it plays, with what names it in a scene file (for the message).
     let mut sources: Vec<(SourceDoc, Option<BindingDoc>, Option<PathBuf>, String)> = match scene_path(paths) {
         Some(scene) => read_scene(scene)
             .map_err(|e| e.to_string())
-            .inspect(|doc| shot = doc.shot)?
+            .inspect(|doc| (shot, poses) = (doc.shot, doc.poses.keys().cloned().collect()))?
             .characters
             .into_iter()
             .map(|c| {
@@ -160,7 +194,7 @@ fn preload(paths: &[PathBuf], edits: &StartupEdits) -> Result<(AssetLibrary, Sho
             loaded.and(clip).err().map(|e| format!("{e}{named_in}"))
         })
         .collect();
-    if errors.is_empty() { Ok((library, shot)) } else { Err(errors.join("\n")) }
+    if errors.is_empty() { Ok((library, shot, poses)) } else { Err(errors.join("\n")) }
 }
 
 /// Once the gate opens, captures the target once, saves it and exits; gives up after
@@ -189,7 +223,7 @@ fn capture_when_ready(
         job.done = Some(Err(format!("the render was not ready within {GIVE_UP_SECONDS} s; still pending: {pending}")));
         return;
     }
-    if job.requested || job.saved.is_some() || !gate.is_ready() {
+    if job.requested || job.saved.is_some() || !job.set_up || !gate.is_ready() {
         return;
     }
     job.requested = true;
@@ -198,6 +232,7 @@ fn capture_when_ready(
     commands.spawn(Screenshot::image(job.target.clone())).observe(
         move |captured: On<ScreenshotCaptured>, mut job: ResMut<RenderJob>| {
             job.saved = Some(save_picture(&captured.image, samples, &background, &out));
+            eprintln!("progress: {}/{}", job.next + 1, job.frames.len());
         },
     );
 }
@@ -240,7 +275,8 @@ fn next_frame(
     let first_yaw = *job.first_yaw.get_or_insert_with(|| cameras.iter().next().map_or(0.0, |c| c.0.yaw));
     job.next += 1;
     job.requested = false;
-    let Some(t) = job.frames[job.next].0 else { return };
+    job.set_up = false;
+    let FrameAt::Time(t) = job.frames[job.next].0 else { return };
     for mut player in &mut keyframes {
         (player.state.time, player.state.playing) = (t, false);
     }
@@ -254,4 +290,53 @@ fn next_frame(
         cameras.iter_mut().for_each(|mut c| c.0.yaw = first_yaw + sequence.turn_at(t));
     }
     gate.restart();
+}
+
+/// Sets up the frame to render: a pose frame puts the pose on every character that has its
+/// joints (as ordinary pose edits, applied next `Animate`), and the gate counts afresh;
+/// other frames are set up already (writes `EditQueue`, `CaptureGate`).
+fn pose_frame(
+    mut job: ResMut<RenderJob>,
+    mut gate: ResMut<CaptureGate>,
+    library: Res<crate::editor::edits::pose_library::PoseLibrary>,
+    characters: Query<(&crate::editor::scene_doc::document::SceneCharacter, &crate::scene::Character)>,
+    mut edits: ResMut<crate::editor::edits::edit::EditQueue>,
+) {
+    if job.set_up || job.done.is_some() {
+        return;
+    }
+    job.set_up = true;
+    let FrameAt::Pose(name) = &job.frames[job.next].0 else { return };
+    let Some(pose) = library.0.get(name) else { return };
+    let joints: Vec<_> = pose.joints.iter().map(|(k, r)| (k.clone(), *r)).collect();
+    for (sc, character) in &characters {
+        let skeleton = &character.asset.skeleton;
+        if let Some(edit) = crate::editor::edits::pose_library::apply_named_pose(sc.id, skeleton, &joints, false) {
+            edits.push(edit);
+        }
+    }
+    gate.restart();
+}
+
+/// The cells (all of one size) in a grid as near square as they fill, row by row, into
+/// `out`.
+fn contact_sheet(cells: &[PathBuf], out: &std::path::Path) -> Result<(), String> {
+    let images = cells
+        .iter()
+        .map(|c| image::open(c).map_err(|e| format!("{}: {e}", c.display())))
+        .collect::<Result<Vec<_>, _>>()?;
+    let (w, h) = images.first().map_or((1, 1), |i| (i.width(), i.height()));
+    let columns = (images.len() as f64).sqrt().ceil().max(1.0) as u32;
+    let rows = (images.len() as u32).div_ceil(columns);
+    let mut sheet = image::RgbaImage::new(w * columns, h * rows);
+    for (k, cell) in images.iter().enumerate() {
+        let (x, y) = ((k as u32 % columns) * w, (k as u32 / columns) * h);
+        image::imageops::overlay(&mut sheet, &cell.to_rgba8(), i64::from(x), i64::from(y));
+    }
+    let mut bytes = Vec::new();
+    image::DynamicImage::ImageRgba8(sheet)
+        .write_to(&mut std::io::Cursor::new(&mut bytes), image::ImageFormat::Png)
+        .map_err(|e| e.to_string())?;
+    crate::formats::write_atomically(out, |w| std::io::Write::write_all(w, &bytes))
+        .map_err(|e| format!("{}: {e}", out.display()))
 }
