@@ -3,6 +3,7 @@
 //! frame may be captured, screenshots and the headless render.
 
 pub mod draw;
+pub mod frames_job;
 pub mod readiness;
 pub mod render;
 pub mod screenshot;

@@ -91,6 +91,8 @@ pub struct Panels<'w, 's> {
     pub pending: ResMut<'w, PendingScene>,
     /// A camera the panels ask for.
     pub camera_request: ResMut<'w, crate::editor::interact::camera::CameraRequest>,
+    /// "Render frames…" (none in an app without the inspector).
+    pub frames: Option<ResMut<'w, crate::editor::present::frames_job::FramesJob>>,
     /// The recent files (none in an app without the inspector: nothing is remembered).
     pub recent: Option<ResMut<'w, crate::editor::ui::recent::RecentFiles>>,
 }
@@ -136,6 +138,8 @@ impl Plugin for InspectorPlugin {
         app.init_resource::<InspectorState>()
             .init_resource::<crate::editor::ui::recent::RecentFiles>()
             .init_resource::<ViewportArea>()
+            .init_resource::<crate::editor::present::frames_job::FramesJob>()
+            .add_systems(Update, crate::editor::present::frames_job::finish_frames_job)
             .add_systems(Startup, save_to_the_opened_scene)
             .add_systems(PostUpdate, fit_camera_viewport)
             .add_systems(EguiPrimaryContextPass, inspector_ui)

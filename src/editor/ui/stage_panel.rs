@@ -24,9 +24,52 @@ pub fn stage_panel(ui: &mut egui::Ui, state: &mut InspectorState, panels: &mut P
         egui::CollapsingHeader::new("Camera and lens").show(ui, |ui| camera_rows(ui, state, panels, camera));
     }
     let mut shot = panels.scene.shot.0;
-    egui::CollapsingHeader::new("Shot").show(ui, |ui| shot_rows(ui, state, &mut shot));
+    egui::CollapsingHeader::new("Shot").show(ui, |ui| {
+        shot_rows(ui, state, &mut shot);
+        frames_rows(ui, panels);
+    });
     if shot != panels.scene.shot.0 {
         panels.push(Edit::Shot(shot));
+    }
+}
+
+/// "Render frames…": the span, rate, turntable and files; then a progress bar and Cancel.
+fn frames_rows(ui: &mut egui::Ui, panels: &mut Panels) {
+    let Some(job) = panels.frames.as_deref_mut() else { return };
+    ui.label("Render frames of the scene's clips");
+    if job.running() {
+        let (done, all) = job.progress();
+        ui.horizontal(|ui| {
+            let share = if all > 0 { done as f32 / all as f32 } else { 0.0 };
+            ui.add(egui::ProgressBar::new(share).text(format!("{done} of {all}")).desired_width(150.0));
+            if ui.button("Cancel").clicked() {
+                job.cancel();
+            }
+        });
+        ui.ctx().request_repaint();
+        return;
+    }
+    let r = &mut job.request;
+    ui.horizontal(|ui| {
+        ui.add(egui::DragValue::new(&mut r.from).speed(0.05).prefix("from ").suffix(" s"));
+        ui.add(egui::DragValue::new(&mut r.to).speed(0.05).prefix("to ").suffix(" s"));
+        ui.add(egui::DragValue::new(&mut r.fps).range(1.0..=240.0).suffix(" fps"));
+    });
+    ui.horizontal(|ui| {
+        let mut turn = r.turntable.is_some();
+        ui.checkbox(&mut turn, "turntable");
+        let mut seconds = r.turntable.unwrap_or(4.0);
+        if turn {
+            ui.add(egui::DragValue::new(&mut seconds).range(0.1..=600.0).suffix(" s a turn"));
+        }
+        r.turntable = turn.then_some(seconds);
+    });
+    ui.add(egui::TextEdit::singleline(&mut r.pattern).desired_width(230.0))
+        .on_hover_text("one %04d for the frame number");
+    if ui.button("Render frames…").clicked()
+        && let Err(e) = job.start(&panels.scene.capture())
+    {
+        panels.messages.push(e);
     }
 }
 
