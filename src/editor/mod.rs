@@ -139,6 +139,7 @@ pub fn run(paths: Vec<PathBuf>, edits: StartupEdits) {
         // solves, runs the matrix stack and skins: an edit is skinned the frame it is made.
         .configure_sets(PostUpdate, MarionetteSystems::Animate.after(bevy_egui::EguiPostUpdateSet::EndPass))
         .add_systems(Startup, spawn_window_camera)
+        .add_systems(PostUpdate, present::stage::show_gradient_backdrop.in_set(order::EditorSystems::Present))
         .run();
 }
 

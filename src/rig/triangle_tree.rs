@@ -95,6 +95,20 @@ impl TriangleTree {
     }
 }
 
+/// The nearest `t ≥ 0` at which the line `origin + t·direction` crosses one of the mesh's
+/// triangles (every one tried: for a mesh that moves, where a tree would be rebuilt each
+/// time); triangles with an index out of range are skipped.
+pub fn first_hit(positions: &[Vec3], triangles: &[[u32; 3]], origin: Vec3, direction: Vec3) -> Option<f32> {
+    triangles
+        .iter()
+        .filter_map(|t| {
+            let corner = |k: usize| positions.get(t[k] as usize).copied();
+            let tri = [corner(0)?, corner(1)?, corner(2)?];
+            triangle_hit(origin, direction, &tri).filter(|&t| t >= 0.0)
+        })
+        .min_by(f32::total_cmp)
+}
+
 fn bounds(tris: &[[Vec3; 3]]) -> (Vec3, Vec3) {
     tris.iter().flatten().fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(l, h), p| (l.min(*p), h.max(*p)))
 }

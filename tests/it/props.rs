@@ -181,3 +181,17 @@ fn a_held_prop_round_trips_through_a_scene_file() {
     crate::common::assert_mat_close(placement(&again, 2).to_mat4(), placement(&app, 2).to_mat4(), 1e-6);
     assert!(again.world().get::<Attached>(entity(&again, 2)).is_some(), "still held");
 }
+
+#[test]
+fn a_ray_finds_the_nearest_triangle_of_a_moving_mesh() {
+    use marionette::rig::triangle_tree::first_hit;
+    // Two squares facing the ray, at z = -1 and z = -3; the ray from the origin along -z.
+    let square =
+        |z: f32| [Vec3::new(-1.0, -1.0, z), Vec3::new(1.0, -1.0, z), Vec3::new(1.0, 1.0, z), Vec3::new(-1.0, 1.0, z)];
+    let positions: Vec<Vec3> = square(-3.0).into_iter().chain(square(-1.0)).collect();
+    let triangles = [[0, 1, 2], [0, 2, 3], [4, 5, 6], [4, 6, 7], [4, 5, 99]];
+    let t = first_hit(&positions, &triangles, Vec3::ZERO, Vec3::new(0.1, 0.2, -2.0)).unwrap();
+    assert!((t - 0.5).abs() < 1e-6, "the nearer square, half way along the direction: {t}");
+    assert_eq!(first_hit(&positions, &triangles, Vec3::ZERO, Vec3::Z), None, "behind the ray");
+    assert_eq!(first_hit(&positions, &triangles, Vec3::new(5.0, 0.0, 0.0), -Vec3::Z), None, "beside the squares");
+}

@@ -27,6 +27,7 @@ pub struct JointPicker<'w, 's> {
     cameras: Query<'w, 's, (&'static Camera, &'static GlobalTransform), With<OrbitCamera>>,
     pub characters: PickableCharacters<'w, 's>,
     pub joints: Query<'w, 's, &'static CurrentJointToWorld>,
+    skins: Query<'w, 's, &'static crate::scene::SkinScratch>,
 }
 
 impl JointPicker<'_, '_> {
@@ -38,6 +39,31 @@ impl JointPicker<'_, '_> {
     /// The orbit camera.
     pub fn camera(&self) -> Option<(&Camera, &GlobalTransform)> {
         self.cameras.single().ok()
+    }
+
+    /// The visible character (or prop) whose skin is nearest the camera under `cursor`.
+    pub fn character_at(&self, cursor: Vec2) -> Option<CharacterId> {
+        let (camera, camera_transform) = self.camera()?;
+        let ray = camera.viewport_to_world(camera_transform, cursor).ok()?;
+        self.characters
+            .iter()
+            .filter(|c| c.4.get())
+            .filter_map(|(entity, sc, character, placement, _)| {
+                // The ray in model space keeps its parameter: t there is t in the world.
+                let to_model = placement.to_mat4().inverse();
+                let (origin, direction) =
+                    (to_model.transform_point3(ray.origin), to_model.transform_vector3(*ray.direction));
+                let skin = self.skins.get(entity).ok()?;
+                let t = crate::rig::triangle_tree::first_hit(
+                    &skin.positions,
+                    &character.asset.skin.triangles,
+                    origin,
+                    direction,
+                )?;
+                Some((t, sc.id))
+            })
+            .min_by(|a, b| a.0.total_cmp(&b.0))
+            .map(|(_, id)| id)
     }
 
     /// The visible joint nearest to `cursor` on screen, within `radius` pixels.
@@ -77,8 +103,9 @@ pub const PICK_RADIUS_PX: f32 = 40.0;
 pub const CLICK_SLOP_PX: f32 = 4.0;
 
 /// On a left click (press and release within a few pixels) in the viewport, selects the
-/// visible joint nearest to the cursor on screen; Shift or Ctrl adds to the selection
-/// (reads input, joint matrices; writes `Selection`).
+/// visible joint nearest to the cursor on screen, else the character whose skin is under
+/// it (none: nothing selected); Shift or Ctrl adds joints to the selection (reads input,
+/// joint matrices, skins; writes `Selection`).
 pub fn pick_joint_on_click(
     buttons: Res<ButtonInput<MouseButton>>,
     keys: Res<ButtonInput<KeyCode>>,
@@ -111,7 +138,8 @@ pub fn pick_joint_on_click(
         keys.any_pressed([KeyCode::ShiftLeft, KeyCode::ShiftRight, KeyCode::ControlLeft, KeyCode::ControlRight]);
     match best {
         Some(hit) => select_joint(&mut selection, hit.id, hit.joint, additive),
-        None if !additive => selection.joints.clear(),
+        // A click on a character's (or prop's) skin selects it, without joints: its move gizmo.
+        None if !additive => *selection = Selection { character: picker.character_at(cursor), joints: Vec::new() },
         None => {}
     }
 }

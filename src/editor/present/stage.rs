@@ -213,3 +213,69 @@ pub fn draw_grid_and_axes(settings: Res<StageSettings>, extent: Res<StageExtent>
         gizmos.axes(Transform::from_xyz(0.0, settings.floor_height + 0.002, 0.0), 0.5 * extent.step / 0.5);
     }
 }
+
+/// The viewport's gradient background: a quad of the gradient's colours far behind
+/// everything, carried by the camera (the render instead puts the exact gradient behind its
+/// picture once captured).
+#[derive(Component)]
+pub struct Backdrop;
+
+/// How far behind the camera's focus the backdrop stands (within every lens's far plane).
+const BACKDROP_DEPTH: f32 = 800.0;
+
+/// Keeps a backdrop on the orbit camera showing the stage's gradient, sized to its lens;
+/// hidden for any other background (reads `StageSettings`, the camera; writes the
+/// backdrop).
+pub fn show_gradient_backdrop(
+    mut commands: Commands,
+    settings: Res<StageSettings>,
+    cameras: Query<(Entity, Ref<crate::editor::interact::camera::OrbitCamera>)>,
+    mut backdrops: Query<(Entity, &mut Transform, &mut Visibility, &Mesh3d), With<Backdrop>>,
+    mut meshes: ResMut<Assets<Mesh>>,
+    mut materials: ResMut<Assets<StandardMaterial>>,
+) {
+    let Some((camera, orbit)) = cameras.iter().next() else { return };
+    let crate::formats::scene::BackgroundDoc::Gradient { top, bottom } = settings.background else {
+        backdrops.iter_mut().for_each(|(.., mut v, _)| *v = Visibility::Hidden);
+        return;
+    };
+    if !settings.is_changed() && !orbit.is_changed() && !backdrops.is_empty() {
+        return;
+    }
+    let height = match orbit.ortho {
+        Some(h) => h,
+        None => 2.0 * (orbit.distance + BACKDROP_DEPTH) * (orbit.fov.to_radians() / 2.0).tan(),
+    };
+    let at = Transform::from_xyz(0.0, 0.0, -(orbit.distance + BACKDROP_DEPTH)).with_scale(Vec3::new(
+        height * 8.0,
+        height * 1.02,
+        1.0,
+    ));
+    let colors = |c: [f32; 3]| {
+        let linear = Color::srgb(c[0], c[1], c[2]).to_linear();
+        [linear.red, linear.green, linear.blue, 1.0]
+    };
+    // Rectangle vertices: top right, top left, bottom left, bottom right.
+    let vertex_colors = vec![colors(top), colors(top), colors(bottom), colors(bottom)];
+    if let Some((_, mut transform, mut visibility, mesh)) = backdrops.iter_mut().next() {
+        *transform = at;
+        *visibility = Visibility::Inherited;
+        if let Some(mut m) = meshes.get_mut(&mesh.0) {
+            m.insert_attribute(Mesh::ATTRIBUTE_COLOR, vertex_colors);
+        }
+        return;
+    }
+    let mesh = Mesh::from(Rectangle::new(1.0, 1.0)).with_inserted_attribute(Mesh::ATTRIBUTE_COLOR, vertex_colors);
+    let material = StandardMaterial { unlit: true, ..default() };
+    let backdrop = commands
+        .spawn((
+            Backdrop,
+            Mesh3d(meshes.add(mesh)),
+            MeshMaterial3d(materials.add(material)),
+            at,
+            bevy::light::NotShadowCaster,
+            bevy::light::NotShadowReceiver,
+        ))
+        .id();
+    commands.entity(camera).add_child(backdrop);
+}
