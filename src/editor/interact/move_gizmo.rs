@@ -217,6 +217,14 @@ fn add_to_pointer_owner(gizmo: Res<MoveGizmo>, mut owner: ResMut<crate::editor::
     }
 }
 
+/// What a move needs of the characters besides the picker's: their skins' boxes, and
+/// which are held by a joint (those follow it and have no gizmo).
+#[derive(bevy::ecs::system::SystemParam)]
+pub struct MoveTargets<'w, 's> {
+    skins: Query<'w, 's, &'static crate::scene::SkinScratch>,
+    held: Query<'w, 's, (), With<crate::editor::scene_doc::document::Attached>>,
+}
+
 /// The selected character's gizmo as the camera sees it.
 struct MoveView {
     character: CharacterId,
@@ -228,18 +236,15 @@ struct MoveView {
 }
 
 impl MoveView {
-    /// The selected character's, when it is selected without a joint and in front of the camera.
-    fn of_selection(
-        selection: &Selection,
-        picker: &JointPicker,
-        skins: &Query<&crate::scene::SkinScratch>,
-    ) -> Option<Self> {
+    /// The selected character's, when it is selected without a joint, not held by another's
+    /// joint, and in front of the camera.
+    fn of_selection(selection: &Selection, picker: &JointPicker, skins: &MoveTargets) -> Option<Self> {
         let id = selection.character?;
         if !selection.joints.is_empty() {
             return None;
         }
         let (entity, sc, _, placement, visible) = picker.characters.iter().find(|c| c.1.id == id)?;
-        if !visible.get() {
+        if !visible.get() || skins.held.contains(entity) {
             return None;
         }
         let (camera, camera_transform) = picker.camera()?;
@@ -247,7 +252,7 @@ impl MoveView {
         let center_px = camera.world_to_viewport(camera_transform, center).ok()?;
         let step = camera_transform.right().as_vec3() * 0.1;
         let step_px = camera.world_to_viewport(camera_transform, center + step).ok()?.distance(center_px);
-        let lowest = skins.get(entity).map_or(0.0, |s| s.bounds.0.y);
+        let lowest = skins.skins.get(entity).map_or(0.0, |s| s.bounds.0.y);
         Some(Self {
             character: id,
             name: sc.name.clone(),
@@ -320,7 +325,7 @@ fn grab_move_gizmo(
     pointer: Res<ViewportHasPointer>,
     selection: Res<Selection>,
     picker: JointPicker,
-    skins: Query<&crate::scene::SkinScratch>,
+    skins: MoveTargets,
     ik: Res<JointDrag>,
     mut gizmo: ResMut<MoveGizmo>,
 ) {
@@ -345,7 +350,7 @@ fn follow_move(
     keys: Res<ButtonInput<KeyCode>>,
     selection: Res<Selection>,
     picker: JointPicker,
-    skins: Query<&crate::scene::SkinScratch>,
+    skins: MoveTargets,
     stage: Res<crate::editor::present::stage::StageSettings>,
     mut edits: ResMut<EditQueue>,
     mut gizmo: ResMut<MoveGizmo>,
@@ -393,7 +398,7 @@ fn type_move(
     wants: Option<Res<bevy_egui::input::EguiWantsInput>>,
     selection: Res<Selection>,
     picker: JointPicker,
-    skins: Query<&crate::scene::SkinScratch>,
+    skins: MoveTargets,
     mut edits: ResMut<EditQueue>,
     mut gizmo: ResMut<MoveGizmo>,
     mut hold: ResMut<GestureHold>,
@@ -474,7 +479,7 @@ fn finish(gizmo: &mut MoveGizmo, hold: &mut GestureHold) {
 fn draw_move_gizmo(
     selection: Res<Selection>,
     picker: JointPicker,
-    skins: Query<&crate::scene::SkinScratch>,
+    skins: MoveTargets,
     gizmo: Res<MoveGizmo>,
     mut gizmos: Gizmos<SkeletonGizmos>,
 ) {

@@ -80,7 +80,7 @@ fn history_row(ui: &mut egui::Ui, panels: &mut Panels) {
 }
 
 fn add_row(ui: &mut egui::Ui, state: &mut InspectorState, panels: &mut Panels) {
-    ui.label("Add a character or prop (.skel, .skin, .glb, .gltf, .fbx, SMPL folder, rig .json, .bvh), a clip for the selected one (.anim) or open a scene (.ron); or drop files on the window:");
+    ui.label("Add a character or prop (.skel, .skin, .glb, .gltf, .fbx, SMPL folder, rig .json, .bvh; an .obj alone is a prop), a clip for the selected one (.anim) or open a scene (.ron); or drop files on the window:");
     ui.horizontal(|ui| {
         ui.add(egui::TextEdit::singleline(&mut state.add_path).desired_width(220.0));
         if ui.button("Add").clicked() {
