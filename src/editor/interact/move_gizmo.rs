@@ -14,6 +14,7 @@ use bevy::prelude::*;
 
 use crate::editor::edits::edit::{Edit, EditQueue, GestureHold};
 use crate::editor::interact::picking::JointPicker;
+use crate::editor::interact::rotate_gizmo::{distance_to_segment, typed_char};
 use crate::editor::interact::pointer::ViewportHasPointer;
 use crate::editor::present::draw::SkeletonGizmos;
 use crate::editor::state::{JointDrag, Selection};
@@ -303,12 +304,6 @@ impl MoveView {
     }
 }
 
-fn distance_to_segment(p: Vec2, a: Vec2, b: Vec2) -> f32 {
-    let ab = b - a;
-    let t = ((p - a).dot(ab) / ab.length_squared().max(1e-12)).clamp(0.0, 1.0);
-    p.distance(a + ab * t)
-}
-
 /// The snapping the modifier keys ask for.
 fn snap_of(keys: &ButtonInput<KeyCode>, floor: f32, lowest: f32) -> Snap {
     Snap {
@@ -445,7 +440,7 @@ fn type_move(
             }
         }
         for key in keys.get_just_pressed() {
-            match crate::editor::interact::rotate_gizmo::typed_char(*key) {
+            match typed_char(*key) {
                 Some(c) => text.push(c),
                 None if *key == KeyCode::Backspace => {
                     text.pop();

@@ -279,7 +279,8 @@ fn character_scale(character: &Character, scale: f32) -> f32 {
     crate::editor::present::draw::character_size(character) * scale
 }
 
-fn distance_to_segment(p: Vec2, a: Vec2, b: Vec2) -> f32 {
+/// The distance (pixels) from `p` to the segment `a`–`b` on screen.
+pub fn distance_to_segment(p: Vec2, a: Vec2, b: Vec2) -> f32 {
     let ab = b - a;
     let t = ((p - a).dot(ab) / ab.length_squared().max(1e-12)).clamp(0.0, 1.0);
     p.distance(a + ab * t)
