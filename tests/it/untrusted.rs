@@ -158,6 +158,15 @@ const SCENE_CASES: &[(&str, &str)] = &[
     ("scene-morphs-nan.ron", "characters[0].morphs: expected a finite number, found NaN"),
     ("scene-playback-blend-nan.ron", "characters[0].playback.blend: expected a blend weight in 0..=1, found NaN"),
     ("scene-pose-library-nan.ron", "poses[\"wave\"].joints[\"l_elbow\"]: expected a finite number, found NaN"),
+    ("scene-tilt-zero-quaternion.ron", "characters[0].placement.tilt: expected a rotation, found a zero quaternion"),
+    ("scene-attached-singular-offset.ron", "characters[1].attached.offset: expected an invertible matrix"),
+    ("scene-four-lamps.ron", "stage.lamps: expected at most 3 lamps, found 4"),
+    ("scene-sun-elevation-100.ron", "stage.sun.elevation: expected -90 to 90 degrees, found 100"),
+    ("scene-camera-fov-0.ron", "camera.fov: expected a field of view of 1 to 170 degrees, found 0"),
+    ("scene-shot-samples-9.ron", "shot.samples: expected 1 to 4, found 9"),
+    ("scene-shot-too-wide.ron", "shot.width: expected 1 to 4096 pixels at 2 samples, found 8000"),
+    ("scene-bookmark-ortho-negative.ron", "bookmarks[\"side\"].ortho: expected a positive finite number, found -2"),
+    ("scene-background-colour-2.ron", "stage.background: expected colour parts in 0..=1, found 2"),
 ];
 
 #[test]
