@@ -38,27 +38,6 @@ impl SkinUpload {
         self.floats = pack_vertices(positions, texcoords, colors, self.buffer());
     }
 
-    /// New positions for the same texture coordinates and colours: written in place into
-    /// the packed vertices when the render world no longer holds them (only 12 of each
-    /// vertex's bytes rewritten), packed afresh otherwise. Returns the positions' box,
-    /// found on the way.
-    pub fn repack_positions(&mut self, positions: &[Vec3], texcoords: &[Vec2], colors: &[[f32; 4]]) -> (Vec3, Vec3) {
-        let floats = self.floats;
-        if floats >= 3
-            && self.vertices.len() == positions.len() * floats
-            && let Some(packed) = Arc::get_mut(&mut self.vertices)
-        {
-            let (mut lo, mut hi) = (Vec3::INFINITY, Vec3::NEG_INFINITY);
-            for (vertex, p) in packed.chunks_exact_mut(floats).zip(positions) {
-                vertex[..3].copy_from_slice(&p.to_array());
-                (lo, hi) = (lo.min(*p), hi.max(*p));
-            }
-            return (lo, hi);
-        }
-        self.pack(positions, texcoords, colors);
-        crate::rig::skinning::bounds(positions)
-    }
-
     /// The vertices as the bytes the GPU takes.
     pub fn bytes(&self) -> &[u8] {
         bytemuck::cast_slice(&self.vertices)

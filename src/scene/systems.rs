@@ -167,29 +167,16 @@ pub fn skin_changed_characters(
             if job.0.is_some() {
                 job.0 = None;
             }
-            match (moved, recolored) {
-                (true, false) => {
-                    skin_positions(skin, method.0, scratch);
-                    scratch.bounds = upload.repack_positions(&scratch.positions, &skin.texcoords, &scratch.colors);
-                }
-                (true, true) => {
-                    skin_on_cpu(skin, method.0, scratch);
-                    upload.pack(&scratch.positions, &skin.texcoords, &scratch.colors);
-                }
-                (false, _) => upload.pack(&scratch.positions, &skin.texcoords, &scratch.colors),
+            if moved {
+                skin_on_cpu(skin, method.0, scratch);
             }
+            upload.pack(&scratch.positions, &skin.texcoords, &scratch.colors);
         },
     );
 }
 
 /// The LBS or DQ kernel of the skin into `scratch.positions`, and their bounds.
 fn skin_on_cpu(skin: &crate::rig::Skin, method: dqs::SkinningMethod, scratch: &mut SkinScratch) {
-    skin_positions(skin, method, scratch);
-    scratch.bounds = bounds(&scratch.positions);
-}
-
-/// The LBS or DQ kernel of the skin into `scratch.positions` (bounds left as they were).
-fn skin_positions(skin: &crate::rig::Skin, method: dqs::SkinningMethod, scratch: &mut SkinScratch) {
     scratch.positions.resize(skin.bind_positions.len(), Vec3::ZERO);
     if method.is_linear() {
         skin_in_chunks(skin, &scratch.palette, &mut scratch.positions);
@@ -197,6 +184,7 @@ fn skin_positions(skin: &crate::rig::Skin, method: dqs::SkinningMethod, scratch:
         dqs::dual_quaternion_palette(&scratch.palette, &mut scratch.dual_quaternions);
         dqs::skin_dq(&skin.bind_positions, &skin.weights, &scratch.dual_quaternions, &mut scratch.positions);
     }
+    scratch.bounds = bounds(&scratch.positions);
 }
 
 /// Vertices per task when one mesh is skinned on several threads.

@@ -93,31 +93,3 @@ fn the_kernel_matches_the_oracle_on_every_data_set() {
         assert_kernel_matches_oracle(&name, &asset.skin.bind_positions, &asset.skin.weights, &posed_palette(&asset));
     }
 }
-
-/// Repacking new positions writes them in place where the render world let the buffer go,
-/// packs afresh where it still holds it; either way the bytes are what a fresh pack gives,
-/// colours and texture coordinates kept, and the box is the positions'.
-#[test]
-fn repacked_positions_equal_a_fresh_pack_in_place_or_not() {
-    use marionette::scene::upload::{SkinUpload, pack_vertices};
-    let n = 50;
-    let at = |k: f32| (0..n).map(|i| glam::Vec3::new(i as f32 * k, -(i as f32), k)).collect::<Vec<_>>();
-    let texcoords: Vec<glam::Vec2> = (0..n).map(|i| glam::Vec2::new(i as f32, 0.5)).collect();
-    let colors: Vec<[f32; 4]> = (0..n).map(|i| [i as f32 / 50.0, 0.2, 0.3, 1.0]).collect();
-    for uv in [&texcoords[..], &[][..]] {
-        let mut upload = SkinUpload::default();
-        upload.pack(&at(1.0), uv, &colors);
-        let held = upload.vertices.clone();
-        let (lo, hi) = upload.repack_positions(&at(2.0), uv, &colors);
-        let mut fresh = Vec::new();
-        pack_vertices(&at(2.0), uv, &colors, &mut fresh);
-        assert_eq!(*upload.vertices, fresh, "packed afresh while the old buffer is held");
-        assert_eq!((lo, hi), (glam::Vec3::new(0.0, -49.0, 2.0), glam::Vec3::new(98.0, 0.0, 2.0)));
-        drop(held);
-        let before = upload.vertices.as_ptr();
-        upload.repack_positions(&at(3.0), uv, &colors);
-        pack_vertices(&at(3.0), uv, &colors, &mut fresh);
-        assert_eq!(*upload.vertices, fresh, "written in place");
-        assert_eq!(upload.vertices.as_ptr(), before, "the same buffer");
-    }
-}
