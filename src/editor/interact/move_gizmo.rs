@@ -14,8 +14,8 @@ use bevy::prelude::*;
 
 use crate::editor::edits::edit::{Edit, EditQueue, GestureHold};
 use crate::editor::interact::picking::JointPicker;
-use crate::editor::interact::rotate_gizmo::{distance_to_segment, typed_char};
 use crate::editor::interact::pointer::ViewportHasPointer;
+use crate::editor::interact::rotate_gizmo::{distance_to_segment, typed_char};
 use crate::editor::present::draw::SkeletonGizmos;
 use crate::editor::state::{JointDrag, Selection};
 use crate::formats::scene::{CharacterId, PlacementDoc};
