@@ -101,7 +101,9 @@ fn names_a_place(e: &FormatError) -> bool {
     match e {
         FormatError::Syntax { line, .. } => *line >= 1,
         FormatError::Other { message, .. } => {
-            ["at $", "at byte ", "characters[", "camera.", "stage.", "poses["].iter().any(|p| message.starts_with(p))
+            ["at $", "at byte ", "characters[", "camera.", "stage.", "poses[", "shot.", "bookmarks["]
+                .iter()
+                .any(|p| message.starts_with(p))
         }
         FormatError::Rig { .. } | FormatError::Io { .. } => false,
     }
