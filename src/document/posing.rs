@@ -189,6 +189,7 @@ pub fn describe(asset: &CharacterAsset) -> String {
         crate::rig::character::SkinKind::Rigid => "meshes carried by their nodes (a prop: nothing skinned)",
     };
     out += &format!("skin: {kind}\n");
+    out += &describe_humanoid(s);
     out += &format!("vertices: {}\n", asset.vertex_count());
     out += &format!("triangles: {}\n", asset.triangle_count());
     if !asset.morphs.is_empty() {
@@ -206,6 +207,21 @@ pub fn describe(asset: &CharacterAsset) -> String {
         }
     }
     out
+}
+
+/// The humanoid map, a line of `bone joint` pairs (or why there is none).
+pub fn describe_humanoid(skeleton: &Skeleton) -> String {
+    if skeleton.len() < 5 {
+        return String::new();
+    }
+    match crate::rig::humanoid::detect(skeleton) {
+        Some(map) => {
+            let pairs: Vec<String> =
+                map.iter().map(|(bone, &j)| format!("{bone:?} {}", skeleton.joint(j).name)).collect();
+            format!("humanoid: {}\n", pairs.join(", "))
+        }
+        None => "humanoid: not found (no two legs and two arms)\n".to_string(),
+    }
 }
 
 /// A parsed `JOINT=x,y,z`: move the joint to a world-space target by IK.

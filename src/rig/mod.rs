@@ -8,6 +8,7 @@ pub mod character;
 pub mod dqs;
 pub mod fk;
 pub mod heat;
+pub mod humanoid;
 pub mod ik;
 pub mod influences;
 pub mod keyframe_splines;

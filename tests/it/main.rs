@@ -19,6 +19,7 @@ mod gltf_fuzz;
 mod gltf_spec;
 mod gpu;
 mod heat;
+mod humanoid;
 mod ik;
 mod kernel;
 mod khronos;

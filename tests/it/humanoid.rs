@@ -1,0 +1,125 @@
+//! The humanoid map found from structure: the SMPL body, the puppet, the four 6.837 models
+//! (numbered joints, hips hung from the chest), CesiumMan and RiggedFigure each get every
+//! limb bone, the hips and the chest, with left on the character's left.
+
+use marionette::rig::Skeleton;
+use marionette::rig::humanoid::{HumanBone, HumanoidMap, detect};
+
+use crate::common::optional_data_dir;
+
+fn named(skeleton: &Skeleton, map: &HumanoidMap) -> Vec<(HumanBone, String)> {
+    map.iter().map(|(b, &j)| (*b, skeleton.joint(j).name.clone())).collect()
+}
+
+fn expect(skeleton: &Skeleton, pairs: &[(HumanBone, &str)]) {
+    let map = detect(skeleton).expect("a humanoid");
+    for (bone, joint) in pairs {
+        let found = map.get(bone).map(|&j| skeleton.joint(j).name.as_str());
+        assert_eq!(found, Some(*joint), "{bone:?} in {:?}", named(skeleton, &map));
+    }
+}
+
+use HumanBone::*;
+
+#[test]
+fn the_puppet_maps_by_its_structure_and_names() {
+    let puppet = marionette::formats::puppet::embedded_puppet();
+    expect(
+        &puppet.skeleton,
+        &[
+            (Hips, "pelvis"),
+            (Spine, "spine"),
+            (Chest, "chest"),
+            (Neck, "neck"),
+            (Head, "head"),
+            (LeftUpperArm, "l_shoulder"),
+            (LeftLowerArm, "l_elbow"),
+            (LeftHand, "l_wrist"),
+            (RightUpperArm, "r_shoulder"),
+            (RightHand, "r_wrist"),
+            (LeftUpperLeg, "l_hip"),
+            (LeftLowerLeg, "l_knee"),
+            (LeftFoot, "l_ankle"),
+            (LeftToes, "l_toe"),
+            (RightUpperLeg, "r_hip"),
+            (RightToes, "r_toe"),
+        ],
+    );
+}
+
+#[test]
+fn the_smpl_body_maps_collars_to_shoulders_and_its_feet_to_toes() {
+    let Some(data) = optional_data_dir() else { return };
+    let asset = marionette::formats::load_character(&data.join("smpl")).unwrap();
+    expect(
+        &asset.skeleton,
+        &[
+            (Hips, "Pelvis"),
+            (Spine, "Spine1"),
+            (Chest, "Spine3"),
+            (Neck, "Neck"),
+            (Head, "Head"),
+            (LeftShoulder, "L_Collar"),
+            (LeftUpperArm, "L_Shoulder"),
+            (LeftLowerArm, "L_Elbow"),
+            (LeftHand, "L_Wrist"),
+            (RightShoulder, "R_Collar"),
+            (RightHand, "R_Wrist"),
+            (LeftUpperLeg, "L_Hip"),
+            (LeftLowerLeg, "L_Knee"),
+            (LeftFoot, "L_Ankle"),
+            (LeftToes, "L_Foot"),
+            (RightFoot, "R_Ankle"),
+        ],
+    );
+}
+
+#[test]
+fn the_6837_models_map_by_structure_alone() {
+    let Some(data) = optional_data_dir() else { return };
+    for k in 1..=4 {
+        let skeleton =
+            marionette::formats::character::load_skeleton(&data.join(format!("mit6837/Model{k}.skel"))).unwrap();
+        // Numbered joints: the hips (joint2) hang from the chest (joint0), the legs from
+        // joint4 and joint8, the arms from the chest; the left side is +x.
+        expect(
+            &skeleton,
+            &[
+                (Hips, "joint2"),
+                (Chest, "joint0"),
+                (RightUpperLeg, "joint5"),
+                (RightLowerLeg, "joint6"),
+                (RightFoot, "joint7"),
+                (LeftUpperLeg, "joint9"),
+                (LeftLowerLeg, "joint10"),
+                (LeftFoot, "joint11"),
+                (RightUpperArm, "joint12"),
+                (RightLowerArm, "joint13"),
+                (RightHand, "joint14"),
+                (LeftUpperArm, "joint15"),
+                (LeftLowerArm, "joint16"),
+                (LeftHand, "joint17"),
+            ],
+        );
+    }
+}
+
+#[test]
+fn the_khronos_figures_map_every_limb_with_left_as_named() {
+    let Some(data) = optional_data_dir() else { return };
+    for file in ["khronos/CesiumMan.glb", "khronos/RiggedFigure.glb"] {
+        let skeleton = marionette::formats::character::load_skeleton(&data.join(file)).unwrap();
+        let map = detect(&skeleton).expect(file);
+        for bone in [Hips, Spine, Chest, Neck, Head, LeftUpperArm, LeftLowerArm, LeftHand, RightUpperArm]
+            .into_iter()
+            .chain([RightLowerArm, RightHand, LeftUpperLeg, LeftLowerLeg, LeftFoot, RightUpperLeg, RightLowerLeg])
+            .chain([RightFoot])
+        {
+            assert!(map.contains_key(&bone), "{file}: no {bone:?} in {:?}", named(&skeleton, &map));
+        }
+        for bone in [LeftUpperArm, LeftHand, LeftUpperLeg, LeftFoot] {
+            let name = &skeleton.joint(map[&bone]).name;
+            assert!(name.contains("_L"), "{file}: {bone:?} is {name}");
+        }
+    }
+}
