@@ -280,3 +280,48 @@ impl Tree<'_> {
         })
     }
 }
+
+/// The world rotation of every joint for `pose` (parents before children).
+fn world_rotations(skeleton: &Skeleton, pose: &[super::JointRotation]) -> Vec<glam::Quat> {
+    let mut out = vec![glam::Quat::IDENTITY; skeleton.len()];
+    for j in 0..skeleton.len() {
+        let parent = skeleton.parent(j).map_or(glam::Quat::IDENTITY, |p| out[p]);
+        out[j] = (parent * pose[j].to_quat()).normalize();
+    }
+    out
+}
+
+/// `source_pose` of the source carried onto the target, bone by mapped bone: each mapped
+/// target bone turns in the world as its source bone turned from the source's initial pose,
+/// starting from the target's own initial pose (so rest poses that differ, a T-pose against
+/// an A-pose, are aligned bone by bone). Joints without a mapped bone keep their initial
+/// rotation; every mapped joint's rotation is a quaternion.
+pub fn retarget_pose(
+    source: (&Skeleton, &HumanoidMap),
+    source_pose: &[super::JointRotation],
+    target: (&Skeleton, &HumanoidMap),
+) -> Vec<super::JointRotation> {
+    let ((s, s_map), (t, t_map)) = (source, target);
+    let (s_rest, s_now) = (world_rotations(s, &s.initial_pose()), world_rotations(s, source_pose));
+    let t_initial = t.initial_pose();
+    let t_rest = world_rotations(t, &t_initial);
+    let mut pose = t_initial;
+    // The source bone that drives each target joint.
+    let mut driver = vec![None; t.len()];
+    for (bone, &tj) in t_map {
+        if let Some(&sj) = s_map.get(bone) {
+            driver[tj] = Some(sj);
+        }
+    }
+    let mut world = vec![glam::Quat::IDENTITY; t.len()];
+    for j in 0..t.len() {
+        let parent = t.parent(j).map_or(glam::Quat::IDENTITY, |p| world[p]);
+        if let Some(sj) = driver[j] {
+            let turned = (s_now[sj] * s_rest[sj].inverse()).normalize();
+            let wanted = (turned * t_rest[j]).normalize();
+            pose[j] = super::JointRotation::Quat((parent.inverse() * wanted).normalize());
+        }
+        world[j] = (parent * pose[j].to_quat()).normalize();
+    }
+    pose
+}

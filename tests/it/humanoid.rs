@@ -123,3 +123,43 @@ fn the_khronos_figures_map_every_limb_with_left_as_named() {
         }
     }
 }
+
+/// A pose carried from a character onto itself is that pose (within 1e-5 in every joint's
+/// world rotation); carried from the puppet onto the SMPL body, every mapped bone turns
+/// in the world exactly as the puppet's did from its initial pose.
+#[test]
+fn a_retargeted_pose_turns_each_bone_as_its_source_turned() {
+    use glam::Quat;
+    use marionette::rig::JointRotation;
+    use marionette::rig::humanoid::retarget_pose;
+    let puppet = marionette::formats::puppet::embedded_puppet().skeleton;
+    let map = detect(&puppet).unwrap();
+    let mut pose = puppet.initial_pose();
+    for (k, rotation) in pose.iter_mut().enumerate() {
+        *rotation = JointRotation::euler_xyz(0.1 * k as f32, -0.05 * k as f32, 0.3);
+    }
+    let world = |skeleton: &Skeleton, pose: &[JointRotation]| {
+        let mut out = vec![Quat::IDENTITY; skeleton.len()];
+        for j in 0..skeleton.len() {
+            let parent = skeleton.parent(j).map_or(Quat::IDENTITY, |p| out[p]);
+            out[j] = parent * pose[j].to_quat();
+        }
+        out
+    };
+    let same = retarget_pose((&puppet, &map), &pose, (&puppet, &map));
+    let (want, got) = (world(&puppet, &pose), world(&puppet, &same));
+    for &j in map.values() {
+        assert!(want[j].angle_between(got[j]) < 1e-5, "{}", puppet.joint(j).name);
+    }
+    let Some(data) = optional_data_dir() else { return };
+    let body = marionette::formats::load_character(&data.join("smpl")).unwrap().skeleton;
+    let body_map = detect(&body).unwrap();
+    let carried = retarget_pose((&puppet, &map), &pose, (&body, &body_map));
+    let (p_rest, p_now) = (world(&puppet, &puppet.initial_pose()), world(&puppet, &pose));
+    let (b_rest, b_now) = (world(&body, &body.initial_pose()), world(&body, &carried));
+    for (bone, &bj) in &body_map {
+        let Some(&pj) = map.get(bone) else { continue };
+        let (turned_source, turned_target) = (p_now[pj] * p_rest[pj].inverse(), b_now[bj] * b_rest[bj].inverse());
+        assert!(turned_source.angle_between(turned_target) < 1e-4, "{bone:?}");
+    }
+}
