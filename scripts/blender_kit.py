@@ -1,6 +1,7 @@
 """What the Blender fixture scripts build with: a tube mesh, an armature of chained bones,
 automatic weights. Imported by `make_gltf_pair_fixture.py` and `make_nested_fixture.py`
-(run them from anywhere: they put this folder on the path)."""
+(run them from anywhere: they put this folder on the path); and writing a mesh as
+Blender deforms it."""
 from math import cos, pi, sin
 
 import bpy
@@ -62,3 +63,18 @@ def bind(mesh, rig):
     rig.select_set(True)
     bpy.context.view_layer.objects.active = rig
     bpy.ops.object.parent_set(type="ARMATURE_AUTO")
+
+
+def write_deformed(f, obj, t, fps):
+    """`time T`, then `obj`'s vertices as Blender deforms them at `t` seconds, one `x y z`
+    per line in glTF's y-up axes."""
+    frame = int(t * fps)
+    bpy.context.scene.frame_set(frame, subframe=t * fps - frame)
+    depsgraph = bpy.context.evaluated_depsgraph_get()
+    evaluated = obj.evaluated_get(depsgraph)
+    mesh = evaluated.to_mesh()
+    f.write(f"time {t}\n")
+    for v in mesh.vertices:
+        p = evaluated.matrix_world @ v.co
+        f.write(f"{p.x:.7f} {p.z:.7f} {-p.y:.7f}\n")
+    evaluated.to_mesh_clear()

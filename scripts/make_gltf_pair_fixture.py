@@ -32,7 +32,7 @@ from pathlib import Path
 import bpy
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from blender_kit import armature, bind, fresh_scene, tube  # noqa: E402
+from blender_kit import armature, bind, fresh_scene, tube, write_deformed  # noqa: E402
 
 out = Path(sys.argv[1])
 FPS = 24
@@ -214,16 +214,7 @@ with open(out / "blender_pair.txt", "w") as f:
         for t in times[obj.name]:
             # The importer keys frame = time * fps (the actions' frame ranges, written last,
             # show it: 0 to 24 for 0 to 1 s).
-            frame = int(t * FPS)
-            bpy.context.scene.frame_set(frame, subframe=t * FPS - frame)
-            depsgraph = bpy.context.evaluated_depsgraph_get()
-            evaluated = obj.evaluated_get(depsgraph)
-            mesh = evaluated.to_mesh()
-            f.write(f"time {t}\n")
-            for v in mesh.vertices:
-                p = evaluated.matrix_world @ v.co
-                f.write(f"{p.x:.7f} {p.z:.7f} {-p.y:.7f}\n")
-            evaluated.to_mesh_clear()
+            write_deformed(f, obj, t, FPS)
     for a in bpy.data.actions:
         f.write(f"# action {a.name} frames {tuple(a.frame_range)}\n")
 print("wrote", glb, [o.name for o in meshes])

@@ -26,7 +26,7 @@ from pathlib import Path
 import bpy
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from blender_kit import armature, bind, fresh_scene, tube  # noqa: E402
+from blender_kit import armature, bind, fresh_scene, tube, write_deformed  # noqa: E402
 
 out = Path(sys.argv[1])
 FPS = 24
@@ -105,14 +105,5 @@ with open(out / "blender_nested.txt", "w") as f:
     for obj in objects:
         f.write(f"mesh {obj.name}\n")
         for t in times:
-            frame = int(t * FPS)
-            bpy.context.scene.frame_set(frame, subframe=t * FPS - frame)
-            depsgraph = bpy.context.evaluated_depsgraph_get()
-            evaluated = obj.evaluated_get(depsgraph)
-            mesh = evaluated.to_mesh()
-            f.write(f"time {t}\n")
-            for v in mesh.vertices:
-                p = evaluated.matrix_world @ v.co
-                f.write(f"{p.x:.7f} {p.z:.7f} {-p.y:.7f}\n")
-            evaluated.to_mesh_clear()
+            write_deformed(f, obj, t, FPS)
 print("wrote", glb, [o.name for o in objects])

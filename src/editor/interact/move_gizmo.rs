@@ -15,7 +15,7 @@ use bevy::prelude::*;
 use crate::editor::edits::edit::{Edit, EditQueue, GestureHold};
 use crate::editor::interact::picking::JointPicker;
 use crate::editor::interact::pointer::ViewportHasPointer;
-use crate::editor::interact::rotate_gizmo::{distance_to_segment, typed_char};
+use crate::editor::interact::rotate_gizmo::{distance_to_segment, read_typing};
 use crate::editor::present::draw::SkeletonGizmos;
 use crate::editor::state::{JointDrag, Selection};
 use crate::formats::scene::{CharacterId, PlacementDoc};
@@ -434,20 +434,8 @@ fn type_move(
         return;
     }
     if let MoveGrip::Typed { turn, axis, text } = &mut active.grip {
-        for (key, a) in [(KeyCode::KeyX, 0), (KeyCode::KeyY, 1), (KeyCode::KeyZ, 2)] {
-            if keys.just_pressed(key) && !*turn {
-                *axis = Some(a);
-            }
-        }
-        for key in keys.get_just_pressed() {
-            match typed_char(*key) {
-                Some(c) => text.push(c),
-                None if *key == KeyCode::Backspace => {
-                    text.pop();
-                }
-                None => {}
-            }
-        }
+        let turn = *turn;
+        read_typing(&keys, axis, text, |_| !turn);
     }
     // Until an axis is typed, the cursor moves it in the ground plane.
     if let (MoveGrip::Typed { turn: false, axis: None, .. }, Some(from)) = (&active.grip, gizmo.typed_from)

@@ -445,20 +445,7 @@ fn type_rotation(
         return;
     }
     if let Grip::Typed { axis, text } = &mut turn.grip {
-        for (key, a) in [(KeyCode::KeyX, 0), (KeyCode::KeyY, 1), (KeyCode::KeyZ, 2)] {
-            if keys.just_pressed(key) && view.rings[a] {
-                *axis = Some(a);
-            }
-        }
-        for key in keys.get_just_pressed() {
-            match typed_char(*key) {
-                Some(c) => text.push(c),
-                None if *key == KeyCode::Backspace => {
-                    text.pop();
-                }
-                None => {}
-            }
-        }
+        read_typing(&keys, axis, text, |a| view.rings[a]);
     }
     push_turn(&mut edits, &turn, &view.rotation);
     gizmo.readout = Some(turn.describe(&view.name));
@@ -471,8 +458,32 @@ fn finish_typing(gizmo: &mut RotateGizmo, hold: &mut GestureHold) {
     hold.typing = false;
 }
 
+/// This frame's keys of a typed number: X/Y/Z pick the axis (where `allowed`), digits,
+/// '-' and '.' type, Backspace deletes.
+pub fn read_typing(
+    keys: &ButtonInput<KeyCode>,
+    axis: &mut Option<usize>,
+    text: &mut String,
+    allowed: impl Fn(usize) -> bool,
+) {
+    for (key, a) in [(KeyCode::KeyX, 0), (KeyCode::KeyY, 1), (KeyCode::KeyZ, 2)] {
+        if keys.just_pressed(key) && allowed(a) {
+            *axis = Some(a);
+        }
+    }
+    for key in keys.get_just_pressed() {
+        match typed_char(*key) {
+            Some(c) => text.push(c),
+            None if *key == KeyCode::Backspace => {
+                text.pop();
+            }
+            None => {}
+        }
+    }
+}
+
 /// The character a key types into a number of degrees.
-pub fn typed_char(key: KeyCode) -> Option<char> {
+fn typed_char(key: KeyCode) -> Option<char> {
     use KeyCode::*;
     let digits = [Digit0, Digit1, Digit2, Digit3, Digit4, Digit5, Digit6, Digit7, Digit8, Digit9];
     let numpad = [Numpad0, Numpad1, Numpad2, Numpad3, Numpad4, Numpad5, Numpad6, Numpad7, Numpad8, Numpad9];
