@@ -28,22 +28,6 @@ pub fn keyframes_as_splines(
         .map_err(|e| format!("{e} (MAX_SAMPLED_FRAMES)"))
 }
 
-/// A character's asset as the document shapes it: an SMPL body by its β. (Morph targets go
-/// out as targets, with the document's weights.)
-fn shaped(
-    library: &mut super::AssetLibrary,
-    c: &crate::formats::scene::CharacterDoc,
-) -> Result<std::sync::Arc<crate::rig::CharacterAsset>, FormatError> {
-    let mut asset = library.load_bound(&c.source, c.binding)?;
-    if let (Some(smpl), crate::formats::scene::SourceDoc::File(dir)) = (&c.smpl, &c.source)
-        && !smpl.betas.is_empty()
-    {
-        let set = library.smpl(dir)?;
-        asset = std::sync::Arc::new(set.model.asset(&c.name, &smpl.betas).map_err(|e| FormatError::rig(dir, e))?);
-    }
-    Ok(asset)
-}
-
 /// A character's pose, motion and keyed rest for export.
 struct Posed {
     /// Where it stands (its document's placement, or where its holder carries it).
@@ -113,8 +97,8 @@ fn load_posed(
     let mut library = super::AssetLibrary::default();
     let mut loaded = Vec::new();
     for c in &doc.characters {
-        let asset = shaped(&mut library, c)?;
-        let posed = posed(&mut library, c, &asset, animated)?;
+        let asset = super::retarget::shaped_asset(&mut library, c)?;
+        let posed = posed(&mut library, doc, c, &asset, animated)?;
         loaded.push((c, asset, posed));
     }
     for i in 0..loaded.len() {
@@ -131,6 +115,7 @@ fn load_posed(
 /// its clip sampled over its length.
 fn posed(
     library: &mut super::AssetLibrary,
+    scene: &SceneDoc,
     c: &crate::formats::scene::CharacterDoc,
     asset: &crate::rig::CharacterAsset,
     animated: bool,
@@ -148,10 +133,7 @@ fn posed(
         clips: std::sync::Arc::new([]),
     };
     if let Some(anim) = &c.anim {
-        let clip = match &anim.keys {
-            Some(keys) => keys.clone(),
-            None => crate::formats::load_clip(&anim.file)?,
-        };
+        let clip = super::retarget::anim_clip(library, scene, c, asset, anim)?;
         let clip = clip.retargeted(skeleton, &anim.names);
         if animated {
             let clip_file = if anim.file.as_os_str().is_empty() { std::path::Path::new(&c.name) } else { &anim.file };

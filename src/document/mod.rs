@@ -12,6 +12,7 @@ pub mod layout;
 pub mod library;
 pub mod picture;
 pub mod posing;
+pub mod retarget;
 pub mod scenes;
 
 pub use library::{AssetLibrary, LoadedPart, SmplSet, own_motion, rebind};

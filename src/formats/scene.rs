@@ -266,6 +266,10 @@ pub struct CharacterDoc {
     /// that joint.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub attached: Option<AttachDoc>,
+    /// Standard bones assigned by hand (bone → pose key), over those found from the
+    /// skeleton; an empty key takes the bone off.
+    #[serde(default, skip_serializing_if = "BTreeMap::is_empty")]
+    pub humanoid: BTreeMap<crate::rig::humanoid::HumanBone, String>,
 }
 
 /// A prop (or character) held by a joint of another character: it follows the joint,
@@ -334,6 +338,47 @@ pub struct AnimDoc {
     /// they differ (e.g. `L_Knee: "LeftLeg"`).
     #[serde(skip_serializing_if = "BTreeMap::is_empty")]
     pub names: BTreeMap<String, String>,
+    /// The motion of another humanoid, carried onto this one through their humanoid maps
+    /// (when there are no `keys`: keys edited or baked play instead).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub retarget: Option<RetargetDoc>,
+}
+
+/// Whose motion a retargeted clip plays, and how.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct RetargetDoc {
+    pub from: MotionSourceDoc,
+    /// How rest poses are matched (files without it: bone directions).
+    #[serde(default)]
+    pub rest: crate::rig::retarget::RestAlignment,
+    /// Feet the source plants stay planted (files without it: yes).
+    #[serde(default = "yes")]
+    pub plant_feet: bool,
+}
+
+fn yes() -> bool {
+    true
+}
+
+impl RetargetDoc {
+    /// The motion of `from`, directions followed, feet planted.
+    pub fn of(from: MotionSourceDoc) -> Self {
+        Self { from, rest: Default::default(), plant_feet: true }
+    }
+}
+
+/// A humanoid whose motion is retargeted: a character of the scene (its own motion), or a
+/// file and its clip: a glTF clip by name or index, an SMPL clip by the end of its name
+/// (`7516`), or an `.anim`/`.bvh` file played on the file's character (a `.bvh` plays its
+/// own motion).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub enum MotionSourceDoc {
+    Character(CharacterId),
+    File {
+        path: PathBuf,
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        clip: Option<String>,
+    },
 }
 
 impl Default for AnimDoc {
@@ -346,6 +391,7 @@ impl Default for AnimDoc {
             looping: true,
             speed: 1.0,
             names: BTreeMap::new(),
+            retarget: None,
         }
     }
 }
@@ -380,6 +426,7 @@ impl CharacterDoc {
             morphs: Vec::new(),
             playback: None,
             attached: None,
+            humanoid: BTreeMap::new(),
         }
     }
 }

@@ -538,6 +538,38 @@ impl Clip {
         (root, pose)
     }
 
+    /// A clip keyed at every frame (`fps` a second from 0): the root's position and the
+    /// x, y, z angles of the joints `joints`, linear between frames. Each joint's angles
+    /// are taken, of the two Euler triples of its rotation and their turns by 2π, nearest
+    /// the frame before, so the curves do not jump.
+    pub fn from_frames(skeleton: &Skeleton, frames: &[super::retarget::Frame], fps: f32, joints: &[usize]) -> Self {
+        let key =
+            |time: f32, value: f32| Key { time, value, tangent_in: Tangent::Linear, tangent_out: Tangent::Linear };
+        let channel = |keys: Vec<Key>| Channel::new(keys, Extrapolation::Constant, Extrapolation::Constant);
+        let times: Vec<f32> = (0..frames.len()).map(|f| f as f32 / fps).collect();
+        let mut clip = Clip::empty(skeleton.len());
+        clip.range = (0.0, times.last().copied().unwrap_or(0.0).max(1.0 / fps));
+        for axis in 0..3 {
+            clip.channels[axis] = channel(frames.iter().zip(&times).map(|(f, &t)| key(t, f.root[axis])).collect());
+        }
+        for &j in joints {
+            let mut previous: Option<Vec3> = None;
+            let angles: Vec<Vec3> = frames
+                .iter()
+                .map(|f| {
+                    let a = nearest_euler(f.pose[j].to_euler(EulerOrder::Xyz), previous);
+                    previous = Some(a);
+                    a
+                })
+                .collect();
+            for axis in 0..3 {
+                let keys = angles.iter().zip(&times).map(|(a, &t)| key(t, a[axis])).collect();
+                clip.channels[Self::joint_channel(j, axis)] = channel(keys);
+            }
+        }
+        clip
+    }
+
     /// This clip with keys at `time` for the joints `joints` of `pose` (their x, y, z
     /// angles), the range grown to hold `time`.
     pub fn with_pose_keyed(&self, joints: &[usize], pose: &[JointRotation], time: f32) -> Self {
@@ -556,4 +588,16 @@ impl Clip {
         clip.range = (clip.range.0.min(time), clip.range.1.max(time));
         clip
     }
+}
+
+/// Of the XYZ Euler triples for the same rotation as `angles` (it, and (x+π, π−y, z+π),
+/// each angle give or take 2π), the one nearest `previous`.
+fn nearest_euler(angles: Vec3, previous: Option<Vec3>) -> Vec3 {
+    use std::f32::consts::{PI, TAU};
+    let Some(previous) = previous else { return angles };
+    let near = |a: f32, to: f32| a + ((to - a) / TAU).round() * TAU;
+    let wrapped = |v: Vec3| Vec3::new(near(v.x, previous.x), near(v.y, previous.y), near(v.z, previous.z));
+    let first = wrapped(angles);
+    let second = wrapped(Vec3::new(angles.x + PI, PI - angles.y, angles.z + PI));
+    if first.distance_squared(previous) <= second.distance_squared(previous) { first } else { second }
 }

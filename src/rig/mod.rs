@@ -18,6 +18,7 @@ pub mod matrix_stack;
 pub mod mirror;
 pub mod node_clip;
 pub mod pose;
+pub mod retarget;
 pub mod skeleton;
 pub mod skinning;
 pub mod smpl;

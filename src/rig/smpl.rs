@@ -112,6 +112,16 @@ impl Clip {
     }
 }
 
+/// The turn that stands a clip up (`upright`): its first frame's root brought to +y (the
+/// mocap clips carry a global rotation from a z-up capture); none otherwise.
+pub fn upright_turn(clip: &Clip, upright: bool) -> Quat {
+    if !upright {
+        return Quat::IDENTITY;
+    }
+    let first_up = clip.frame(0).first().copied().unwrap_or(Quat::IDENTITY) * Vec3::Y;
+    Quat::from_rotation_arc(first_up.normalize(), Vec3::Y)
+}
+
 /// How two rotations are interpolated.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize, serde::Deserialize)]
 pub enum BlendMode {

@@ -138,12 +138,7 @@ fn pose_from_clips(
             }
             _ => &a,
         };
-        let upright = if state.upright {
-            let first_up = clip.frame(0).first().copied().unwrap_or(Quat::IDENTITY) * Vec3::Y;
-            Quat::from_rotation_arc(first_up.normalize(), Vec3::Y)
-        } else {
-            Quat::IDENTITY
-        };
+        let upright = crate::rig::smpl::upright_turn(clip, state.upright);
         for (j, (&e, q)) in character.joints.iter().zip(rotations).enumerate() {
             let q = if j == 0 { upright * *q } else { *q };
             if let Ok(mut pose) = poses.get_mut(e) {

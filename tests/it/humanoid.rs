@@ -131,7 +131,7 @@ fn the_khronos_figures_map_every_limb_with_left_as_named() {
 fn a_retargeted_pose_turns_each_bone_as_its_source_turned() {
     use glam::Quat;
     use marionette::rig::JointRotation;
-    use marionette::rig::humanoid::retarget_pose;
+    use marionette::rig::retarget::{RestAlignment, retarget_pose};
     let puppet = marionette::formats::puppet::embedded_puppet().skeleton;
     let map = detect(&puppet).unwrap();
     let mut pose = puppet.initial_pose();
@@ -146,15 +146,17 @@ fn a_retargeted_pose_turns_each_bone_as_its_source_turned() {
         }
         out
     };
-    let same = retarget_pose((&puppet, &map), &pose, (&puppet, &map));
-    let (want, got) = (world(&puppet, &pose), world(&puppet, &same));
-    for &j in map.values() {
-        assert!(want[j].angle_between(got[j]) < 1e-5, "{}", puppet.joint(j).name);
+    for rest in [RestAlignment::Directions, RestAlignment::OwnRest] {
+        let same = retarget_pose((&puppet, &map), &pose, (&puppet, &map), rest).unwrap();
+        let (want, got) = (world(&puppet, &pose), world(&puppet, &same));
+        for &j in map.values() {
+            assert!(want[j].angle_between(got[j]) < 1e-5, "{rest:?}: {}", puppet.joint(j).name);
+        }
     }
     let Some(data) = optional_data_dir() else { return };
     let body = marionette::formats::load_character(&data.join("smpl")).unwrap().skeleton;
     let body_map = detect(&body).unwrap();
-    let carried = retarget_pose((&puppet, &map), &pose, (&body, &body_map));
+    let carried = retarget_pose((&puppet, &map), &pose, (&body, &body_map), RestAlignment::OwnRest).unwrap();
     let (p_rest, p_now) = (world(&puppet, &puppet.initial_pose()), world(&puppet, &pose));
     let (b_rest, b_now) = (world(&body, &body.initial_pose()), world(&body, &carried));
     for (bone, &bj) in &body_map {

@@ -27,6 +27,7 @@ mod layers;
 mod order;
 mod poses;
 mod props;
+mod retarget;
 mod rig;
 mod robust;
 mod shot;

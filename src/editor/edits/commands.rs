@@ -311,6 +311,7 @@ fn set_clip(world: &mut World, id: CharacterId, anim: Option<AnimDoc>) -> Result
     if let Some(mut player) = world.get_mut::<ClipPlayer>(entity)
         && player.state.file == anim.file
         && player.state.keys == anim.keys
+        && player.state.retarget == anim.retarget
     {
         player.state = anim;
         return Ok(());

@@ -47,7 +47,9 @@ impl Plugin for ScenePlugin {
                 PostUpdate,
                 (
                     apply_pending_scene.in_set(crate::editor::order::EditorSystems::OpenScene),
-                    sync_character_views.in_set(crate::editor::order::EditorSystems::SyncViews),
+                    (sync_character_views, crate::editor::scene_doc::retarget::resolve_retargets)
+                        .chain()
+                        .in_set(crate::editor::order::EditorSystems::SyncViews),
                 ),
             )
             .add_systems(

@@ -100,6 +100,11 @@ impl NextCharacterId {
     }
 }
 
+/// Standard bones assigned by hand to a character's joints (bone → pose key), over those
+/// found from its skeleton (the scene file's `humanoid`).
+#[derive(Component, Clone, Debug, Default, PartialEq)]
+pub struct HumanoidBones(pub std::collections::BTreeMap<crate::rig::humanoid::HumanBone, String>);
+
 /// Everything needed to capture the scene as a document (read only).
 /// What the panels and capture read of a scene character, by name.
 #[derive(QueryData)]
@@ -116,6 +121,7 @@ pub struct SceneCharacterData {
     pub morphs: Option<&'static crate::scene::morphs::Morphs>,
     pub node_clips: Option<&'static crate::scene::node_clips::NodeClipPlayer>,
     pub attached: Option<&'static Attached>,
+    pub humanoid: Option<&'static HumanoidBones>,
 }
 
 #[derive(SystemParam)]
@@ -179,6 +185,7 @@ impl SceneReader<'_, '_> {
             morphs: c.morphs.map(|m| m.weights.clone()).unwrap_or_default(),
             playback: c.node_clips.map(|p| p.state.clone()),
             attached: c.attached.map(|a| a.0.clone()),
+            humanoid: c.humanoid.map(|h| h.0.clone()).unwrap_or_default(),
         })
     }
 }
@@ -239,6 +246,9 @@ pub fn spawn_from_doc(
     if let Some(attached) = &doc.attached {
         commands.entity(entity).insert(Attached(attached.clone()));
     }
+    if !doc.humanoid.is_empty() {
+        commands.entity(entity).insert(HumanoidBones(doc.humanoid.clone()));
+    }
     if let Some((dir, set)) = smpl {
         let state = doc.smpl.clone().unwrap_or_default();
         commands.entity(entity).insert(SmplCharacter::new(set.model, dir.clone(), set.clips, state));
@@ -254,9 +264,11 @@ pub fn clip_player(
     name: &str,
     anim: &crate::formats::scene::AnimDoc,
 ) -> Result<(ClipPlayer, Option<String>), FormatError> {
-    let clip = match &anim.keys {
-        Some(keys) => Arc::new(keys.clone()),
-        None => library.keyframe_clip(&anim.file)?,
+    let clip = match (&anim.keys, &anim.retarget) {
+        (Some(keys), _) => Arc::new(keys.clone()),
+        // Worked out from the scene by `retarget::resolve_retargets`.
+        (None, Some(_)) => Arc::new(crate::rig::anim::Clip::empty(asset.skeleton.len())),
+        (None, None) => library.keyframe_clip(&anim.file)?,
     };
     let wanted = 3 + 3 * asset.skeleton.len();
     let note = if !clip.joint_names.is_empty() {

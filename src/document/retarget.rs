@@ -1,0 +1,302 @@
+//! Retargeting in documents: a character's motion (its SMPL clip, keyframed clip or glTF
+//! clip) sampled as frames, carried onto another character through their humanoid maps
+//! and baked into a keyframed clip the target plays like any other.
+
+use std::path::Path;
+
+use crate::formats::FormatError;
+use crate::formats::scene::{
+    AnimDoc, CharacterDoc, MotionSourceDoc, PlaybackDoc, RetargetDoc, SceneDoc, SmplDoc, SourceDoc,
+};
+use crate::rig::anim::Clip;
+use crate::rig::humanoid::{HumanBone, HumanoidMap};
+use crate::rig::retarget::{Frame, Humanoid, Retargeted, Retargeter};
+use crate::rig::{CharacterAsset, JointRotation};
+
+/// Frames a second at which motion is sampled for retargeting (the SMPL clips' rate).
+pub const FPS: f32 = crate::rig::smpl::CLIP_FPS;
+
+/// A retargeted clip and what retargeting did.
+pub struct Retargeting {
+    pub clip: Clip,
+    pub report: Retargeted,
+    /// Target leg length over the source's.
+    pub leg_ratio: f32,
+    /// The source's frames as sampled.
+    pub source_frames: Vec<Frame>,
+    /// The floors (model space) of the source's motion and of the target.
+    pub floors: (f32, f32),
+}
+
+/// A character's humanoid map: found from its skeleton, with the document's bones
+/// assigned by hand over it (an empty or unknown key takes the bone off).
+pub fn humanoid_map(asset: &CharacterAsset, assigned: &std::collections::BTreeMap<HumanBone, String>) -> HumanoidMap {
+    let skeleton = &asset.skeleton;
+    let mut map = crate::rig::humanoid::detect(skeleton).unwrap_or_default();
+    for (bone, key) in assigned {
+        match crate::formats::scene::joint_of_pose_key(skeleton, key) {
+            Some(j) => map.insert(*bone, j),
+            None => map.remove(bone),
+        };
+    }
+    map
+}
+
+/// The height of a character's floor in its model space: its lowest skin vertex standing
+/// in its initial pose, or its lowest joint without a skin.
+pub fn floor_of(asset: &CharacterAsset) -> f32 {
+    let skeleton = &asset.skeleton;
+    let initial = skeleton.initial_pose();
+    let skin = super::posing::posed_positions(asset, &initial, glam::Mat4::IDENTITY);
+    let lowest = skin.iter().map(|p| p.y).fold(f32::INFINITY, f32::min);
+    if lowest.is_finite() {
+        return lowest;
+    }
+    let (_, at) = crate::rig::retarget::world_frames(skeleton, skeleton.joint(0).rest_offset, &initial);
+    at.iter().map(|p| p.y).fold(f32::INFINITY, f32::min)
+}
+
+/// The floor a motion stands on: the character's own, lowered where the motion takes its
+/// feet lower than they stand (a clip that hangs from a fixed root).
+pub fn motion_floor(asset: &CharacterAsset, map: &HumanoidMap, frames: &[Frame]) -> f32 {
+    let skeleton = &asset.skeleton;
+    let feet: Vec<usize> = [HumanBone::LeftFoot, HumanBone::RightFoot, HumanBone::LeftToes, HumanBone::RightToes]
+        .iter()
+        .filter_map(|b| map.get(b).copied())
+        .collect();
+    let lowest_foot = |root, pose: &[JointRotation]| {
+        let (_, at) = crate::rig::retarget::world_frames(skeleton, root, pose);
+        feet.iter().map(|&j| at[j].y).fold(f32::INFINITY, f32::min)
+    };
+    let floor = floor_of(asset);
+    let standing = lowest_foot(skeleton.joint(0).rest_offset, &skeleton.initial_pose());
+    let lowest = frames.iter().map(|f| lowest_foot(f.root, &f.pose)).fold(f32::INFINITY, f32::min);
+    if lowest.is_finite() { floor.min(lowest - (standing - floor)) } else { floor }
+}
+
+/// A character's own motion as frames at [`FPS`] over the clip's length: its keyframed
+/// clip, else its glTF clip, else its SMPL clip (stood upright when it asks). None when it
+/// has no motion of its own.
+pub fn motion_frames(
+    library: &mut super::AssetLibrary,
+    c: &CharacterDoc,
+    asset: &CharacterAsset,
+) -> Result<Option<Vec<Frame>>, FormatError> {
+    let skeleton = &asset.skeleton;
+    let (base, _) = super::scenes::pose_from_doc(asset, c);
+    let named =
+        |path: &Path| FormatError::other(path, "expected a clip of its own to retarget, found a retargeted one");
+    if let Some(anim) = &c.anim {
+        let clip = match (&anim.keys, &anim.retarget) {
+            (Some(keys), _) => keys.clone(),
+            (None, Some(_)) => return Err(named(Path::new(&c.name))),
+            (None, None) => (*library.keyframe_clip(&anim.file)?).clone(),
+        };
+        let clip = clip.retargeted(skeleton, &anim.names);
+        let frames = sample_times(clip.range)
+            .map(|t| {
+                let (root, pose) = clip.pose_at(skeleton, t, &base);
+                Frame { root, pose }
+            })
+            .collect();
+        return Ok(Some(frames));
+    }
+    if let (Some(part), Some(playback)) = (library.part_of_source(&c.source), &c.playback) {
+        let find = |name: &Option<String>| part.clips.iter().find(|k| Some(&k.name) == name.as_ref());
+        if let Some(clip) = find(&playback.clip) {
+            let blend = find(&playback.blend_clip).map(|k| (k, playback.blend));
+            let frames = sample_times((0.0, clip.duration()))
+                .map(|t| {
+                    let now = crate::rig::node_clip::sample_mix(skeleton, clip, blend, t);
+                    let mut pose = base.clone();
+                    for (j, q) in now.rotations.iter().enumerate() {
+                        if clip.turns(j) || blend.is_some_and(|(k, _)| k.turns(j)) {
+                            pose[j] = JointRotation::Quat(*q);
+                        }
+                    }
+                    Frame { root: now.offsets[0], pose }
+                })
+                .collect();
+            return Ok(Some(frames));
+        }
+    }
+    if let (Some(smpl), SourceDoc::File(dir)) = (&c.smpl, &c.source)
+        && let Some(name) = &smpl.clip
+    {
+        let set = library.smpl(dir)?;
+        let Some((_, clip)) = set.clips.iter().find(|(n, _)| n == name) else { return Ok(None) };
+        let blend = smpl.blend_clip.as_ref().and_then(|b| set.clips.iter().find(|(n, _)| n == b)).map(|(_, k)| k);
+        let upright = crate::rig::smpl::upright_turn(clip, smpl.upright);
+        let root = skeleton.joint(0).rest_offset;
+        let mut a = Vec::new();
+        let mut b = Vec::new();
+        let mut mixed = Vec::new();
+        let frames = (0..clip.frame_count())
+            .map(|f| {
+                clip.sample(f as f32, false, crate::rig::smpl::BlendMode::Nlerp, &mut a);
+                let rotations = match blend {
+                    Some(other) if smpl.blend > 0.0 => {
+                        other.sample(f as f32, true, crate::rig::smpl::BlendMode::Nlerp, &mut b);
+                        crate::rig::smpl::blend_rotations(
+                            &a,
+                            &b,
+                            smpl.blend,
+                            crate::rig::smpl::BlendMode::Nlerp,
+                            &mut mixed,
+                        );
+                        &mixed
+                    }
+                    _ => &a,
+                };
+                // Clamped to the joints' limits, as the editor plays it.
+                let pose = rotations
+                    .iter()
+                    .enumerate()
+                    .map(|(j, q)| {
+                        let q = if j == 0 { upright * *q } else { *q };
+                        JointRotation::Quat(q).clamped(&skeleton.joint(j).limits)
+                    })
+                    .collect();
+                Frame { root, pose }
+            })
+            .collect();
+        return Ok(Some(frames));
+    }
+    Ok(None)
+}
+
+/// The times of frames at [`FPS`] from the start of `range` to its end (at least one).
+fn sample_times((start, end): (f32, f32)) -> impl Iterator<Item = f32> {
+    let n = ((end - start).max(0.0) * FPS).round() as usize;
+    let n = n.min(crate::formats::limits::MAX_SAMPLED_FRAMES.saturating_sub(1));
+    (0..=n).map(move |f| start + f as f32 / FPS)
+}
+
+/// The document of the character a file brings, playing the clip `clip` names (see
+/// [`MotionSourceDoc::File`]).
+pub fn file_motion_doc(
+    library: &mut super::AssetLibrary,
+    path: &Path,
+    clip: Option<&str>,
+) -> Result<CharacterDoc, FormatError> {
+    let source = SourceDoc::File(path.to_path_buf());
+    let asset = library.load(&source)?;
+    let mut doc = library.new_character_doc(source.clone(), &asset);
+    let is_motion_file =
+        |p: &Path| p.extension().is_some_and(|e| e.eq_ignore_ascii_case("anim") || e.eq_ignore_ascii_case("bvh"));
+    if is_motion_file(path) {
+        doc.anim = Some(AnimDoc::of(path));
+    } else if let Some(spec) = clip {
+        if is_motion_file(Path::new(spec)) {
+            doc.anim = Some(AnimDoc::of(spec));
+        } else if crate::formats::smpl::is_smpl_dir(path) {
+            let set = library.smpl(path)?;
+            let name = set.clips.iter().map(|(n, _)| n.clone()).find(|n| n.trim_end_matches(".txt").ends_with(spec));
+            let name = name.ok_or_else(|| {
+                FormatError::other(path, format!("expected an SMPL clip ending in `{spec}`, found none"))
+            })?;
+            doc.smpl = Some(SmplDoc { clip: Some(name), upright: true, ..SmplDoc::default() });
+        } else {
+            let part = library.part_of_source(&source);
+            let found = part.as_ref().and_then(|p| super::posing::find_clip(&p.clips, spec));
+            let found = found.ok_or_else(|| {
+                FormatError::other(path, format!("expected a clip named or numbered `{spec}`, found none"))
+            })?;
+            doc.playback = Some(PlaybackDoc { clip: Some(found.name.clone()), ..PlaybackDoc::default() });
+        }
+    } else if crate::formats::smpl::is_smpl_dir(path) {
+        let set = library.smpl(path)?;
+        doc.smpl =
+            Some(SmplDoc { clip: set.clips.first().map(|(n, _)| n.clone()), upright: true, ..SmplDoc::default() });
+    } else if let Some(first) = library.part_of_source(&source).and_then(|p| p.clips.first().cloned()) {
+        doc.playback = Some(PlaybackDoc { clip: Some(first.name.clone()), ..PlaybackDoc::default() });
+    }
+    Ok(doc)
+}
+
+/// The document of the humanoid `from` names: a character of `scene`, or a file's.
+pub fn motion_source_doc(
+    library: &mut super::AssetLibrary,
+    scene: &SceneDoc,
+    from: &MotionSourceDoc,
+) -> Result<CharacterDoc, FormatError> {
+    match from {
+        MotionSourceDoc::Character(id) => {
+            scene.characters.iter().find(|c| c.id == Some(*id)).cloned().ok_or_else(|| {
+                FormatError::other(
+                    Path::new(&id.to_string()),
+                    "expected a character of the scene to take the motion of, found none",
+                )
+            })
+        }
+        MotionSourceDoc::File { path, clip } => file_motion_doc(library, path, clip.as_deref()),
+    }
+}
+
+/// The shaped asset a character document stands for (an SMPL body by its β).
+pub fn shaped_asset(
+    library: &mut super::AssetLibrary,
+    c: &CharacterDoc,
+) -> Result<std::sync::Arc<CharacterAsset>, FormatError> {
+    let mut asset = library.load_bound(&c.source, c.binding)?;
+    if let (Some(smpl), SourceDoc::File(dir)) = (&c.smpl, &c.source)
+        && !smpl.betas.is_empty()
+    {
+        let set = library.smpl(dir)?;
+        asset = std::sync::Arc::new(set.model.asset(&c.name, &smpl.betas).map_err(|e| FormatError::rig(dir, e))?);
+    }
+    Ok(asset)
+}
+
+/// The motion of `source` carried onto `target` (whose asset is `target_asset`) as
+/// `settings` ask, baked into a keyframed clip of the target's mapped joints.
+pub fn retarget(
+    library: &mut super::AssetLibrary,
+    source: &CharacterDoc,
+    target: &CharacterDoc,
+    target_asset: &CharacterAsset,
+    settings: &RetargetDoc,
+) -> Result<Retargeting, FormatError> {
+    let here = |what: String| FormatError::other(Path::new(&target.name), what);
+    let source_asset = shaped_asset(library, source)?;
+    let source_frames = motion_frames(library, source, &source_asset)?
+        .ok_or_else(|| here(format!("expected {} to have a motion of its own, found none", source.name)))?;
+    let (s_map, t_map) = (humanoid_map(&source_asset, &source.humanoid), humanoid_map(target_asset, &target.humanoid));
+    let (s_skel, t_skel) = (&source_asset.skeleton, &target_asset.skeleton);
+    let (s_floor, t_floor) = (motion_floor(&source_asset, &s_map, &source_frames), floor_of(target_asset));
+    let retargeter = Retargeter::new(
+        Humanoid { skeleton: s_skel, map: &s_map, floor: s_floor },
+        Humanoid { skeleton: t_skel, map: &t_map, floor: t_floor },
+        settings.rest,
+    )
+    .ok_or_else(|| {
+        here(format!(
+            "expected both {} and {} to have hips and two legs in their humanoid maps",
+            source.name, target.name
+        ))
+    })?;
+    let report = retargeter.motion(&source_frames, FPS, settings.plant_feet);
+    let keyed: Vec<usize> = t_map.values().copied().collect();
+    let clip = Clip::from_frames(t_skel, &report.frames, FPS, &keyed);
+    let leg_ratio = retargeter.leg_ratio();
+    Ok(Retargeting { clip, report, leg_ratio, source_frames, floors: (s_floor, t_floor) })
+}
+
+/// The keyframed clip an `AnimDoc` plays on `target` in `scene`: its keys, its file's, or
+/// the motion it retargets.
+pub fn anim_clip(
+    library: &mut super::AssetLibrary,
+    scene: &SceneDoc,
+    target: &CharacterDoc,
+    target_asset: &CharacterAsset,
+    anim: &AnimDoc,
+) -> Result<Clip, FormatError> {
+    match (&anim.keys, &anim.retarget) {
+        (Some(keys), _) => Ok(keys.clone()),
+        (None, Some(settings)) => {
+            let source = motion_source_doc(library, scene, &settings.from)?;
+            Ok(retarget(library, &source, target, target_asset, settings)?.clip)
+        }
+        (None, None) => Ok((*library.keyframe_clip(&anim.file)?).clone()),
+    }
+}

@@ -1,0 +1,457 @@
+//! Retargeting: the motion of one humanoid carried onto another through their humanoid
+//! maps, frame by frame.
+//!
+//! - **Rotations.** Each mapped target bone turns in the world as its source bone turned
+//!   from the source's initial pose, starting from the target's initial pose aligned to the
+//!   source's: with [`RestAlignment::Directions`] each bone's rest is first swung to point
+//!   where the source's rest bone points (so a T-pose clip lifts an A-pose character's arms
+//!   where the clip lifts them), and each frame the bone is swung onto the source bone's
+//!   direction (to its next mapped bone), its twist the source's. With
+//!   [`RestAlignment::OwnRest`] the rotations are carried from rest to rest (the source's
+//!   rest frame gives the target its own rest pose). Rigs facing another way in their
+//!   model space (a multiple of 90° about +y) are turned to face the source's way.
+//! - **Translation.** The hips move as the source's, scaled by the ratio of leg lengths
+//!   (thigh + shin), their height over each one's floor likewise.
+//! - **Feet.** Where the source plants a foot (low and still), the target's foot keeps the
+//!   place it had when the contact began, moving only as the source's foot moves (scaled);
+//!   no foot sinks lower than the source's (mapped to the target's ankle height). The legs
+//!   reach by the IK solver, the feet keeping their turn in the world; after a contact
+//!   the correction fades over a few frames.
+//! - **Limits.** Every rotation is clamped to the target joint's limits; the joints and
+//!   frames clamped are reported.
+
+use glam::{Mat4, Quat, Vec3};
+
+use super::humanoid::{HumanBone, HumanoidMap};
+use super::ik::{IkGoal, solve_ik};
+use super::{JointRotation, Skeleton};
+
+/// How the rest poses of source and target are matched.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize, serde::Deserialize)]
+pub enum RestAlignment {
+    /// Each target bone points where the source's points.
+    #[default]
+    Directions,
+    /// Rotations carried from rest to rest: the source's rest gives the target its own.
+    OwnRest,
+}
+
+/// A humanoid to retarget from or onto: its skeleton, map, and the height of its floor in
+/// model space (its lowest point standing in its initial pose).
+#[derive(Clone, Copy)]
+pub struct Humanoid<'a> {
+    pub skeleton: &'a Skeleton,
+    pub map: &'a HumanoidMap,
+    pub floor: f32,
+}
+
+/// One frame of motion: the root joint's position in model space and every joint's
+/// rotation.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Frame {
+    pub root: Vec3,
+    pub pose: Vec<JointRotation>,
+}
+
+/// A retargeted motion: its frames, which of them hold each foot (left, right) planted,
+/// in which the legs were turned off the source's directions to plant a foot or keep it
+/// above the floor, and the (frame, joint) pairs whose rotation the target's limits
+/// clamped.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct Retargeted {
+    pub frames: Vec<Frame>,
+    pub planted: [Vec<bool>; 2],
+    pub legs_moved: [Vec<bool>; 2],
+    pub clamped: Vec<(usize, usize)>,
+}
+
+/// A mapped target joint and the source joint that drives it.
+struct Bone {
+    target: usize,
+    source: usize,
+    /// The target's rest world rotation turned to line up with the source's rest.
+    aligned_rest: Quat,
+    /// The next mapped joint on each side, where the bone has one.
+    aim: Option<(usize, usize)>,
+}
+
+/// Carries frames of one humanoid's motion onto another. Made once per pair.
+pub struct Retargeter<'a> {
+    source: Humanoid<'a>,
+    target: Humanoid<'a>,
+    rest: RestAlignment,
+    source_rest: Vec<Quat>,
+    source_rest_at: Vec<Vec3>,
+    target_rest_at: Vec<Vec3>,
+    bones: Vec<Option<Bone>>,
+    /// For each unmapped target joint, the source joint of the same name (a rig of the
+    /// same family: fingers, spine joints between mapped ones), whose local turn it takes.
+    namesakes: Vec<Option<usize>>,
+    /// Target leg length over the source's.
+    ratio: f32,
+    source_leg: f32,
+    target_leg: f32,
+}
+
+/// The bones each standard bone points at, the first mapped on both sides taken.
+fn aims(bone: HumanBone) -> &'static [HumanBone] {
+    use HumanBone::*;
+    match bone {
+        Hips => &[Spine, Chest],
+        Spine => &[Chest],
+        Chest => &[Neck, Head],
+        Neck => &[Head],
+        LeftShoulder => &[LeftUpperArm],
+        LeftUpperArm => &[LeftLowerArm],
+        LeftLowerArm => &[LeftHand],
+        RightShoulder => &[RightUpperArm],
+        RightUpperArm => &[RightLowerArm],
+        RightLowerArm => &[RightHand],
+        LeftUpperLeg => &[LeftLowerLeg],
+        LeftLowerLeg => &[LeftFoot],
+        LeftFoot => &[LeftToes],
+        RightUpperLeg => &[RightLowerLeg],
+        RightLowerLeg => &[RightFoot],
+        RightFoot => &[RightToes],
+        Head | LeftHand | RightHand | LeftToes | RightToes => &[],
+    }
+}
+
+/// Each joint's world rotation and position for `pose` with the root at `root`.
+pub fn world_frames(skeleton: &Skeleton, root: Vec3, pose: &[JointRotation]) -> (Vec<Quat>, Vec<Vec3>) {
+    let mut rotations = vec![Quat::IDENTITY; skeleton.len()];
+    for j in 0..skeleton.len() {
+        let parent = skeleton.parent(j).map_or(Quat::IDENTITY, |p| rotations[p]);
+        rotations[j] = (parent * pose[j].to_quat()).normalize();
+    }
+    let mut world = vec![Mat4::IDENTITY; skeleton.len()];
+    let origin = Mat4::from_translation(root - skeleton.joint(0).rest_offset);
+    super::fk::forward_kinematics(skeleton, pose, origin, &mut world);
+    (rotations, world.iter().map(|m| m.w_axis.truncate()).collect())
+}
+
+/// The leg length (thigh + shin, the mean of both legs) in the initial pose.
+pub fn leg_length(map: &HumanoidMap, at: &[Vec3]) -> Option<f32> {
+    use HumanBone::*;
+    let leg = |[upper, lower, foot]: [HumanBone; 3]| {
+        let (u, l, f) = (at[*map.get(&upper)?], at[*map.get(&lower)?], at[*map.get(&foot)?]);
+        Some(u.distance(l) + l.distance(f))
+    };
+    Some((leg([LeftUpperLeg, LeftLowerLeg, LeftFoot])? + leg([RightUpperLeg, RightLowerLeg, RightFoot])?) / 2.0)
+}
+
+/// The turn about +y, a multiple of 90°, that faces the target's hips (right to left leg)
+/// the source's way.
+fn facing(source: &HumanoidMap, s_at: &[Vec3], target: &HumanoidMap, t_at: &[Vec3]) -> Quat {
+    use HumanBone::*;
+    let side = |map: &HumanoidMap, at: &[Vec3]| {
+        let v = at[map[&LeftUpperLeg]] - at[map[&RightUpperLeg]];
+        v.z.atan2(v.x)
+    };
+    let turn = side(target, t_at) - side(source, s_at);
+    let quarter = (turn / std::f32::consts::FRAC_PI_2).round() * std::f32::consts::FRAC_PI_2;
+    Quat::from_rotation_y(quarter)
+}
+
+impl<'a> Retargeter<'a> {
+    /// A retargeter from `source` to `target`; none when either lacks the legs (thigh,
+    /// shin, foot) or the hips.
+    pub fn new(source: Humanoid<'a>, target: Humanoid<'a>, rest: RestAlignment) -> Option<Self> {
+        let (s, t) = (source.skeleton, target.skeleton);
+        let (source_rest, source_rest_at) = world_frames(s, s.joint(0).rest_offset, &s.initial_pose());
+        let (target_rest, target_rest_at) = world_frames(t, t.joint(0).rest_offset, &t.initial_pose());
+        source.map.get(&HumanBone::Hips)?;
+        target.map.get(&HumanBone::Hips)?;
+        let (source_leg, target_leg) =
+            (leg_length(source.map, &source_rest_at)?, leg_length(target.map, &target_rest_at)?);
+        let turn = facing(source.map, &source_rest_at, target.map, &target_rest_at);
+        let mut bones: Vec<Option<Bone>> = (0..t.len()).map(|_| None).collect();
+        for (&bone, &tj) in target.map {
+            let Some(&sj) = source.map.get(&bone) else { continue };
+            // Only a bone below it is one the joint's turn can aim.
+            let below = |map: &HumanoidMap, skeleton: &Skeleton, b: &HumanBone, j: usize| {
+                map.get(b).copied().filter(|&c| is_below(skeleton, c, j))
+            };
+            let next =
+                aims(bone).iter().find_map(|b| Some((below(target.map, t, b, tj)?, below(source.map, s, b, sj)?)));
+            let turned_rest = turn * target_rest[tj];
+            let (aligned_rest, aim) = match next {
+                Some((tc, sc)) => {
+                    let t_dir = (target_rest_at[tc] - target_rest_at[tj]).normalize_or_zero();
+                    let s_dir = (source_rest_at[sc] - source_rest_at[sj]).normalize_or_zero();
+                    let swing = match rest {
+                        RestAlignment::Directions => Quat::from_rotation_arc(turn * t_dir, s_dir),
+                        RestAlignment::OwnRest => Quat::IDENTITY,
+                    };
+                    ((swing * turned_rest).normalize(), Some((tc, sc)))
+                }
+                None => (turned_rest, None),
+            };
+            bones[tj] = Some(Bone { target: tj, source: sj, aligned_rest, aim });
+        }
+        // A bone without a direction of its own (a hand, the head) keeps its rest as it
+        // lies on its parent bone's aligned rest.
+        for j in 0..t.len() {
+            let Some(bone) = &bones[j] else { continue };
+            if bone.aim.is_some() || rest == RestAlignment::OwnRest {
+                continue;
+            }
+            let mut p = t.parent(j);
+            while let Some(up) = p {
+                if let Some(parent) = &bones[up] {
+                    let carried = parent.aligned_rest * target_rest[up].inverse() * target_rest[j];
+                    bones[j].as_mut().expect("checked above").aligned_rest = carried.normalize();
+                    break;
+                }
+                p = t.parent(up);
+            }
+        }
+        let namesakes =
+            (0..t.len()).map(|j| if bones[j].is_some() { None } else { s.find(&t.joint(j).name) }).collect();
+        Some(Self {
+            source,
+            target,
+            rest,
+            namesakes,
+            source_rest,
+            source_rest_at,
+            target_rest_at,
+            bones,
+            ratio: target_leg / source_leg.max(1e-9),
+            source_leg,
+            target_leg,
+        })
+    }
+
+    /// Target leg length over the source's.
+    pub fn leg_ratio(&self) -> f32 {
+        self.ratio
+    }
+
+    /// The source's frame carried onto the target (no feet planted), and the joints whose
+    /// rotations the target's limits clamped.
+    pub fn frame(&self, source: &Frame) -> (Frame, Vec<usize>) {
+        let (s, t) = (self.source.skeleton, self.target.skeleton);
+        let (s_rot, s_at) = world_frames(s, source.root, &source.pose);
+        let mut pose = t.initial_pose();
+        let mut world = vec![Quat::IDENTITY; t.len()];
+        let mut clamped = Vec::new();
+        // Unmapped joints first (they hang on no mapped turn): their namesakes' turns.
+        for (j, rotation) in pose.iter_mut().enumerate() {
+            if let (None, Some(sj)) = (&self.bones[j], self.namesakes[j]) {
+                *rotation = rotation.with_rotation_of(source.pose[sj].to_quat()).clamped(&t.joint(j).limits);
+            }
+        }
+        for j in 0..t.len() {
+            let parent = t.parent(j).map_or(Quat::IDENTITY, |p| world[p]);
+            if let Some(bone) = &self.bones[j] {
+                let turned = (s_rot[bone.source] * self.source_rest[bone.source].inverse()).normalize();
+                let mut wanted = (turned * bone.aligned_rest).normalize();
+                if let (RestAlignment::Directions, Some((tc, sc))) = (self.rest, bone.aim) {
+                    let local = reach_in_frame(t, &pose, j, tc).normalize_or_zero();
+                    let now = (s_at[sc] - s_at[bone.source]).normalize_or_zero();
+                    if now != Vec3::ZERO && local != Vec3::ZERO {
+                        wanted = (Quat::from_rotation_arc((wanted * local).normalize(), now) * wanted).normalize();
+                    }
+                }
+                let free = pose[j].with_rotation_of((parent.inverse() * wanted).normalize());
+                let held = free.clamped(&t.joint(bone.target).limits);
+                let (a, b) = (held.to_quat(), free.to_quat());
+                if (a - b).length().min((a + b).length()) > 1e-4 {
+                    clamped.push(j);
+                }
+                pose[j] = held;
+            }
+            world[j] = (parent * pose[j].to_quat()).normalize();
+        }
+        let root = self.placed_root(&s_at, &pose);
+        (Frame { root, pose }, clamped)
+    }
+
+    /// The target root that puts its hips where the source's are, scaled by the leg ratio:
+    /// across from their rests, and their height over the floor.
+    fn placed_root(&self, s_at: &[Vec3], pose: &[JointRotation]) -> Vec3 {
+        let t = self.target.skeleton;
+        let (sh, th) = (self.source.map[&HumanBone::Hips], self.target.map[&HumanBone::Hips]);
+        let root_offset = t.joint(0).rest_offset;
+        let (_, at) = world_frames(t, root_offset, pose);
+        let moved = (s_at[sh] - self.source_rest_at[sh]) * self.ratio;
+        let mut wanted = self.target_rest_at[th] + moved;
+        wanted.y = self.target.floor + (s_at[sh].y - self.source.floor) * self.ratio;
+        root_offset + (wanted - at[th])
+    }
+
+    /// Every frame carried onto the target (`fps` frames a second), with the source's
+    /// planted feet kept planted when `plant`.
+    pub fn motion(&self, frames: &[Frame], fps: f32, plant: bool) -> Retargeted {
+        let mut out = Retargeted::default();
+        for (f, frame) in frames.iter().enumerate() {
+            let (carried, clamped) = self.frame(frame);
+            out.clamped.extend(clamped.into_iter().map(|j| (f, j)));
+            out.frames.push(carried);
+        }
+        use HumanBone::*;
+        for (k, (bone, toes)) in [(LeftFoot, LeftToes), (RightFoot, RightToes)].into_iter().enumerate() {
+            if let (Some(&sf), Some(&tf)) = (self.source.map.get(&bone), self.target.map.get(&bone)) {
+                let toes = self.target.map.get(&toes).copied();
+                (out.planted[k], out.legs_moved[k]) =
+                    self.plant_foot(frames, &mut out.frames, fps, (sf, tf, toes), plant);
+            }
+        }
+        out
+    }
+
+    /// Keeps the source's planted foot `sf` planted on the target's `tf` (with `plant`),
+    /// and the target's foot and its toes above the floor: which frames hold it, and in
+    /// which the leg was moved.
+    fn plant_foot(
+        &self,
+        source: &[Frame],
+        target: &mut [Frame],
+        fps: f32,
+        (sf, tf, toes): (usize, usize, Option<usize>),
+        plant: bool,
+    ) -> (Vec<bool>, Vec<bool>) {
+        let (s, t) = (self.source.skeleton, self.target.skeleton);
+        let s_foot: Vec<Vec3> = source.iter().map(|f| world_frames(s, f.root, &f.pose).1[sf]).collect();
+        let mut planted = planted_frames(&s_foot, fps, self.source.floor, self.source_rest_at[sf].y, self.source_leg);
+        planted.iter_mut().for_each(|p| *p &= plant);
+        let (s_ankle, t_ankle) =
+            (self.source_rest_at[sf].y - self.source.floor, self.target_rest_at[tf].y - self.target.floor);
+        // The lowest the target's ankle may go, for the source's ankle at `y`.
+        let lowest = |y: f32| self.target.floor + (t_ankle + (y - self.source.floor - s_ankle) * self.ratio).max(0.0);
+        let fade = (fps * 0.15).round().max(1.0) as usize;
+        let mut anchor: Option<(Vec3, Vec3)> = None;
+        let mut last_fix = Vec3::ZERO;
+        let mut since_contact = usize::MAX;
+        let mut moved = vec![false; target.len()];
+        for f in 0..target.len() {
+            let free = world_frames(t, target[f].root, &target[f].pose).1[tf];
+            let floor_fix = Vec3::Y * (lowest(s_foot[f].y) - free.y).max(0.0);
+            let goal = if planted[f] {
+                let (start_target, start_source) = *anchor.get_or_insert((free + floor_fix, s_foot[f]));
+                since_contact = 0;
+                (start_target + (s_foot[f] - start_source) * self.ratio).max_y(lowest(s_foot[f].y))
+            } else {
+                anchor = None;
+                since_contact = since_contact.saturating_add(1);
+                let fading = if since_contact <= fade {
+                    last_fix * (1.0 - since_contact as f32 / (fade + 1) as f32)
+                } else {
+                    Vec3::ZERO
+                };
+                (free + fading).max_y(lowest(s_foot[f].y))
+            };
+            last_fix = if planted[f] { goal - free } else { last_fix };
+            if goal.distance(free) > 1e-6 * self.target_leg {
+                self.reach(&mut target[f], tf, goal);
+                moved[f] = true;
+            }
+            if let Some(toes) = toes {
+                self.lift_toes(&mut target[f], tf, toes);
+            }
+        }
+        (planted, moved)
+    }
+
+    /// Turns the target's foot `foot` up about its ankle as far as keeps its toes `toes`
+    /// on the floor, where they would go below it.
+    fn lift_toes(&self, frame: &mut Frame, foot: usize, toes: usize) {
+        let t = self.target.skeleton;
+        let (rotations, at) = world_frames(t, frame.root, &frame.pose);
+        let floor = self.target.floor;
+        let (ankle, tip) = (at[foot], at[toes]);
+        if tip.y >= floor || ankle.y <= floor {
+            return;
+        }
+        let along = tip - ankle;
+        let (length, flat) = (along.length(), Vec3::new(along.x, 0.0, along.z));
+        let drop = floor - ankle.y;
+        let wanted = (flat.normalize_or_zero() * (length * length - drop * drop).max(0.0).sqrt()) + Vec3::Y * drop;
+        let turn = Quat::from_rotation_arc(along.normalize(), wanted.normalize());
+        let parent = t.parent(foot).map_or(Quat::IDENTITY, |p| rotations[p]);
+        let local = (parent.inverse() * turn * rotations[foot]).normalize();
+        frame.pose[foot] = frame.pose[foot].with_rotation_of(local).clamped(&t.joint(foot).limits);
+    }
+
+    /// Moves the target's foot `foot` to `goal` by IK on its leg, the foot keeping its turn
+    /// in the world.
+    fn reach(&self, frame: &mut Frame, foot: usize, goal: Vec3) {
+        let t = self.target.skeleton;
+        let origin = Mat4::from_translation(frame.root - t.joint(0).rest_offset);
+        let (before, _) = world_frames(t, frame.root, &frame.pose);
+        let tolerance = 1e-4 * self.target_leg;
+        solve_ik(t, &mut frame.pose, origin, &[IkGoal { end: foot, target: goal }], tolerance, 8);
+        let (after, _) = world_frames(t, frame.root, &frame.pose);
+        if let Some(p) = t.parent(foot) {
+            let local = (after[p].inverse() * before[foot]).normalize();
+            frame.pose[foot] = frame.pose[foot].with_rotation_of(local).clamped(&t.joint(foot).limits);
+        }
+    }
+}
+
+/// Where joint `below` lies in joint `j`'s turned frame, through the turns `pose` gives
+/// the joints between them.
+fn reach_in_frame(skeleton: &Skeleton, pose: &[JointRotation], j: usize, below: usize) -> Vec3 {
+    let mut at = skeleton.joint(below).rest_offset;
+    let mut k = below;
+    while let Some(p) = skeleton.parent(k).filter(|&p| p != j) {
+        at = skeleton.joint(p).rest_offset + pose[p].to_quat() * at;
+        k = p;
+    }
+    at
+}
+
+/// Whether `j` lies below `ancestor` in the tree.
+fn is_below(skeleton: &Skeleton, mut j: usize, ancestor: usize) -> bool {
+    while let Some(p) = skeleton.parent(j) {
+        if p == ancestor {
+            return true;
+        }
+        j = p;
+    }
+    false
+}
+
+trait MaxY {
+    fn max_y(self, y: f32) -> Self;
+}
+
+impl MaxY for Vec3 {
+    fn max_y(self, y: f32) -> Self {
+        Vec3::new(self.x, self.y.max(y), self.z)
+    }
+}
+
+/// The frames in which a foot at `at` (a position per frame) is planted: still (slower
+/// than a tenth of its leg length a second) and low (its ankle within a quarter leg of its
+/// standing height over the floor).
+pub fn planted_frames(at: &[Vec3], fps: f32, floor: f32, standing: f32, leg: f32) -> Vec<bool> {
+    let n = at.len();
+    (0..n)
+        .map(|f| {
+            let (a, b) = (f.saturating_sub(1), (f + 1).min(n.saturating_sub(1)));
+            let span = (b - a).max(1) as f32 / fps;
+            let speed = at[b].distance(at[a]) / span;
+            let height = at[f].y - floor;
+            speed < 0.1 * leg && height < (standing - floor) + 0.25 * leg
+        })
+        .collect()
+}
+
+/// `source_pose` of the source carried onto the target, rotations only (the pose library,
+/// copy and paste): each mapped bone turned as the source's from rest to rest.
+pub fn retarget_pose(
+    source: (&Skeleton, &HumanoidMap),
+    source_pose: &[JointRotation],
+    target: (&Skeleton, &HumanoidMap),
+    rest: RestAlignment,
+) -> Option<Vec<JointRotation>> {
+    let retargeter = Retargeter::new(
+        Humanoid { skeleton: source.0, map: source.1, floor: 0.0 },
+        Humanoid { skeleton: target.0, map: target.1, floor: 0.0 },
+        rest,
+    )?;
+    let frame = Frame { root: source.0.joint(0).rest_offset, pose: source_pose.to_vec() };
+    Some(retargeter.frame(&frame).0.pose)
+}

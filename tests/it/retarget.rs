@@ -1,0 +1,289 @@
+//! Retargeting clips between humanoids of different origins, checked from the joints'
+//! world positions (this file's own forward kinematics walk, not the retargeter's): bone
+//! directions against the source's, the hips' height over the floor against the source's
+//! times the leg ratio, feet above the floor, and feet the source keeps still kept still.
+
+use std::path::{Path, PathBuf};
+
+use glam::{Mat4, Vec3};
+use marionette::document::AssetLibrary;
+use marionette::document::retarget::{file_motion_doc, humanoid_map, retarget, shaped_asset};
+use marionette::formats::scene::{CharacterDoc, MotionSourceDoc, RetargetDoc, SourceDoc};
+use marionette::rig::humanoid::{HumanBone, HumanoidMap};
+use marionette::rig::retarget::{Frame, Retargeted};
+use marionette::rig::{CharacterAsset, JointRotation, Skeleton};
+
+use crate::common::optional_data_dir;
+
+/// Each joint's world position: the root at `root`, then parent · T(offset) · R, walked
+/// here by hand.
+fn positions(skeleton: &Skeleton, root: Vec3, pose: &[JointRotation]) -> Vec<Vec3> {
+    let mut world: Vec<Mat4> = Vec::with_capacity(skeleton.len());
+    for (j, joint) in skeleton.joints().iter().enumerate() {
+        let offset = if j == 0 { root } else { joint.rest_offset };
+        let local = Mat4::from_translation(offset) * Mat4::from_quat(pose[j].to_quat());
+        let parent = skeleton.parent(j).map_or(Mat4::IDENTITY, |p| world[p]);
+        world.push(parent * local);
+    }
+    world.iter().map(|m| m.w_axis.truncate()).collect()
+}
+
+/// The bones whose directions are compared: (bone, the bone it points at).
+const AIMED: [(HumanBone, HumanBone); 14] = {
+    use HumanBone::*;
+    [
+        (Hips, Spine),
+        (Chest, Neck),
+        (LeftUpperArm, LeftLowerArm),
+        (LeftLowerArm, LeftHand),
+        (RightUpperArm, RightLowerArm),
+        (RightLowerArm, RightHand),
+        (LeftUpperLeg, LeftLowerLeg),
+        (LeftLowerLeg, LeftFoot),
+        (RightUpperLeg, RightLowerLeg),
+        (RightLowerLeg, RightFoot),
+        (Hips, Chest),
+        (Chest, Head),
+        (LeftShoulder, LeftUpperArm),
+        (RightShoulder, RightUpperArm),
+    ]
+};
+
+/// The figures of one retargeting.
+#[derive(Debug, Default)]
+struct Figures {
+    /// The worst angle (degrees) between a target bone and its source bone, and which.
+    worst_direction: (f32, String),
+    /// The range of target hips height over the source's, over the leg ratio.
+    hips_ratio: (f32, f32),
+    /// The lowest foot joint over the floor, in target leg lengths.
+    lowest_foot: f32,
+    /// The worst slide of a target foot while its source foot stays still (≥ 5 frames), in
+    /// target leg lengths; and how many such stretches there were.
+    worst_slide: f32,
+    still_stretches: usize,
+    /// Bone-frames not compared because the report says they were clamped or moved.
+    excused: usize,
+}
+
+struct Side {
+    asset: std::sync::Arc<CharacterAsset>,
+    map: HumanoidMap,
+    floor: f32,
+    leg: f32,
+}
+
+fn side(library: &mut AssetLibrary, doc: &CharacterDoc, floor: f32) -> Side {
+    let asset = shaped_asset(library, doc).unwrap();
+    let map = humanoid_map(&asset, &doc.humanoid);
+    let skeleton = &asset.skeleton;
+    let at = positions(skeleton, skeleton.joint(0).rest_offset, &skeleton.initial_pose());
+    use HumanBone::*;
+    let leg = |u, l, f| at[map[&u]].distance(at[map[&l]]) + at[map[&l]].distance(at[map[&f]]);
+    let leg = (leg(LeftUpperLeg, LeftLowerLeg, LeftFoot) + leg(RightUpperLeg, RightLowerLeg, RightFoot)) / 2.0;
+    Side { asset, map, floor, leg }
+}
+
+/// Whether `j` lies below `ancestor`.
+fn below(skeleton: &Skeleton, j: usize, ancestor: usize) -> bool {
+    let mut up = skeleton.parent(j);
+    while let Some(p) = up {
+        if p == ancestor {
+            return true;
+        }
+        up = skeleton.parent(p);
+    }
+    false
+}
+
+/// The legs of each side, for skipping where the report says a leg was moved.
+const LEGS: [[HumanBone; 2]; 2] =
+    [[HumanBone::LeftUpperLeg, HumanBone::LeftLowerLeg], [HumanBone::RightUpperLeg, HumanBone::RightLowerLeg]];
+
+fn measure(s: &Side, source: &[Frame], t: &Side, report: &Retargeted) -> Figures {
+    let target = &report.frames;
+    let mut figures =
+        Figures { hips_ratio: (f32::INFINITY, f32::NEG_INFINITY), lowest_foot: f32::INFINITY, ..Default::default() };
+    let ratio = t.leg / s.leg;
+    let (s_at, t_at): (Vec<Vec<Vec3>>, Vec<Vec<Vec3>>) = source
+        .iter()
+        .zip(target)
+        .map(|(a, b)| (positions(&s.asset.skeleton, a.root, &a.pose), positions(&t.asset.skeleton, b.root, &b.pose)))
+        .unzip();
+    for (f, (sa, ta)) in s_at.iter().zip(&t_at).enumerate() {
+        for (bone, next) in AIMED {
+            let (Some(&sj), Some(&sn), Some(&tj), Some(&tn)) =
+                (s.map.get(&bone), s.map.get(&next), t.map.get(&bone), t.map.get(&next))
+            else {
+                continue;
+            };
+            // The bone's mapped child: the spine, else the chest; the neck, else the head.
+            let first_choice = |b: HumanBone| {
+                [(HumanBone::Hips, HumanBone::Spine), (HumanBone::Chest, HumanBone::Neck)]
+                    .iter()
+                    .find(|(k, _)| *k == b)
+                    .map(|(_, c)| *c)
+            };
+            if first_choice(bone).is_some_and(|c| c != next && s.map.contains_key(&c) && t.map.contains_key(&c)) {
+                continue;
+            }
+            if !below(&t.asset.skeleton, tn, tj) || !below(&s.asset.skeleton, sn, sj) {
+                continue;
+            }
+            // Where the report says the target's limits clamped the bone, or its leg was
+            // moved to plant the foot or keep it above the floor.
+            let moved = (0..2).any(|k| report.legs_moved[k][f] && LEGS[k].contains(&bone));
+            if moved || report.clamped.contains(&(f, tj)) {
+                figures.excused += 1;
+                continue;
+            }
+            let angle = (sa[sn] - sa[sj]).angle_between(ta[tn] - ta[tj]).to_degrees();
+            if angle > figures.worst_direction.0 {
+                figures.worst_direction = (angle, format!("{bone:?}"));
+            }
+        }
+        let h = HumanBone::Hips;
+        let hips = (ta[t.map[&h]].y - t.floor) / ((sa[s.map[&h]].y - s.floor) * ratio);
+        figures.hips_ratio = (figures.hips_ratio.0.min(hips), figures.hips_ratio.1.max(hips));
+        for foot in [HumanBone::LeftFoot, HumanBone::RightFoot, HumanBone::LeftToes, HumanBone::RightToes] {
+            if let Some(&j) = t.map.get(&foot) {
+                figures.lowest_foot = figures.lowest_foot.min((ta[j].y - t.floor) / t.leg);
+            }
+        }
+    }
+    // Stretches of at least 5 frames over which the source's foot stays within 0.5 % of
+    // its leg length of where it was at their start (and near the floor).
+    for foot in [HumanBone::LeftFoot, HumanBone::RightFoot] {
+        let (sj, tj) = (s.map[&foot], t.map[&foot]);
+        let mut start = 0;
+        while start < s_at.len() {
+            let mut end = start;
+            while end + 1 < s_at.len() && s_at[end + 1][sj].distance(s_at[start][sj]) < 0.005 * s.leg {
+                end += 1;
+            }
+            if end - start + 1 >= 5 {
+                figures.still_stretches += 1;
+                let slide = (start..=end).map(|f| t_at[f][tj].distance(t_at[start][tj])).fold(0.0, f32::max);
+                figures.worst_slide = figures.worst_slide.max(slide / t.leg);
+            }
+            start = end + 1;
+        }
+    }
+    figures
+}
+
+fn doc_of(library: &mut AssetLibrary, path: &Path) -> CharacterDoc {
+    let source = SourceDoc::File(path.to_path_buf());
+    let asset = library.load(&source).unwrap();
+    library.new_character_doc(source, &asset)
+}
+
+/// Every source with a clip of its own onto every target, the figures printed and held to
+/// the bounds.
+#[test]
+fn clips_carry_across_humanoids_of_every_origin() {
+    let Some(data) = optional_data_dir() else { return };
+    let mut library = AssetLibrary::default();
+    let sources: Vec<(PathBuf, Option<&str>)> = vec![
+        (data.join("smpl"), Some("7516")),
+        (data.join("smpl"), Some("8806")),
+        (data.join("khronos/CesiumMan.glb"), None),
+        (data.join("khronos/RiggedFigure.glb"), None),
+    ];
+    let mut targets: Vec<CharacterDoc> = ["Model1", "Model2", "Model3", "Model4"]
+        .iter()
+        .map(|m| doc_of(&mut library, &data.join(format!("mit6837/{m}.skel"))))
+        .collect();
+    targets.push(CharacterDoc::new(SourceDoc::Embedded("puppet".into()), "puppet"));
+    for f in ["smpl", "khronos/CesiumMan.glb", "khronos/RiggedFigure.glb"] {
+        targets.push(doc_of(&mut library, &data.join(f)));
+    }
+    let mut stretches = 0;
+    for (path, clip) in &sources {
+        let source = file_motion_doc(&mut library, path, *clip).unwrap();
+        for target in &targets {
+            let asset = shaped_asset(&mut library, target).unwrap();
+            for plant in [false, true] {
+                let settings = RetargetDoc {
+                    plant_feet: plant,
+                    ..RetargetDoc::of(MotionSourceDoc::File { path: path.clone(), clip: clip.map(str::to_owned) })
+                };
+                let done = retarget(&mut library, &source, target, &asset, &settings).unwrap();
+                let (s, t) = (side(&mut library, &source, done.floors.0), side(&mut library, target, done.floors.1));
+                let figures = measure(&s, &done.source_frames, &t, &done.report);
+                eprintln!(
+                    "{plant} {} {} → {}: worst direction {:.2}° ({}), hips height / (source's × leg ratio) {:.4}–{:.4}, lowest foot {:+.4} legs, {} still stretches, worst slide {:.4} legs, {} clamped, {} bone-frames excused",
+                    path.file_name().unwrap().to_string_lossy(),
+                    clip.unwrap_or(""),
+                    target.name,
+                    figures.worst_direction.0,
+                    figures.worst_direction.1,
+                    figures.hips_ratio.0,
+                    figures.hips_ratio.1,
+                    figures.lowest_foot,
+                    figures.still_stretches,
+                    figures.worst_slide,
+                    done.report.clamped.len(),
+                    figures.excused,
+                );
+                assert!(figures.worst_direction.0 < 2.0, "{}: {:?}", target.name, figures.worst_direction);
+                assert!(
+                    figures.hips_ratio.0 > 0.98 && figures.hips_ratio.1 < 1.02,
+                    "{}: {:?}",
+                    target.name,
+                    figures.hips_ratio
+                );
+                assert!(
+                    figures.lowest_foot > -1e-3,
+                    "{}: a foot {} legs below the floor",
+                    target.name,
+                    figures.lowest_foot
+                );
+                assert!(figures.worst_slide < 0.01, "{}: a still foot slid {} legs", target.name, figures.worst_slide);
+                stretches += figures.still_stretches;
+            }
+        }
+    }
+    assert!(stretches > 0, "some source keeps a foot still");
+}
+
+/// Quaternions equal within `tolerance`, either sign.
+fn same_rotation(a: glam::Quat, b: glam::Quat, tolerance: f32) -> bool {
+    (a - b).length().min((a + b).length()) < tolerance
+}
+
+/// A clip retargeted onto its own character is that clip: every joint's rotation and the
+/// root within 1e-5 (the root lifted onto the floor where the clip dips below it), for the
+/// SMPL body (its clip stood upright) and CesiumMan.
+#[test]
+fn a_clip_retargeted_onto_its_own_character_is_itself() {
+    let Some(data) = optional_data_dir() else { return };
+    let mut library = AssetLibrary::default();
+    for (path, clip) in [(data.join("smpl"), Some("7516")), (data.join("khronos/CesiumMan.glb"), None)] {
+        let source = file_motion_doc(&mut library, &path, clip).unwrap();
+        let asset = shaped_asset(&mut library, &source).unwrap();
+        let settings = RetargetDoc::of(MotionSourceDoc::File { path: path.clone(), clip: clip.map(str::to_owned) });
+        let done = retarget(&mut library, &source, &source, &asset, &settings).unwrap();
+        assert!(done.report.clamped.is_empty());
+        eprintln!("{path:?}: floors {:?}", done.floors);
+        assert_eq!(done.report.frames.len(), done.source_frames.len());
+        for (f, (got, want)) in done.report.frames.iter().zip(&done.source_frames).enumerate() {
+            // The clip stands on its own floor (the SMPL clips hang from a fixed root and dip
+            // below the body's floor; retargeted, the body stands on it): the root lifted by
+            // the difference of the floors, and nothing else.
+            let lift = glam::Vec3::Y * (done.floors.1 - done.floors.0);
+            assert!(
+                got.root.distance(want.root + lift) < 1e-5,
+                "{path:?} frame {f}: root {} against {}",
+                got.root,
+                want.root
+            );
+            for (j, (a, b)) in got.pose.iter().zip(&want.pose).enumerate() {
+                assert!(
+                    same_rotation(a.to_quat(), b.to_quat(), 1e-5),
+                    "{path:?} frame {f} joint {j}: {a:?} against {b:?}"
+                );
+            }
+        }
+    }
+}
