@@ -25,7 +25,7 @@ fn run(cli: Cli) -> Result<()> {
             let edits = marionette::editor::StartupEdits {
                 anim: clip.anim_doc(true),
                 time: clip.time,
-                clip: clip.clip.clone(),
+                clip: clip.own_clip(),
                 ..Default::default()
             };
             marionette::editor::run(paths, edits)
@@ -41,7 +41,7 @@ fn run(cli: Cli) -> Result<()> {
                 match_height,
                 anim: clip.anim_doc(false),
                 time: clip.time,
-                clip: clip.clip.clone(),
+                clip: clip.own_clip(),
                 view: shot.view,
                 ortho: shot.ortho,
                 transparent: shot.transparent,

@@ -242,10 +242,27 @@ pub struct ClipArgs {
     /// character of the file it moves (without it the file's node transforms are the pose).
     #[arg(long, value_name = "NAME|INDEX")]
     pub clip: Option<String>,
+    /// The motion of another humanoid, carried onto the characters through their humanoid
+    /// maps: a glTF file (`--clip` picks its animation), an SMPL folder (`--clip 7516`), a
+    /// `.bvh`, or a character file with `--anim FILE`.
+    #[arg(long, value_name = "FILE")]
+    pub retarget: Option<PathBuf>,
 }
 
 impl ClipArgs {
+    /// `--clip` for the characters themselves (with `--retarget` it picks the source's).
+    pub fn own_clip(&self) -> Option<String> {
+        self.clip.clone().filter(|_| self.retarget.is_none())
+    }
+
     pub fn anim_doc(&self, playing: bool) -> Option<crate::formats::scene::AnimDoc> {
+        use crate::formats::scene::{AnimDoc, MotionSourceDoc, RetargetDoc};
+        if let Some(path) = &self.retarget {
+            let clip = self.anim.as_ref().map(|a| a.display().to_string()).or_else(|| self.clip.clone());
+            let from = MotionSourceDoc::File { path: path.clone(), clip };
+            let time = self.time.unwrap_or(0.0);
+            return Some(AnimDoc { retarget: Some(RetargetDoc::of(from)), time, playing, ..AnimDoc::default() });
+        }
         let file = self.anim.clone()?;
         Some(crate::formats::scene::AnimDoc {
             time: self.time.unwrap_or(0.0),

@@ -14,6 +14,9 @@ use crate::formats::{load_character, obj};
 
 /// Runs `export`: a glTF file's characters, a scene as glTF, or a character as OBJ or glTF.
 pub fn run(a: &ExportArgs) -> Result<()> {
+    if a.clip.retarget.is_some() {
+        return export_retargeted(a);
+    }
     if crate::formats::has_parts(&a.path) {
         return export_gltf_file(&a.path, &a.out, &a.poses, a.skinning.into(), &a.clip, a.bake, a.animation);
     }
@@ -30,6 +33,35 @@ pub fn run(a: &ExportArgs) -> Result<()> {
         return Ok(());
     }
     export_character(a)
+}
+
+/// `export TARGET --retarget SOURCE`: the target's characters playing the source's motion
+/// (at `--time`; with `--animation` the retargeted clip goes out), each retargeting
+/// described.
+fn export_retargeted(a: &ExportArgs) -> Result<()> {
+    let mut library = crate::document::AssetLibrary::default();
+    let mut doc = crate::formats::scene::SceneDoc::default();
+    let anim = a.clip.anim_doc(false).expect("--retarget makes a clip");
+    let settings = anim.retarget.clone().expect("--retarget sets it");
+    for source in library.sources_of(&a.path) {
+        let asset = library.load(&source)?;
+        let mut c = library.new_character_doc(source, &asset);
+        c.playback = None;
+        c.anim = Some(anim.clone());
+        let from = crate::document::retarget::motion_source_doc(&mut library, &doc, &settings.from)?;
+        let done = crate::document::retarget::retarget(&mut library, &from, &c, &asset, &settings)?;
+        eprintln!("{}", crate::document::retarget::describe(&done, &from.name, &c.name, &asset.skeleton));
+        doc.characters.push(c);
+    }
+    if is_glb(&a.out) {
+        let glb = crate::document::export::scene_glb(&doc, mesh_kind(a.bake), a.animation)?;
+        write_file(&a.out, |w| w.write_all(&glb))?;
+    } else {
+        let (positions, triangles) = crate::document::export::scene_mesh(&doc)?;
+        write_file(&a.out, |w| obj::write_obj(w, &positions, &triangles))?;
+    }
+    println!("wrote {} ({} characters)", a.out.display(), doc.characters.len());
+    Ok(())
 }
 
 fn mesh_kind(bake: bool) -> GltfMesh {

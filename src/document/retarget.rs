@@ -300,3 +300,21 @@ pub fn anim_clip(
         (None, None) => Ok((*library.keyframe_clip(&anim.file)?).clone()),
     }
 }
+
+/// One line on what a retargeting did: frames, the leg ratio, the frames each foot was
+/// planted, and the joints the target's limits clamped (with how many frames).
+pub fn describe(done: &Retargeting, source: &str, target: &str, skeleton: &crate::rig::Skeleton) -> String {
+    let report = &done.report;
+    let planted = |k: usize| report.planted[k].iter().filter(|&&p| p).count();
+    let mut clamped: std::collections::BTreeMap<usize, usize> = Default::default();
+    report.clamped.iter().for_each(|&(_, j)| *clamped.entry(j).or_default() += 1);
+    let clamped: Vec<String> = clamped.iter().map(|(&j, n)| format!("{} ({n})", skeleton.joint(j).name)).collect();
+    format!(
+        "{target}: {} frames of {source}'s motion, leg ratio {:.3}, feet planted in {} (left) and {} (right) frames; clamped by the limits: {}",
+        report.frames.len(),
+        done.leg_ratio,
+        planted(0),
+        planted(1),
+        if clamped.is_empty() { "none".to_string() } else { clamped.join(", ") }
+    )
+}

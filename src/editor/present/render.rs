@@ -22,6 +22,7 @@ use crate::editor::present::view::ViewPlugin;
 use crate::editor::scene_doc::document::Library;
 use crate::editor::state::{Messages, StartupEdits, StartupPaths};
 use crate::formats::scene::{BackgroundDoc, BindingDoc, ShotDoc, SourceDoc};
+use crate::formats::scene::{MotionSourceDoc, RetargetDoc};
 use crate::scene::{RigCorePlugin, SkinningPlugin};
 
 /// Seconds after which the render gives up, saying what was still pending.
@@ -177,14 +178,19 @@ fn preload(paths: &[PathBuf], edits: &StartupEdits) -> Result<(AssetLibrary, Sho
             .characters
             .into_iter()
             .map(|c| {
-                let clip = c.anim.filter(|a| a.keys.is_none()).map(|a| a.file);
+                let clip = c.anim.filter(|a| a.keys.is_none() && a.retarget.is_none()).map(|a| a.file);
                 (c.source, c.binding, clip, format!(" (character `{}` of {})", c.name, scene.display()))
             })
             .collect(),
         None => paths.iter().flat_map(|p| library.sources_of(p)).map(|s| (s, None, None, String::new())).collect(),
     };
-    if let Some(anim) = &edits.anim {
-        sources.iter_mut().for_each(|s| s.2 = Some(anim.file.clone()));
+    match edits.anim.as_ref().map(|a| (&a.retarget, &a.file)) {
+        // `--retarget`: the file whose motion plays must load too.
+        Some((Some(RetargetDoc { from: MotionSourceDoc::File { path, .. }, .. }), _)) => {
+            sources.push((SourceDoc::File(path.clone()), None, None, " (--retarget)".into()));
+        }
+        Some((_, file)) => sources.iter_mut().for_each(|s| s.2 = Some(file.clone())),
+        None => {}
     }
     let errors: Vec<String> = sources
         .iter()

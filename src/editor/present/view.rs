@@ -234,6 +234,9 @@ fn put_clip_on_fitting_characters(
     library: &mut AssetLibrary,
     messages: &mut Messages,
 ) {
+    if anim.retarget.is_some() {
+        return put_motion_on_humanoids(doc, anim, library, messages);
+    }
     let clip = match library.keyframe_clip(&anim.file) {
         Ok(clip) => clip,
         Err(e) => return messages.push(e.to_string()),
@@ -255,6 +258,26 @@ fn put_clip_on_fitting_characters(
             anim.file.display(),
             clip.channels.len()
         ));
+    }
+}
+
+/// Puts a retargeted motion on every character with a humanoid map; says when none has one.
+fn put_motion_on_humanoids(
+    doc: &mut crate::formats::scene::SceneDoc,
+    anim: &crate::formats::scene::AnimDoc,
+    library: &mut AssetLibrary,
+    messages: &mut Messages,
+) {
+    let mut fitted = 0;
+    for c in &mut doc.characters {
+        if library.load(&c.source).is_ok_and(|a| crate::rig::humanoid::detect(&a.skeleton).is_some()) {
+            c.anim = Some(anim.clone());
+            fitted += 1;
+        }
+    }
+    if fitted == 0 {
+        messages
+            .push("--retarget: no character has a humanoid map (two legs, two arms) to take the motion".to_string());
     }
 }
 
