@@ -14,7 +14,7 @@ use crate::editor::interact::camera::Bookmarks;
 use crate::editor::present::stage::{ShotSettings, StageSettings};
 use crate::editor::scene_doc::attach::Attached;
 use crate::editor::scene_doc::document::{
-    CharacterIndex, Library, NextCharacterId, SceneCharacter, SceneReader, spawn_from_doc,
+    CharacterIndex, HumanoidBones, Library, NextCharacterId, SceneCharacter, SceneReader, spawn_from_doc,
 };
 use crate::editor::state::Messages;
 use crate::formats::scene::{AnimDoc, BindingDoc, CharacterDoc, CharacterId};
@@ -188,6 +188,11 @@ pub fn inverse_of(world: &mut World, edit: &Edit) -> Result<Option<Edit>, String
                 undo,
             )
         }
+        Edit::Humanoid { character, bones } => {
+            let old =
+                world.get::<HumanoidBones>(entity_of(world, *character)?).map(|h| h.0.clone()).unwrap_or_default();
+            unless(old == *bones, Edit::Humanoid { character: *character, bones: old })
+        }
         Edit::Library { name, pose } => {
             let old = world.resource::<PoseLibrary>().0.get(name).cloned();
             unless(old == *pose, Edit::Library { name: name.clone(), pose: old })
@@ -265,6 +270,13 @@ fn write(world: &mut World, edit: Edit) -> Result<(), String> {
                 None => world.entity_mut(entity).remove::<Attached>(),
             };
         }
+        Edit::Humanoid { character, bones } => {
+            let entity = entity_of(world, character)?;
+            match bones.is_empty() {
+                true => world.entity_mut(entity).remove::<HumanoidBones>(),
+                false => world.entity_mut(entity).insert(HumanoidBones(bones)),
+            };
+        }
         Edit::Stage(stage) => world.resource_mut::<StageSettings>().0 = stage,
         Edit::Shot(shot) => world.resource_mut::<ShotSettings>().0 = shot,
         Edit::Bookmark { name, camera } => {
@@ -328,7 +340,8 @@ fn set_clip(world: &mut World, id: CharacterId, anim: Option<AnimDoc>) -> Result
     if let Some(note) = note {
         world.resource_mut::<Messages>().push(note);
     }
-    world.entity_mut(entity).insert(player);
+    // A retargeting is worked out afresh for the new player.
+    world.entity_mut(entity).insert(player).remove::<crate::editor::scene_doc::retarget::RetargetedFrom>();
     Ok(())
 }
 

@@ -80,6 +80,12 @@ pub enum Edit {
         attached: Option<AttachDoc>,
         placement: PlacementDoc,
     },
+    /// Standard bones assigned by hand (bone → pose key; an empty key takes the bone off),
+    /// over those found from the skeleton.
+    Humanoid {
+        character: CharacterId,
+        bones: std::collections::BTreeMap<crate::rig::humanoid::HumanBone, String>,
+    },
     /// Floor, lights, background, axes.
     Stage(StageDoc),
     /// The picture `render` takes.
@@ -110,6 +116,7 @@ impl Edit {
             | Edit::Morph { character, .. }
             | Edit::Playback { character, .. }
             | Edit::Attach { character, .. }
+            | Edit::Humanoid { character, .. }
             | Edit::Remove(character) => Some(*character),
             Edit::Add(doc) => doc.id,
             Edit::Stage(_) | Edit::Shot(_) | Edit::Library { .. } | Edit::Bookmark { .. } => None,

@@ -122,6 +122,7 @@ pub struct SceneCharacterData {
     pub node_clips: Option<&'static crate::scene::node_clips::NodeClipPlayer>,
     pub attached: Option<&'static Attached>,
     pub humanoid: Option<&'static HumanoidBones>,
+    pub retargeted: Option<&'static super::retarget::RetargetedFrom>,
 }
 
 #[derive(SystemParam)]

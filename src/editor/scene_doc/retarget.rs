@@ -1,19 +1,28 @@
 //! Retargeted clips in the editor: a clip that plays another humanoid's motion
 //! (`AnimDoc::retarget`, without keys of its own) is worked out by the document layer from
-//! the scene as it stands, once per setting, and plays as any keyframed clip.
+//! the scene as it stands, once per setting and humanoid map, and plays as any keyframed
+//! clip.
 
+use std::collections::BTreeMap;
 use std::sync::Arc;
 
 use bevy::prelude::*;
 
+use crate::document::retarget::{describe, motion_source_doc, retarget, shaped_asset};
 use crate::editor::scene_doc::document::{Library, SceneReader};
 use crate::editor::state::Messages;
 use crate::formats::scene::RetargetDoc;
+use crate::rig::humanoid::HumanBone;
 use crate::scene::keyframes::ClipPlayer;
 
-/// The retargeting a character's clip was last worked out for.
+/// What a character's retargeted clip was last worked out for (the setting and the bones
+/// assigned by hand), and what the retargeting did (or why it failed).
 #[derive(Component, Clone, PartialEq, Debug)]
-pub struct RetargetedFrom(pub RetargetDoc);
+pub struct RetargetedFrom {
+    pub settings: RetargetDoc,
+    pub bones: BTreeMap<HumanBone, String>,
+    pub report: String,
+}
 
 /// Works out the clip of every character whose player asks for a retargeting it has not
 /// had yet (reads the scene; writes `ClipPlayer`, `RetargetedFrom` by commands). A failure
@@ -28,19 +37,27 @@ pub fn resolve_retargets(
     let mut doc = None;
     for (entity, player, done) in &players {
         let (None, Some(wanted)) = (&player.state.keys, &player.state.retarget) else { continue };
-        if done.is_some_and(|d| &d.0 == wanted) {
+        let Some(target) = scene.character_doc(entity) else { continue };
+        if done.is_some_and(|d| &d.settings == wanted && d.bones == target.humanoid) {
             continue;
         }
-        let Some(target) = scene.character_doc(entity) else { continue };
         let doc = doc.get_or_insert_with(|| scene.capture());
-        let clip = crate::document::retarget::shaped_asset(&mut library, &target)
-            .and_then(|asset| crate::document::retarget::anim_clip(&mut library, doc, &target, &asset, &player.state));
-        match clip {
-            Ok(clip) => {
+        let worked = shaped_asset(&mut library, &target).and_then(|asset| {
+            let source = motion_source_doc(&mut library, doc, &wanted.from)?;
+            let done = retarget(&mut library, &source, &target, &asset, wanted)?;
+            Ok((describe(&done, &source.name, &target.name, &asset.skeleton), done.clip))
+        });
+        let report = match worked {
+            Ok((report, clip)) => {
                 commands.entity(entity).insert(ClipPlayer { clip: Arc::new(clip), state: player.state.clone() });
+                report
             }
-            Err(e) => messages.push(format!("{}: the motion was not retargeted: {e}", target.name)),
-        }
-        commands.entity(entity).insert(RetargetedFrom(wanted.clone()));
+            Err(e) => {
+                let said = format!("{}: the motion was not retargeted: {e}", target.name);
+                messages.push(said.clone());
+                said
+            }
+        };
+        commands.entity(entity).insert(RetargetedFrom { settings: wanted.clone(), bones: target.humanoid, report });
     }
 }

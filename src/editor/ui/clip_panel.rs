@@ -14,7 +14,10 @@ use crate::scene::node_clips::NodeClipPlayer;
 pub fn clip_panel(ui: &mut egui::Ui, player: &ClipPlayer) -> Option<Option<AnimDoc>> {
     let mut state = player.state.clone();
     let mut remove = false;
-    let title = format!("Clip {}", state.file.file_name().map(|f| f.to_string_lossy()).unwrap_or_default());
+    let title = match (&state.keys, &state.retarget) {
+        (None, Some(_)) => "Clip (another character's motion)".to_string(),
+        _ => format!("Clip {}", state.file.file_name().map(|f| f.to_string_lossy()).unwrap_or_default()),
+    };
     egui::CollapsingHeader::new(title).default_open(true).show(ui, |ui| {
         ui.horizontal(|ui| {
             if ui.button(if state.playing { "Pause" } else { "Play" }).clicked() {

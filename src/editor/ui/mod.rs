@@ -7,6 +7,7 @@ pub mod clip_panel;
 pub mod dialogs;
 pub mod joint_panel;
 pub mod keyframe_panel;
+pub mod motion_panel;
 pub mod open;
 pub mod pose_panel;
 pub mod recent;

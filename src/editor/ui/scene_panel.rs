@@ -261,6 +261,8 @@ fn selected_character(ui: &mut egui::Ui, panels: &mut Panels, entity: Entity, id
     {
         edits.push(Edit::Playback { character: id, state });
     }
+    edits.extend(super::motion_panel::motion_rows(ui, panels, entity, id));
+    edits.extend(super::motion_panel::humanoid_rows(ui, panels, entity, id));
     if let Some(morphs) = morphs
         && let Some(weights) = morph_sliders(ui, morphs)
     {
