@@ -400,3 +400,71 @@ mod editor {
         assert_eq!(state(&mut app), (retargeted, count));
     }
 }
+
+/// Blender's bones in `tests/data/blender_ta.txt`: for each pose label, each bone's head
+/// and tail.
+fn blender_bones() -> std::collections::BTreeMap<String, std::collections::BTreeMap<String, (Vec3, Vec3)>> {
+    let text = std::fs::read_to_string(crate::common::path("tests/data/blender_ta.txt")).unwrap();
+    let mut out: std::collections::BTreeMap<String, std::collections::BTreeMap<String, (Vec3, Vec3)>> =
+        Default::default();
+    let mut label = String::new();
+    for line in text.lines() {
+        if let Some(l) = line.strip_prefix("pose ") {
+            label = l.to_string();
+            continue;
+        }
+        let words: Vec<&str> = line.split_whitespace().collect();
+        let n: Vec<f32> = words[2..].iter().map(|w| w.parse().unwrap()).collect();
+        let (head, tail) = (Vec3::new(n[0], n[1], n[2]), Vec3::new(n[3], n[4], n[5]));
+        out.entry(label.clone()).or_default().insert(words[1].to_string(), (head, tail));
+    }
+    out
+}
+
+/// A T-pose humanoid's clip on an A-pose one, both made with Blender: carried rest to
+/// rest, the source's rest frame gives the target its own A-pose (every bone along its
+/// rest bone as Blender has it, 0.1°); with bones following directions, the target's arms
+/// point where Blender says the source's point, at rest (straight out) and with them
+/// raised (2°).
+#[test]
+fn a_t_pose_clip_drives_an_a_pose_character() {
+    let mut library = AssetLibrary::default();
+    let blender = blender_bones();
+    let source_path = crate::common::path("tests/data/blender_tpose.glb").to_path_buf();
+    let source = file_motion_doc(&mut library, &source_path, None).unwrap();
+    let target = doc_of(&mut library, crate::common::path("tests/data/blender_apose.glb"));
+    let asset = shaped_asset(&mut library, &target).unwrap();
+    let skeleton = &asset.skeleton;
+    let from = MotionSourceDoc::File { path: source_path.clone(), clip: None };
+    let angle = |a: Vec3, b: Vec3| a.normalize().dot(b.normalize()).clamp(-1.0, 1.0).acos().to_degrees();
+    let direction = |frame: &Frame, joint: usize, child: usize| {
+        let at = positions(skeleton, frame.root, &frame.pose);
+        at[child] - at[joint]
+    };
+    let child_of = |j: usize| skeleton.joints().iter().position(|c| c.parent == Some(j));
+
+    let rest = RetargetDoc { rest: marionette::rig::retarget::RestAlignment::OwnRest, ..RetargetDoc::of(from.clone()) };
+    let done = retarget(&mut library, &source, &target, &asset, &rest).unwrap();
+    let mut compared = 0;
+    for (j, joint) in skeleton.joints().iter().enumerate() {
+        let (Some(child), Some((head, tail))) = (child_of(j), blender["apose rest"].get(&joint.name)) else { continue };
+        let off = angle(direction(&done.report.frames[0], j, child), *tail - *head);
+        assert!(off < 0.1, "{}: {off}° off its rest", joint.name);
+        compared += 1;
+    }
+    assert!(compared >= 14, "{compared} bones compared");
+
+    let follow = RetargetDoc::of(from);
+    let done = retarget(&mut library, &source, &target, &asset, &follow).unwrap();
+    for (frame, label) in [(0, "tpose 0"), (15, "tpose 12")] {
+        for name in ["upper_arm.L", "upper_arm.R", "forearm.L", "thigh.L", "shin.R", "spine"] {
+            let j = skeleton.find(name).unwrap();
+            let (head, tail) = blender[label][name];
+            let off = angle(direction(&done.report.frames[frame], j, child_of(j).unwrap()), tail - head);
+            assert!(off < 2.0, "{label}: {name} {off}° off the source's");
+        }
+    }
+    let raised =
+        direction(&done.report.frames[15], skeleton.find("upper_arm.L").unwrap(), skeleton.find("forearm.L").unwrap());
+    assert!(raised.normalize().y > 0.9, "the arm is raised: {raised}");
+}
