@@ -318,3 +318,36 @@ pub fn describe(done: &Retargeting, source: &str, target: &str, skeleton: &crate
         if clamped.is_empty() { "none".to_string() } else { clamped.join(", ") }
     )
 }
+
+/// What a pose named by joints of `source` (its skeleton and map, where known) gives
+/// `target` (posed as `current`), mirrored left to right first when asked: the joints by
+/// name where the target has every one named (a rig of the same family); otherwise the
+/// pose carried through the humanoid maps, each bone the source's names drive pointing as
+/// the source's does, under the target's own parents.
+pub fn pose_onto(
+    target: (&crate::rig::Skeleton, &HumanoidMap),
+    current: &[JointRotation],
+    pose: &[(String, JointRotation)],
+    source: Option<(&crate::rig::Skeleton, &HumanoidMap)>,
+    mirrored: bool,
+) -> Vec<(usize, JointRotation)> {
+    use crate::formats::scene::joint_of_pose_key;
+    let pose = if mirrored { crate::rig::mirror::mirrored_pose(pose) } else { pose.to_vec() };
+    let by_name: Vec<(usize, JointRotation)> =
+        pose.iter().filter_map(|(key, r)| Some((joint_of_pose_key(target.0, key)?, *r))).collect();
+    let Some((s, s_map)) = source.filter(|_| by_name.len() < pose.len()) else { return by_name };
+    let mut full = s.initial_pose();
+    let mut named = Vec::new();
+    for (key, r) in &pose {
+        if let Some(j) = joint_of_pose_key(s, key) {
+            full[j] = *r;
+            named.push(j);
+        }
+    }
+    let side = |(skeleton, map)| Humanoid { skeleton, map, floor: 0.0 };
+    let rest = crate::rig::retarget::RestAlignment::Directions;
+    match Retargeter::new(side((s, s_map)), side(target), rest) {
+        Some(retargeter) => retargeter.pose_over(&full, current, &named),
+        None => by_name,
+    }
+}

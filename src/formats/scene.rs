@@ -467,6 +467,10 @@ pub struct SceneDoc {
 pub struct LibraryPoseDoc {
     pub joints: BTreeMap<String, JointRotation>,
     pub thumbnail: Vec<[f32; 4]>,
+    /// The character it was kept from, so that characters without its joint names take it
+    /// through their humanoid maps.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub rig: Option<SourceDoc>,
 }
 
 impl Default for SmplDoc {

@@ -231,20 +231,36 @@ impl<'a> Retargeter<'a> {
     /// The source's frame carried onto the target (no feet planted), and the joints whose
     /// rotations the target's limits clamped.
     pub fn frame(&self, source: &Frame) -> (Frame, Vec<usize>) {
+        let (pose, clamped, s_at) = self.carried(source, self.target.skeleton.initial_pose(), |_| true);
+        let root = self.placed_root(&s_at, &pose);
+        (Frame { root, pose }, clamped)
+    }
+
+    /// The source's pose carried onto `base` (a pose of the target): the mapped joints
+    /// whose source joints `drives` says, and (driving every joint) the unmapped joints
+    /// with namesakes; the rest keep `base`. With the joints it clamped and the source's
+    /// joint positions.
+    fn carried(
+        &self,
+        source: &Frame,
+        mut pose: Vec<JointRotation>,
+        drives: impl Fn(usize) -> bool,
+    ) -> (Vec<JointRotation>, Vec<usize>, Vec<Vec3>) {
         let (s, t) = (self.source.skeleton, self.target.skeleton);
         let (s_rot, s_at) = world_frames(s, source.root, &source.pose);
-        let mut pose = t.initial_pose();
         let mut world = vec![Quat::IDENTITY; t.len()];
         let mut clamped = Vec::new();
         // Unmapped joints first (they hang on no mapped turn): their namesakes' turns.
         for (j, rotation) in pose.iter_mut().enumerate() {
-            if let (None, Some(sj)) = (&self.bones[j], self.namesakes[j]) {
+            if let (None, Some(sj)) = (&self.bones[j], self.namesakes[j])
+                && drives(sj)
+            {
                 *rotation = rotation.with_rotation_of(source.pose[sj].to_quat()).clamped(&t.joint(j).limits);
             }
         }
         for j in 0..t.len() {
             let parent = t.parent(j).map_or(Quat::IDENTITY, |p| world[p]);
-            if let Some(bone) = &self.bones[j] {
+            if let Some(bone) = self.bones[j].as_ref().filter(|b| drives(b.source)) {
                 let turned = (s_rot[bone.source] * self.source_rest[bone.source].inverse()).normalize();
                 let mut wanted = (turned * bone.aligned_rest).normalize();
                 if let (RestAlignment::Directions, Some((tc, sc))) = (self.rest, bone.aim) {
@@ -264,8 +280,21 @@ impl<'a> Retargeter<'a> {
             }
             world[j] = (parent * pose[j].to_quat()).normalize();
         }
-        let root = self.placed_root(&s_at, &pose);
-        (Frame { root, pose }, clamped)
+        (pose, clamped, s_at)
+    }
+
+    /// The target's joints driven by the source joints `driving`, carried from
+    /// `source_pose` onto the target posed as `base`: each such bone turned in the world
+    /// as the source's (pointing as it does), under its parents as `base` has them.
+    pub fn pose_over(
+        &self,
+        source_pose: &[JointRotation],
+        base: &[JointRotation],
+        driving: &[usize],
+    ) -> Vec<(usize, JointRotation)> {
+        let frame = Frame { root: self.source.skeleton.joint(0).rest_offset, pose: source_pose.to_vec() };
+        let (pose, _, _) = self.carried(&frame, base.to_vec(), |sj| driving.contains(&sj));
+        (0..pose.len()).filter(|&j| pose[j] != base[j]).map(|j| (j, pose[j])).collect()
     }
 
     /// The target root that puts its hips where the source's are, scaled by the leg ratio:

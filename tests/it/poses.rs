@@ -58,7 +58,15 @@ fn paste_mirrored_puts_the_other_arm_in_the_mirror_image() {
     let left =
         [skeleton.find("l_shoulder").unwrap(), skeleton.find("l_elbow").unwrap(), skeleton.find("l_wrist").unwrap()];
     let copied = pose_by_name(skeleton, &posed, &left);
-    let Some(Edit::Pose { joints, .. }) = apply_named_pose(CharacterId(1), skeleton, &copied, true) else { panic!() };
+    let Some(Edit::Pose { joints, .. }) = apply_named_pose(
+        CharacterId(1),
+        (skeleton, &Default::default(), &skeleton.initial_pose()),
+        &copied,
+        None,
+        true,
+    ) else {
+        panic!()
+    };
     let mut mirrored = rest.clone();
     joints.iter().for_each(|&(j, r)| mirrored[j] = r);
     let fk = |pose: &[JointRotation]| {
@@ -89,7 +97,15 @@ fn a_kept_pose_reapplied_gives_the_same_matrices() {
     assert_eq!(kept.thumbnail.len(), skeleton.len() - 1, "a segment per bone");
     assert!(kept.thumbnail.iter().flatten().all(|v| (-1e-6..=1.0 + 1e-6).contains(v)));
     let named: Vec<_> = kept.joints.into_iter().collect();
-    let Some(Edit::Pose { joints, .. }) = apply_named_pose(CharacterId(1), skeleton, &named, false) else { panic!() };
+    let Some(Edit::Pose { joints, .. }) = apply_named_pose(
+        CharacterId(1),
+        (skeleton, &Default::default(), &skeleton.initial_pose()),
+        &named,
+        None,
+        false,
+    ) else {
+        panic!()
+    };
     let mut again = skeleton.initial_pose();
     joints.iter().for_each(|&(j, r)| again[j] = r);
     let mut after = vec![Mat4::IDENTITY; skeleton.len()];

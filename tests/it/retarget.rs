@@ -468,3 +468,49 @@ fn a_t_pose_clip_drives_an_a_pose_character() {
         direction(&done.report.frames[15], skeleton.find("upper_arm.L").unwrap(), skeleton.find("forearm.L").unwrap());
     assert!(raised.normalize().y > 0.9, "the arm is raised: {raised}");
 }
+
+/// A pose kept on the puppet, put on the SMPL body (whose joints have other names) through
+/// their humanoid maps: each posed arm bone points as the puppet's (2°); mirrored, the
+/// body's right arm points as the puppet's left, reflected in x.
+#[test]
+fn a_pose_carries_to_a_rig_with_other_names_as_it_was_or_mirrored() {
+    use marionette::document::retarget::pose_onto;
+    use marionette::editor::edits::pose_library::pose_by_name;
+    let Some(data) = optional_data_dir() else { return };
+    let puppet = marionette::formats::puppet::embedded_puppet();
+    let body = marionette::formats::load_character(&data.join("smpl")).unwrap();
+    let (p_map, b_map) = (humanoid_map(&puppet, &Default::default()), humanoid_map(&body, &Default::default()));
+    let mut pose = puppet.skeleton.initial_pose();
+    let named = |n: &str| puppet.skeleton.find(n).unwrap();
+    pose[named("l_shoulder")] = JointRotation::euler_xyz(0.4, 0.2, -1.1);
+    pose[named("l_elbow")] = JointRotation::euler_xyz(0.0, -0.9, 0.0);
+    let joints = [named("l_shoulder"), named("l_elbow")];
+    let copied = pose_by_name(&puppet.skeleton, &pose, &joints);
+    let p_at = positions(&puppet.skeleton, puppet.skeleton.joint(0).rest_offset, &pose);
+    let direction = |at: &[Vec3], map: &HumanoidMap, a: HumanBone, b: HumanBone| at[map[&b]] - at[map[&a]];
+    use HumanBone::*;
+    for mirrored in [false, true] {
+        let joints = pose_onto(
+            (&body.skeleton, &b_map),
+            &body.skeleton.initial_pose(),
+            &copied,
+            Some((&puppet.skeleton, &p_map)),
+            mirrored,
+        );
+        assert_eq!(joints.len(), 2, "the two posed bones, mapped");
+        let mut b_pose = body.skeleton.initial_pose();
+        joints.iter().for_each(|&(j, r)| b_pose[j] = r);
+        let b_at = positions(&body.skeleton, body.skeleton.joint(0).rest_offset, &b_pose);
+        let reflect = |v: Vec3| if mirrored { Vec3::new(-v.x, v.y, v.z) } else { v };
+        let (upper, lower, hand) =
+            if mirrored { (RightUpperArm, RightLowerArm, RightHand) } else { (LeftUpperArm, LeftLowerArm, LeftHand) };
+        for ((a, b), (sa, sb)) in
+            [((upper, lower), (LeftUpperArm, LeftLowerArm)), ((lower, hand), (LeftLowerArm, LeftHand))]
+        {
+            let want = reflect(direction(&p_at, &p_map, sa, sb));
+            let got = direction(&b_at, &b_map, a, b);
+            let off = want.angle_between(got).to_degrees();
+            assert!(off < 2.0, "mirrored {mirrored}: {a:?} {off}° off");
+        }
+    }
+}

@@ -144,7 +144,7 @@ fn a_contact_sheet_shows_every_kept_pose_in_a_grid() {
         Some(CameraDoc { focus: glam::Vec3::new(0.0, 0.6, 0.0), pitch: 0.0, distance: 2.6, ..CameraDoc::default() });
     for (name, angle) in [("a raised", -2.2), ("b level", -1.4), ("c lowered", 0.0)] {
         let joints = [("r_shoulder".to_string(), JointRotation::euler_xyz(0.0, 0.0, angle))].into_iter().collect();
-        doc.poses.insert(name.into(), LibraryPoseDoc { joints, thumbnail: Vec::new() });
+        doc.poses.insert(name.into(), LibraryPoseDoc { joints, thumbnail: Vec::new(), rig: None });
     }
     let scene = scene_file(&dir, "poses.ron", &doc);
     let sheet = render(&scene, &["--poses"], &dir.join("sheet.png"));

@@ -1,13 +1,14 @@
 //! Poses kept by name: the scene's pose library (saved in the scene file, with a stick
 //! figure thumbnail), and copying a pose (or the selected joints') to paste on any
-//! character with the same joint names, as it was or mirrored left to right.
+//! character with the same joint names, or through the humanoid maps onto any other, as
+//! it was or mirrored left to right.
 
 use std::collections::BTreeMap;
 
 use bevy::prelude::*;
 
 use crate::formats::scene::{CharacterId, LibraryPoseDoc, pose_key};
-use crate::rig::mirror::mirrored_pose;
+use crate::rig::humanoid::HumanoidMap;
 use crate::rig::{JointRotation, Skeleton};
 
 use crate::editor::edits::edit::Edit;
@@ -39,21 +40,22 @@ pub fn library_pose(skeleton: &Skeleton, positions: &[Vec3], joints: Vec<(String
             Some([a.x, a.y, b.x, b.y])
         })
         .collect();
-    LibraryPoseDoc { joints: joints.into_iter().collect(), thumbnail }
+    LibraryPoseDoc { joints: joints.into_iter().collect(), thumbnail, rig: None }
 }
 
-/// The pose edit that gives character `id` (of `skeleton`) the rotations named in `pose`,
-/// mirrored left to right when asked; joints it does not have are skipped.
+/// The pose edit that gives character `id` (of `target`: its skeleton, humanoid map and
+/// current pose)
+/// the rotations named in `pose`, mirrored left to right when asked: by name, or through
+/// the humanoid maps from `source` (the rig the names are of) where the target lacks the
+/// names; none when nothing applies.
 pub fn apply_named_pose(
     id: CharacterId,
-    skeleton: &Skeleton,
+    target: (&Skeleton, &HumanoidMap, &[JointRotation]),
     pose: &[(String, JointRotation)],
+    source: Option<(&Skeleton, &HumanoidMap)>,
     mirrored: bool,
 ) -> Option<Edit> {
-    let pose = if mirrored { mirrored_pose(pose) } else { pose.to_vec() };
-    let joints: Vec<(usize, JointRotation)> = pose
-        .iter()
-        .filter_map(|(name, r)| Some((crate::formats::scene::joint_of_pose_key(skeleton, name)?, *r)))
-        .collect();
+    let (skeleton, map, current) = target;
+    let joints = crate::document::retarget::pose_onto((skeleton, map), current, pose, source, mirrored);
     (!joints.is_empty()).then_some(Edit::Pose { character: id, joints })
 }

@@ -305,8 +305,14 @@ fn pose_frame(
     mut job: ResMut<RenderJob>,
     mut gate: ResMut<CaptureGate>,
     library: Res<crate::editor::edits::pose_library::PoseLibrary>,
-    characters: Query<(&crate::editor::scene_doc::document::SceneCharacter, &crate::scene::Character)>,
+    characters: Query<(
+        &crate::editor::scene_doc::document::SceneCharacter,
+        &crate::scene::Character,
+        Option<&crate::editor::scene_doc::document::HumanoidBones>,
+    )>,
+    poses: Query<&crate::scene::JointPose>,
     mut edits: ResMut<crate::editor::edits::edit::EditQueue>,
+    mut assets: ResMut<crate::editor::scene_doc::document::Library>,
 ) {
     if job.set_up || job.done.is_some() {
         return;
@@ -315,9 +321,16 @@ fn pose_frame(
     let FrameAt::Pose(name) = &job.frames[job.next].0 else { return };
     let Some(pose) = library.0.get(name) else { return };
     let joints: Vec<_> = pose.joints.iter().map(|(k, r)| (k.clone(), *r)).collect();
-    for (sc, character) in &characters {
-        let skeleton = &character.asset.skeleton;
-        if let Some(edit) = crate::editor::edits::pose_library::apply_named_pose(sc.id, skeleton, &joints, false) {
+    use crate::document::retarget::humanoid_map;
+    let rig = pose.rig.as_ref().and_then(|rig| assets.load(rig).ok());
+    let rig_map = rig.as_ref().map(|a| humanoid_map(a, &Default::default()));
+    let from = rig.as_ref().zip(rig_map.as_ref()).map(|(a, m)| (&a.skeleton, m));
+    for (sc, character, bones) in &characters {
+        let map = humanoid_map(&character.asset, &bones.map(|b| b.0.clone()).unwrap_or_default());
+        let current: Vec<_> =
+            character.joints.iter().map(|&e| poses.get(e).map_or(Default::default(), |p| p.0)).collect();
+        let target = (&character.asset.skeleton, &map, &current[..]);
+        if let Some(edit) = crate::editor::edits::pose_library::apply_named_pose(sc.id, target, &joints, from, false) {
             edits.push(edit);
         }
     }

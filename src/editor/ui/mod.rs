@@ -45,6 +45,8 @@ pub struct InspectorState {
     pub anim_path: String,
     /// A pose copied by joint name, to paste.
     pub copied_pose: Vec<(String, crate::rig::JointRotation)>,
+    /// The character the copied pose was taken from (its asset and humanoid map).
+    pub copied_rig: Option<(std::sync::Arc<crate::rig::CharacterAsset>, crate::rig::humanoid::HumanoidMap)>,
     /// The name "Keep pose" keeps the pose under.
     pub pose_name: String,
     /// The file dialog.
@@ -65,6 +67,7 @@ impl Default for InspectorState {
             picked_key: None,
             anim_path: format!("{cwd}/keys.anim"),
             copied_pose: Vec::new(),
+            copied_rig: None,
             pose_name: "pose 1".into(),
             dialogs: Default::default(),
             active_dof: None,

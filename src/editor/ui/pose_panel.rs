@@ -1,6 +1,7 @@
 //! The pose section of the joint panel: copy the selected character's pose (or its
-//! selected joints'), paste it on any character with those joint names, as it was or
-//! mirrored; keep poses in the scene's library with a thumbnail, apply or remove them.
+//! selected joints'), paste it on any character (by joint names, or through the humanoid
+//! maps), as it was or mirrored; keep poses in the scene's library with a thumbnail, apply
+//! or remove them.
 
 use bevy_egui::egui;
 
@@ -13,10 +14,12 @@ use crate::rig::JointRotation;
 const THUMBNAIL: f32 = 56.0;
 
 pub fn pose_panel(ui: &mut egui::Ui, state: &mut InspectorState, panels: &mut Panels, id: CharacterId) {
-    let Some(character) = panels.scene.characters.iter().find(|c| c.scene.id == id).map(|c| c.character) else {
+    let Some(c) = panels.scene.characters.iter().find(|c| c.scene.id == id) else {
         return;
     };
-    let character = character.clone();
+    let (character, source) = (c.character.clone(), c.scene.source.clone());
+    let assigned = c.humanoid.map(|h| h.0.clone()).unwrap_or_default();
+    let map = crate::document::retarget::humanoid_map(&character.asset, &assigned);
     let skeleton = &character.asset.skeleton;
     let pose: Vec<JointRotation> =
         character.joints.iter().map(|&e| panels.scene.poses.get(e).map_or(Default::default(), |p| p.0)).collect();
@@ -26,18 +29,21 @@ pub fn pose_panel(ui: &mut egui::Ui, state: &mut InspectorState, panels: &mut Pa
         .map(|&e| panels.joint_matrices.get(e).map_or(glam::Vec3::ZERO, |m| m.position()))
         .collect();
     let selected = panels.selection.joints.clone();
+    let target = (skeleton, &map, &pose[..]);
     let mut edits = Vec::new();
     egui::CollapsingHeader::new("Poses").default_open(false).show(ui, |ui| {
         ui.horizontal(|ui| {
             if ui.button("Copy").on_hover_text("the selected joints' rotations (all when none)").clicked() {
                 state.copied_pose = pose_by_name(skeleton, &pose, &selected);
+                state.copied_rig = Some((character.asset.clone(), map.clone()));
             }
             let any = !state.copied_pose.is_empty();
+            let from = state.copied_rig.as_ref().map(|(asset, map)| (&asset.skeleton, map));
             if ui.add_enabled(any, egui::Button::new("Paste")).clicked() {
-                edits.extend(apply_named_pose(id, skeleton, &state.copied_pose, false));
+                edits.extend(apply_named_pose(id, target, &state.copied_pose, from, false));
             }
             if ui.add_enabled(any, egui::Button::new("Paste mirrored")).clicked() {
-                edits.extend(apply_named_pose(id, skeleton, &state.copied_pose, true));
+                edits.extend(apply_named_pose(id, target, &state.copied_pose, from, true));
             }
         });
         ui.horizontal(|ui| {
@@ -45,11 +51,21 @@ pub fn pose_panel(ui: &mut egui::Ui, state: &mut InspectorState, panels: &mut Pa
             if ui.button("Keep pose").on_hover_text("in the scene's library under this name").clicked()
                 && !state.pose_name.trim().is_empty()
             {
-                let kept = library_pose(skeleton, &positions, pose_by_name(skeleton, &pose, &selected));
+                let mut kept = library_pose(skeleton, &positions, pose_by_name(skeleton, &pose, &selected));
+                kept.rig = Some(source.clone());
                 edits.push(Edit::Library { name: state.pose_name.trim().to_string(), pose: Some(kept) });
             }
         });
-        for (name, kept) in panels.scene.pose_library.0.iter() {
+        let kept_rigs: Vec<_> = panels
+            .scene
+            .pose_library
+            .0
+            .values()
+            .map(|kept| kept.rig.as_ref().and_then(|rig| panels.library.load(rig).ok()))
+            .collect();
+        for ((name, kept), rig) in panels.scene.pose_library.0.iter().zip(&kept_rigs) {
+            let rig_map = rig.as_ref().map(|a| crate::document::retarget::humanoid_map(a, &Default::default()));
+            let from = rig.as_ref().zip(rig_map.as_ref()).map(|(a, m)| (&a.skeleton, m));
             ui.horizontal(|ui| {
                 thumbnail(ui, kept);
                 ui.vertical(|ui| {
@@ -57,10 +73,10 @@ pub fn pose_panel(ui: &mut egui::Ui, state: &mut InspectorState, panels: &mut Pa
                     ui.horizontal(|ui| {
                         let named: Vec<(String, JointRotation)> = kept.joints.clone().into_iter().collect();
                         if ui.small_button("Apply").clicked() {
-                            edits.extend(apply_named_pose(id, skeleton, &named, false));
+                            edits.extend(apply_named_pose(id, target, &named, from, false));
                         }
                         if ui.small_button("Mirrored").clicked() {
-                            edits.extend(apply_named_pose(id, skeleton, &named, true));
+                            edits.extend(apply_named_pose(id, target, &named, from, true));
                         }
                         if ui.small_button("Remove").clicked() {
                             edits.push(Edit::Library { name: name.clone(), pose: None });
