@@ -269,7 +269,9 @@ impl Tree<'_> {
             return None;
         }
         let length = |k: usize| self.at[chain[k + 1]].distance(self.at[chain[k]]);
-        let k = (0..chain.len() - 2)
+        // The body joint itself is no limb bone, where the limb has joints enough.
+        let first = usize::from(chain.len() >= 4);
+        let k = (first..chain.len() - 2)
             .max_by(|&a, &b| (length(a) + length(a + 1)).total_cmp(&(length(b) + length(b + 1))))?;
         Some(Limb {
             before: (k >= 1 && chain[k - 1] != from).then(|| chain[k - 1]),

@@ -165,3 +165,27 @@ fn a_retargeted_pose_turns_each_bone_as_its_source_turned() {
         assert!(turned_source.angle_between(turned_target) < 1e-4, "{bone:?}");
     }
 }
+
+/// Homer's rig (the chest its root, the abdomen hung below it): every limb from the joint
+/// at the shoulder or hip, the chest never an arm bone.
+#[test]
+fn homer_maps_his_arms_from_the_shoulders() {
+    let Some(data) = optional_data_dir() else { return };
+    let homer = marionette::formats::load_character(&data.join("homer/homer.json")).unwrap();
+    expect(
+        &homer.skeleton,
+        &[
+            (Hips, "LowerAbdomen"),
+            (Chest, "Root"),
+            (Head, "Head"),
+            (LeftUpperArm, "Shoulder.L"),
+            (LeftLowerArm, "Elbow.L"),
+            (LeftHand, "Wrist.L"),
+            (RightUpperArm, "Shoulder.R"),
+            (RightHand, "Wrist.R"),
+            (LeftUpperLeg, "Hip.L"),
+            (LeftFoot, "Ankle.L"),
+            (RightLowerLeg, "Knee.R"),
+        ],
+    );
+}

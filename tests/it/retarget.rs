@@ -195,7 +195,7 @@ fn clips_carry_across_humanoids_of_every_origin() {
         .map(|m| doc_of(&mut library, &data.join(format!("mit6837/{m}.skel"))))
         .collect();
     targets.push(CharacterDoc::new(SourceDoc::Embedded("puppet".into()), "puppet"));
-    for f in ["smpl", "khronos/CesiumMan.glb", "khronos/RiggedFigure.glb"] {
+    for f in ["smpl", "khronos/CesiumMan.glb", "khronos/RiggedFigure.glb", "homer/homer.json"] {
         targets.push(doc_of(&mut library, &data.join(f)));
     }
     let mut stretches = 0;
