@@ -105,6 +105,15 @@ impl NextCharacterId {
 #[derive(Component, Clone, Debug, Default, PartialEq)]
 pub struct HumanoidBones(pub std::collections::BTreeMap<crate::rig::humanoid::HumanBone, String>);
 
+/// What a character's retargeted clip was last worked out for (the setting and the bones
+/// assigned by hand), and what the retargeting did (or why it failed).
+#[derive(Component, Clone, PartialEq, Debug)]
+pub struct RetargetedFrom {
+    pub settings: crate::formats::scene::RetargetDoc,
+    pub bones: std::collections::BTreeMap<crate::rig::humanoid::HumanBone, String>,
+    pub report: String,
+}
+
 /// Everything needed to capture the scene as a document (read only).
 /// What the panels and capture read of a scene character, by name.
 #[derive(QueryData)]
@@ -122,7 +131,7 @@ pub struct SceneCharacterData {
     pub node_clips: Option<&'static crate::scene::node_clips::NodeClipPlayer>,
     pub attached: Option<&'static Attached>,
     pub humanoid: Option<&'static HumanoidBones>,
-    pub retargeted: Option<&'static super::retarget::RetargetedFrom>,
+    pub retargeted: Option<&'static RetargetedFrom>,
 }
 
 #[derive(SystemParam)]

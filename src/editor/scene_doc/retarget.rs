@@ -3,26 +3,15 @@
 //! the scene as it stands, once per setting and humanoid map, and plays as any keyframed
 //! clip.
 
-use std::collections::BTreeMap;
 use std::sync::Arc;
 
 use bevy::prelude::*;
 
 use crate::document::retarget::{describe, motion_source_doc, retarget, shaped_asset};
+pub use crate::editor::scene_doc::document::RetargetedFrom;
 use crate::editor::scene_doc::document::{Library, SceneReader};
 use crate::editor::state::Messages;
-use crate::formats::scene::RetargetDoc;
-use crate::rig::humanoid::HumanBone;
 use crate::scene::keyframes::ClipPlayer;
-
-/// What a character's retargeted clip was last worked out for (the setting and the bones
-/// assigned by hand), and what the retargeting did (or why it failed).
-#[derive(Component, Clone, PartialEq, Debug)]
-pub struct RetargetedFrom {
-    pub settings: RetargetDoc,
-    pub bones: BTreeMap<HumanBone, String>,
-    pub report: String,
-}
 
 /// Works out the clip of every character whose player asks for a retargeting it has not
 /// had yet (reads the scene; writes `ClipPlayer`, `RetargetedFrom` by commands). A failure
