@@ -5,6 +5,7 @@ them (tests/data/blender_ta.txt).
 - `tpose`: a humanoid armature with Blender's `.L`/`.R` names, arms straight out along
   ±x. Its action: frame 0 its rest, frame 12 both upper arms raised 80° towards the
   head and the left forearm bent 30°, frame 24 its rest again (24 frames a second).
+- `blender_tpose.bvh`: the same action as BVH motion capture (Blender's exporter).
 - `apose`: another humanoid, longer legs and a shorter spine, its arms resting 45° down.
   No action.
 
@@ -158,3 +159,12 @@ with open(out / "blender_ta.txt", "w") as f:
     a.select_set(True)
     a_skin.select_set(True)
     bpy.ops.export_scene.gltf(filepath=str(out / "blender_apose.glb"), export_format="GLB", use_selection=True)
+
+# The T-pose action as BVH motion capture (tests/data/blender_tpose.bvh), stood up in y as
+# BVH files are: the armature turned -90° about x and the turn applied to its rest.
+bpy.ops.object.select_all(action="DESELECT")
+t.select_set(True)
+bpy.context.view_layer.objects.active = t
+t.rotation_euler = (radians(-90), 0, 0)
+bpy.ops.object.transform_apply(location=False, rotation=True, scale=False)
+bpy.ops.export_anim.bvh(filepath=str(out / "blender_tpose.bvh"), frame_start=0, frame_end=24)

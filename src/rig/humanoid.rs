@@ -4,8 +4,9 @@
 //! either side, the hips where their chains meet; the hands the two leaves off the legs
 //! farthest out on either side, the chest where theirs meet; the head the highest leaf
 //! beyond the chest. Along each limb the upper and lower bone are its two longest
-//! consecutive segments. Left is the side the names say (`L_`, `Left`, `.L`, `l_`), or
-//! else +x (a character facing +z).
+//! consecutive segments. Sides are told across the hips (from one hip joint to the other,
+//! so a character turned or walking is read the same); left is the side the names say
+//! (`L_`, `Left`, `.L`, `l_`), or else the one towards +x (a character facing +z).
 
 use std::collections::BTreeMap;
 
@@ -85,20 +86,28 @@ pub fn detect(skeleton: &Skeleton) -> Option<HumanoidMap> {
     let second_foot = leaves
         .iter()
         .copied()
-        .filter(|&l| tree.apart(first_foot, l) && (at[l].x - at[first_foot].x).abs() > 0.05 * size)
+        .filter(|&l| tree.apart(first_foot, l) && flat(at[l] - at[first_foot]).length() > 0.05 * size)
         .min_by(by_height)?;
     let hips = tree.meeting(first_foot, second_foot);
 
     // The hands: off the legs, the leaves farthest out on either side. (A rig may hang its
     // hips from the chest, and its arms below the hips: neither is assumed.)
-    let legs = [tree.path(hips, first_foot)[0], tree.path(hips, second_foot)[0]];
+    let (first_leg, second_leg) = (tree.path(hips, first_foot), tree.path(hips, second_foot));
+    let legs = [first_leg[0], second_leg[0]];
+    // Across the body: from one hip joint to the other (the first joints down the legs
+    // that part), level, towards +x: whatever the pose, the hips keep their width.
+    let parted =
+        first_leg.iter().zip(&second_leg).map(|(&a, &b)| flat(at[b] - at[a])).find(|v| v.length() > 1e-3 * size);
+    let across = parted.and_then(Vec3::try_normalize).unwrap_or(Vec3::X);
+    let across = if across.x < 0.0 || (across.x == 0.0 && across.z < 0.0) { -across } else { across };
+    let out_by = |j: usize| (at[j] - at[hips]).dot(across);
     let upper: Vec<usize> = leaves.iter().copied().filter(|&l| !legs.iter().any(|&leg| tree.below(l, leg))).collect();
     let out = |side: f32| {
         upper
             .iter()
             .copied()
-            .filter(|&l| (at[l].x - at[hips].x) * side > 0.05 * size)
-            .max_by(|a, b| ((at[*a].x - at[hips].x) * side).total_cmp(&((at[*b].x - at[hips].x) * side)))
+            .filter(|&l| out_by(l) * side > 0.05 * size)
+            .max_by(|a, b| (out_by(*a) * side).total_cmp(&(out_by(*b) * side)))
     };
     let (plus_hand, minus_hand) = (out(1.0)?, out(-1.0)?);
     let chest = tree.meeting(plus_hand, minus_hand);
@@ -108,9 +117,9 @@ pub fn detect(skeleton: &Skeleton) -> Option<HumanoidMap> {
         .filter(|&l| tree.below(l, chest) && tree.apart(l, plus_hand) && tree.apart(l, minus_hand))
         .max_by(by_height);
 
-    let left_is_plus = left_side(skeleton, &at, hips).unwrap_or(true);
+    let left_is_plus = left_side(skeleton, &at, hips, across).unwrap_or(true);
     let (left_hand, right_hand) = if left_is_plus { (plus_hand, minus_hand) } else { (minus_hand, plus_hand) };
-    let foot_plus = if at[first_foot].x > at[second_foot].x { first_foot } else { second_foot };
+    let foot_plus = if across.dot(at[second_foot] - at[first_foot]) < 0.0 { first_foot } else { second_foot };
     let foot_minus = if foot_plus == first_foot { second_foot } else { first_foot };
     let (left_foot, right_foot) = if left_is_plus { (foot_plus, foot_minus) } else { (foot_minus, foot_plus) };
 
@@ -158,9 +167,14 @@ pub fn detect(skeleton: &Skeleton) -> Option<HumanoidMap> {
     Some(map)
 }
 
-/// Whether the names put the character's left on +x: the side of the hips that joints named
-/// left lie on (none when no joint is named for a side).
-fn left_side(skeleton: &Skeleton, at: &[Vec3], hips: usize) -> Option<bool> {
+/// A vector made level (its height dropped).
+fn flat(v: Vec3) -> Vec3 {
+    Vec3::new(v.x, 0.0, v.z)
+}
+
+/// Whether the names put the character's left on the side `across` points to: the side of
+/// the hips that joints named left lie on (none when no joint is named for a side).
+fn left_side(skeleton: &Skeleton, at: &[Vec3], hips: usize, across: Vec3) -> Option<bool> {
     let mut votes = 0i32;
     for (j, joint) in skeleton.joints().iter().enumerate() {
         let side = match name_side(&joint.name) {
@@ -168,7 +182,7 @@ fn left_side(skeleton: &Skeleton, at: &[Vec3], hips: usize) -> Option<bool> {
             Some(false) => -1,
             None => continue,
         };
-        let dx = at[j].x - at[hips].x;
+        let dx = (at[j] - at[hips]).dot(across);
         if dx.abs() > 1e-4 {
             votes += side * if dx > 0.0 { 1 } else { -1 };
         }

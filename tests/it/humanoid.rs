@@ -189,3 +189,26 @@ fn homer_maps_his_arms_from_the_shoulders() {
         ],
     );
 }
+
+/// A character written mid-stride and turned (the puppet walking the SMPL clip, exported to
+/// glTF, whose file pose is the stride) maps as the puppet does: sides are told across its
+/// hips, not along x.
+#[test]
+fn a_character_in_mid_stride_maps_as_at_rest() {
+    use marionette::formats::scene::{AnimDoc, CharacterDoc, MotionSourceDoc, RetargetDoc, SceneDoc, SourceDoc};
+    let Some(data) = optional_data_dir() else { return };
+    let from = MotionSourceDoc::File { path: data.join("smpl"), clip: Some("7516".into()) };
+    let anim = AnimDoc { retarget: Some(RetargetDoc::of(from)), time: 1.0, playing: false, ..AnimDoc::default() };
+    let walker = CharacterDoc { anim: Some(anim), ..CharacterDoc::new(SourceDoc::Embedded("puppet".into()), "walker") };
+    let doc = SceneDoc { characters: vec![walker], ..SceneDoc::default() };
+    let glb =
+        marionette::document::export::scene_glb(&doc, marionette::formats::gltf::GltfMesh::Skinned, false).unwrap();
+    let path = crate::common::scratch("humanoid-stride").join("walker.glb");
+    std::fs::write(&path, glb).unwrap();
+    let walker = marionette::formats::load_character(&path).unwrap();
+    let puppet = marionette::formats::puppet::embedded_puppet();
+    assert_eq!(
+        named(&walker.skeleton, &detect(&walker.skeleton).unwrap()),
+        named(&puppet.skeleton, &detect(&puppet.skeleton).unwrap())
+    );
+}

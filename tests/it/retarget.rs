@@ -425,7 +425,7 @@ fn blender_bones() -> std::collections::BTreeMap<String, std::collections::BTree
 /// rest, the source's rest frame gives the target its own A-pose (every bone along its
 /// rest bone as Blender has it, 0.1°); with bones following directions, the target's arms
 /// point where Blender says the source's point, at rest (straight out) and with them
-/// raised (2°).
+/// raised (2°), the motion read from the glTF file and from Blender's BVH of it.
 #[test]
 fn a_t_pose_clip_drives_an_a_pose_character() {
     let mut library = AssetLibrary::default();
@@ -443,7 +443,7 @@ fn a_t_pose_clip_drives_an_a_pose_character() {
     };
     let child_of = |j: usize| skeleton.joints().iter().position(|c| c.parent == Some(j));
 
-    let rest = RetargetDoc { rest: marionette::rig::retarget::RestAlignment::OwnRest, ..RetargetDoc::of(from.clone()) };
+    let rest = RetargetDoc { rest: marionette::rig::retarget::RestAlignment::OwnRest, ..RetargetDoc::of(from) };
     let done = retarget(&mut library, &source, &target, &asset, &rest).unwrap();
     let mut compared = 0;
     for (j, joint) in skeleton.joints().iter().enumerate() {
@@ -454,19 +454,27 @@ fn a_t_pose_clip_drives_an_a_pose_character() {
     }
     assert!(compared >= 14, "{compared} bones compared");
 
-    let follow = RetargetDoc::of(from);
-    let done = retarget(&mut library, &source, &target, &asset, &follow).unwrap();
-    for (frame, label) in [(0, "tpose 0"), (15, "tpose 12")] {
-        for name in ["upper_arm.L", "upper_arm.R", "forearm.L", "thigh.L", "shin.R", "spine"] {
-            let j = skeleton.find(name).unwrap();
-            let (head, tail) = blender[label][name];
-            let off = angle(direction(&done.report.frames[frame], j, child_of(j).unwrap()), tail - head);
-            assert!(off < 2.0, "{label}: {name} {off}° off the source's");
+    // The same motion from the glTF file and from Blender's BVH of it.
+    for file in ["tests/data/blender_tpose.glb", "tests/data/blender_tpose.bvh"] {
+        let path = crate::common::path(file).to_path_buf();
+        let source = file_motion_doc(&mut library, &path, None).unwrap();
+        let follow = RetargetDoc::of(MotionSourceDoc::File { path, clip: None });
+        let done = retarget(&mut library, &source, &target, &asset, &follow).unwrap();
+        for (frame, label) in [(0, "tpose 0"), (15, "tpose 12")] {
+            for name in ["upper_arm.L", "upper_arm.R", "forearm.L", "thigh.L", "shin.R", "spine"] {
+                let j = skeleton.find(name).unwrap();
+                let (head, tail) = blender[label][name];
+                let off = angle(direction(&done.report.frames[frame], j, child_of(j).unwrap()), tail - head);
+                assert!(off < 2.0, "{file} {label}: {name} {off}° off the source's");
+            }
         }
+        let raised = direction(
+            &done.report.frames[15],
+            skeleton.find("upper_arm.L").unwrap(),
+            skeleton.find("forearm.L").unwrap(),
+        );
+        assert!(raised.normalize().y > 0.9, "{file}: the arm is raised: {raised}");
     }
-    let raised =
-        direction(&done.report.frames[15], skeleton.find("upper_arm.L").unwrap(), skeleton.find("forearm.L").unwrap());
-    assert!(raised.normalize().y > 0.9, "the arm is raised: {raised}");
 }
 
 /// A pose kept on the puppet, put on the SMPL body (whose joints have other names) through
