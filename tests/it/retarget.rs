@@ -397,7 +397,19 @@ mod editor {
         assert_eq!(read.characters[1].anim.as_ref().unwrap().retarget, anim.retarget);
         request(&mut app, HistoryRequest::Undo);
         app.update();
-        assert_eq!(state(&mut app), (retargeted, count));
+        assert_eq!(state(&mut app), (retargeted.clone(), count));
+
+        // The source's motion changes (its keys scaled in time): the clip follows.
+        let mut source_anim = retargeted.characters[0].anim.clone().unwrap();
+        let mut keys = source_anim.keys.take().unwrap();
+        keys = keys.with_pose_keyed(&[1, 2], &[JointRotation::euler_xyz(0.5, 0.0, 0.0); 3], 2.0);
+        source_anim.keys = Some(keys);
+        edit(&mut app, Edit::Clip { character: CharacterId(1), anim: Some(source_anim) });
+        app.update();
+        let (changed, _) = state(&mut app);
+        let oracle = marionette::document::retarget::anim_clip(&mut library, &changed, target, &asset, anim).unwrap();
+        assert!(oracle.range.1 > 1.5, "the source's clip is longer now");
+        assert!(*player(&app, 2).clip == oracle, "the editor's clip follows the source's motion");
     }
 }
 

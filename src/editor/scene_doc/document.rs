@@ -105,12 +105,15 @@ impl NextCharacterId {
 #[derive(Component, Clone, Debug, Default, PartialEq)]
 pub struct HumanoidBones(pub std::collections::BTreeMap<crate::rig::humanoid::HumanBone, String>);
 
-/// What a character's retargeted clip was last worked out for (the setting and the bones
-/// assigned by hand), and what the retargeting did (or why it failed).
+/// What a character's retargeted clip was last worked out for (the setting, the bones
+/// assigned by hand and the source's motion), and what the retargeting did (or why it
+/// failed).
 #[derive(Component, Clone, PartialEq, Debug)]
 pub struct RetargetedFrom {
     pub settings: crate::formats::scene::RetargetDoc,
     pub bones: std::collections::BTreeMap<crate::rig::humanoid::HumanBone, String>,
+    /// What the source character's motion was (its clip, blend and shape; not its time).
+    pub source_motion: String,
     pub report: String,
 }
 
