@@ -22,15 +22,7 @@ pub fn run(a: &ExportArgs) -> Result<()> {
     }
     if is_scene(&a.path) {
         let doc = crate::document::scenes::read_scene(&a.path)?;
-        if is_glb(&a.out) {
-            let glb = crate::document::export::scene_glb(&doc, mesh_kind(a.bake), a.animation)?;
-            write_file(&a.out, |w| w.write_all(&glb))?;
-        } else {
-            let (positions, triangles) = crate::document::export::scene_mesh(&doc)?;
-            write_file(&a.out, |w| obj::write_obj(w, &positions, &triangles))?;
-        }
-        println!("wrote {} ({} characters)", a.out.display(), doc.characters.len());
-        return Ok(());
+        return export_scene(&doc, a);
     }
     export_character(a)
 }
@@ -53,11 +45,16 @@ fn export_retargeted(a: &ExportArgs) -> Result<()> {
         eprintln!("{}", crate::document::retarget::describe(&done, &from.name, &c.name, &asset.skeleton));
         doc.characters.push(c);
     }
+    export_scene(&doc, a)
+}
+
+/// A scene document as `--out` asks: glTF (with `--bake`, `--animation`) or one OBJ mesh.
+fn export_scene(doc: &crate::formats::scene::SceneDoc, a: &ExportArgs) -> Result<()> {
     if is_glb(&a.out) {
-        let glb = crate::document::export::scene_glb(&doc, mesh_kind(a.bake), a.animation)?;
+        let glb = crate::document::export::scene_glb(doc, mesh_kind(a.bake), a.animation)?;
         write_file(&a.out, |w| w.write_all(&glb))?;
     } else {
-        let (positions, triangles) = crate::document::export::scene_mesh(&doc)?;
+        let (positions, triangles) = crate::document::export::scene_mesh(doc)?;
         write_file(&a.out, |w| obj::write_obj(w, &positions, &triangles))?;
     }
     println!("wrote {} ({} characters)", a.out.display(), doc.characters.len());

@@ -249,7 +249,7 @@ pub fn shaped_asset(
 }
 
 /// The motion of `source` carried onto `target` (whose asset is `target_asset`) as
-/// `settings` ask, baked into a keyframed clip of the target's mapped joints.
+/// `settings` ask, baked into a keyframed clip of the joints the source drives.
 pub fn retarget(
     library: &mut super::AssetLibrary,
     source: &CharacterDoc,
@@ -276,8 +276,7 @@ pub fn retarget(
         ))
     })?;
     let report = retargeter.motion(&source_frames, FPS, settings.plant_feet);
-    let keyed: Vec<usize> = t_map.values().copied().collect();
-    let clip = Clip::from_frames(t_skel, &report.frames, FPS, &keyed);
+    let clip = Clip::from_frames(t_skel, &report.frames, FPS, &retargeter.driven());
     let leg_ratio = retargeter.leg_ratio();
     Ok(Retargeting { clip, report, leg_ratio, source_frames, floors: (s_floor, t_floor) })
 }

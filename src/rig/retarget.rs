@@ -223,6 +223,11 @@ impl<'a> Retargeter<'a> {
         })
     }
 
+    /// The target's joints the source drives: the mapped ones and the namesakes.
+    pub fn driven(&self) -> Vec<usize> {
+        (0..self.bones.len()).filter(|&j| self.bones[j].is_some() || self.namesakes[j].is_some()).collect()
+    }
+
     /// Target leg length over the source's.
     pub fn leg_ratio(&self) -> f32 {
         self.ratio

@@ -284,6 +284,14 @@ fn a_clip_retargeted_onto_its_own_character_is_itself() {
                     "{path:?} frame {f} joint {j}: {a:?} against {b:?}"
                 );
             }
+            // The baked clip plays the same at the frame's time.
+            let t = f as f32 / marionette::document::retarget::FPS;
+            let (root, played) = done.clip.pose_at(&asset.skeleton, t, &asset.skeleton.initial_pose());
+            assert!(root.distance(want.root + lift) < 1e-5, "{path:?} frame {f}: the clip's root");
+            for (j, (a, b)) in played.iter().zip(&want.pose).enumerate() {
+                let (a, b) = (a.to_quat(), b.to_quat());
+                assert!(same_rotation(a, b, 1e-5), "{path:?} frame {f} joint {j}: the clip's {a:?} against {b:?}");
+            }
         }
     }
 }
