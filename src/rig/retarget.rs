@@ -14,7 +14,8 @@
 //!   (thigh + shin), their height over each one's floor likewise.
 //! - **Feet.** Where the source plants a foot (low and still), the target's foot keeps the
 //!   place it had when the contact began, moving only as the source's foot moves (scaled);
-//!   no foot sinks lower than the source's (mapped to the target's ankle height). The legs
+//!   no ankle sinks below its standing height where the source's stands on the floor, and
+//!   no toe below the floor. The legs
 //!   reach by the IK solver, the feet keeping their turn in the world; after a contact
 //!   the correction fades over a few frames.
 //! - **Limits.** Every rotation is clamped to the target joint's limits; the joints and
@@ -352,8 +353,13 @@ impl<'a> Retargeter<'a> {
         planted.iter_mut().for_each(|p| *p &= plant);
         let (s_ankle, t_ankle) =
             (self.source_rest_at[sf].y - self.source.floor, self.target_rest_at[tf].y - self.target.floor);
-        // The lowest the target's ankle may go, for the source's ankle at `y`.
-        let lowest = |y: f32| self.target.floor + (t_ankle + (y - self.source.floor - s_ankle) * self.ratio).max(0.0);
+        // The lowest the target's ankle may go, for the source's ankle at `y`: standing
+        // height where the source's stands (or higher), lower in proportion where the
+        // source's is lower (a foot rolled onto its toes).
+        let lowest = |y: f32| {
+            let standing = ((y - self.source.floor) / s_ankle.max(1e-6)).clamp(0.0, 1.0);
+            self.target.floor + t_ankle.max(0.0) * standing
+        };
         let fade = (fps * 0.15).round().max(1.0) as usize;
         let mut anchor: Option<(Vec3, Vec3)> = None;
         let mut last_fix = Vec3::ZERO;

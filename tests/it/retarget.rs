@@ -62,8 +62,10 @@ struct Figures {
     /// target leg lengths; and how many such stretches there were.
     worst_slide: f32,
     still_stretches: usize,
-    /// Bone-frames not compared because the report says they were clamped or moved.
+    /// Bone-frames not compared because the report says they were clamped or moved, and
+    /// the worst angle among them.
     excused: usize,
+    worst_excused: f32,
 }
 
 struct Side {
@@ -132,12 +134,13 @@ fn measure(s: &Side, source: &[Frame], t: &Side, report: &Retargeted) -> Figures
             }
             // Where the report says the target's limits clamped the bone, or its leg was
             // moved to plant the foot or keep it above the floor.
+            let angle = (sa[sn] - sa[sj]).angle_between(ta[tn] - ta[tj]).to_degrees();
             let moved = (0..2).any(|k| report.legs_moved[k][f] && LEGS[k].contains(&bone));
             if moved || report.clamped.contains(&(f, tj)) {
                 figures.excused += 1;
+                figures.worst_excused = figures.worst_excused.max(angle);
                 continue;
             }
-            let angle = (sa[sn] - sa[sj]).angle_between(ta[tn] - ta[tj]).to_degrees();
             if angle > figures.worst_direction.0 {
                 figures.worst_direction = (angle, format!("{bone:?}"));
             }
@@ -212,7 +215,7 @@ fn clips_carry_across_humanoids_of_every_origin() {
                 let (s, t) = (side(&mut library, &source, done.floors.0), side(&mut library, target, done.floors.1));
                 let figures = measure(&s, &done.source_frames, &t, &done.report);
                 eprintln!(
-                    "{plant} {} {} → {}: worst direction {:.2}° ({}), hips height / (source's × leg ratio) {:.4}–{:.4}, lowest foot {:+.4} legs, {} still stretches, worst slide {:.4} legs, {} clamped, {} bone-frames excused",
+                    "{plant} {} {} → {}: worst direction {:.2}° ({}), hips height / (source's × leg ratio) {:.4}–{:.4}, lowest foot {:+.4} legs, {} still stretches, worst slide {:.4} legs, {} clamped, {} bone-frames excused (worst {:.1}°)",
                     path.file_name().unwrap().to_string_lossy(),
                     clip.unwrap_or(""),
                     target.name,
@@ -225,6 +228,7 @@ fn clips_carry_across_humanoids_of_every_origin() {
                     figures.worst_slide,
                     done.report.clamped.len(),
                     figures.excused,
+                    figures.worst_excused,
                 );
                 assert!(figures.worst_direction.0 < 2.0, "{}: {:?}", target.name, figures.worst_direction);
                 assert!(
@@ -540,5 +544,45 @@ fn a_pose_carries_to_a_rig_with_other_names_as_it_was_or_mirrored() {
             let off = want.angle_between(got).to_degrees();
             assert!(off < 2.0, "mirrored {mirrored}: {a:?} {off}° off");
         }
+    }
+}
+
+/// A target whose elbow is limited: the bent source elbow is clamped into the limits and
+/// the report names the elbow in the frames it clamped; the other bones still point as the
+/// source's.
+#[test]
+fn the_targets_limits_clamp_and_the_report_says_where() {
+    use marionette::rig::retarget::{Humanoid, RestAlignment, Retargeter};
+    use marionette::rig::{DofLimits, RawJoint};
+    let source = marionette::formats::puppet::embedded_puppet().skeleton;
+    let raw: Vec<RawJoint> = source
+        .joints()
+        .iter()
+        .map(|j| {
+            let mut raw = RawJoint::new(j.name.clone(), j.parent, j.rest_offset);
+            if j.name == "l_elbow" {
+                raw.limits = DofLimits { min: Vec3::splat(-0.2), max: Vec3::splat(0.2) };
+            }
+            raw
+        })
+        .collect();
+    let target = Skeleton::build(raw).unwrap();
+    let map = marionette::rig::humanoid::detect(&source).unwrap();
+    let side = |skeleton| Humanoid { skeleton, map: &map, floor: 0.0 };
+    let retargeter = Retargeter::new(side(&source), side(&target), RestAlignment::Directions).unwrap();
+    let elbow = source.find("l_elbow").unwrap();
+    let frames: Vec<Frame> = (0..4)
+        .map(|f| {
+            let mut pose = source.initial_pose();
+            pose[elbow] = JointRotation::euler_xyz(0.0, 0.0, 0.1 + 0.4 * f as f32);
+            Frame { root: source.joint(0).rest_offset, pose }
+        })
+        .collect();
+    let done = retargeter.motion(&frames, 30.0, false);
+    // 0.1 fits within ±0.2; 0.5, 0.9, 1.3 do not.
+    assert_eq!(done.clamped, vec![(1, elbow), (2, elbow), (3, elbow)]);
+    for frame in &done.frames {
+        let held = frame.pose[elbow].to_euler(marionette::rig::EulerOrder::Xyz);
+        assert!(held.z <= 0.2 + 1e-5 && held.z >= -0.2 - 1e-5, "clamped: {held}");
     }
 }
