@@ -11,9 +11,26 @@ use crate::rig::CharacterAsset;
 use crate::rig::dqs::SkinningMethod;
 
 /// Bytes per skin vertex without texture coordinates: position (3 × f32) then colour
-/// (4 × f32), the order in which Bevy packs the mesh's attributes. Texture coordinates
-/// (2 × f32) go between them where a skin has them.
-pub const SKIN_VERTEX_BYTES: usize = 7 * 4;
+/// (4 × u8, [`SKIN_COLOR`]), the order in which Bevy packs the mesh's attributes. Texture
+/// coordinates (2 × f32) go between them where a skin has them.
+pub const SKIN_VERTEX_BYTES: usize = 4 * 4;
+
+/// The skin mesh's vertex colour: Bevy's own attribute (its id, so the PBR shader takes it
+/// at its location as a `vec4<f32>`) in four bytes (unorm8x4) instead of four floats: 16
+/// bytes a vertex handed on instead of 28.
+pub const SKIN_COLOR: bevy::mesh::MeshVertexAttribute =
+    bevy::mesh::MeshVertexAttribute::new("Vertex_Color", 5, bevy::render::render_resource::VertexFormat::Unorm8x4);
+
+/// A colour as [`SKIN_COLOR`] holds it: each channel clamped to 0–1, to the nearest of 255
+/// steps.
+pub fn color_bytes(c: [f32; 4]) -> [u8; 4] {
+    c.map(|x| (x.clamp(0.0, 1.0) * 255.0).round() as u8)
+}
+
+/// Packed colour bytes in the slot of one float of the upload.
+fn color_word(c: [f32; 4]) -> f32 {
+    f32::from_bits(u32::from_le_bytes(color_bytes(c)))
+}
 
 /// A character's packed vertices (`floats` per vertex), replaced whenever it is re-skinned
 /// or recoloured (its change tick is what the render world looks for).
@@ -38,6 +55,21 @@ impl SkinUpload {
         self.floats = pack_vertices(positions, texcoords, colors, self.buffer());
     }
 
+    /// Writes new positions over the packed ones, leaving texture coordinates and colours
+    /// as they are; false (nothing written) when the buffer is still held elsewhere or
+    /// holds another number of vertices, and must be packed whole.
+    pub fn repack_positions(&mut self, positions: &[Vec3]) -> bool {
+        let floats = self.floats;
+        let Some(buffer) = Arc::get_mut(&mut self.vertices) else { return false };
+        if floats < 4 || buffer.len() != positions.len() * floats {
+            return false;
+        }
+        for (slot, p) in buffer.chunks_exact_mut(floats).zip(positions) {
+            slot[..3].copy_from_slice(&p.to_array());
+        }
+        true
+    }
+
     /// The vertices as the bytes the GPU takes.
     pub fn bytes(&self) -> &[u8] {
         bytemuck::cast_slice(&self.vertices)
@@ -53,18 +85,14 @@ pub fn pack_vertices(positions: &[Vec3], texcoords: &[Vec2], colors: &[[f32; 4]]
     assert_eq!(positions.len(), colors.len(), "one colour per vertex");
     out.clear();
     if texcoords.is_empty() {
-        out.extend(positions.iter().zip(colors).flat_map(|(p, c)| [p.x, p.y, p.z, c[0], c[1], c[2], c[3]]));
-        return 7;
+        out.extend(positions.iter().zip(colors).flat_map(|(p, c)| [p.x, p.y, p.z, color_word(*c)]));
+        return 4;
     }
     assert_eq!(positions.len(), texcoords.len(), "texture coordinates for every vertex");
     out.extend(
-        positions
-            .iter()
-            .zip(texcoords)
-            .zip(colors)
-            .flat_map(|((p, t), c)| [p.x, p.y, p.z, t.x, t.y, c[0], c[1], c[2], c[3]]),
+        positions.iter().zip(texcoords).zip(colors).flat_map(|((p, t), c)| [p.x, p.y, p.z, t.x, t.y, color_word(*c)]),
     );
-    9
+    6
 }
 
 /// What the render world needs to skin a character on the GPU (`None`: it is skinned on

@@ -97,7 +97,8 @@ fn surface_mesh(skin: &crate::rig::Skin, surface: &crate::rig::material::Surface
     empty_skin_mesh(&triangles, (end - first) as usize, texcoords)
 }
 
-/// A render mesh of the skin's own vertices and triangles: positions and colours, no
+/// A render mesh of the skin's own vertices and triangles: positions and colours (four
+/// bytes, [`SKIN_COLOR`](super::handoff::SKIN_COLOR)), no
 /// normals (the skin material lights each triangle with its own normal, from the
 /// derivatives of the position). Its vertex data is what `upload::pack_vertices` packs.
 pub fn empty_skin_mesh(triangles: &[[u32; 3]], vertex_count: usize, texcoords: &[Vec2]) -> Mesh {
@@ -105,7 +106,10 @@ pub fn empty_skin_mesh(triangles: &[[u32; 3]], vertex_count: usize, texcoords: &
     // GPU slot (see `upload`), never into this asset.
     let mut mesh = Mesh::new(PrimitiveTopology::TriangleList, RenderAssetUsages::RENDER_WORLD)
         .with_inserted_attribute(Mesh::ATTRIBUTE_POSITION, vec![[0.0f32; 3]; vertex_count])
-        .with_inserted_attribute(Mesh::ATTRIBUTE_COLOR, vec![[1.0f32; 4]; vertex_count])
+        .with_inserted_attribute(
+            super::handoff::SKIN_COLOR,
+            bevy::mesh::VertexAttributeValues::Unorm8x4(vec![[255; 4]; vertex_count]),
+        )
         .with_inserted_indices(Indices::U32(triangles.iter().flatten().copied().collect()));
     if !texcoords.is_empty() {
         mesh.insert_attribute(Mesh::ATTRIBUTE_UV_0, texcoords.iter().map(|t| t.to_array()).collect::<Vec<_>>());

@@ -170,7 +170,10 @@ pub fn skin_changed_characters(
             if moved {
                 skin_on_cpu(skin, method.0, scratch);
             }
-            upload.pack(&scratch.positions, &skin.texcoords, &scratch.colors);
+            // Colours and texture coordinates stay in the buffer when only the pose moved.
+            if recolored || !upload.repack_positions(&scratch.positions) {
+                upload.pack(&scratch.positions, &skin.texcoords, &scratch.colors);
+            }
         },
     );
 }

@@ -34,12 +34,9 @@ pub fn spawn(app: &mut App, asset: Arc<CharacterAsset>, placement: Placement) ->
 /// The positions and colours a character hands to the GPU (decoded from its packed upload).
 fn uploaded_vertices(app: &App, character: Entity) -> (Vec<[f32; 3]>, Vec<[f32; 4]>) {
     let upload = app.world().get::<marionette::scene::upload::SkinUpload>(character).unwrap();
-    let color = upload.floats - 4;
-    upload
-        .vertices
-        .chunks(upload.floats)
-        .map(|v| ([v[0], v[1], v[2]], [v[color], v[color + 1], v[color + 2], v[color + 3]]))
-        .unzip()
+    // The colour is the last four bytes of each vertex (unorm8x4).
+    let color = |word: f32| word.to_bits().to_le_bytes().map(|b| f32::from(b) / 255.0);
+    upload.vertices.chunks(upload.floats).map(|v| ([v[0], v[1], v[2]], color(v[upload.floats - 1]))).unzip()
 }
 
 fn mesh_positions(app: &App, character: Entity) -> Vec<[f32; 3]> {
@@ -141,8 +138,10 @@ fn mesh_triangles_and_weight_colours_match_the_kernels() {
     assert!(mesh.attribute(Mesh::ATTRIBUTE_NORMAL).is_none(), "no normals are written");
     let Some(bevy::mesh::Indices::U32(indices)) = mesh.indices() else { panic!("indices are u32") };
     assert_eq!(indices.as_slice(), asset.skin.triangles.as_flattened());
+    // Colours go out in 8 bits a channel: each within half a step of the kernel's.
     for (color, [r, g, b]) in colors.iter().zip(per_vertex) {
-        assert_eq!(*color, [r, g, b, 1.0]);
+        let off = color.iter().zip([r, g, b, 1.0]).map(|(a, b)| (a - b).abs()).fold(0.0f32, f32::max);
+        assert!(off <= 0.5 / 255.0 + 1e-6, "{color:?} against {:?}", [r, g, b, 1.0]);
     }
 }
 
@@ -200,19 +199,23 @@ fn packed_vertices_match_bevys_vertex_buffer() {
     let triangles = [[0u32, 1, 2], [2, 1, 3]];
     let positions = [Vec3::new(0.0, 1.0, 2.0), Vec3::X, Vec3::new(-1.5, 0.25, 8.0), Vec3::splat(3.0)];
     let colors = [[0.1, 0.2, 0.3, 1.0], [1.0, 0.0, 0.5, 1.0], [0.0; 4], [0.7, 0.7, 0.7, 1.0]];
+    // Each channel to the nearest of 255 steps, worked out here.
+    let bytes: Vec<[u8; 4]> = colors.iter().map(|c| c.map(|x: f32| (x * 255.0).round() as u8)).collect();
+    let color_values = || bevy::mesh::VertexAttributeValues::Unorm8x4(bytes.clone());
+    let skin_color = marionette::scene::handoff::SKIN_COLOR;
     let mut mesh = marionette::scene::spawn::empty_skin_mesh(&triangles, positions.len(), &[]);
     mesh.insert_attribute(Mesh::ATTRIBUTE_POSITION, positions.map(|p| p.to_array()).to_vec());
-    mesh.insert_attribute(Mesh::ATTRIBUTE_COLOR, colors.to_vec());
+    mesh.insert_attribute(skin_color, color_values());
     let mut upload = marionette::scene::upload::SkinUpload::default();
-    assert_eq!(pack_vertices(&positions, &[], &colors, upload.buffer()), 7);
+    assert_eq!(pack_vertices(&positions, &[], &colors, upload.buffer()), 4);
     assert_eq!(upload.bytes(), mesh.create_packed_vertex_buffer_data());
     assert_eq!(upload.bytes().len(), positions.len() * marionette::scene::upload::SKIN_VERTEX_BYTES);
     // A textured skin: its texture coordinates go where Bevy puts them.
     let uv = [Vec2::new(0.0, 0.5), Vec2::new(1.0, 0.25), Vec2::ZERO, Vec2::ONE];
     let mut textured = marionette::scene::spawn::empty_skin_mesh(&triangles, positions.len(), &uv);
     textured.insert_attribute(Mesh::ATTRIBUTE_POSITION, positions.map(|p| p.to_array()).to_vec());
-    textured.insert_attribute(Mesh::ATTRIBUTE_COLOR, colors.to_vec());
-    assert_eq!(pack_vertices(&positions, &uv, &colors, upload.buffer()), 9);
+    textured.insert_attribute(skin_color, color_values());
+    assert_eq!(pack_vertices(&positions, &uv, &colors, upload.buffer()), 6);
     assert_eq!(upload.bytes(), textured.create_packed_vertex_buffer_data());
 }
 
