@@ -353,3 +353,27 @@ fn ik_solve_dragon_tail(bencher: Bencher) {
         marionette::rig::ik::solve_ik(s, &mut pose, Mat4::IDENTITY, &goal, 1e-3, 24)
     });
 }
+
+/// The passes of one SMPL body's share of the crowd's skin phase, each alone, in vertices
+/// per second: the kernel, the bounds of its output, writing the positions over a packed
+/// upload with their bounds in the same pass (a pose change), and packing the upload
+/// whole (a colour change).
+#[divan::bench(args = ["kernel", "bounds", "repack", "pack"])]
+fn skin_phase_parts(bencher: Bencher, part: &str) {
+    use marionette::scene::upload::SkinUpload;
+    let body = smpl_body();
+    let palette = posed_palette(&body);
+    let skin = &body.skin;
+    let mut positions = vec![Vec3::ZERO; skin.bind_positions.len()];
+    marionette::rig::lbs::skin(&skin.bind_positions, &skin.weights, &palette, &mut positions);
+    let colors = vec![[0.8, 0.7, 0.6, 1.0]; positions.len()];
+    let mut upload = SkinUpload::default();
+    upload.pack(&positions, &skin.texcoords, &colors);
+    let mut out = positions.clone();
+    bencher.counter(divan::counter::ItemsCount::new(positions.len())).bench_local(|| match part {
+        "kernel" => marionette::rig::lbs::skin(&skin.bind_positions, &skin.weights, &palette, &mut out),
+        "bounds" => drop(divan::black_box(marionette::rig::skinning::bounds(&positions))),
+        "repack" => drop(divan::black_box(upload.repack_positions(&positions).expect("not shared"))),
+        _ => upload.pack(&positions, &skin.texcoords, &colors),
+    });
+}

@@ -56,18 +56,20 @@ impl SkinUpload {
     }
 
     /// Writes new positions over the packed ones, leaving texture coordinates and colours
-    /// as they are; false (nothing written) when the buffer is still held elsewhere or
-    /// holds another number of vertices, and must be packed whole.
-    pub fn repack_positions(&mut self, positions: &[Vec3]) -> bool {
+    /// as they are, and returns their bounds (found in the same pass); none (nothing
+    /// written) when the buffer is still held elsewhere or holds another number of
+    /// vertices, and must be packed whole.
+    pub fn repack_positions(&mut self, positions: &[Vec3]) -> Option<(Vec3, Vec3)> {
         let floats = self.floats;
-        let Some(buffer) = Arc::get_mut(&mut self.vertices) else { return false };
+        let buffer = Arc::get_mut(&mut self.vertices)?;
         if floats < 4 || buffer.len() != positions.len() * floats {
-            return false;
+            return None;
         }
-        for (slot, p) in buffer.chunks_exact_mut(floats).zip(positions) {
+        let written = positions.iter().zip(buffer.chunks_exact_mut(floats)).map(|(p, slot)| {
             slot[..3].copy_from_slice(&p.to_array());
-        }
-        true
+            *p
+        });
+        Some(crate::rig::skinning::bounds_of(written))
     }
 
     /// The vertices as the bytes the GPU takes.

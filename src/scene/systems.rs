@@ -168,11 +168,20 @@ pub fn skin_changed_characters(
                 job.0 = None;
             }
             if moved {
-                skin_on_cpu(skin, method.0, scratch);
+                skin_positions_on_cpu(skin, method.0, scratch);
             }
-            // Colours and texture coordinates stay in the buffer when only the pose moved.
-            if recolored || !upload.repack_positions(&scratch.positions) {
-                upload.pack(&scratch.positions, &skin.texcoords, &scratch.colors);
+            // Colours and texture coordinates stay in the buffer when only the pose moved;
+            // the bounds are found as the positions are written.
+            match (recolored, moved) {
+                (false, true) if let Some(bounds) = upload.repack_positions(&scratch.positions) => {
+                    scratch.bounds = bounds;
+                }
+                _ => {
+                    if moved {
+                        scratch.bounds = bounds(&scratch.positions);
+                    }
+                    upload.pack(&scratch.positions, &skin.texcoords, &scratch.colors);
+                }
             }
         },
     );
@@ -180,6 +189,13 @@ pub fn skin_changed_characters(
 
 /// The LBS or DQ kernel of the skin into `scratch.positions`, and their bounds.
 fn skin_on_cpu(skin: &crate::rig::Skin, method: dqs::SkinningMethod, scratch: &mut SkinScratch) {
+    skin_positions_on_cpu(skin, method, scratch);
+    scratch.bounds = bounds(&scratch.positions);
+}
+
+/// The LBS or DQ kernel of the skin into `scratch.positions` (their bounds left to the
+/// caller).
+fn skin_positions_on_cpu(skin: &crate::rig::Skin, method: dqs::SkinningMethod, scratch: &mut SkinScratch) {
     scratch.positions.resize(skin.bind_positions.len(), Vec3::ZERO);
     if method.is_linear() {
         skin_in_chunks(skin, &scratch.palette, &mut scratch.positions);
@@ -187,7 +203,6 @@ fn skin_on_cpu(skin: &crate::rig::Skin, method: dqs::SkinningMethod, scratch: &m
         dqs::dual_quaternion_palette(&scratch.palette, &mut scratch.dual_quaternions);
         dqs::skin_dq(&skin.bind_positions, &skin.weights, &scratch.dual_quaternions, &mut scratch.positions);
     }
-    scratch.bounds = bounds(&scratch.positions);
 }
 
 /// Vertices per task when one mesh is skinned on several threads.
