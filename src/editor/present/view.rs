@@ -47,7 +47,11 @@ impl Plugin for ScenePlugin {
                 PostUpdate,
                 (
                     apply_pending_scene.in_set(crate::editor::order::EditorSystems::OpenScene),
-                    (sync_character_views, crate::editor::scene_doc::retarget::resolve_retargets)
+                    (
+                        sync_character_views,
+                        crate::editor::scene_doc::retarget::resolve_retargets
+                            .run_if(any_with_component::<crate::scene::keyframes::ClipPlayer>),
+                    )
                         .chain()
                         .in_set(crate::editor::order::EditorSystems::SyncViews),
                 ),
