@@ -9,6 +9,8 @@
 //! Run: `cargo bench --profile dev --bench marionette` (with `MARIONETTE_DATA` set, the
 //! 6.837 Model1 is used; otherwise the project's puppet).
 
+mod ozz_jobs;
+
 use std::sync::{Arc, OnceLock};
 
 use bevy::prelude::*;
@@ -19,6 +21,17 @@ use marionette::rig::{CharacterAsset, JointRotation};
 use marionette::scene::*;
 
 fn main() {
+    // `MARIONETTE_OZZ_DUMP=FILE`: only write the SMPL body's jobs for the ozz harness.
+    if let Some(path) = std::env::var_os("MARIONETTE_OZZ_DUMP") {
+        let body = smpl_body();
+        let palette = posed_palette(&body);
+        let skin = &body.skin;
+        let mut want = vec![Vec3::ZERO; skin.bind_positions.len()];
+        skin_positions(&skin.bind_positions, &skin.weights, &palette, &mut want);
+        let jobs = ozz_jobs::jobs(&skin.bind_positions, &skin.weights);
+        ozz_jobs::dump(&jobs, &palette, &want, std::path::Path::new(&path)).expect("the jobs are written");
+        return;
+    }
     divan::main();
 }
 
