@@ -6,7 +6,7 @@ use std::path::Path;
 
 use crate::formats::FormatError;
 use crate::formats::scene::{
-    AnimDoc, CharacterDoc, MotionSourceDoc, PlaybackDoc, RetargetDoc, SceneDoc, SmplDoc, SourceDoc,
+    AnimDoc, CharacterDoc, MotionSourceDoc, PlaybackDoc, RetargetDoc, SceneDoc, SmplDoc, SourceDoc, is_motion_file,
 };
 use crate::rig::anim::Clip;
 use crate::rig::humanoid::{HumanBone, HumanoidMap};
@@ -93,7 +93,7 @@ pub fn motion_frames(
             (None, None) => (*library.keyframe_clip(&anim.file)?).clone(),
         };
         let clip = clip.retargeted(skeleton, &anim.names);
-        let frames = sample_times(clip.range)
+        let frames = sample_times(clip.range, &c.name)?
             .map(|t| {
                 let (root, pose) = clip.pose_at(skeleton, t, &base);
                 Frame { root, pose }
@@ -105,7 +105,7 @@ pub fn motion_frames(
         let find = |name: &Option<String>| part.clips.iter().find(|k| Some(&k.name) == name.as_ref());
         if let Some(clip) = find(&playback.clip) {
             let blend = find(&playback.blend_clip).map(|k| (k, playback.blend));
-            let frames = sample_times((0.0, clip.duration()))
+            let frames = sample_times((0.0, clip.duration()), &c.name)?
                 .map(|t| {
                     let now = crate::rig::node_clip::sample_mix(skeleton, clip, blend, t);
                     let mut pose = base.clone();
@@ -165,11 +165,19 @@ pub fn motion_frames(
     Ok(None)
 }
 
-/// The times of frames at [`FPS`] from the start of `range` to its end (at least one).
-fn sample_times((start, end): (f32, f32)) -> impl Iterator<Item = f32> {
-    let n = ((end - start).max(0.0) * FPS).round() as usize;
-    let n = n.min(crate::formats::limits::MAX_SAMPLED_FRAMES.saturating_sub(1));
-    (0..=n).map(move |f| start + f as f32 / FPS)
+/// The times of frames at [`FPS`] from the start of `range` to its end (at least one);
+/// refused, naming `what`, when there would be more than
+/// [`MAX_SAMPLED_FRAMES`](crate::formats::limits::MAX_SAMPLED_FRAMES).
+fn sample_times((start, end): (f32, f32), what: &str) -> Result<impl Iterator<Item = f32>, FormatError> {
+    let most = crate::formats::limits::MAX_SAMPLED_FRAMES;
+    let n = ((end - start).max(0.0) * FPS).round();
+    if !(n < most as f32) {
+        return Err(FormatError::other(
+            Path::new(what),
+            format!("expected a clip of at most {most} frames at {FPS} a second to retarget, found {end} − {start} s"),
+        ));
+    }
+    Ok((0..=n as usize).map(move |f| start + f as f32 / FPS))
 }
 
 /// The document of the character a file brings, playing the clip `clip` names (see
@@ -182,8 +190,6 @@ pub fn file_motion_doc(
     let source = SourceDoc::File(path.to_path_buf());
     let asset = library.load(&source)?;
     let mut doc = library.new_character_doc(source.clone(), &asset);
-    let is_motion_file =
-        |p: &Path| p.extension().is_some_and(|e| e.eq_ignore_ascii_case("anim") || e.eq_ignore_ascii_case("bvh"));
     if is_motion_file(path) {
         doc.anim = Some(AnimDoc::of(path));
     } else if let Some(spec) = clip {

@@ -113,8 +113,13 @@ pub fn read_scene(path: &Path) -> Result<SceneDoc, FormatError> {
     let dir = path.parent().unwrap_or(Path::new("."));
     for c in &mut doc.characters {
         c.source = c.source.resolved(dir);
-        if let Some(anim) = c.anim.as_mut().filter(|a| !a.file.as_os_str().is_empty()) {
-            anim.file = dir.join(&anim.file);
+        if let Some(anim) = c.anim.as_mut() {
+            if !anim.file.as_os_str().is_empty() {
+                anim.file = dir.join(&anim.file);
+            }
+            if let Some(retarget) = &mut anim.retarget {
+                retarget.from = retarget.from.resolved(dir);
+            }
         }
     }
     Ok(doc)
@@ -126,8 +131,13 @@ pub fn write_scene(path: &Path, doc: &SceneDoc) -> Result<(), FormatError> {
     let dir = path.parent().filter(|d| !d.as_os_str().is_empty()).unwrap_or(Path::new("."));
     for c in &mut doc.characters {
         c.source = c.source.relative_to(dir);
-        if let Some(anim) = c.anim.as_mut().filter(|a| !a.file.as_os_str().is_empty()) {
-            anim.file = crate::formats::scene::relative_path(&anim.file, dir);
+        if let Some(anim) = c.anim.as_mut() {
+            if !anim.file.as_os_str().is_empty() {
+                anim.file = crate::formats::scene::relative_path(&anim.file, dir);
+            }
+            if let Some(retarget) = &mut anim.retarget {
+                retarget.from = retarget.from.relative_to(dir);
+            }
         }
     }
     crate::formats::scene::save_scene(path, &doc)

@@ -381,6 +381,38 @@ pub enum MotionSourceDoc {
     },
 }
 
+impl MotionSourceDoc {
+    /// Its file (and a motion file its clip names) found from `dir`, as a scene file's
+    /// folder resolves its sources.
+    pub fn resolved(&self, dir: &Path) -> Self {
+        self.with_paths(|p| dir.join(p))
+    }
+
+    /// Its file (and a motion file its clip names) relative to `dir`, as a scene file
+    /// keeps its sources.
+    pub fn relative_to(&self, dir: &Path) -> Self {
+        self.with_paths(|p| relative_path(p, dir))
+    }
+
+    fn with_paths(&self, path_of: impl Fn(&Path) -> PathBuf) -> Self {
+        match self {
+            MotionSourceDoc::Character(id) => MotionSourceDoc::Character(*id),
+            MotionSourceDoc::File { path, clip } => MotionSourceDoc::File {
+                path: path_of(path),
+                clip: clip.as_ref().map(|c| match is_motion_file(Path::new(c)) {
+                    true => path_of(Path::new(c)).to_string_lossy().into_owned(),
+                    false => c.clone(),
+                }),
+            },
+        }
+    }
+}
+
+/// Whether a path names a motion file (a CSE169 `.anim` or a `.bvh`).
+pub fn is_motion_file(path: &Path) -> bool {
+    path.extension().is_some_and(|e| e.eq_ignore_ascii_case("anim") || e.eq_ignore_ascii_case("bvh"))
+}
+
 impl Default for AnimDoc {
     fn default() -> Self {
         Self {

@@ -586,3 +586,36 @@ fn the_targets_limits_clamp_and_the_report_says_where() {
         assert!(held.z <= 0.2 + 1e-5 && held.z >= -0.2 - 1e-5, "clamped: {held}");
     }
 }
+
+/// A scene file keeps a retargeting's file (and a motion file its clip names) relative to
+/// its folder, as it keeps sources, and reading it finds them again from there.
+#[test]
+fn a_scene_file_keeps_the_motion_file_relative_to_its_folder() {
+    use marionette::document::scenes::{read_scene, write_scene};
+    use marionette::formats::scene::{AnimDoc, SceneDoc};
+    let dir = crate::common::scratch("retarget-relative");
+    let motion = dir.join("clips").join("walk.glb");
+    let skel = dir.join("clips").join("rig.skel");
+    let anim = dir.join("clips").join("walk.anim");
+    let mut doc = SceneDoc::default();
+    for (path, clip) in [(motion.clone(), Some("Walk".to_string())), (skel.clone(), Some(anim.display().to_string()))] {
+        let retarget = Some(RetargetDoc::of(MotionSourceDoc::File { path, clip }));
+        let c = CharacterDoc {
+            anim: Some(AnimDoc { retarget, ..AnimDoc::default() }),
+            ..CharacterDoc::new(SourceDoc::Embedded("puppet".into()), "a")
+        };
+        doc.characters.push(c);
+    }
+    let scene = dir.join("scene.ron");
+    write_scene(&scene, &doc).unwrap();
+    let text = std::fs::read_to_string(&scene).unwrap();
+    assert!(
+        text.contains("\"clips/walk.glb\"") && text.contains("\"clips/walk.anim\"") && text.contains("\"Walk\""),
+        "{text}"
+    );
+    assert!(!text.contains(&dir.display().to_string()), "no absolute path: {text}");
+    let read = read_scene(&scene).unwrap();
+    let from = |i: usize| read.characters[i].anim.as_ref().unwrap().retarget.as_ref().unwrap().from.clone();
+    assert_eq!(from(0), MotionSourceDoc::File { path: motion, clip: Some("Walk".into()) });
+    assert_eq!(from(1), MotionSourceDoc::File { path: skel, clip: Some(anim.display().to_string()) });
+}

@@ -241,6 +241,38 @@ fn long_clips_go_out_key_for_key_and_endless_cycles_are_refused_naming_the_limit
     assert!(!out.exists(), "wrote {}", out.display());
 }
 
+/// Retargetings that cannot be: from a character not in the scene, two characters each
+/// playing the other's motion, a file outside every folder that is no character, a rig
+/// with no arms, a source clip 3e38 seconds long. Each is refused naming what is wrong, and
+/// nothing is written.
+#[test]
+fn impossible_retargetings_are_refused_and_write_nothing() {
+    let dir = scratch("impossible-retargetings");
+    let commands = regressions().join("commands");
+    let out = dir.join("out.obj");
+    let refused = |args: &[&std::ffi::OsStr], says: &str| {
+        let mut all: Vec<&std::ffi::OsStr> = vec!["export".as_ref()];
+        all.extend_from_slice(args);
+        all.extend(["--out".as_ref(), out.as_os_str()]);
+        let output = marionette(&all, &dir);
+        let said = stderr(&output);
+        assert_eq!(output.status.code(), Some(1), "{said}");
+        assert!(said.contains(says), "{said}");
+        assert!(!out.exists(), "wrote {}", out.display());
+    };
+    for (file, says) in [
+        ("retarget-from-a-missing-character.ron", "#99: expected a character of the scene to take the motion of"),
+        ("retarget-cycle.ron", "expected a clip of its own to retarget, found a retargeted one"),
+        ("retarget-from-outside.ron", "etc/passwd: expected a character file"),
+        ("retarget-from-no-humanoid.ron", "expected both steps and a to have hips and two legs"),
+    ] {
+        refused(&[commands.join(file).as_os_str()], says);
+    }
+    let puppet = Path::new(env!("CARGO_MANIFEST_DIR")).join("assets/puppet.skel");
+    let long = commands.join("gltf-clip-3e38-seconds.glb");
+    refused(&[puppet.as_os_str(), "--retarget".as_ref(), long.as_os_str()], "frames at 30 a second to retarget");
+}
+
 fn make_fifo(path: &Path) {
     let c = std::ffi::CString::new(path.as_os_str().as_encoded_bytes()).unwrap();
     // SAFETY: a valid NUL-terminated path; mkfifo only creates a file.
