@@ -10,6 +10,7 @@ use super::args::{ClipArgs, ExportArgs};
 use super::write_file;
 use crate::document::posing::{PoseSpec, apply_ik_specs, apply_pose_specs, describe_ik, posed_positions_by};
 use crate::formats::gltf::{GltfCharacter, GltfMesh, write_glb};
+use crate::formats::scene::AnimDoc;
 use crate::formats::{load_character, obj};
 
 /// Runs `export`: a glTF file's characters, a scene as glTF, or a character as OBJ or glTF.
@@ -39,10 +40,11 @@ fn export_retargeted(a: &ExportArgs) -> Result<()> {
         let asset = library.load(&source)?;
         let mut c = library.new_character_doc(source, &asset);
         c.playback = None;
-        c.anim = Some(anim.clone());
         let from = crate::document::retarget::motion_source_doc(&mut library, &doc, &settings.from)?;
         let done = crate::document::retarget::retarget(&mut library, &from, &c, &asset, &settings)?;
         eprintln!("{}", crate::document::retarget::describe(&done, &from.name, &c.name, &asset.skeleton));
+        // Its clip as worked out here, so the export does not retarget it again.
+        c.anim = Some(AnimDoc { keys: Some(done.clip), ..anim.clone() });
         doc.characters.push(c);
     }
     export_scene(&doc, a)

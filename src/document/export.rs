@@ -7,7 +7,7 @@ use crate::formats::gltf::{GltfCharacter, GltfMesh, Motion, write_glb};
 use crate::formats::limits::MAX_SAMPLED_FRAMES;
 use crate::formats::scene::{CharacterDoc, SceneDoc};
 use crate::rig::fk::RestOverride;
-use crate::rig::node_clip::{NodeClip, NodePose, sample_mix};
+use crate::rig::node_clip::{NodeClip, NodePose, pose_mix};
 
 /// The name a clip from `file` goes out under: the file's stem, else `otherwise`.
 pub fn clip_name(file: &std::path::Path, otherwise: &str) -> String {
@@ -97,7 +97,7 @@ fn load_posed(
     let mut library = super::AssetLibrary::default();
     let mut loaded = Vec::new();
     for c in &doc.characters {
-        let asset = super::retarget::shaped_asset(&mut library, c)?;
+        let asset = library.shaped(c)?;
         let posed = posed(&mut library, doc, c, &asset, animated)?;
         loaded.push((c, asset, posed));
     }
@@ -194,12 +194,7 @@ fn play_node_clip(
     let find = |name: &Option<String>| clips.iter().find(|k| Some(&k.name) == name.as_ref());
     let Some(clip) = find(&playback.clip) else { return Ok(()) };
     let blend = find(&playback.blend_clip).map(|k| (k, playback.blend));
-    let now = sample_mix(skeleton, clip, blend, playback.time);
-    for (j, q) in now.rotations.iter().enumerate() {
-        if clip.turns(j) || blend.is_some_and(|(k, _)| k.turns(j)) {
-            posed.pose[j] = crate::rig::JointRotation::Quat(*q);
-        }
-    }
+    let now = pose_mix(skeleton, clip, blend, playback.time, &mut posed.pose);
     posed.root = now.offsets[0];
     if clip.moves_rest() || blend.is_some_and(|(k, _)| k.moves_rest()) {
         posed.rest = Some(rest_of(skeleton, &now));

@@ -172,6 +172,19 @@ impl AssetLibrary {
         Ok(bound)
     }
 
+    /// The asset a character document stands for: its source, bound as it asks, an SMPL
+    /// body shaped by its β.
+    pub fn shaped(&mut self, c: &crate::formats::scene::CharacterDoc) -> Result<Arc<CharacterAsset>, FormatError> {
+        let mut asset = self.load_bound(&c.source, c.binding)?;
+        if let (Some(smpl), SourceDoc::File(dir)) = (&c.smpl, &c.source)
+            && !smpl.betas.is_empty()
+        {
+            let set = self.smpl(dir)?;
+            asset = Arc::new(set.model.asset(&c.name, &smpl.betas).map_err(|e| FormatError::rig(dir, e))?);
+        }
+        Ok(asset)
+    }
+
     /// The SMPL model and clips of a folder, loaded once.
     pub fn smpl(&mut self, dir: &Path) -> Result<SmplSet, FormatError> {
         if let Some(set) = self.smpl.get(dir) {

@@ -107,13 +107,8 @@ pub fn motion_frames(
             let blend = find(&playback.blend_clip).map(|k| (k, playback.blend));
             let frames = sample_times((0.0, clip.duration()), &c.name)?
                 .map(|t| {
-                    let now = crate::rig::node_clip::sample_mix(skeleton, clip, blend, t);
                     let mut pose = base.clone();
-                    for (j, q) in now.rotations.iter().enumerate() {
-                        if clip.turns(j) || blend.is_some_and(|(k, _)| k.turns(j)) {
-                            pose[j] = JointRotation::Quat(*q);
-                        }
-                    }
+                    let now = crate::rig::node_clip::pose_mix(skeleton, clip, blend, t, &mut pose);
                     Frame { root: now.offsets[0], pose }
                 })
                 .collect();
@@ -128,26 +123,10 @@ pub fn motion_frames(
         let blend = smpl.blend_clip.as_ref().and_then(|b| set.clips.iter().find(|(n, _)| n == b)).map(|(_, k)| k);
         let upright = crate::rig::smpl::upright_turn(clip, smpl.upright);
         let root = skeleton.joint(0).rest_offset;
-        let mut a = Vec::new();
-        let mut b = Vec::new();
-        let mut mixed = Vec::new();
+        let mut sampler = crate::rig::smpl::BlendSampler::default();
         let frames = (0..clip.frame_count())
             .map(|f| {
-                clip.sample(f as f32, false, crate::rig::smpl::BlendMode::Nlerp, &mut a);
-                let rotations = match blend {
-                    Some(other) if smpl.blend > 0.0 => {
-                        other.sample(f as f32, true, crate::rig::smpl::BlendMode::Nlerp, &mut b);
-                        crate::rig::smpl::blend_rotations(
-                            &a,
-                            &b,
-                            smpl.blend,
-                            crate::rig::smpl::BlendMode::Nlerp,
-                            &mut mixed,
-                        );
-                        &mixed
-                    }
-                    _ => &a,
-                };
+                let rotations = sampler.sample(clip, blend.map(|k| (&**k, smpl.blend)), f as f32, false);
                 // Clamped to the joints' limits, as the editor plays it.
                 let pose = rotations
                     .iter()
@@ -171,7 +150,7 @@ pub fn motion_frames(
 fn sample_times((start, end): (f32, f32), what: &str) -> Result<impl Iterator<Item = f32>, FormatError> {
     let most = crate::formats::limits::MAX_SAMPLED_FRAMES;
     let n = ((end - start).max(0.0) * FPS).round();
-    if !(n < most as f32) {
+    if n.is_nan() || n >= most as f32 {
         return Err(FormatError::other(
             Path::new(what),
             format!("expected a clip of at most {most} frames at {FPS} a second to retarget, found {end} − {start} s"),
@@ -239,21 +218,6 @@ pub fn motion_source_doc(
     }
 }
 
-/// The shaped asset a character document stands for (an SMPL body by its β).
-pub fn shaped_asset(
-    library: &mut super::AssetLibrary,
-    c: &CharacterDoc,
-) -> Result<std::sync::Arc<CharacterAsset>, FormatError> {
-    let mut asset = library.load_bound(&c.source, c.binding)?;
-    if let (Some(smpl), SourceDoc::File(dir)) = (&c.smpl, &c.source)
-        && !smpl.betas.is_empty()
-    {
-        let set = library.smpl(dir)?;
-        asset = std::sync::Arc::new(set.model.asset(&c.name, &smpl.betas).map_err(|e| FormatError::rig(dir, e))?);
-    }
-    Ok(asset)
-}
-
 /// The motion of `source` carried onto `target` (whose asset is `target_asset`) as
 /// `settings` ask, baked into a keyframed clip of the joints the source drives.
 pub fn retarget(
@@ -264,7 +228,7 @@ pub fn retarget(
     settings: &RetargetDoc,
 ) -> Result<Retargeting, FormatError> {
     let here = |what: String| FormatError::other(Path::new(&target.name), what);
-    let source_asset = shaped_asset(library, source)?;
+    let source_asset = library.shaped(source)?;
     let source_frames = motion_frames(library, source, &source_asset)?
         .ok_or_else(|| here(format!("expected {} to have a motion of its own, found none", source.name)))?;
     let (s_map, t_map) = (humanoid_map(&source_asset, &source.humanoid), humanoid_map(target_asset, &target.humanoid));

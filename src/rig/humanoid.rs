@@ -250,7 +250,7 @@ impl Tree<'_> {
 
     /// Whether `j` is `ancestor` or below it.
     fn below(&self, j: usize, ancestor: usize) -> bool {
-        self.ancestors(j).contains(&ancestor)
+        j == ancestor || self.skeleton.is_below(j, ancestor)
     }
 
     /// Whether neither lies on the other's chain.

@@ -268,6 +268,24 @@ impl NodeClip {
     }
 }
 
+/// [`sample_mix`] at `t`, its rotations put on the joints either clip turns in `pose`
+/// (the others keep theirs); the sample itself returned for its offsets and scales.
+pub fn pose_mix(
+    skeleton: &Skeleton,
+    clip: &NodeClip,
+    blend: Option<(&NodeClip, f32)>,
+    t: f32,
+    pose: &mut [JointRotation],
+) -> NodePose {
+    let now = sample_mix(skeleton, clip, blend, t);
+    for (j, q) in now.rotations.iter().enumerate() {
+        if clip.turns(j) || blend.is_some_and(|(k, _)| k.turns(j)) {
+            pose[j] = JointRotation::Quat(*q);
+        }
+    }
+    now
+}
+
 /// The pose of `clip` at `t` seconds, blended with `blend`'s clip by its weight (which runs
 /// on the same clock, wrapped to its own length).
 pub fn sample_mix(skeleton: &Skeleton, clip: &NodeClip, blend: Option<(&NodeClip, f32)>, t: f32) -> NodePose {

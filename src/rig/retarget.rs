@@ -68,7 +68,6 @@ pub struct Retargeted {
 
 /// A mapped target joint and the source joint that drives it.
 struct Bone {
-    target: usize,
     source: usize,
     /// The target's rest world rotation turned to line up with the source's rest.
     aligned_rest: Quat,
@@ -171,7 +170,7 @@ impl<'a> Retargeter<'a> {
             let Some(&sj) = source.map.get(&bone) else { continue };
             // Only a bone below it is one the joint's turn can aim.
             let below = |map: &HumanoidMap, skeleton: &Skeleton, b: &HumanBone, j: usize| {
-                map.get(b).copied().filter(|&c| is_below(skeleton, c, j))
+                map.get(b).copied().filter(|&c| skeleton.is_below(c, j))
             };
             let next =
                 aims(bone).iter().find_map(|b| Some((below(target.map, t, b, tj)?, below(source.map, s, b, sj)?)));
@@ -188,7 +187,7 @@ impl<'a> Retargeter<'a> {
                 }
                 None => (turned_rest, None),
             };
-            bones[tj] = Some(Bone { target: tj, source: sj, aligned_rest, aim });
+            bones[tj] = Some(Bone { source: sj, aligned_rest, aim });
         }
         // A bone without a direction of its own (a hand, the head) keeps its rest as it
         // lies on its parent bone's aligned rest.
@@ -277,7 +276,7 @@ impl<'a> Retargeter<'a> {
                     }
                 }
                 let free = pose[j].with_rotation_of((parent.inverse() * wanted).normalize());
-                let held = free.clamped(&t.joint(bone.target).limits);
+                let held = free.clamped(&t.joint(j).limits);
                 let (a, b) = (held.to_quat(), free.to_quat());
                 if (a - b).length().min((a + b).length()) > 1e-4 {
                     clamped.push(j);
@@ -371,7 +370,7 @@ impl<'a> Retargeter<'a> {
             let goal = if planted[f] {
                 let (start_target, start_source) = *anchor.get_or_insert((free + floor_fix, s_foot[f]));
                 since_contact = 0;
-                (start_target + (s_foot[f] - start_source) * self.ratio).max_y(lowest(s_foot[f].y))
+                at_least_at(start_target + (s_foot[f] - start_source) * self.ratio, lowest(s_foot[f].y))
             } else {
                 anchor = None;
                 since_contact = since_contact.saturating_add(1);
@@ -380,7 +379,7 @@ impl<'a> Retargeter<'a> {
                 } else {
                     Vec3::ZERO
                 };
-                (free + fading).max_y(lowest(s_foot[f].y))
+                at_least_at(free + fading, lowest(s_foot[f].y))
             };
             last_fix = if planted[f] { goal - free } else { last_fix };
             if goal.distance(free) > 1e-6 * self.target_leg {
@@ -442,25 +441,9 @@ fn reach_in_frame(skeleton: &Skeleton, pose: &[JointRotation], j: usize, below: 
     at
 }
 
-/// Whether `j` lies below `ancestor` in the tree.
-fn is_below(skeleton: &Skeleton, mut j: usize, ancestor: usize) -> bool {
-    while let Some(p) = skeleton.parent(j) {
-        if p == ancestor {
-            return true;
-        }
-        j = p;
-    }
-    false
-}
-
-trait MaxY {
-    fn max_y(self, y: f32) -> Self;
-}
-
-impl MaxY for Vec3 {
-    fn max_y(self, y: f32) -> Self {
-        Vec3::new(self.x, self.y.max(y), self.z)
-    }
+/// `v` raised to height `y` where it lies lower.
+fn at_least_at(v: Vec3, y: f32) -> Vec3 {
+    Vec3::new(v.x, v.y.max(y), v.z)
 }
 
 /// The frames in which a foot at `at` (a position per frame) is planted: still (slower

@@ -148,6 +148,17 @@ impl Skeleton {
         self.joints[index].parent
     }
 
+    /// Whether joint `j` lies below `ancestor` (not `ancestor` itself).
+    pub fn is_below(&self, mut j: usize, ancestor: usize) -> bool {
+        while let Some(p) = self.parent(j) {
+            if p == ancestor {
+                return true;
+            }
+            j = p;
+        }
+        false
+    }
+
     /// First joint with this name (names are not unique in every file).
     pub fn find(&self, name: &str) -> Option<usize> {
         self.joints.iter().position(|j| j.name == name)

@@ -122,6 +122,32 @@ pub fn upright_turn(clip: &Clip, upright: bool) -> Quat {
     Quat::from_rotation_arc(first_up.normalize(), Vec3::Y)
 }
 
+/// Scratch for sampling a clip with a second one blended in (the editor's playback and
+/// the frames a retargeting samples), reused from call to call.
+#[derive(Debug, Default)]
+pub struct BlendSampler {
+    first: Vec<Quat>,
+    second: Vec<Quat>,
+    mixed: Vec<Quat>,
+}
+
+impl BlendSampler {
+    /// `clip` at `time_frames` (looping, or clamped to its frames), with `blend`'s clip
+    /// mixed in by its weight when that is positive (on the same clock, wrapped to its own
+    /// length).
+    pub fn sample(&mut self, clip: &Clip, blend: Option<(&Clip, f32)>, time_frames: f32, looping: bool) -> &[Quat] {
+        clip.sample(time_frames, looping, BlendMode::Nlerp, &mut self.first);
+        match blend {
+            Some((other, weight)) if weight > 0.0 => {
+                other.sample(time_frames, true, BlendMode::Nlerp, &mut self.second);
+                blend_rotations(&self.first, &self.second, weight, BlendMode::Nlerp, &mut self.mixed);
+                &self.mixed
+            }
+            _ => &self.first,
+        }
+    }
+}
+
 /// How two rotations are interpolated.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize, serde::Deserialize)]
 pub enum BlendMode {

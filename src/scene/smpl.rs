@@ -8,7 +8,7 @@ use bevy::prelude::*;
 
 use crate::formats::scene::SmplDoc;
 use crate::rig::JointRotation;
-use crate::rig::smpl::{BlendMode, Clip, SmplModel, blend_rotations};
+use crate::rig::smpl::{Clip, SmplModel};
 use crate::scene::{Character, JointPose, MarionetteSystems, PoseDirty};
 
 pub use crate::rig::smpl::CLIP_FPS;
@@ -122,22 +122,12 @@ fn pose_from_clips(
     bodies: Query<(&SmplCharacter, &Character), Changed<SmplCharacter>>,
     mut poses: Query<&mut JointPose>,
 ) {
-    let mut a = Vec::new();
-    let mut b = Vec::new();
-    let mut mixed = Vec::new();
+    let mut sampler = crate::rig::smpl::BlendSampler::default();
     for (body, character) in &bodies {
         let Some(clip) = body.clip() else { continue };
         let state = &body.state;
-        clip.sample(state.time, state.looping, BlendMode::Nlerp, &mut a);
-        let rotations = match body.blend_clip() {
-            Some(other) if state.blend > 0.0 => {
-                // The second clip runs on the same clock, wrapped to its own length.
-                other.sample(state.time, true, BlendMode::Nlerp, &mut b);
-                blend_rotations(&a, &b, state.blend, BlendMode::Nlerp, &mut mixed);
-                &mixed
-            }
-            _ => &a,
-        };
+        let blend = body.blend_clip().map(|other| (other, state.blend));
+        let rotations = sampler.sample(clip, blend, state.time, state.looping);
         let upright = crate::rig::smpl::upright_turn(clip, state.upright);
         for (j, (&e, q)) in character.joints.iter().zip(rotations).enumerate() {
             let q = if j == 0 { upright * *q } else { *q };

@@ -7,7 +7,7 @@ use std::path::{Path, PathBuf};
 
 use glam::{Mat4, Vec3};
 use marionette::document::AssetLibrary;
-use marionette::document::retarget::{file_motion_doc, humanoid_map, retarget, shaped_asset};
+use marionette::document::retarget::{file_motion_doc, humanoid_map, retarget};
 use marionette::formats::scene::{CharacterDoc, MotionSourceDoc, RetargetDoc, SourceDoc};
 use marionette::rig::humanoid::{HumanBone, HumanoidMap};
 use marionette::rig::retarget::{Frame, Retargeted};
@@ -76,7 +76,7 @@ struct Side {
 }
 
 fn side(library: &mut AssetLibrary, doc: &CharacterDoc, floor: f32) -> Side {
-    let asset = shaped_asset(library, doc).unwrap();
+    let asset = library.shaped(doc).unwrap();
     let map = humanoid_map(&asset, &doc.humanoid);
     let skeleton = &asset.skeleton;
     let at = positions(skeleton, skeleton.joint(0).rest_offset, &skeleton.initial_pose());
@@ -205,7 +205,7 @@ fn clips_carry_across_humanoids_of_every_origin() {
     for (path, clip) in &sources {
         let source = file_motion_doc(&mut library, path, *clip).unwrap();
         for target in &targets {
-            let asset = shaped_asset(&mut library, target).unwrap();
+            let asset = library.shaped(target).unwrap();
             for plant in [false, true] {
                 let settings = RetargetDoc {
                     plant_feet: plant,
@@ -265,7 +265,7 @@ fn a_clip_retargeted_onto_its_own_character_is_itself() {
     let mut library = AssetLibrary::default();
     for (path, clip) in [(data.join("smpl"), Some("7516")), (data.join("khronos/CesiumMan.glb"), None)] {
         let source = file_motion_doc(&mut library, &path, clip).unwrap();
-        let asset = shaped_asset(&mut library, &source).unwrap();
+        let asset = library.shaped(&source).unwrap();
         let settings = RetargetDoc::of(MotionSourceDoc::File { path: path.clone(), clip: clip.map(str::to_owned) });
         let done = retarget(&mut library, &source, &source, &asset, &settings).unwrap();
         assert!(done.report.clamped.is_empty());
@@ -457,7 +457,7 @@ fn a_t_pose_clip_drives_an_a_pose_character() {
     let source_path = crate::common::path("tests/data/blender_tpose.glb").to_path_buf();
     let source = file_motion_doc(&mut library, &source_path, None).unwrap();
     let target = doc_of(&mut library, crate::common::path("tests/data/blender_apose.glb"));
-    let asset = shaped_asset(&mut library, &target).unwrap();
+    let asset = library.shaped(&target).unwrap();
     let skeleton = &asset.skeleton;
     let from = MotionSourceDoc::File { path: source_path.clone(), clip: None };
     let angle = |a: Vec3, b: Vec3| a.normalize().dot(b.normalize()).clamp(-1.0, 1.0).acos().to_degrees();

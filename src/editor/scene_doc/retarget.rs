@@ -7,7 +7,7 @@ use std::sync::Arc;
 
 use bevy::prelude::*;
 
-use crate::document::retarget::{describe, motion_source_doc, retarget, shaped_asset};
+use crate::document::retarget::{describe, motion_source_doc, retarget};
 pub use crate::editor::scene_doc::document::RetargetedFrom;
 use crate::editor::scene_doc::document::{Library, SceneReader};
 use crate::editor::state::Messages;
@@ -34,7 +34,7 @@ pub fn resolve_retargets(
         }
         let Some(target) = scene.character_doc(entity) else { continue };
         let doc = doc.get_or_insert_with(|| scene.capture());
-        let worked = shaped_asset(&mut library, &target).and_then(|asset| {
+        let worked = library.shaped(&target).and_then(|asset| {
             let source = motion_source_doc(&mut library, doc, &wanted.from)?;
             let done = retarget(&mut library, &source, &target, &asset, wanted)?;
             Ok((describe(&done, &source.name, &target.name, &asset.skeleton), done.clip))
