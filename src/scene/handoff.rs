@@ -65,17 +65,37 @@ impl SkinUpload {
         if floats < 4 || buffer.len() != positions.len() * floats {
             return None;
         }
-        let written = positions.iter().zip(buffer.chunks_exact_mut(floats)).map(|(p, slot)| {
-            slot[..3].copy_from_slice(&p.to_array());
-            *p
-        });
-        Some(crate::rig::skinning::bounds_of(written))
+        Some(match floats {
+            4 => write_positions::<4>(positions, buffer),
+            6 => write_positions::<6>(positions, buffer),
+            _ => write_positions_strided(positions, buffer, floats),
+        })
     }
 
     /// The vertices as the bytes the GPU takes.
     pub fn bytes(&self) -> &[u8] {
         bytemuck::cast_slice(&self.vertices)
     }
+}
+
+/// Writes `positions` over the first three floats of each `F`-float vertex of `buffer`
+/// (a constant stride, so the copy is three plain stores) and returns their bounds.
+fn write_positions<const F: usize>(positions: &[Vec3], buffer: &mut [f32]) -> (Vec3, Vec3) {
+    let (slots, _) = buffer.as_chunks_mut::<F>();
+    let written = positions.iter().zip(slots).map(|(p, slot)| {
+        [slot[0], slot[1], slot[2]] = p.to_array();
+        *p
+    });
+    crate::rig::skinning::bounds_of(written)
+}
+
+/// [`write_positions`] for a stride known only at run time.
+fn write_positions_strided(positions: &[Vec3], buffer: &mut [f32], floats: usize) -> (Vec3, Vec3) {
+    let written = positions.iter().zip(buffer.chunks_exact_mut(floats)).map(|(p, slot)| {
+        slot[..3].copy_from_slice(&p.to_array());
+        *p
+    });
+    crate::rig::skinning::bounds_of(written)
 }
 
 /// Packs positions, texture coordinates (none, or one per vertex) and colours as the skin
