@@ -8,7 +8,7 @@
 
 use glam::{Mat4, Vec3, Vec4};
 
-use super::influences::{FixedGroup, whole_blocks};
+use super::influences::FixedGroup;
 use super::skinning::SkinWeights;
 
 /// Skins bind-pose vertices: `out[v] = (Σ wᵢ · palette[jᵢ]) · bind[v]` (the same result as
@@ -33,21 +33,6 @@ pub fn skin_chunk(bind_positions: &[Vec3], weights: &SkinWeights, palette: &[Mat
     assert!(first + out.len() <= bind_positions.len(), "the chunk lies inside the mesh");
     let groups = weights.groups();
     assert!(groups.joint_bound <= palette.len(), "an influence names a joint beyond the palette");
-    #[cfg(target_arch = "x86_64")]
-    if std::arch::is_x86_feature_detected!("avx512f")
-        && std::arch::is_x86_feature_detected!("avx512vl")
-        && whole_blocks(first, out.len(), bind_positions.len())
-    {
-        // SAFETY: the CPU has AVX-512 F and VL (checked above), and so AVX2 and FMA.
-        unsafe {
-            avx512::skin_runs::<1>(bind_positions, &groups.runs[0], palette, first, out);
-            avx512::skin_runs::<2>(bind_positions, &groups.runs[1], palette, first, out);
-            avx512::skin_runs::<3>(bind_positions, &groups.runs[2], palette, first, out);
-            avx512::skin_runs::<4>(bind_positions, &groups.runs[3], palette, first, out);
-            avx2::skin_wide(bind_positions, weights, palette, first, out);
-        }
-        return;
-    }
     #[cfg(target_arch = "x86_64")]
     if std::arch::is_x86_feature_detected!("avx2") && std::arch::is_x86_feature_detected!("fma") {
         // SAFETY: the CPU has AVX2 and FMA (checked above).
@@ -134,21 +119,6 @@ fn skin_wide(bind: &[Vec3], weights: &SkinWeights, wide: &[u32], palette: &[Mat4
     }
 }
 
-/// Reads a `T` from `p` at any alignment, as one load. (`_mm512_loadu_ps` and
-/// `ptr::read_unaligned` copy through `copy_nonoverlapping`, which debug assertions check
-/// on every call: four times the kernel's time in the dev profile the app runs in.)
-///
-/// # Safety
-/// `p` must point to a readable `T`.
-#[cfg(target_arch = "x86_64")]
-#[inline(always)]
-unsafe fn load_unaligned<T: Copy>(p: *const T) -> T {
-    #[repr(C, packed)]
-    struct Unaligned<T>(T);
-    // SAFETY: `Unaligned<T>` has alignment 1 and is `T`'s bytes; `p` points to a `T`.
-    unsafe { (*p.cast::<Unaligned<T>>()).0 }
-}
-
 #[cfg(target_arch = "x86_64")]
 mod avx2 {
     use std::arch::x86_64::*;
@@ -223,14 +193,11 @@ mod avx2 {
         }
     }
 
-    /// A palette matrix as two registers: columns 0 and 1, columns 2 and 3 (a `Mat4` is
-    /// its four columns in a row, so each is one load).
+    /// A palette matrix as two registers: columns 0 and 1, columns 2 and 3.
     #[inline]
     #[target_feature(enable = "avx2,fma")]
     fn columns(m: &Mat4) -> (__m256, __m256) {
-        let halves = (m as *const Mat4).cast::<__m256>();
-        // SAFETY: a `Mat4` is sixteen floats, its columns in a row: two halves of eight.
-        unsafe { (super::load_unaligned(halves), super::load_unaligned(halves.add(1))) }
+        (_mm256_set_m128(m.y_axis.into(), m.x_axis.into()), _mm256_set_m128(m.w_axis.into(), m.z_axis.into()))
     }
 
     /// A blended matrix (as [`columns`] gives it) applied to a bind position: one
@@ -243,83 +210,5 @@ mod avx2 {
         let p = _mm256_fmadd_ps(c01, xy, _mm256_mul_ps(c23, z1));
         let p = _mm_add_ps(_mm256_castps256_ps128(p), _mm256_extractf128_ps::<1>(p));
         Vec4::from(p).truncate()
-    }
-}
-
-#[cfg(target_arch = "x86_64")]
-mod avx512 {
-    use std::arch::x86_64::*;
-
-    use glam::{Mat4, Vec3};
-
-    use crate::rig::influences::JointRuns;
-
-    /// The rows of one influence count `K` run by run: a run's `K` palette matrices are
-    /// loaded once into 512-bit registers (one matrix each); each of its vertices blends
-    /// them with `K` multiply-adds and transforms its bind position with one multiply (the
-    /// translation column kept) and two adds of halves. Only the weights and the bind
-    /// position are read per vertex.
-    ///
-    /// # Safety
-    /// The CPU must have AVX-512 F and VL. (Indices are checked: a joint beyond the palette
-    /// or a vertex beyond the buffers panics; so does a range that is not whole blocks.)
-    #[target_feature(enable = "avx512f,avx512vl")]
-    pub unsafe fn skin_runs<const K: usize>(
-        bind: &[Vec3],
-        group: &JointRuns,
-        palette: &[Mat4],
-        first: usize,
-        out: &mut [Vec3],
-    ) {
-        let (runs, mut row) = group.in_range(first, out.len(), bind.len());
-        let (bind_at, out_at) = (bind.as_ptr(), out.as_mut_ptr());
-        for &(joints, end) in runs {
-            let m: [__m512; K] = std::array::from_fn(|k| matrix(&palette[joints[k] as usize]));
-            let (vertices, weights) = group.rows(row..end as usize, K);
-            for (&v, w) in vertices.iter().zip(weights.as_chunks::<K>().0) {
-                // Two sums (even and odd influences) halve the chain of dependent
-                // multiply-adds.
-                let mut sums = [_mm512_setzero_ps(); 2];
-                for k in 0..K {
-                    sums[k % 2] = _mm512_fmadd_ps(_mm512_set1_ps(w[k]), m[k], sums[k % 2]);
-                }
-                let v = v as usize;
-                // SAFETY: the runs' vertices lie in `first..first + out.len()` (`in_range`),
-                // inside the mesh (`bind.len()` vertices). Unchecked: the checks of the two
-                // indices cost a quarter of the kernel's time.
-                unsafe { transform(_mm512_add_ps(sums[0], sums[1]), bind_at.add(v), out_at.add(v - first)) };
-            }
-            row = end as usize;
-        }
-    }
-
-    /// A palette matrix as one register, its four columns in a row.
-    #[inline]
-    #[target_feature(enable = "avx512f")]
-    fn matrix(m: &Mat4) -> __m512 {
-        // SAFETY: a `Mat4` is sixteen floats, its columns in a row.
-        unsafe { super::load_unaligned((m as *const Mat4).cast::<__m512>()) }
-    }
-
-    /// A blended matrix (as [`matrix`] gives it) applied to a bind position, into `out`:
-    /// columns 0–2 times x, y, z (the translation column kept as it is), then the four
-    /// columns summed. The position is read and written with masked moves of three floats
-    /// (building it with `_mm_set_ps`, or storing it as a `Vec3`, costs shuffles: together
-    /// a third of the kernel's time on Zen 4).
-    #[inline]
-    #[target_feature(enable = "avx512f,avx512vl")]
-    ///
-    /// # Safety
-    /// `b` must be readable and `out` writable.
-    unsafe fn transform(m: __m512, b: *const Vec3, out: *mut Vec3) {
-        // SAFETY: the mask reads only the three floats of `b`.
-        let xyz = _mm512_castps128_ps512(unsafe { _mm_maskz_loadu_ps(0b0111, b.cast()) });
-        let spread = _mm512_permutexvar_ps(_mm512_set_epi32(3, 3, 3, 3, 2, 2, 2, 2, 1, 1, 1, 1, 0, 0, 0, 0), xyz);
-        let terms = _mm512_mask_mul_ps(m, 0x0fff, m, spread);
-        let high = _mm256_castpd_ps(_mm512_extractf64x4_pd::<1>(_mm512_castps_pd(terms)));
-        let p = _mm256_add_ps(_mm512_castps512_ps256(terms), high);
-        let p = _mm_add_ps(_mm256_castps256_ps128(p), _mm256_extractf128_ps::<1>(p));
-        // SAFETY: the mask writes only the three floats of `out`.
-        unsafe { _mm_mask_storeu_ps(out.cast(), 0b0111, p) }
     }
 }

@@ -205,9 +205,8 @@ fn skin_positions_on_cpu(skin: &crate::rig::Skin, method: dqs::SkinningMethod, s
     }
 }
 
-/// Vertices per task when one mesh is skinned on several threads: whole blocks of the
-/// kernel's runs, so that the output is the same however the mesh is split.
-pub const SKIN_CHUNK_VERTICES: usize = crate::rig::influences::RUN_BLOCK_VERTICES;
+/// Vertices per task when one mesh is skinned on several threads.
+pub const SKIN_CHUNK_VERTICES: usize = 16_384;
 
 /// Skins a mesh, in chunks of [`SKIN_CHUNK_VERTICES`] on the compute task pool when it is
 /// larger than one.
