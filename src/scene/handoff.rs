@@ -57,19 +57,19 @@ impl SkinUpload {
 
     /// Writes new positions over the packed ones, leaving texture coordinates and colours
     /// as they are, and returns their bounds (found in the same pass); none (nothing
-    /// written) when the buffer is still held elsewhere or holds another number of
-    /// vertices, and must be packed whole.
+    /// written) when the buffer is still held elsewhere, holds another number of vertices
+    /// or another layout than [`pack_vertices`] makes, and must be packed whole.
     pub fn repack_positions(&mut self, positions: &[Vec3]) -> Option<(Vec3, Vec3)> {
         let floats = self.floats;
         let buffer = Arc::get_mut(&mut self.vertices)?;
-        if floats < 4 || buffer.len() != positions.len() * floats {
+        if buffer.len() != positions.len() * floats {
             return None;
         }
-        Some(match floats {
-            4 => write_positions::<4>(positions, buffer),
-            6 => write_positions::<6>(positions, buffer),
-            _ => write_positions_strided(positions, buffer, floats),
-        })
+        match floats {
+            4 => Some(write_positions::<4>(positions, buffer)),
+            6 => Some(write_positions::<6>(positions, buffer)),
+            _ => None,
+        }
     }
 
     /// The vertices as the bytes the GPU takes.
@@ -84,15 +84,6 @@ fn write_positions<const F: usize>(positions: &[Vec3], buffer: &mut [f32]) -> (V
     let (slots, _) = buffer.as_chunks_mut::<F>();
     let written = positions.iter().zip(slots).map(|(p, slot)| {
         [slot[0], slot[1], slot[2]] = p.to_array();
-        *p
-    });
-    crate::rig::skinning::bounds_of(written)
-}
-
-/// [`write_positions`] for a stride known only at run time.
-fn write_positions_strided(positions: &[Vec3], buffer: &mut [f32], floats: usize) -> (Vec3, Vec3) {
-    let written = positions.iter().zip(buffer.chunks_exact_mut(floats)).map(|(p, slot)| {
-        slot[..3].copy_from_slice(&p.to_array());
         *p
     });
     crate::rig::skinning::bounds_of(written)
