@@ -88,7 +88,9 @@ fn kernel_skin_positions(bencher: Bencher, kernel: &str) {
     let run: Kernel = match kernel {
         "oracle" => skin_positions,
         "fast" => marionette::rig::lbs::skin,
-        _ => marionette::rig::lbs::skin_portable,
+        _ => |b, w, p, o| {
+            marionette::rig::lbs::skin_portable(b, w, p, o);
+        },
     };
     bencher
         .counter(divan::counter::ItemsCount::new(body.vertex_count()))
@@ -367,13 +369,13 @@ fn ik_solve_dragon_tail(bencher: Bencher) {
     });
 }
 
-/// The passes of one SMPL body's share of the crowd's skin phase, each alone, in vertices
-/// per second: the kernel, the bounds of its output, writing the positions over a packed
-/// upload with their bounds in the same pass (a pose change), and packing the upload
-/// whole (a colour change).
-#[divan::bench(args = ["kernel", "bounds", "repack", "pack"])]
+/// The passes of one SMPL body's share of the crowd's skin phase and upload, each alone,
+/// in vertices per second: the kernel, the bounds of its output, packing the other
+/// attributes (a colour change), and interleaving positions and attributes as the render
+/// world writes them into the mesh's slot.
+#[divan::bench(args = ["kernel", "bounds", "pack", "interleave"])]
 fn skin_phase_parts(bencher: Bencher, part: &str) {
-    use marionette::scene::upload::SkinUpload;
+    use marionette::scene::upload::{SkinUpload, interleaved};
     let body = smpl_body();
     let palette = posed_palette(&body);
     let skin = &body.skin;
@@ -381,12 +383,17 @@ fn skin_phase_parts(bencher: Bencher, part: &str) {
     marionette::rig::lbs::skin(&skin.bind_positions, &skin.weights, &palette, &mut positions);
     let colors = vec![[0.8, 0.7, 0.6, 1.0]; positions.len()];
     let mut upload = SkinUpload::default();
-    upload.pack(&positions, &skin.texcoords, &colors);
+    upload.pack_attributes(&skin.texcoords, &colors);
+    assert_eq!(upload.floats, 4, "the body has no texture coordinates");
     let mut out = positions.clone();
+    let mut slot = vec![[0u8; 16]; positions.len()];
     bencher.counter(divan::counter::ItemsCount::new(positions.len())).bench_local(|| match part {
         "kernel" => marionette::rig::lbs::skin(&skin.bind_positions, &skin.weights, &palette, &mut out),
         "bounds" => drop(divan::black_box(marionette::rig::skinning::bounds(&positions))),
-        "repack" => drop(divan::black_box(upload.repack_positions(&positions).expect("not shared"))),
-        _ => upload.pack(&positions, &skin.texcoords, &colors),
+        "pack" => upload.pack_attributes(&skin.texcoords, &colors),
+        _ => slot
+            .iter_mut()
+            .zip(interleaved::<4>(&positions, &upload.attributes))
+            .for_each(|(s, v)| *s = bytemuck::cast(v)),
     });
 }

@@ -1,6 +1,8 @@
 //! Linear blend skinning (skeletal subspace deformation) over plain slices, flat normals
 //! and weight colours. No allocation per call: callers own every buffer.
 
+use std::sync::Arc;
+
 use glam::{Mat4, Vec3, Vec3A};
 
 use super::RigError;
@@ -24,13 +26,15 @@ impl SkinningMethod {
 }
 
 /// Sparse per-vertex influences, stored compressed: the influences of vertex `v` are
-/// `influences[offsets[v]..offsets[v + 1]]`. Any number per vertex.
+/// `influences[offsets[v]..offsets[v + 1]]`. Any number per vertex. Never changed once
+/// built, so a clone shares them: the characters of one model (a crowd of SMPL bodies of
+/// different shapes) skin from one copy in the cache.
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct SkinWeights {
-    offsets: Vec<u32>,
-    influences: Vec<Influence>,
+    offsets: Arc<[u32]>,
+    influences: Arc<[Influence]>,
     /// The same rows partitioned by influence count, for the fast kernel.
-    groups: InfluenceGroups,
+    groups: Arc<InfluenceGroups>,
 }
 
 /// A vertex whose weights did not sum to 1 and were normalised.
@@ -54,10 +58,10 @@ impl SkinWeights {
         I: IntoIterator<Item = R>,
         R: IntoIterator<Item = (usize, f32)>,
     {
-        let mut weights = SkinWeights { offsets: vec![0], ..Self::default() };
+        let (mut offsets, mut influences) = (vec![0], Vec::new());
         let mut normalised = Vec::new();
         for (vertex, row) in rows.into_iter().enumerate() {
-            let start = weights.influences.len();
+            let start = influences.len();
             for (joint, weight) in row {
                 if joint >= joint_count {
                     return Err(RigError::InfluenceJointOutOfRange { vertex, joint, count: joint_count });
@@ -66,10 +70,10 @@ impl SkinWeights {
                     return Err(RigError::BadWeight { vertex, joint, weight });
                 }
                 if weight > 0.0 {
-                    weights.influences.push(Influence { joint: joint as u16, weight });
+                    influences.push(Influence { joint: joint as u16, weight });
                 }
             }
-            let row = &mut weights.influences[start..];
+            let row = &mut influences[start..];
             // Summed in f64: finite f32 weights never overflow it (3e38 + 3e38 does in f32).
             let sum: f64 = row.iter().map(|i| f64::from(i.weight)).sum();
             if sum <= 0.0 {
@@ -79,13 +83,18 @@ impl SkinWeights {
                 normalised.push(NormalisedRow { vertex, sum });
             }
             row.iter_mut().for_each(|i| i.weight = (f64::from(i.weight) / sum) as f32);
-            if weights.influences.len() > u32::MAX as usize {
+            if influences.len() > u32::MAX as usize {
                 return Err(RigError::TooManyInfluences);
             }
-            weights.offsets.push(weights.influences.len() as u32);
+            offsets.push(influences.len() as u32);
         }
-        weights.groups = InfluenceGroups::build(&weights.offsets, &weights.influences);
-        Ok((weights, normalised))
+        Ok((Self::of_rows(offsets, influences), normalised))
+    }
+
+    /// The rows `influences[offsets[v]..offsets[v + 1]]`, and their groups.
+    fn of_rows(offsets: Vec<u32>, influences: Vec<Influence>) -> Self {
+        let groups = Arc::new(InfluenceGroups::build(&offsets, &influences));
+        Self { offsets: offsets.into(), influences: influences.into(), groups }
     }
 
     /// Every vertex bound rigidly to one joint.
@@ -93,8 +102,7 @@ impl SkinWeights {
         let offsets: Vec<u32> = (0..=joint_of_vertex.len() as u32).collect();
         let influences: Vec<Influence> =
             joint_of_vertex.iter().map(|&joint| Influence { joint, weight: 1.0 }).collect();
-        let groups = InfluenceGroups::build(&offsets, &influences);
-        Self { offsets, influences, groups }
+        Self::of_rows(offsets, influences)
     }
 
     /// Where each vertex's row starts in [`influences`](Self::influences) (one more entry
@@ -189,11 +197,36 @@ pub fn bounds(points: &[Vec3]) -> (Vec3, Vec3) {
 
 /// [`bounds`] of points as they come (none stored).
 pub fn bounds_of(points: impl Iterator<Item = Vec3>) -> (Vec3, Vec3) {
-    // In 16-byte lanes: one SIMD min and max per point (the crowd's skin phase spent half
-    // its kernel's time here with `Vec3`'s lane-by-lane min and max).
-    let start = (glam::Vec3A::splat(f32::INFINITY), glam::Vec3A::splat(f32::NEG_INFINITY));
-    let (lo, hi) = points.map(glam::Vec3A::from).fold(start, |(lo, hi), p| (lo.min(p), hi.max(p)));
-    if lo.x > hi.x { (Vec3::ZERO, Vec3::ZERO) } else { (lo.into(), hi.into()) }
+    points.map(Vec3A::from).fold(Bounds::EMPTY, Bounds::with).pair()
+}
+
+/// A box grown point by point in 16-byte lanes: one SIMD min and max per point (the
+/// crowd's skin phase spent half its kernel's time in `Vec3`'s lane-by-lane min and max).
+#[derive(Debug, Clone, Copy)]
+pub struct Bounds {
+    lo: Vec3A,
+    hi: Vec3A,
+}
+
+impl Bounds {
+    /// The box around no point.
+    pub const EMPTY: Self = Self { lo: Vec3A::splat(f32::INFINITY), hi: Vec3A::splat(f32::NEG_INFINITY) };
+
+    /// This box grown to hold `p`.
+    #[inline]
+    pub fn with(self, p: Vec3A) -> Self {
+        Self { lo: self.lo.min(p), hi: self.hi.max(p) }
+    }
+
+    /// The box around both.
+    pub fn union(self, other: Self) -> Self {
+        Self { lo: self.lo.min(other.lo), hi: self.hi.max(other.hi) }
+    }
+
+    /// `(min, max)`, both zero for the empty box.
+    pub fn pair(self) -> (Vec3, Vec3) {
+        if self.lo.x > self.hi.x { (Vec3::ZERO, Vec3::ZERO) } else { (self.lo.into(), self.hi.into()) }
+    }
 }
 
 /// For each joint, the box of the bind positions of the vertices it influences (an empty

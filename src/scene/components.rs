@@ -194,8 +194,9 @@ pub struct JointScratch {
 #[derive(Component, Default)]
 pub struct SkinScratch {
     pub palette: Vec<Mat4>,
-    /// The skinned vertices, model space.
-    pub positions: Vec<Vec3>,
+    /// The skinned vertices, model space; shared with the render world while it writes
+    /// them into the mesh (see [`reclaimed`](super::handoff::reclaimed)).
+    pub positions: Arc<Vec<Vec3>>,
     /// The vertex colours.
     pub colors: Vec<[f32; 4]>,
     /// The skinned vertices' box.

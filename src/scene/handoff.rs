@@ -1,6 +1,6 @@
-//! What the main world hands the render world for each character's skin: its packed
-//! vertices ([`SkinUpload`], skinned on the CPU) or its palette ([`GpuSkinJob`], skinned by
-//! the compute shader). Plain data, required by [`Character`](super::Character); the
+//! What the main world hands the render world for each character's skin: its skinned
+//! positions with their packed attributes ([`SkinUpload`], skinned on the CPU) or its
+//! palette ([`GpuSkinJob`], skinned by the compute shader). Plain data, required by [`Character`](super::Character); the
 //! systems that fill and take them live in `systems`, `upload` and `gpu_skinning`.
 
 use std::sync::Arc;
@@ -32,61 +32,74 @@ fn color_word(c: [f32; 4]) -> f32 {
     f32::from_bits(u32::from_le_bytes(color_bytes(c)))
 }
 
-/// A character's packed vertices (`floats` per vertex), replaced whenever it is re-skinned
-/// or recoloured (its change tick is what the render world looks for).
+/// What follows each skinned position in the skin mesh's vertex layout (texture
+/// coordinates where the skin has them, then the colour word), packed once and again only
+/// when the colours change. The render world interleaves them with the skinned positions
+/// (`SkinScratch::positions`) as it writes them into the mesh's slot, so a pose change
+/// copies nothing on the main world's side. Marked changed whenever either changed: its
+/// change tick is what the render world looks for.
 #[derive(Component, Default, Debug)]
 pub struct SkinUpload {
-    pub vertices: Arc<Vec<f32>>,
+    /// `floats - 3` per vertex.
+    pub attributes: Arc<Vec<f32>>,
+    /// Floats per vertex in the mesh's layout: the position's three, then the attributes.
     pub floats: usize,
 }
 
 impl SkinUpload {
-    /// The buffer to pack into: the previous one when nothing else holds it any more (no
-    /// allocation per frame), a new one otherwise.
-    pub fn buffer(&mut self) -> &mut Vec<f32> {
-        if Arc::get_mut(&mut self.vertices).is_none() {
-            self.vertices = Arc::new(Vec::with_capacity(self.vertices.len()));
-        }
-        Arc::get_mut(&mut self.vertices).expect("the buffer is not shared")
+    /// Packs a skin's texture coordinates and colours (see [`pack_attributes`]).
+    pub fn pack_attributes(&mut self, texcoords: &[Vec2], colors: &[[f32; 4]]) {
+        self.floats = pack_attributes(texcoords, colors, reclaimed(&mut self.attributes));
     }
 
-    /// Packs a skin's vertices into this upload (see [`pack_vertices`]).
-    pub fn pack(&mut self, positions: &[Vec3], texcoords: &[Vec2], colors: &[[f32; 4]]) {
-        self.floats = pack_vertices(positions, texcoords, colors, self.buffer());
+    /// The vertices the attributes are packed for.
+    pub fn vertex_count(&self) -> usize {
+        self.attributes.len().checked_div(self.floats.saturating_sub(3)).unwrap_or(0)
     }
 
-    /// Writes new positions over the packed ones, leaving texture coordinates and colours
-    /// as they are, and returns their bounds (found in the same pass); none (nothing
-    /// written) when the buffer is still held elsewhere, holds another number of vertices
-    /// or another layout than [`pack_vertices`] makes, and must be packed whole.
-    pub fn repack_positions(&mut self, positions: &[Vec3]) -> Option<(Vec3, Vec3)> {
-        let floats = self.floats;
-        let buffer = Arc::get_mut(&mut self.vertices)?;
-        if buffer.len() != positions.len() * floats {
-            return None;
-        }
-        match floats {
-            4 => Some(write_positions::<4>(positions, buffer)),
-            6 => Some(write_positions::<6>(positions, buffer)),
-            _ => None,
-        }
-    }
-
-    /// The vertices as the bytes the GPU takes.
-    pub fn bytes(&self) -> &[u8] {
-        bytemuck::cast_slice(&self.vertices)
+    /// Bytes of the mesh's vertex buffer these attributes and their positions fill.
+    pub fn byte_len(&self) -> usize {
+        self.vertex_count() * self.floats * 4
     }
 }
 
-/// Writes `positions` over the first three floats of each `F`-float vertex of `buffer`
-/// (a constant stride, so the copy is three plain stores) and returns their bounds.
-fn write_positions<const F: usize>(positions: &[Vec3], buffer: &mut [f32]) -> (Vec3, Vec3) {
-    let (slots, _) = buffer.as_chunks_mut::<F>();
-    let written = positions.iter().zip(slots).map(|(p, slot)| {
-        [slot[0], slot[1], slot[2]] = p.to_array();
-        *p
-    });
-    crate::rig::skinning::bounds_of(written)
+/// The vector behind `shared`, to overwrite: the same one when nothing else holds it any
+/// more (no allocation per frame; the render world drops its copy once written), a new
+/// empty one otherwise.
+pub fn reclaimed<T>(shared: &mut Arc<Vec<T>>) -> &mut Vec<T> {
+    if Arc::get_mut(shared).is_none() {
+        *shared = Arc::new(Vec::with_capacity(shared.len()));
+    }
+    Arc::get_mut(shared).expect("a vector of its own")
+}
+
+/// Packs the attributes that follow each position in the skin mesh's layout: texture
+/// coordinates (none, or one per vertex), then the colour ([`SKIN_COLOR`]) in the slot of
+/// one float; returns the floats per vertex of the whole layout (4 or 6).
+///
+/// # Panics
+/// When there are texture coordinates, but not one per colour.
+pub fn pack_attributes(texcoords: &[Vec2], colors: &[[f32; 4]], out: &mut Vec<f32>) -> usize {
+    out.clear();
+    if texcoords.is_empty() {
+        out.extend(colors.iter().map(|c| color_word(*c)));
+        return 4;
+    }
+    assert_eq!(colors.len(), texcoords.len(), "texture coordinates for every vertex");
+    out.extend(texcoords.iter().zip(colors).flat_map(|(t, c)| [t.x, t.y, color_word(*c)]));
+    6
+}
+
+/// Each vertex in the skin mesh's layout of `F` floats: its position, then its `F - 3`
+/// packed attributes (as [`pack_attributes`] makes them). Stops at the shorter input.
+pub fn interleaved<'a, const F: usize>(
+    positions: &'a [Vec3],
+    attributes: &'a [f32],
+) -> impl Iterator<Item = [f32; F]> + 'a {
+    positions
+        .iter()
+        .zip(attributes.chunks_exact(F - 3))
+        .map(|(p, rest)| std::array::from_fn(|k| if k < 3 { p[k] } else { rest[k - 3] }))
 }
 
 /// Packs positions, texture coordinates (none, or one per vertex) and colours as the skin
@@ -96,16 +109,14 @@ fn write_positions<const F: usize>(positions: &[Vec3], buffer: &mut [f32]) -> (V
 /// When the lengths differ.
 pub fn pack_vertices(positions: &[Vec3], texcoords: &[Vec2], colors: &[[f32; 4]], out: &mut Vec<f32>) -> usize {
     assert_eq!(positions.len(), colors.len(), "one colour per vertex");
+    let mut attributes = Vec::new();
+    let floats = pack_attributes(texcoords, colors, &mut attributes);
     out.clear();
-    if texcoords.is_empty() {
-        out.extend(positions.iter().zip(colors).flat_map(|(p, c)| [p.x, p.y, p.z, color_word(*c)]));
-        return 4;
+    match floats {
+        4 => out.extend(interleaved::<4>(positions, &attributes).flatten()),
+        _ => out.extend(interleaved::<6>(positions, &attributes).flatten()),
     }
-    assert_eq!(positions.len(), texcoords.len(), "texture coordinates for every vertex");
-    out.extend(
-        positions.iter().zip(texcoords).zip(colors).flat_map(|((p, t), c)| [p.x, p.y, p.z, t.x, t.y, color_word(*c)]),
-    );
-    6
+    floats
 }
 
 /// What the render world needs to skin a character on the GPU (`None`: it is skinned on

@@ -7,7 +7,7 @@ use super::components::*;
 use super::handoff::{GpuSkinJob, SkinUpload};
 use crate::rig::JointRotation;
 use crate::rig::fk::forward_kinematics_with_rest;
-use crate::rig::skinning::{bounds, heat_colors, joint_colors, weight_colors};
+use crate::rig::skinning::{Bounds, bounds, heat_colors, joint_colors, weight_colors};
 use crate::rig::{dqs, lbs};
 
 /// Clamps changed joint poses to their limits (reads `JointLimits`, writes `JointPose`).
@@ -113,7 +113,8 @@ pub fn compute_joint_to_world(
 /// Skins characters marked dirty, in model space and in parallel on Bevy's compute task
 /// pool: palette `current · bind` from the matrix stack's output (`JointScratch`) and the
 /// asset's shared inverse binds, the LBS or DQ kernel of the bind vertices and their
-/// bounds; the colours when they changed; then packs the vertices for the GPU. Characters
+/// bounds; the colours when they changed, packed for the GPU (the render world
+/// interleaves them with the positions, see `upload`). Characters
 /// skinned on the GPU hand over the palette instead (reads `JointScratch`, `Character`;
 /// writes `SkinScratch`, `SkinUpload`, `GpuSkinJob`).
 pub fn skin_changed_characters(
@@ -130,7 +131,10 @@ pub fn skin_changed_characters(
         &JointScratch,
     )>,
 ) {
-    characters.par_iter_mut().for_each(
+    // Batches of a few characters, so that a thread held up elsewhere leaves its share to
+    // the others (Bevy's default of one batch a thread left the phase a third longer).
+    let batches = bevy::ecs::batching::BatchingStrategy::new().batches_per_thread(8);
+    characters.par_iter_mut().batching_strategy(batches).for_each(
         |(character, view, method, on_gpu, heat, dirty, mut scratch, mut upload, mut job, joints)| {
             if *dirty == PoseDirty::default() {
                 return;
@@ -168,59 +172,51 @@ pub fn skin_changed_characters(
                 job.0 = None;
             }
             if moved {
-                skin_positions_on_cpu(skin, method.0, scratch);
+                skin_on_cpu(skin, method.0, scratch);
             }
-            // Colours and texture coordinates stay in the buffer when only the pose moved;
-            // the bounds are found as the positions are written.
-            match (recolored, moved) {
-                (false, true) if let Some(bounds) = upload.repack_positions(&scratch.positions) => {
-                    scratch.bounds = bounds;
-                }
-                _ => {
-                    if moved {
-                        scratch.bounds = bounds(&scratch.positions);
-                    }
-                    upload.pack(&scratch.positions, &skin.texcoords, &scratch.colors);
-                }
+            // Colours and texture coordinates are packed again only when they changed; the
+            // render world interleaves them with the new positions as it writes the mesh.
+            if recolored || upload.vertex_count() != skin.bind_positions.len() {
+                upload.pack_attributes(&skin.texcoords, &scratch.colors);
+            } else if moved {
+                upload.set_changed();
             }
         },
     );
 }
 
-/// The LBS or DQ kernel of the skin into `scratch.positions`, and their bounds.
+/// The LBS or DQ kernel of the skin into `scratch.positions`, and their bounds (grown as
+/// the linear kernel writes them).
 fn skin_on_cpu(skin: &crate::rig::Skin, method: dqs::SkinningMethod, scratch: &mut SkinScratch) {
-    skin_positions_on_cpu(skin, method, scratch);
-    scratch.bounds = bounds(&scratch.positions);
-}
-
-/// The LBS or DQ kernel of the skin into `scratch.positions` (their bounds left to the
-/// caller).
-fn skin_positions_on_cpu(skin: &crate::rig::Skin, method: dqs::SkinningMethod, scratch: &mut SkinScratch) {
-    scratch.positions.resize(skin.bind_positions.len(), Vec3::ZERO);
-    if method.is_linear() {
-        skin_in_chunks(skin, &scratch.palette, &mut scratch.positions);
+    let SkinScratch { palette, dual_quaternions, positions, .. } = scratch;
+    let positions = super::handoff::reclaimed(positions);
+    positions.resize(skin.bind_positions.len(), Vec3::ZERO);
+    scratch.bounds = if method.is_linear() {
+        skin_in_chunks(skin, palette, positions).pair()
     } else {
-        dqs::dual_quaternion_palette(&scratch.palette, &mut scratch.dual_quaternions);
-        dqs::skin_dq(&skin.bind_positions, &skin.weights, &scratch.dual_quaternions, &mut scratch.positions);
-    }
+        dqs::dual_quaternion_palette(palette, dual_quaternions);
+        dqs::skin_dq(&skin.bind_positions, &skin.weights, dual_quaternions, positions);
+        bounds(positions)
+    };
 }
 
 /// Vertices per task when one mesh is skinned on several threads.
 pub const SKIN_CHUNK_VERTICES: usize = 16_384;
 
 /// Skins a mesh, in chunks of [`SKIN_CHUNK_VERTICES`] on the compute task pool when it is
-/// larger than one.
-fn skin_in_chunks(skin: &crate::rig::Skin, palette: &[Mat4], out: &mut [Vec3]) {
+/// larger than one; returns the box of its vertices.
+fn skin_in_chunks(skin: &crate::rig::Skin, palette: &[Mat4], out: &mut [Vec3]) -> Bounds {
     if out.len() <= SKIN_CHUNK_VERTICES {
-        return lbs::skin(&skin.bind_positions, &skin.weights, palette, out);
+        return lbs::skin_bounded(&skin.bind_positions, &skin.weights, palette, out);
     }
-    bevy::tasks::ComputeTaskPool::get().scope(|scope| {
+    let chunks = bevy::tasks::ComputeTaskPool::get().scope(|scope| {
         for (k, chunk) in out.chunks_mut(SKIN_CHUNK_VERTICES).enumerate() {
             scope.spawn(async move {
-                lbs::skin_chunk(&skin.bind_positions, &skin.weights, palette, k * SKIN_CHUNK_VERTICES, chunk);
+                lbs::skin_chunk(&skin.bind_positions, &skin.weights, palette, k * SKIN_CHUNK_VERTICES, chunk)
             });
         }
     });
+    chunks.into_iter().fold(Bounds::EMPTY, Bounds::union)
 }
 
 /// Keeps each re-skinned character's bounds right (so culling follows the deformed mesh),

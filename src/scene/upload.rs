@@ -1,7 +1,9 @@
 //! Handing skinned vertices to the GPU without Bevy's whole-mesh path: the skinning system
-//! packs each re-skinned character's vertices (position, texture coordinates where the
-//! skin has them, colour: the skin mesh's own layout) into its [`SkinUpload`]; the render world takes the changed ones (an `Arc`, no
-//! copy) and writes them straight into the mesh's slot of the vertex buffer. The skin mesh
+//! skins each re-posed character's positions into its `SkinScratch` and packs the other
+//! attributes (texture coordinates where the skin has them, colour) into its
+//! [`SkinUpload`] only when they change; the render world takes the changed ones (`Arc`s,
+//! no copy) and interleaves them, in the skin mesh's own layout, straight into the staging
+//! memory of the mesh's slot of the vertex buffer. The skin mesh
 //! asset itself is never modified after it is made, so Bevy neither clones it into the
 //! render world nor re-packs it each frame, and indices stay as they were uploaded.
 
@@ -10,19 +12,21 @@ use std::sync::Arc;
 
 use bevy::prelude::*;
 use bevy::render::mesh::allocator::MeshAllocator;
+use bevy::render::render_resource::BufferSize;
 use bevy::render::renderer::RenderQueue;
 use bevy::render::{Extract, ExtractSchedule, Render, RenderApp, RenderSystems};
 
 use super::components::Character;
 
-pub use super::handoff::{SKIN_VERTEX_BYTES, SkinUpload, pack_vertices};
+use super::components::SkinScratch;
+pub use super::handoff::{SKIN_VERTEX_BYTES, SkinUpload, interleaved, pack_vertices};
 
 /// Bytes handed to the GPU in the last frame (the packed uploads that changed, and the
 /// palettes of characters skinned on the GPU), for benchmarks and readouts.
 #[derive(Resource, Default, Debug)]
 pub struct HandedOn(pub usize);
 
-/// Counts the packed vertices that changed and, for characters skinned on the GPU, their
+/// Counts the vertices that changed and, for characters skinned on the GPU, their
 /// palettes (reads `SkinUpload`, `GpuSkinJob`; writes `HandedOn`).
 fn count_handed_on(
     changed: Query<&SkinUpload, Changed<SkinUpload>>,
@@ -31,16 +35,28 @@ fn count_handed_on(
 ) {
     let palettes: usize =
         gpu_jobs.iter().filter_map(|j| j.0.as_ref()).map(|j| std::mem::size_of_val(j.palette.as_slice())).sum();
-    handed.0 = changed.iter().map(|u| u.bytes().len()).sum::<usize>() + palettes;
+    handed.0 = changed.iter().map(SkinUpload::byte_len).sum::<usize>() + palettes;
 }
 
-/// An upload waiting for its mesh's slot: the character's packed vertices, the floats per
-/// vertex, the range of vertices that mesh shows, and the frames waited.
+/// An upload waiting for its mesh's slot: the character's skinned positions and packed
+/// attributes, the floats per vertex, the range of vertices that mesh shows, and the
+/// frames waited.
 struct Pending {
-    vertices: Arc<Vec<f32>>,
+    positions: Arc<Vec<Vec3>>,
+    attributes: Arc<Vec<f32>>,
     floats: usize,
     range: std::ops::Range<u32>,
     waited: u32,
+}
+
+impl Pending {
+    /// The positions and attributes of this part's vertices; none when they do not hold
+    /// all of them (or `floats` is no layout of [`pack_vertices`]).
+    fn part(&self) -> Option<(&[Vec3], &[f32])> {
+        let (start, end) = (self.range.start as usize, self.range.end as usize);
+        let rest = [4, 6].contains(&self.floats).then(|| self.floats - 3)?;
+        Some((self.positions.get(start..end)?, self.attributes.get(start * rest..end * rest)?))
+    }
 }
 
 /// Uploads waiting in the render world: by mesh, the newest bytes (kept until the mesh has
@@ -67,24 +83,27 @@ impl Plugin for SkinUploadPlugin {
     }
 }
 
-/// Takes the uploads that changed this frame (reads `SkinUpload`; writes `PendingUploads`).
+/// Takes the uploads that changed this frame (reads `SkinUpload`, `SkinScratch`; writes
+/// `PendingUploads`).
 fn extract_skin_uploads(
-    skins: Extract<Query<(&Character, &SkinUpload), Changed<SkinUpload>>>,
+    skins: Extract<Query<(&Character, &SkinUpload, &SkinScratch), Changed<SkinUpload>>>,
     mut pending: ResMut<PendingUploads>,
 ) {
-    for (character, upload) in &skins {
-        if upload.vertices.is_empty() {
+    for (character, upload, scratch) in &skins {
+        if upload.attributes.is_empty() {
             continue;
         }
         for part in &character.skins {
-            let (vertices, floats, range) = (upload.vertices.clone(), upload.floats, part.vertices.clone());
-            pending.0.insert(part.mesh.id(), Pending { vertices, floats, range, waited: 0 });
+            let (positions, attributes) = (scratch.positions.clone(), upload.attributes.clone());
+            let (floats, range) = (upload.floats, part.vertices.clone());
+            pending.0.insert(part.mesh.id(), Pending { positions, attributes, floats, range, waited: 0 });
         }
     }
 }
 
-/// Writes each pending upload into its mesh's slot of the vertex buffer, after Bevy has
-/// allocated and filled the slots of new meshes (reads `MeshAllocator`; writes GPU buffers).
+/// Writes each pending upload into its mesh's slot of the vertex buffer, interleaved in
+/// the staging memory the queue copies from, after Bevy has allocated and filled the slots
+/// of new meshes (reads `MeshAllocator`; writes GPU buffers).
 fn write_skin_uploads(
     mut pending: ResMut<PendingUploads>,
     allocator: Option<Res<MeshAllocator>>,
@@ -96,11 +115,29 @@ fn write_skin_uploads(
             upload.waited += 1;
             return upload.waited < MAX_WAIT_FRAMES;
         };
-        let floats = upload.floats;
-        let part = upload.vertices.get(upload.range.start as usize * floats..upload.range.end as usize * floats);
-        if let Some(part) = part.filter(|p| (slice.range.end - slice.range.start) as usize * floats == p.len()) {
-            let offset = (slice.range.start as usize * floats * 4) as u64;
-            queue.write_buffer(slice.buffer, offset, bytemuck::cast_slice(part));
+        let slot_vertices = (slice.range.end - slice.range.start) as usize;
+        let Some((positions, attributes)) = upload.part().filter(|(p, _)| p.len() == slot_vertices) else {
+            return false;
+        };
+        let bytes = (slot_vertices * upload.floats * 4) as u64;
+        let offset = u64::from(slice.range.start) * upload.floats as u64 * 4;
+        let Some(mut view) =
+            BufferSize::new(bytes).and_then(|size| queue.write_buffer_with(slice.buffer, offset, size))
+        else {
+            return false;
+        };
+        match upload.floats {
+            4 => view
+                .slice(..)
+                .into_chunks::<16>()
+                .0
+                .write_iter(interleaved::<4>(positions, attributes).map(bytemuck::cast)),
+            6 => view
+                .slice(..)
+                .into_chunks::<24>()
+                .0
+                .write_iter(interleaved::<6>(positions, attributes).map(bytemuck::cast)),
+            _ => {}
         }
         false
     });

@@ -31,12 +31,15 @@ pub fn spawn(app: &mut App, asset: Arc<CharacterAsset>, placement: Placement) ->
     entity
 }
 
-/// The positions and colours a character hands to the GPU (decoded from its packed upload).
+/// The positions and colours a character hands to the GPU (its skinned positions and the
+/// colours decoded from its packed attributes).
 fn uploaded_vertices(app: &App, character: Entity) -> (Vec<[f32; 3]>, Vec<[f32; 4]>) {
     let upload = app.world().get::<marionette::scene::upload::SkinUpload>(character).unwrap();
+    let positions = &app.world().get::<marionette::scene::SkinScratch>(character).unwrap().positions;
     // The colour is the last four bytes of each vertex (unorm8x4).
     let color = |word: f32| word.to_bits().to_le_bytes().map(|b| f32::from(b) / 255.0);
-    upload.vertices.chunks(upload.floats).map(|v| ([v[0], v[1], v[2]], color(v[upload.floats - 1]))).unzip()
+    let colors = upload.attributes.chunks(upload.floats - 3).map(|a| color(a[a.len() - 1]));
+    positions.iter().map(|p| p.to_array()).zip(colors).unzip()
 }
 
 fn mesh_positions(app: &App, character: Entity) -> Vec<[f32; 3]> {
@@ -191,11 +194,12 @@ fn moving_a_character_uploads_nothing_and_posing_one_uploads_only_its_own() {
     assert_eq!(modified, 0, "no mesh asset is modified");
 }
 
-/// The packed upload is byte for byte what Bevy would pack from a mesh holding the same
-/// positions and colours (the skin mesh's layout).
+/// The packed vertices, as the render world interleaves them into the mesh's slot, are byte
+/// for byte what Bevy would pack from a mesh holding the same positions and colours (the
+/// skin mesh's layout).
 #[test]
 fn packed_vertices_match_bevys_vertex_buffer() {
-    use marionette::scene::upload::pack_vertices;
+    use marionette::scene::upload::{SkinUpload, interleaved, pack_vertices};
     let triangles = [[0u32, 1, 2], [2, 1, 3]];
     let positions = [Vec3::new(0.0, 1.0, 2.0), Vec3::X, Vec3::new(-1.5, 0.25, 8.0), Vec3::splat(3.0)];
     let colors = [[0.1, 0.2, 0.3, 1.0], [1.0, 0.0, 0.5, 1.0], [0.0; 4], [0.7, 0.7, 0.7, 1.0]];
@@ -206,17 +210,25 @@ fn packed_vertices_match_bevys_vertex_buffer() {
     let mut mesh = marionette::scene::spawn::empty_skin_mesh(&triangles, positions.len(), &[]);
     mesh.insert_attribute(Mesh::ATTRIBUTE_POSITION, positions.map(|p| p.to_array()).to_vec());
     mesh.insert_attribute(skin_color, color_values());
-    let mut upload = marionette::scene::upload::SkinUpload::default();
-    assert_eq!(pack_vertices(&positions, &[], &colors, upload.buffer()), 4);
-    assert_eq!(upload.bytes(), mesh.create_packed_vertex_buffer_data());
-    assert_eq!(upload.bytes().len(), positions.len() * marionette::scene::upload::SKIN_VERTEX_BYTES);
+    // As the render world writes them: the positions interleaved with the packed attributes.
+    let mut upload = SkinUpload::default();
+    upload.pack_attributes(&[], &colors);
+    let written: Vec<[u8; 16]> = interleaved::<4>(&positions, &upload.attributes).map(bytemuck::cast).collect();
+    assert_eq!(written.as_flattened(), mesh.create_packed_vertex_buffer_data());
+    assert_eq!(upload.byte_len(), positions.len() * marionette::scene::upload::SKIN_VERTEX_BYTES);
+    let mut packed = Vec::new();
+    assert_eq!(pack_vertices(&positions, &[], &colors, &mut packed), 4);
+    assert_eq!(bytemuck::cast_slice::<f32, u8>(&packed), mesh.create_packed_vertex_buffer_data());
     // A textured skin: its texture coordinates go where Bevy puts them.
     let uv = [Vec2::new(0.0, 0.5), Vec2::new(1.0, 0.25), Vec2::ZERO, Vec2::ONE];
     let mut textured = marionette::scene::spawn::empty_skin_mesh(&triangles, positions.len(), &uv);
     textured.insert_attribute(Mesh::ATTRIBUTE_POSITION, positions.map(|p| p.to_array()).to_vec());
     textured.insert_attribute(skin_color, color_values());
-    assert_eq!(pack_vertices(&positions, &uv, &colors, upload.buffer()), 6);
-    assert_eq!(upload.bytes(), textured.create_packed_vertex_buffer_data());
+    upload.pack_attributes(&uv, &colors);
+    let written: Vec<[u8; 24]> = interleaved::<6>(&positions, &upload.attributes).map(bytemuck::cast).collect();
+    assert_eq!(written.as_flattened(), textured.create_packed_vertex_buffer_data());
+    assert_eq!(pack_vertices(&positions, &uv, &colors, &mut packed), 6);
+    assert_eq!(bytemuck::cast_slice::<f32, u8>(&packed), textured.create_packed_vertex_buffer_data());
 }
 
 #[test]

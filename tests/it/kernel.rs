@@ -1,10 +1,11 @@
 //! The fast skinning kernel (`rig::lbs`, AVX2 and portable paths) against the plain loop it
 //! replaces (`skinning::skin_positions`, the oracle): within 1e-5 on every data set and on
-//! synthetic rows of 1 to 13 influences.
+//! synthetic rows of 1 to 13 influences; the box each grows as it writes is the box of
+//! what it wrote.
 
 use glam::{Mat4, Quat, Vec3};
-use marionette::rig::lbs::{skin, skin_portable};
-use marionette::rig::skinning::skin_positions;
+use marionette::rig::lbs::{skin, skin_bounded, skin_portable};
+use marionette::rig::skinning::{Bounds, bounds, skin_positions};
 use marionette::rig::{CharacterAsset, JointRotation, SkinWeights};
 
 /// A pose that turns every joint (and so every palette matrix) differently.
@@ -17,18 +18,20 @@ fn posed_palette(asset: &CharacterAsset) -> Vec<Mat4> {
 }
 
 /// Both paths of the kernel agree with the oracle within `1e-5` (relative to the mesh's size).
+type Kernel = fn(&[Vec3], &SkinWeights, &[Mat4], &mut [Vec3]) -> Bounds;
+
 fn assert_kernel_matches_oracle(name: &str, bind: &[Vec3], weights: &SkinWeights, palette: &[Mat4]) {
     let n = bind.len();
     let mut expected = vec![Vec3::ZERO; n];
     skin_positions(bind, weights, palette, &mut expected);
     let scale = expected.iter().fold(1.0f32, |m, p| m.max(p.abs().max_element()));
-    for (path, run) in
-        [("dispatch", skin as fn(&[Vec3], &SkinWeights, &[Mat4], &mut [Vec3])), ("portable", skin_portable)]
-    {
+    for (path, run) in [("dispatch", skin_bounded as Kernel), ("portable", skin_portable)] {
         let mut out = vec![Vec3::splat(f32::NAN); n];
-        run(bind, weights, palette, &mut out);
+        let grown = run(bind, weights, palette, &mut out);
         let worst = expected.iter().zip(&out).map(|(a, b)| (*a - *b).abs().max_element()).fold(0.0f32, f32::max);
         assert!(worst <= 1e-5 * scale, "{name} ({path}): worst difference {worst:e} (mesh scale {scale})");
+        // The box grown as the vertices are written is the box of what was written.
+        assert_eq!(grown.pair(), bounds(&out), "{name} ({path}): bounds");
     }
 }
 
@@ -61,10 +64,13 @@ fn the_kernel_matches_the_oracle_on_rows_of_1_to_13_influences() {
     let mut whole = vec![Vec3::ZERO; n];
     skin(&bind, &weights, &palette, &mut whole);
     let mut chunked = vec![Vec3::splat(f32::NAN); n];
-    for (k, chunk) in chunked.chunks_mut(300).enumerate() {
-        marionette::rig::lbs::skin_chunk(&bind, &weights, &palette, k * 300, chunk);
-    }
+    let boxes = chunked
+        .chunks_mut(300)
+        .enumerate()
+        .map(|(k, chunk)| marionette::rig::lbs::skin_chunk(&bind, &weights, &palette, k * 300, chunk));
+    let grown = boxes.fold(Bounds::EMPTY, Bounds::union);
     assert_eq!(chunked, whole);
+    assert_eq!(grown.pair(), bounds(&whole));
 }
 
 #[test]
