@@ -1,7 +1,8 @@
 //! What the main world hands the render world for each character's skin: its skinned
 //! positions with their packed attributes ([`SkinUpload`], skinned on the CPU) or its
-//! palette ([`GpuSkinJob`], skinned by the compute shader). Plain data, required by [`Character`](super::Character); the
-//! systems that fill and take them live in `systems`, `upload` and `gpu_skinning`.
+//! palette ([`GpuSkinJob`], skinned by the compute shader). Plain data, required by
+//! [`Character`](super::Character); the systems that fill and take them live in
+//! `systems`, `upload` and `gpu_skinning`.
 
 use std::sync::Arc;
 

@@ -114,9 +114,9 @@ pub fn compute_joint_to_world(
 /// pool: palette `current · bind` from the matrix stack's output (`JointScratch`) and the
 /// asset's shared inverse binds, the LBS or DQ kernel of the bind vertices and their
 /// bounds; the colours when they changed, packed for the GPU (the render world
-/// interleaves them with the positions, see `upload`). Characters
-/// skinned on the GPU hand over the palette instead (reads `JointScratch`, `Character`;
-/// writes `SkinScratch`, `SkinUpload`, `GpuSkinJob`).
+/// interleaves them with the positions, see `upload`). Characters skinned on the GPU hand
+/// over the palette instead (reads `JointScratch`, `Character`; writes `SkinScratch`,
+/// `SkinUpload`, `GpuSkinJob`).
 pub fn skin_changed_characters(
     mut characters: Query<(
         &Character,

@@ -3,9 +3,9 @@
 //! attributes (texture coordinates where the skin has them, colour) into its
 //! [`SkinUpload`] only when they change; the render world takes the changed ones (`Arc`s,
 //! no copy) and interleaves them, in the skin mesh's own layout, straight into the staging
-//! memory of the mesh's slot of the vertex buffer. The skin mesh
-//! asset itself is never modified after it is made, so Bevy neither clones it into the
-//! render world nor re-packs it each frame, and indices stay as they were uploaded.
+//! memory of the mesh's slot of the vertex buffer. The skin mesh asset itself is never
+//! modified after it is made, so Bevy neither clones it into the render world nor re-packs
+//! it each frame, and indices stay as they were uploaded.
 
 use std::collections::HashMap;
 use std::sync::Arc;
@@ -16,13 +16,12 @@ use bevy::render::render_resource::BufferSize;
 use bevy::render::renderer::RenderQueue;
 use bevy::render::{Extract, ExtractSchedule, Render, RenderApp, RenderSystems};
 
-use super::components::Character;
+use super::components::{Character, SkinScratch};
 
-use super::components::SkinScratch;
 pub use super::handoff::{SKIN_VERTEX_BYTES, SkinUpload, interleaved, pack_vertices};
 
-/// Bytes handed to the GPU in the last frame (the packed uploads that changed, and the
-/// palettes of characters skinned on the GPU), for benchmarks and readouts.
+/// Bytes handed to the GPU in the last frame (the vertices of the uploads that changed,
+/// and the palettes of characters skinned on the GPU), for benchmarks and readouts.
 #[derive(Resource, Default, Debug)]
 pub struct HandedOn(pub usize);
 
