@@ -11,7 +11,7 @@ use std::collections::HashMap;
 use std::sync::Arc;
 
 use bevy::prelude::*;
-use bevy::render::mesh::allocator::MeshAllocator;
+use bevy::render::mesh::allocator::{MeshAllocator, MeshBufferSlice};
 use bevy::render::render_resource::BufferSize;
 use bevy::render::renderer::RenderQueue;
 use bevy::render::{Extract, ExtractSchedule, Render, RenderApp, RenderSystems};
@@ -102,42 +102,79 @@ fn extract_skin_uploads(
 
 /// Writes each pending upload into its mesh's slot of the vertex buffer, interleaved in
 /// the staging memory the queue copies from, after Bevy has allocated and filled the slots
-/// of new meshes (reads `MeshAllocator`; writes GPU buffers).
+/// of new meshes (reads `MeshAllocator`; writes GPU buffers). Slots that follow one another
+/// in a buffer (a crowd's meshes, allocated in turn) are written through one staging
+/// allocation: each allocation costs about as much as filling a body's slot.
 fn write_skin_uploads(
     mut pending: ResMut<PendingUploads>,
     allocator: Option<Res<MeshAllocator>>,
     queue: Res<RenderQueue>,
 ) {
     let Some(allocator) = allocator else { return };
-    pending.0.retain(|id, upload| {
-        let Some(slice) = allocator.mesh_vertex_slice(id) else {
-            upload.waited += 1;
-            return upload.waited < MAX_WAIT_FRAMES;
-        };
-        let slot_vertices = (slice.range.end - slice.range.start) as usize;
-        let Some((positions, attributes)) = upload.part().filter(|(p, _)| p.len() == slot_vertices) else {
-            return false;
-        };
-        let bytes = (slot_vertices * upload.floats * 4) as u64;
-        let offset = u64::from(slice.range.start) * upload.floats as u64 * 4;
-        let Some(mut view) =
-            BufferSize::new(bytes).and_then(|size| queue.write_buffer_with(slice.buffer, offset, size))
-        else {
-            return false;
-        };
-        match upload.floats {
-            4 => view
-                .slice(..)
-                .into_chunks::<16>()
-                .0
-                .write_iter(interleaved::<4>(positions, attributes).map(bytemuck::cast)),
-            6 => view
-                .slice(..)
-                .into_chunks::<24>()
-                .0
-                .write_iter(interleaved::<6>(positions, attributes).map(bytemuck::cast)),
+    let (ready, waiting): (Vec<_>, Vec<_>) =
+        pending.0.drain().partition(|(id, _)| allocator.mesh_vertex_slice(id).is_some());
+    pending.0.extend(waiting.into_iter().filter_map(|(id, mut upload)| {
+        upload.waited += 1;
+        (upload.waited < MAX_WAIT_FRAMES).then_some((id, upload))
+    }));
+    let mut writes: Vec<SlotWrite> =
+        ready.iter().filter_map(|(id, upload)| SlotWrite::of(allocator.mesh_vertex_slice(id)?, upload)).collect();
+    writes.sort_by_key(|w| (w.buffer.id(), w.offset));
+    for run in writes.chunk_by(|a, b| a.buffer.id() == b.buffer.id() && a.end() == b.offset) {
+        write_run(&queue, run);
+    }
+}
+
+/// One mesh's slot and what goes in it.
+struct SlotWrite<'a> {
+    buffer: &'a bevy::render::render_resource::Buffer,
+    /// Bytes into the buffer.
+    offset: u64,
+    positions: &'a [Vec3],
+    attributes: &'a [f32],
+    floats: usize,
+}
+
+impl<'a> SlotWrite<'a> {
+    /// The write of `upload` into `slice`; none when its vertices do not fill the slot
+    /// exactly.
+    fn of(slice: MeshBufferSlice<'a>, upload: &'a Pending) -> Option<Self> {
+        let (positions, attributes) = upload.part()?;
+        (positions.len() == (slice.range.end - slice.range.start) as usize).then(|| Self {
+            buffer: slice.buffer,
+            offset: u64::from(slice.range.start) * upload.floats as u64 * 4,
+            positions,
+            attributes,
+            floats: upload.floats,
+        })
+    }
+
+    fn bytes(&self) -> usize {
+        self.positions.len() * self.floats * 4
+    }
+
+    /// The byte after the slot.
+    fn end(&self) -> u64 {
+        self.offset + self.bytes() as u64
+    }
+}
+
+/// Writes slots that follow one another in one buffer through one staging allocation.
+fn write_run(queue: &RenderQueue, run: &[SlotWrite]) {
+    let (Some(first), Some(last)) = (run.first(), run.last()) else { return };
+    let Some(mut view) = BufferSize::new(last.end() - first.offset)
+        .and_then(|size| queue.write_buffer_with(first.buffer, first.offset, size))
+    else {
+        return;
+    };
+    for write in run {
+        let at = (write.offset - first.offset) as usize;
+        let slot = view.slice(at..at + write.bytes());
+        let (positions, attributes) = (write.positions, write.attributes);
+        match write.floats {
+            4 => slot.into_chunks::<16>().0.write_iter(interleaved::<4>(positions, attributes).map(bytemuck::cast)),
+            6 => slot.into_chunks::<24>().0.write_iter(interleaved::<6>(positions, attributes).map(bytemuck::cast)),
             _ => {}
         }
-        false
-    });
+    }
 }
