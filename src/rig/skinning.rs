@@ -196,7 +196,7 @@ pub fn bounds(points: &[Vec3]) -> (Vec3, Vec3) {
 }
 
 /// [`bounds`] of points as they come (none stored).
-pub fn bounds_of(points: impl Iterator<Item = Vec3>) -> (Vec3, Vec3) {
+fn bounds_of(points: impl Iterator<Item = Vec3>) -> (Vec3, Vec3) {
     points.map(Vec3A::from).fold(Bounds::EMPTY, Bounds::with).pair()
 }
 
