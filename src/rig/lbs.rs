@@ -1,14 +1,14 @@
-//! The fast linear-blend-skinning kernel. Vertices are grouped by influence count when the
-//! weights are built (1, 2, 3 or 4 influences in fixed-size rows; more in a general
-//! group); each vertex blends its palette matrices once (`M = Σ wᵢ Pᵢ`) and transforms its
-//! bind position by `M`. On x86-64 with AVX2 and FMA (detected at run time) the blend is
-//! fused multiply-adds on 256-bit registers (two columns of a matrix in each); elsewhere
-//! glam's `Vec4` does it.
+//! The fast linear-blend-skinning kernel. When the weights are built, the vertices are put
+//! in blocks of eight that share few joints ([`LaneBlocks`]); a block blends each of its
+//! joints' matrices into all eight vertices' matrices at once (`Mᵥ = Σ wᵥⱼ Pⱼ`, one vertex
+//! a lane) and transforms each lane's bind position by its own. On x86-64 with AVX2 and FMA
+//! (detected at run time) the lanes are 256-bit registers; elsewhere plain arrays.
 //! [`skin_positions`](super::skinning::skin_positions) stays as the plain oracle.
 
-use glam::{Mat4, Vec3, Vec3A, Vec4};
+use glam::{Mat4, Vec3, Vec3A};
 
-use super::influences::FixedGroup;
+pub use super::influences::TILE_VERTICES;
+use super::influences::{LANES, LaneBlocks};
 use super::skinning::{Bounds, SkinWeights};
 
 /// Skins bind-pose vertices: `out[v] = (Σ wᵢ · palette[jᵢ]) · bind[v]` (the same result as
@@ -33,7 +33,8 @@ pub fn skin_bounded(bind_positions: &[Vec3], weights: &SkinWeights, palette: &[M
 
 /// Skins the vertices `first..first + out.len()` into `out` (a large mesh is skinned in
 /// chunks on several threads, each writing its own part of the output) and returns their
-/// box.
+/// box. Chunks that start and end on multiples of [`TILE_VERTICES`] read only their own
+/// blocks; others also skin (and do not write) their tiles' other vertices.
 ///
 /// # Panics
 /// When `bind_positions` and `weights` differ in length, the chunk runs past the mesh, or
@@ -52,106 +53,68 @@ pub fn skin_chunk(
     #[cfg(target_arch = "x86_64")]
     if std::arch::is_x86_feature_detected!("avx2") && std::arch::is_x86_feature_detected!("fma") {
         // SAFETY: the CPU has AVX2 and FMA (checked above).
-        return unsafe {
-            avx2::skin_fixed::<1>(bind_positions, &groups.fixed[0], palette, first, out)
-                .union(avx2::skin_fixed::<2>(bind_positions, &groups.fixed[1], palette, first, out))
-                .union(avx2::skin_fixed::<3>(bind_positions, &groups.fixed[2], palette, first, out))
-                .union(avx2::skin_fixed::<4>(bind_positions, &groups.fixed[3], palette, first, out))
-                .union(avx2::skin_wide(bind_positions, weights, palette, first, out))
-        };
+        return unsafe { avx2::skin_blocks(bind_positions, &groups.blocks, palette, first, out) };
     }
-    skin_portable_chunk(bind_positions, weights, palette, first, out)
+    skin_blocks_portable(bind_positions, &groups.blocks, palette, first, out)
 }
 
-/// [`skin_bounded`] without the AVX2 path: glam's `Vec4` on any target (what other CPUs
-/// run).
+/// [`skin_bounded`] without the AVX2 path: the same blocks in plain arrays, on any target
+/// (what other CPUs run).
 ///
 /// # Panics
 /// As [`skin`].
 pub fn skin_portable(bind_positions: &[Vec3], weights: &SkinWeights, palette: &[Mat4], out: &mut [Vec3]) -> Bounds {
     assert_eq!(bind_positions.len(), weights.vertex_count(), "one weight row per vertex");
     assert_eq!(out.len(), bind_positions.len(), "one output per vertex");
-    skin_portable_chunk(bind_positions, weights, palette, 0, out)
+    skin_blocks_portable(bind_positions, &weights.groups().blocks, palette, 0, out)
 }
 
-fn skin_portable_chunk(
-    bind: &[Vec3],
-    weights: &SkinWeights,
-    palette: &[Mat4],
-    first: usize,
-    out: &mut [Vec3],
-) -> Bounds {
-    let groups = weights.groups();
-    skin_fixed_portable::<1>(bind, &groups.fixed[0], palette, first, out)
-        .union(skin_fixed_portable::<2>(bind, &groups.fixed[1], palette, first, out))
-        .union(skin_fixed_portable::<3>(bind, &groups.fixed[2], palette, first, out))
-        .union(skin_fixed_portable::<4>(bind, &groups.fixed[3], palette, first, out))
-        .union(skin_wide(bind, weights, &groups.wide, palette, first, out))
+/// Element `e` of the blended matrix in a block: column `e / 3`, row `e % 3` (the fourth
+/// row of an affine matrix is not needed).
+const ELEMENTS: usize = 12;
+
+/// A palette matrix's twelve elements, as [`ELEMENTS`] orders them.
+#[inline]
+fn elements(m: &Mat4) -> [f32; ELEMENTS] {
+    let c = m.to_cols_array();
+    std::array::from_fn(|e| c[e / 3 * 4 + e % 3])
 }
 
-/// The rows of `group` whose vertices lie in `first..first + len` (vertices ascend).
-fn rows_in<const K: usize>(group: &FixedGroup, first: usize, len: usize) -> (&[u32], &[u16], &[f32]) {
-    let lo = group.vertices.partition_point(|&v| (v as usize) < first);
-    let hi = group.vertices.partition_point(|&v| (v as usize) < first + len);
-    (&group.vertices[lo..hi], &group.joints[lo * K..hi * K], &group.weights[lo * K..hi * K])
-}
-
-/// The vertices of `wide` that lie in `first..first + len` (vertices ascend).
-fn wide_in(wide: &[u32], first: usize, len: usize) -> &[u32] {
-    let lo = wide.partition_point(|&v| (v as usize) < first);
-    let hi = wide.partition_point(|&v| (v as usize) < first + len);
-    &wide[lo..hi]
-}
-
-/// The portable path of one fixed group: blend `K` matrices with glam's `Vec4`.
-fn skin_fixed_portable<const K: usize>(
-    bind: &[Vec3],
-    group: &FixedGroup,
-    palette: &[Mat4],
-    first: usize,
-    out: &mut [Vec3],
-) -> Bounds {
-    let (vertices, joints, weights) = rows_in::<K>(group, first, out.len());
-    let mut bounds = Bounds::EMPTY;
-    for (&v, (joints, weights)) in vertices.iter().zip(joints.chunks_exact(K).zip(weights.chunks_exact(K))) {
-        let mut m = [Vec4::ZERO; 4];
-        for (&j, &w) in joints.iter().zip(weights) {
-            let p = &palette[j as usize];
-            m[0] += p.x_axis * w;
-            m[1] += p.y_axis * w;
-            m[2] += p.z_axis * w;
-            m[3] += p.w_axis * w;
-        }
-        let b = bind[v as usize];
-        let p = Vec3A::from_vec4(m[0] * b.x + m[1] * b.y + m[2] * b.z + m[3]);
-        bounds = bounds.with(p);
-        out[v as usize - first] = p.into();
+/// Writes lane `vertex`'s skinned position `p` when the vertex lies in the chunk
+/// `first..first + out.len()`, growing `bounds`.
+#[inline]
+fn store_lane(out: &mut [Vec3], first: usize, vertex: u32, p: Vec3A, bounds: &mut Bounds) {
+    let at = (vertex as usize).wrapping_sub(first);
+    if at < out.len() {
+        out[at] = p.into();
+        *bounds = bounds.with(p);
     }
-    bounds
 }
 
-/// Vertices with more than four influences, blended the same way from the compressed rows.
-fn skin_wide(
+/// The portable path: each block's matrices blended into all eight lanes in plain arrays.
+fn skin_blocks_portable(
     bind: &[Vec3],
-    weights: &SkinWeights,
-    wide: &[u32],
+    blocks: &LaneBlocks,
     palette: &[Mat4],
     first: usize,
     out: &mut [Vec3],
 ) -> Bounds {
     let mut bounds = Bounds::EMPTY;
-    for &v in wide_in(wide, first, out.len()) {
-        let mut m = Mat4::ZERO;
-        for inf in weights.of_vertex(v as usize) {
-            let p = &palette[inf.joint as usize];
-            m.x_axis += p.x_axis * inf.weight;
-            m.y_axis += p.y_axis * inf.weight;
-            m.z_axis += p.z_axis * inf.weight;
-            m.w_axis += p.w_axis * inf.weight;
+    for b in blocks.covering(first, out.len()) {
+        let joints = blocks.joint_starts[b] as usize..blocks.joint_starts[b + 1] as usize;
+        let mut m = [[0.0f32; LANES]; ELEMENTS];
+        for (&j, w) in blocks.joints[joints.clone()].iter().zip(&blocks.weights[joints]) {
+            for (m, c) in m.iter_mut().zip(elements(&palette[j as usize])) {
+                for (m, w) in m.iter_mut().zip(w.0) {
+                    *m += w * c;
+                }
+            }
         }
-        let p = m.transform_point3(bind[v as usize]);
-        bounds = bounds.with(p.into());
-        out[v as usize - first] = p;
+        for (i, &v) in blocks.vertices[b].iter().enumerate() {
+            let b = bind[v as usize];
+            let row = |r: usize| m[r][i] * b.x + m[3 + r][i] * b.y + m[6 + r][i] * b.z + m[9 + r][i];
+            store_lane(out, first, v, Vec3A::new(row(0), row(1), row(2)), &mut bounds);
+        }
     }
     bounds
 }
@@ -162,104 +125,100 @@ mod avx2 {
 
     use glam::{Mat4, Vec3, Vec3A, Vec4};
 
-    use super::FixedGroup;
-    use crate::rig::skinning::{Bounds, Influence, SkinWeights};
+    use super::{LANES, LaneBlocks, elements, store_lane};
+    use crate::rig::skinning::Bounds;
 
-    /// One fixed group with FMA on 256-bit registers: a palette matrix is two of them
-    /// (columns 0 and 1, columns 2 and 3), so a blend of `K` matrices is `2K` multiply-adds,
-    /// and the blended matrix transforms the bind position with one more multiply-add and
-    /// one add of the register's halves.
+    /// Each block on 256-bit registers, one vertex a lane: each of the block's joints
+    /// transforms all eight bind positions (its matrix's elements broadcast once) and adds
+    /// them in with each lane's weight; twelve multiply-adds a joint for eight vertices.
     ///
     /// # Safety
     /// The CPU must have AVX2 and FMA. (Indices are checked: a joint beyond the palette or a
     /// vertex beyond the buffers panics.)
     #[target_feature(enable = "avx2,fma")]
-    pub unsafe fn skin_fixed<const K: usize>(
+    pub unsafe fn skin_blocks(
         bind: &[Vec3],
-        group: &FixedGroup,
-        palette: &[Mat4],
-        first: usize,
-        out: &mut [Vec3],
-    ) -> Bounds {
-        let (vertices, joints, weights) = super::rows_in::<K>(group, first, out.len());
-        let rows = joints.chunks_exact(K).zip(weights.chunks_exact(K));
-        let mut bounds = Bounds::EMPTY;
-        for (&v, (joints, weights)) in vertices.iter().zip(rows) {
-            let (joints, weights): (&[u16; K], &[f32; K]) = (joints.try_into().unwrap(), weights.try_into().unwrap());
-            // Two accumulators per half (even and odd influences) halve the chain of
-            // dependent multiply-adds.
-            let mut c = [[_mm256_setzero_ps(); 2]; 2];
-            for k in 0..K {
-                let (c01, c23) = columns(&palette[joints[k] as usize]);
-                let w = _mm256_set1_ps(weights[k]);
-                let acc = &mut c[k % 2];
-                acc[0] = _mm256_fmadd_ps(w, c01, acc[0]);
-                acc[1] = _mm256_fmadd_ps(w, c23, acc[1]);
-            }
-            let (c01, c23) = (_mm256_add_ps(c[0][0], c[1][0]), _mm256_add_ps(c[0][1], c[1][1]));
-            let p = transform(c01, c23, bind[v as usize]);
-            bounds = bounds.with(p);
-            out[v as usize - first] = p.into();
-        }
-        bounds
-    }
-
-    /// The vertices with more than four influences, blended as in [`skin_fixed`] from their
-    /// compressed rows.
-    ///
-    /// # Safety
-    /// As [`skin_fixed`].
-    #[target_feature(enable = "avx2,fma")]
-    pub unsafe fn skin_wide(
-        bind: &[Vec3],
-        weights: &SkinWeights,
+        blocks: &LaneBlocks,
         palette: &[Mat4],
         first: usize,
         out: &mut [Vec3],
     ) -> Bounds {
         let mut bounds = Bounds::EMPTY;
-        for &v in super::wide_in(&weights.groups().wide, first, out.len()) {
-            let row = weights.of_vertex(v as usize);
-            let term = |i: &Influence| {
-                let (c01, c23) = columns(&palette[i.joint as usize]);
-                (_mm256_set1_ps(i.weight), c01, c23)
-            };
-            // Even and odd influences in their own sums, as in `skin_fixed`.
-            let (mut even, mut odd) = ([_mm256_setzero_ps(); 2], [_mm256_setzero_ps(); 2]);
-            let pairs = row.chunks_exact(2);
-            if let [last] = pairs.remainder() {
-                let (w, c01, c23) = term(last);
-                even = [_mm256_mul_ps(w, c01), _mm256_mul_ps(w, c23)];
+        for b in blocks.covering(first, out.len()) {
+            let lanes = &blocks.vertices[b];
+            let [x, y, z] = gather(bind, lanes);
+            let mut p = [_mm256_setzero_ps(); 3];
+            let joints = blocks.joint_starts[b] as usize..blocks.joint_starts[b + 1] as usize;
+            for (&j, w) in blocks.joints[joints.clone()].iter().zip(&blocks.weights[joints]) {
+                // SAFETY: `LaneWeights` is eight `f32`s, as `__m256` is.
+                let w: __m256 = unsafe { std::mem::transmute(w.0) };
+                let m = elements(&palette[j as usize]).map(|c| _mm256_set1_ps(c));
+                for (r, p) in p.iter_mut().enumerate() {
+                    let row =
+                        _mm256_fmadd_ps(m[r], x, _mm256_fmadd_ps(m[3 + r], y, _mm256_fmadd_ps(m[6 + r], z, m[9 + r])));
+                    *p = _mm256_fmadd_ps(w, row, *p);
+                }
             }
-            for pair in pairs {
-                let ((w0, a01, a23), (w1, b01, b23)) = (term(&pair[0]), term(&pair[1]));
-                even = [_mm256_fmadd_ps(w0, a01, even[0]), _mm256_fmadd_ps(w0, a23, even[1])];
-                odd = [_mm256_fmadd_ps(w1, b01, odd[0]), _mm256_fmadd_ps(w1, b23, odd[1])];
+            for (p, &v) in scatter(p).into_iter().zip(lanes) {
+                store_lane(out, first, v, p, &mut bounds);
             }
-            let (c01, c23) = (_mm256_add_ps(even[0], odd[0]), _mm256_add_ps(even[1], odd[1]));
-            let p = transform(c01, c23, bind[v as usize]);
-            bounds = bounds.with(p);
-            out[v as usize - first] = p.into();
         }
         bounds
     }
 
-    /// A palette matrix as two registers: columns 0 and 1, columns 2 and 3.
+    /// The lanes' bind positions as three registers: the x, y and z of each lane.
     #[inline]
     #[target_feature(enable = "avx2,fma")]
-    fn columns(m: &Mat4) -> (__m256, __m256) {
-        (_mm256_set_m128(m.y_axis.into(), m.x_axis.into()), _mm256_set_m128(m.w_axis.into(), m.z_axis.into()))
+    fn gather(bind: &[Vec3], lanes: &[u32; LANES]) -> [__m256; 3] {
+        let pair = |i: usize| _mm256_set_m128(load(bind, lanes[i + 4]), load(bind, lanes[i]));
+        // Lanes i and i + 4 side by side, then a 4 × 4 transpose in each half.
+        let (r0, r1, r2, r3) = (pair(0), pair(1), pair(2), pair(3));
+        let (xy01, xy23) = (_mm256_unpacklo_ps(r0, r1), _mm256_unpacklo_ps(r2, r3));
+        let (zw01, zw23) = (_mm256_unpackhi_ps(r0, r1), _mm256_unpackhi_ps(r2, r3));
+        [
+            _mm256_shuffle_ps::<0x44>(xy01, xy23),
+            _mm256_shuffle_ps::<0xEE>(xy01, xy23),
+            _mm256_shuffle_ps::<0x44>(zw01, zw23),
+        ]
     }
 
-    /// A blended matrix (as [`columns`] gives it) applied to a bind position: one
-    /// multiply-add and one add of the register's halves.
+    /// Vertex `v`'s bind position in the first three floats of a register, read in one load
+    /// of four floats (the fourth is the next vertex's x) except for the last vertex.
     #[inline]
     #[target_feature(enable = "avx2,fma")]
-    fn transform(c01: __m256, c23: __m256, b: Vec3) -> Vec3A {
-        let xy = _mm256_set_m128(_mm_set1_ps(b.y), _mm_set1_ps(b.x));
-        let z1 = _mm256_set_m128(_mm_set1_ps(1.0), _mm_set1_ps(b.z));
-        let p = _mm256_fmadd_ps(c01, xy, _mm256_mul_ps(c23, z1));
-        let p = _mm_add_ps(_mm256_castps256_ps128(p), _mm256_extractf128_ps::<1>(p));
-        Vec3A::from_vec4(Vec4::from(p))
+    fn load(bind: &[Vec3], v: u32) -> __m128 {
+        /// Sixteen bytes read from wherever they lie.
+        #[repr(C, packed)]
+        struct Unaligned(__m128);
+        let v = v as usize;
+        match bind.get(v..v + 2) {
+            // SAFETY: two `Vec3`s are 24 readable bytes; `Unaligned` reads 16 of them at any
+            // alignment.
+            Some(two) => unsafe { two.as_ptr().cast::<Unaligned>().read().0 },
+            None => {
+                let b = bind[v];
+                _mm_setr_ps(b.x, b.y, b.z, 0.0)
+            }
+        }
+    }
+
+    /// The inverse of [`gather`]: the x, y and z registers as each lane's point.
+    #[inline]
+    #[target_feature(enable = "avx2,fma")]
+    fn scatter([x, y, z]: [__m256; 3]) -> [Vec3A; LANES] {
+        let zero = _mm256_setzero_ps();
+        let (xy01, xy23) = (_mm256_unpacklo_ps(x, y), _mm256_unpackhi_ps(x, y));
+        let (z01, z23) = (_mm256_unpacklo_ps(z, zero), _mm256_unpackhi_ps(z, zero));
+        let pairs = [
+            _mm256_shuffle_ps::<0x44>(xy01, z01),
+            _mm256_shuffle_ps::<0xEE>(xy01, z01),
+            _mm256_shuffle_ps::<0x44>(xy23, z23),
+            _mm256_shuffle_ps::<0xEE>(xy23, z23),
+        ];
+        let point = |q: __m128| Vec3A::from_vec4(Vec4::from(q));
+        std::array::from_fn(|i| {
+            let pair = pairs[i % 4];
+            point(if i < 4 { _mm256_castps256_ps128(pair) } else { _mm256_extractf128_ps::<1>(pair) })
+        })
     }
 }
