@@ -1,14 +1,15 @@
-//! The fast linear-blend-skinning kernel. When the weights are built, the vertices are put
-//! in blocks of eight that share few joints ([`LaneBlocks`]); a block blends each of its
-//! joints' matrices into all eight vertices' matrices at once (`Mᵥ = Σ wᵥⱼ Pⱼ`, one vertex
-//! a lane) and transforms each lane's bind position by its own. On x86-64 with AVX2 and FMA
-//! (detected at run time) the lanes are 256-bit registers; elsewhere plain arrays.
+//! The fast linear-blend-skinning kernel. On x86-64 with AVX2 and FMA (detected at run
+//! time), the vertices are skinned in blocks of eight that share few joints
+//! ([`LaneBlocks`], built with the weights), one vertex a lane of a 256-bit register: each
+//! of a block's joints transforms all eight bind positions at once, weighted lane by lane
+//! (`pᵥ = Σⱼ wᵥⱼ (Pⱼ bᵥ)`), so a joint's matrix is read once for eight vertices. Elsewhere
+//! each vertex blends its own matrices with glam's `Vec4`, grouped by influence count.
 //! [`skin_positions`](super::skinning::skin_positions) stays as the plain oracle.
 
-use glam::{Mat4, Vec3, Vec3A};
+use glam::{Mat4, Vec3, Vec3A, Vec4};
 
 pub use super::influences::TILE_VERTICES;
-use super::influences::{LANES, LaneBlocks};
+use super::influences::{FixedGroup, LaneBlocks};
 use super::skinning::{Bounds, SkinWeights};
 
 /// Skins bind-pose vertices: `out[v] = (Σ wᵢ · palette[jᵢ]) · bind[v]` (the same result as
@@ -18,7 +19,8 @@ use super::skinning::{Bounds, SkinWeights};
 /// When the lengths of `bind_positions`, `weights` and `out` differ, or an influence names
 /// a joint beyond the palette.
 pub fn skin(bind_positions: &[Vec3], weights: &SkinWeights, palette: &[Mat4], out: &mut [Vec3]) {
-    skin_bounded(bind_positions, weights, palette, out);
+    assert_eq!(out.len(), bind_positions.len(), "one output per vertex");
+    skin_range::<false>(bind_positions, weights, palette, 0, out);
 }
 
 /// [`skin`], returning the box of the skinned vertices (exactly
@@ -46,6 +48,17 @@ pub fn skin_chunk(
     first: usize,
     out: &mut [Vec3],
 ) -> Bounds {
+    skin_range::<true>(bind_positions, weights, palette, first, out)
+}
+
+/// [`skin_chunk`], growing the box only when `BOUNDS` (the empty box otherwise).
+fn skin_range<const BOUNDS: bool>(
+    bind_positions: &[Vec3],
+    weights: &SkinWeights,
+    palette: &[Mat4],
+    first: usize,
+    out: &mut [Vec3],
+) -> Bounds {
     assert_eq!(bind_positions.len(), weights.vertex_count(), "one weight row per vertex");
     assert!(first + out.len() <= bind_positions.len(), "the chunk lies inside the mesh");
     let groups = weights.groups();
@@ -53,68 +66,102 @@ pub fn skin_chunk(
     #[cfg(target_arch = "x86_64")]
     if std::arch::is_x86_feature_detected!("avx2") && std::arch::is_x86_feature_detected!("fma") {
         // SAFETY: the CPU has AVX2 and FMA (checked above).
-        return unsafe { avx2::skin_blocks(bind_positions, &groups.blocks, palette, first, out) };
+        return unsafe { avx2::skin_blocks::<BOUNDS>(bind_positions, &groups.blocks, palette, first, out) };
     }
-    skin_blocks_portable(bind_positions, &groups.blocks, palette, first, out)
+    skin_portable_chunk(bind_positions, weights, palette, first, out)
 }
 
-/// [`skin_bounded`] without the AVX2 path: the same blocks in plain arrays, on any target
-/// (what other CPUs run).
+/// [`skin_bounded`] without the AVX2 path, on any target (what other CPUs run).
 ///
 /// # Panics
 /// As [`skin`].
 pub fn skin_portable(bind_positions: &[Vec3], weights: &SkinWeights, palette: &[Mat4], out: &mut [Vec3]) -> Bounds {
     assert_eq!(bind_positions.len(), weights.vertex_count(), "one weight row per vertex");
     assert_eq!(out.len(), bind_positions.len(), "one output per vertex");
-    skin_blocks_portable(bind_positions, &weights.groups().blocks, palette, 0, out)
+    skin_portable_chunk(bind_positions, weights, palette, 0, out)
 }
 
-/// Element `e` of the blended matrix in a block: column `e / 3`, row `e % 3` (the fourth
-/// row of an affine matrix is not needed).
-const ELEMENTS: usize = 12;
-
-/// A palette matrix's twelve elements, as [`ELEMENTS`] orders them.
-#[inline]
-fn elements(m: &Mat4) -> [f32; ELEMENTS] {
-    let c = m.to_cols_array();
-    std::array::from_fn(|e| c[e / 3 * 4 + e % 3])
-}
-
-/// Writes lane `vertex`'s skinned position `p` when the vertex lies in the chunk
-/// `first..first + out.len()`, growing `bounds`.
-#[inline]
-fn store_lane(out: &mut [Vec3], first: usize, vertex: u32, p: Vec3A, bounds: &mut Bounds) {
-    let at = (vertex as usize).wrapping_sub(first);
-    if at < out.len() {
-        out[at] = p.into();
-        *bounds = bounds.with(p);
-    }
-}
-
-/// The portable path: each block's matrices blended into all eight lanes in plain arrays.
-fn skin_blocks_portable(
+/// The portable path: each vertex blends its matrices (`M = Σ wᵢ Pᵢ`) with glam's `Vec4`
+/// and transforms its bind position by `M`. (Eight lanes in plain arrays spill 128-bit
+/// registers: 71 µs a SMPL body against this path's 38.)
+fn skin_portable_chunk(
     bind: &[Vec3],
-    blocks: &LaneBlocks,
+    weights: &SkinWeights,
+    palette: &[Mat4],
+    first: usize,
+    out: &mut [Vec3],
+) -> Bounds {
+    let groups = weights.groups();
+    skin_fixed_portable::<1>(bind, &groups.fixed[0], palette, first, out)
+        .union(skin_fixed_portable::<2>(bind, &groups.fixed[1], palette, first, out))
+        .union(skin_fixed_portable::<3>(bind, &groups.fixed[2], palette, first, out))
+        .union(skin_fixed_portable::<4>(bind, &groups.fixed[3], palette, first, out))
+        .union(skin_wide(bind, weights, &groups.wide, palette, first, out))
+}
+
+/// The rows of `group` whose vertices lie in `first..first + len` (vertices ascend).
+fn rows_in<const K: usize>(group: &FixedGroup, first: usize, len: usize) -> (&[u32], &[u16], &[f32]) {
+    let lo = group.vertices.partition_point(|&v| (v as usize) < first);
+    let hi = group.vertices.partition_point(|&v| (v as usize) < first + len);
+    (&group.vertices[lo..hi], &group.joints[lo * K..hi * K], &group.weights[lo * K..hi * K])
+}
+
+/// The vertices of `wide` that lie in `first..first + len` (vertices ascend).
+fn wide_in(wide: &[u32], first: usize, len: usize) -> &[u32] {
+    let lo = wide.partition_point(|&v| (v as usize) < first);
+    let hi = wide.partition_point(|&v| (v as usize) < first + len);
+    &wide[lo..hi]
+}
+
+/// The portable path of one fixed group: blend `K` matrices with glam's `Vec4`.
+fn skin_fixed_portable<const K: usize>(
+    bind: &[Vec3],
+    group: &FixedGroup,
+    palette: &[Mat4],
+    first: usize,
+    out: &mut [Vec3],
+) -> Bounds {
+    let (vertices, joints, weights) = rows_in::<K>(group, first, out.len());
+    let mut bounds = Bounds::EMPTY;
+    for (&v, (joints, weights)) in vertices.iter().zip(joints.chunks_exact(K).zip(weights.chunks_exact(K))) {
+        let mut m = [Vec4::ZERO; 4];
+        for (&j, &w) in joints.iter().zip(weights) {
+            let p = &palette[j as usize];
+            m[0] += p.x_axis * w;
+            m[1] += p.y_axis * w;
+            m[2] += p.z_axis * w;
+            m[3] += p.w_axis * w;
+        }
+        let b = bind[v as usize];
+        let p = Vec3A::from_vec4(m[0] * b.x + m[1] * b.y + m[2] * b.z + m[3]);
+        bounds = bounds.with(p);
+        out[v as usize - first] = p.into();
+    }
+    bounds
+}
+
+/// Vertices with more than four influences, blended the same way from the compressed rows.
+fn skin_wide(
+    bind: &[Vec3],
+    weights: &SkinWeights,
+    wide: &[u32],
     palette: &[Mat4],
     first: usize,
     out: &mut [Vec3],
 ) -> Bounds {
     let mut bounds = Bounds::EMPTY;
-    for b in blocks.covering(first, out.len()) {
-        let joints = blocks.joint_starts[b] as usize..blocks.joint_starts[b + 1] as usize;
-        let mut m = [[0.0f32; LANES]; ELEMENTS];
-        for (&j, w) in blocks.joints[joints.clone()].iter().zip(&blocks.weights[joints]) {
-            for (m, c) in m.iter_mut().zip(elements(&palette[j as usize])) {
-                for (m, w) in m.iter_mut().zip(w.0) {
-                    *m += w * c;
-                }
-            }
+    for &v in wide_in(wide, first, out.len()) {
+        let mut m = Mat4::ZERO;
+        for inf in weights.of_vertex(v as usize) {
+            let p = &palette[inf.joint as usize];
+            m.x_axis += p.x_axis * inf.weight;
+            m.y_axis += p.y_axis * inf.weight;
+            m.z_axis += p.z_axis * inf.weight;
+            m.w_axis += p.w_axis * inf.weight;
         }
-        for (i, &v) in blocks.vertices[b].iter().enumerate() {
-            let b = bind[v as usize];
-            let row = |r: usize| m[r][i] * b.x + m[3 + r][i] * b.y + m[6 + r][i] * b.z + m[9 + r][i];
-            store_lane(out, first, v, Vec3A::new(row(0), row(1), row(2)), &mut bounds);
-        }
+        let p = m.transform_point3(bind[v as usize]);
+        bounds = bounds.with(p.into());
+        out[v as usize - first] = p;
     }
     bounds
 }
@@ -125,8 +172,33 @@ mod avx2 {
 
     use glam::{Mat4, Vec3, Vec3A, Vec4};
 
-    use super::{LANES, LaneBlocks, elements, store_lane};
+    use super::LaneBlocks;
+    use crate::rig::influences::LANES;
     use crate::rig::skinning::Bounds;
+
+    /// Element `e` of a palette matrix as a block reads it: column `e / 3`, row `e % 3` (the
+    /// fourth row of an affine matrix is not needed).
+    const ELEMENTS: usize = 12;
+
+    /// A palette matrix's twelve elements, as [`ELEMENTS`] orders them.
+    #[inline]
+    fn elements(m: &Mat4) -> [f32; ELEMENTS] {
+        let c = m.to_cols_array();
+        std::array::from_fn(|e| c[e / 3 * 4 + e % 3])
+    }
+
+    /// Writes lane `vertex`'s skinned position `p` when the vertex lies in the chunk
+    /// `first..first + out.len()`, growing `bounds` when `BOUNDS`.
+    #[inline]
+    fn store_lane<const BOUNDS: bool>(out: &mut [Vec3], first: usize, vertex: u32, p: Vec3A, bounds: &mut Bounds) {
+        let at = (vertex as usize).wrapping_sub(first);
+        if at < out.len() {
+            out[at] = p.into();
+            if BOUNDS {
+                *bounds = bounds.with(p);
+            }
+        }
+    }
 
     /// Each block on 256-bit registers, one vertex a lane: each of the block's joints
     /// transforms all eight bind positions (its matrix's elements broadcast once) and adds
@@ -136,17 +208,45 @@ mod avx2 {
     /// The CPU must have AVX2 and FMA. (Indices are checked: a joint beyond the palette or a
     /// vertex beyond the buffers panics.)
     #[target_feature(enable = "avx2,fma")]
-    pub unsafe fn skin_blocks(
+    pub unsafe fn skin_blocks<const BOUNDS: bool>(
         bind: &[Vec3],
         blocks: &LaneBlocks,
         palette: &[Mat4],
         first: usize,
         out: &mut [Vec3],
     ) -> Bounds {
+        /// Sixteen bytes read from wherever they lie.
+        #[repr(C, packed)]
+        struct Unaligned(__m128);
+        // Vertex `v`'s bind position in the first three floats of a register, read in one
+        // load of four floats (the fourth is the next vertex's x) except for the last vertex.
+        let load = |v: u32| match bind.get(v as usize..v as usize + 2) {
+            // SAFETY: two `Vec3`s are 24 readable bytes; `Unaligned` reads 16 of them at any
+            // alignment.
+            Some(two) => unsafe { two.as_ptr().cast::<Unaligned>().read().0 },
+            None => {
+                let b = bind[v as usize];
+                _mm_setr_ps(b.x, b.y, b.z, 0.0)
+            }
+        };
+        // The lanes' bind positions as three registers, the x, y and z of each lane: lanes i
+        // and i + 4 side by side, then a 4 × 4 transpose in each half. (A closure, so that
+        // it is inlined in each instance of this function.)
+        let gather = |lanes: &[u32; LANES]| {
+            let pair = |i: usize| _mm256_set_m128(load(lanes[i + 4]), load(lanes[i]));
+            let (r0, r1, r2, r3) = (pair(0), pair(1), pair(2), pair(3));
+            let (xy01, xy23) = (_mm256_unpacklo_ps(r0, r1), _mm256_unpacklo_ps(r2, r3));
+            let (zw01, zw23) = (_mm256_unpackhi_ps(r0, r1), _mm256_unpackhi_ps(r2, r3));
+            [
+                _mm256_shuffle_ps::<0x44>(xy01, xy23),
+                _mm256_shuffle_ps::<0xEE>(xy01, xy23),
+                _mm256_shuffle_ps::<0x44>(zw01, zw23),
+            ]
+        };
         let mut bounds = Bounds::EMPTY;
         for b in blocks.covering(first, out.len()) {
             let lanes = &blocks.vertices[b];
-            let [x, y, z] = gather(bind, lanes);
+            let [x, y, z] = gather(lanes);
             let mut p = [_mm256_setzero_ps(); 3];
             let joints = blocks.joint_starts[b] as usize..blocks.joint_starts[b + 1] as usize;
             for (&j, w) in blocks.joints[joints.clone()].iter().zip(&blocks.weights[joints]) {
@@ -160,49 +260,14 @@ mod avx2 {
                 }
             }
             for (p, &v) in scatter(p).into_iter().zip(lanes) {
-                store_lane(out, first, v, p, &mut bounds);
+                store_lane::<BOUNDS>(out, first, v, p, &mut bounds);
             }
         }
         bounds
     }
 
-    /// The lanes' bind positions as three registers: the x, y and z of each lane.
-    #[inline]
-    #[target_feature(enable = "avx2,fma")]
-    fn gather(bind: &[Vec3], lanes: &[u32; LANES]) -> [__m256; 3] {
-        let pair = |i: usize| _mm256_set_m128(load(bind, lanes[i + 4]), load(bind, lanes[i]));
-        // Lanes i and i + 4 side by side, then a 4 × 4 transpose in each half.
-        let (r0, r1, r2, r3) = (pair(0), pair(1), pair(2), pair(3));
-        let (xy01, xy23) = (_mm256_unpacklo_ps(r0, r1), _mm256_unpacklo_ps(r2, r3));
-        let (zw01, zw23) = (_mm256_unpackhi_ps(r0, r1), _mm256_unpackhi_ps(r2, r3));
-        [
-            _mm256_shuffle_ps::<0x44>(xy01, xy23),
-            _mm256_shuffle_ps::<0xEE>(xy01, xy23),
-            _mm256_shuffle_ps::<0x44>(zw01, zw23),
-        ]
-    }
-
-    /// Vertex `v`'s bind position in the first three floats of a register, read in one load
-    /// of four floats (the fourth is the next vertex's x) except for the last vertex.
-    #[inline]
-    #[target_feature(enable = "avx2,fma")]
-    fn load(bind: &[Vec3], v: u32) -> __m128 {
-        /// Sixteen bytes read from wherever they lie.
-        #[repr(C, packed)]
-        struct Unaligned(__m128);
-        let v = v as usize;
-        match bind.get(v..v + 2) {
-            // SAFETY: two `Vec3`s are 24 readable bytes; `Unaligned` reads 16 of them at any
-            // alignment.
-            Some(two) => unsafe { two.as_ptr().cast::<Unaligned>().read().0 },
-            None => {
-                let b = bind[v];
-                _mm_setr_ps(b.x, b.y, b.z, 0.0)
-            }
-        }
-    }
-
-    /// The inverse of [`gather`]: the x, y and z registers as each lane's point.
+    /// The inverse of the gather in [`skin_blocks`]: the x, y and z registers as each lane's
+    /// point.
     #[inline]
     #[target_feature(enable = "avx2,fma")]
     fn scatter([x, y, z]: [__m256; 3]) -> [Vec3A; LANES] {
