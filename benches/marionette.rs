@@ -78,10 +78,9 @@ fn smpl_body() -> Arc<CharacterAsset> {
 type Kernel = fn(&[Vec3], &marionette::rig::SkinWeights, &[Mat4], &mut [Vec3]);
 
 /// The skinning kernels on the SMPL body, positions only, in vertices per second:
-/// `oracle` (the plain loop), `fast` (AVX2 + FMA where the CPU has them: the work ozz's
-/// SkinningJob does), `bounded` (`fast` growing the box as it writes, what a crowd runs),
-/// `portable` (the same blocks in plain arrays).
-#[divan::bench(args = ["oracle", "fast", "bounded", "portable"])]
+/// `oracle` (the plain loop), `fast` (AVX2 + FMA where the CPU has them, in blocks of eight
+/// vertices), `portable` (glam `Vec4`, vertex by vertex).
+#[divan::bench(args = ["oracle", "fast", "portable"])]
 fn kernel_skin_positions(bencher: Bencher, kernel: &str) {
     let body = smpl_body();
     let palette = posed_palette(&body);
@@ -89,9 +88,6 @@ fn kernel_skin_positions(bencher: Bencher, kernel: &str) {
     let run: Kernel = match kernel {
         "oracle" => skin_positions,
         "fast" => marionette::rig::lbs::skin,
-        "bounded" => |b, w, p, o| {
-            marionette::rig::lbs::skin_bounded(b, w, p, o);
-        },
         _ => |b, w, p, o| {
             marionette::rig::lbs::skin_portable(b, w, p, o);
         },

@@ -175,6 +175,7 @@ mod avx2 {
     use glam::{Vec3, Vec4};
 
     use super::DualQuat;
+    use crate::rig::avx2::{deinterleave, interleave};
     use crate::rig::influences::FixedGroup;
     use crate::rig::skinning::{Influence, SkinWeights};
 
@@ -362,49 +363,6 @@ mod avx2 {
         for (i, &v) in vertices.iter().enumerate() {
             out[v as usize] = Vec3::new(lanes[0][i], lanes[1][i], lanes[2][i]);
         }
-    }
-
-    // `deinterleave` and `interleave` read eight `Vec3`s as 24 f32s.
-    const _: () = assert!(std::mem::size_of::<[Vec3; 8]>() == std::mem::size_of::<[f32; 24]>());
-
-    /// Eight points as x, y and z registers (lane i: point i).
-    #[inline]
-    #[target_feature(enable = "avx2,fma")]
-    fn deinterleave(points: &[Vec3]) -> [__m256; 3] {
-        assert_eq!(points.len(), 8, "eight points");
-        // SAFETY: `Vec3` is three f32s (`repr(C)`), so the eight are 24 in a row.
-        let f: &[f32; 24] = unsafe { &*(points.as_ptr() as *const [f32; 24]) };
-        let m03 = _mm256_set_m128(Vec4::from_slice(&f[12..]).into(), Vec4::from_slice(&f[..4]).into());
-        let m14 = _mm256_set_m128(Vec4::from_slice(&f[16..]).into(), Vec4::from_slice(&f[4..]).into());
-        let m25 = _mm256_set_m128(Vec4::from_slice(&f[20..]).into(), Vec4::from_slice(&f[8..]).into());
-        let xy = _mm256_shuffle_ps::<0b10_01_11_10>(m14, m25);
-        let yz = _mm256_shuffle_ps::<0b01_00_10_01>(m03, m14);
-        [
-            _mm256_shuffle_ps::<0b10_00_11_00>(m03, xy),
-            _mm256_shuffle_ps::<0b11_01_10_00>(yz, xy),
-            _mm256_shuffle_ps::<0b11_00_11_01>(yz, m25),
-        ]
-    }
-
-    /// The inverse of [`deinterleave`]: x, y and z registers written as eight points.
-    #[inline]
-    #[target_feature(enable = "avx2,fma")]
-    fn interleave([x, y, z]: [__m256; 3], points: &mut [Vec3]) {
-        assert_eq!(points.len(), 8, "eight points");
-        let xy = _mm256_shuffle_ps::<0b10_00_10_00>(x, y);
-        let yz = _mm256_shuffle_ps::<0b11_01_11_01>(y, z);
-        let zx = _mm256_shuffle_ps::<0b11_01_10_00>(z, x);
-        let m03 = _mm256_shuffle_ps::<0b10_00_10_00>(xy, zx);
-        let m14 = _mm256_shuffle_ps::<0b11_01_10_00>(yz, xy);
-        let m25 = _mm256_shuffle_ps::<0b11_01_11_01>(zx, yz);
-        // SAFETY: as in `deinterleave`.
-        let f: &mut [f32; 24] = unsafe { &mut *(points.as_mut_ptr() as *mut [f32; 24]) };
-        Vec4::from(_mm256_castps256_ps128(m03)).write_to_slice(&mut f[..4]);
-        Vec4::from(_mm256_castps256_ps128(m14)).write_to_slice(&mut f[4..]);
-        Vec4::from(_mm256_castps256_ps128(m25)).write_to_slice(&mut f[8..]);
-        Vec4::from(_mm256_extractf128_ps::<1>(m03)).write_to_slice(&mut f[12..]);
-        Vec4::from(_mm256_extractf128_ps::<1>(m14)).write_to_slice(&mut f[16..]);
-        Vec4::from(_mm256_extractf128_ps::<1>(m25)).write_to_slice(&mut f[20..]);
     }
 
     /// Eight blended dual quaternions (one per register) as eight registers of eight lanes:

@@ -8,7 +8,6 @@
 
 use glam::{Mat4, Vec3, Vec3A, Vec4};
 
-pub use super::influences::TILE_VERTICES;
 use super::influences::{FixedGroup, LaneBlocks};
 use super::skinning::{Bounds, SkinWeights};
 
@@ -19,8 +18,7 @@ use super::skinning::{Bounds, SkinWeights};
 /// When the lengths of `bind_positions`, `weights` and `out` differ, or an influence names
 /// a joint beyond the palette.
 pub fn skin(bind_positions: &[Vec3], weights: &SkinWeights, palette: &[Mat4], out: &mut [Vec3]) {
-    assert_eq!(out.len(), bind_positions.len(), "one output per vertex");
-    skin_range::<false>(bind_positions, weights, palette, 0, out);
+    skin_bounded(bind_positions, weights, palette, out);
 }
 
 /// [`skin`], returning the box of the skinned vertices (exactly
@@ -35,24 +33,12 @@ pub fn skin_bounded(bind_positions: &[Vec3], weights: &SkinWeights, palette: &[M
 
 /// Skins the vertices `first..first + out.len()` into `out` (a large mesh is skinned in
 /// chunks on several threads, each writing its own part of the output) and returns their
-/// box. Chunks that start and end on multiples of [`TILE_VERTICES`] read only their own
-/// blocks; others also skin (and do not write) their tiles' other vertices.
+/// box. (Chunks that start and end on multiples of eight are the fastest.)
 ///
 /// # Panics
 /// When `bind_positions` and `weights` differ in length, the chunk runs past the mesh, or
 /// an influence names a joint beyond the palette.
 pub fn skin_chunk(
-    bind_positions: &[Vec3],
-    weights: &SkinWeights,
-    palette: &[Mat4],
-    first: usize,
-    out: &mut [Vec3],
-) -> Bounds {
-    skin_range::<true>(bind_positions, weights, palette, first, out)
-}
-
-/// [`skin_chunk`], growing the box only when `BOUNDS` (the empty box otherwise).
-fn skin_range<const BOUNDS: bool>(
     bind_positions: &[Vec3],
     weights: &SkinWeights,
     palette: &[Mat4],
@@ -66,7 +52,7 @@ fn skin_range<const BOUNDS: bool>(
     #[cfg(target_arch = "x86_64")]
     if std::arch::is_x86_feature_detected!("avx2") && std::arch::is_x86_feature_detected!("fma") {
         // SAFETY: the CPU has AVX2 and FMA (checked above).
-        return unsafe { avx2::skin_blocks::<BOUNDS>(bind_positions, &groups.blocks, palette, first, out) };
+        return unsafe { avx2::skin_blocks(bind_positions, &groups.blocks, palette, first, out) };
     }
     skin_portable_chunk(bind_positions, weights, palette, first, out)
 }
@@ -170,83 +156,53 @@ fn skin_wide(
 mod avx2 {
     use std::arch::x86_64::*;
 
-    use glam::{Mat4, Vec3, Vec3A, Vec4};
+    use glam::{Mat4, Vec3, Vec3A};
 
     use super::LaneBlocks;
+    use crate::rig::avx2::{deinterleave, interleave};
     use crate::rig::influences::LANES;
     use crate::rig::skinning::Bounds;
 
-    /// Element `e` of a palette matrix as a block reads it: column `e / 3`, row `e % 3` (the
-    /// fourth row of an affine matrix is not needed).
-    const ELEMENTS: usize = 12;
-
-    /// A palette matrix's twelve elements, as [`ELEMENTS`] orders them.
+    /// A palette matrix's twelve elements as a block reads them: element `e` is column
+    /// `e / 3`, row `e % 3` (the fourth row of an affine matrix is not needed).
     #[inline]
-    fn elements(m: &Mat4) -> [f32; ELEMENTS] {
+    fn elements(m: &Mat4) -> [f32; 12] {
         let c = m.to_cols_array();
         std::array::from_fn(|e| c[e / 3 * 4 + e % 3])
-    }
-
-    /// Writes lane `vertex`'s skinned position `p` when the vertex lies in the chunk
-    /// `first..first + out.len()`, growing `bounds` when `BOUNDS`.
-    #[inline]
-    fn store_lane<const BOUNDS: bool>(out: &mut [Vec3], first: usize, vertex: u32, p: Vec3A, bounds: &mut Bounds) {
-        let at = (vertex as usize).wrapping_sub(first);
-        if at < out.len() {
-            out[at] = p.into();
-            if BOUNDS {
-                *bounds = bounds.with(p);
-            }
-        }
     }
 
     /// Each block on 256-bit registers, one vertex a lane: each of the block's joints
     /// transforms all eight bind positions (its matrix's elements broadcast once) and adds
     /// them in with each lane's weight; twelve multiply-adds a joint for eight vertices.
+    /// Blocks that lie wholly in the chunk read and write their eight positions in order;
+    /// the chunk's first and last blocks (when it does not start or end on a multiple of
+    /// eight) and the mesh's last go lane by lane.
     ///
     /// # Safety
     /// The CPU must have AVX2 and FMA. (Indices are checked: a joint beyond the palette or a
     /// vertex beyond the buffers panics.)
     #[target_feature(enable = "avx2,fma")]
-    pub unsafe fn skin_blocks<const BOUNDS: bool>(
+    pub unsafe fn skin_blocks(
         bind: &[Vec3],
         blocks: &LaneBlocks,
         palette: &[Mat4],
         first: usize,
         out: &mut [Vec3],
     ) -> Bounds {
-        /// Sixteen bytes read from wherever they lie.
-        #[repr(C, packed)]
-        struct Unaligned(__m128);
-        // Vertex `v`'s bind position in the first three floats of a register, read in one
-        // load of four floats (the fourth is the next vertex's x) except for the last vertex.
-        let load = |v: u32| match bind.get(v as usize..v as usize + 2) {
-            // SAFETY: two `Vec3`s are 24 readable bytes; `Unaligned` reads 16 of them at any
-            // alignment.
-            Some(two) => unsafe { two.as_ptr().cast::<Unaligned>().read().0 },
-            None => {
-                let b = bind[v as usize];
-                _mm_setr_ps(b.x, b.y, b.z, 0.0)
-            }
-        };
-        // The lanes' bind positions as three registers, the x, y and z of each lane: lanes i
-        // and i + 4 side by side, then a 4 × 4 transpose in each half. (A closure, so that
-        // it is inlined in each instance of this function.)
-        let gather = |lanes: &[u32; LANES]| {
-            let pair = |i: usize| _mm256_set_m128(load(lanes[i + 4]), load(lanes[i]));
-            let (r0, r1, r2, r3) = (pair(0), pair(1), pair(2), pair(3));
-            let (xy01, xy23) = (_mm256_unpacklo_ps(r0, r1), _mm256_unpacklo_ps(r2, r3));
-            let (zw01, zw23) = (_mm256_unpackhi_ps(r0, r1), _mm256_unpackhi_ps(r2, r3));
-            [
-                _mm256_shuffle_ps::<0x44>(xy01, xy23),
-                _mm256_shuffle_ps::<0xEE>(xy01, xy23),
-                _mm256_shuffle_ps::<0x44>(zw01, zw23),
-            ]
-        };
-        let mut bounds = Bounds::EMPTY;
-        for b in blocks.covering(first, out.len()) {
-            let lanes = &blocks.vertices[b];
-            let [x, y, z] = gather(lanes);
+        let end = first + out.len();
+        let (mut lo, mut hi) = ([_mm256_set1_ps(f32::INFINITY); 3], [_mm256_set1_ps(f32::NEG_INFINITY); 3]);
+        let mut edges = Bounds::EMPTY;
+        for b in first / LANES..end.div_ceil(LANES) {
+            let lanes = b * LANES..(b + 1) * LANES;
+            let whole = first <= lanes.start && lanes.end <= end;
+            let [x, y, z] = if whole {
+                deinterleave(&bind[lanes.clone()])
+            } else {
+                let lane = |i: usize| bind.get(lanes.start + i).copied().unwrap_or(Vec3::ZERO);
+                let (x, y, z) = (|i| lane(i).x, |i| lane(i).y, |i| lane(i).z);
+                let set = |c: &dyn Fn(usize) -> f32| _mm256_setr_ps(c(0), c(1), c(2), c(3), c(4), c(5), c(6), c(7));
+                [set(&x), set(&y), set(&z)]
+            };
             let mut p = [_mm256_setzero_ps(); 3];
             let joints = blocks.joint_starts[b] as usize..blocks.joint_starts[b + 1] as usize;
             for (&j, w) in blocks.joints[joints.clone()].iter().zip(&blocks.weights[joints]) {
@@ -259,31 +215,32 @@ mod avx2 {
                     *p = _mm256_fmadd_ps(w, row, *p);
                 }
             }
-            for (p, &v) in scatter(p).into_iter().zip(lanes) {
-                store_lane::<BOUNDS>(out, first, v, p, &mut bounds);
+            if whole {
+                for k in 0..3 {
+                    (lo[k], hi[k]) = (_mm256_min_ps(lo[k], p[k]), _mm256_max_ps(hi[k], p[k]));
+                }
+                interleave(p, &mut out[lanes.start - first..lanes.end - first]);
+            } else {
+                let mut lane = [[0.0f32; LANES]; 3];
+                for (lane, p) in lane.iter_mut().zip(p) {
+                    // SAFETY: eight `f32`s are an `__m256`.
+                    *lane = unsafe { std::mem::transmute::<__m256, [f32; LANES]>(p) };
+                }
+                for (i, v) in lanes.enumerate().filter(|(_, v)| (first..end).contains(v)) {
+                    let q = Vec3A::new(lane[0][i], lane[1][i], lane[2][i]);
+                    out[v - first] = q.into();
+                    edges = edges.with(q);
+                }
             }
         }
-        bounds
-    }
-
-    /// The inverse of the gather in [`skin_blocks`]: the x, y and z registers as each lane's
-    /// point.
-    #[inline]
-    #[target_feature(enable = "avx2,fma")]
-    fn scatter([x, y, z]: [__m256; 3]) -> [Vec3A; LANES] {
-        let zero = _mm256_setzero_ps();
-        let (xy01, xy23) = (_mm256_unpacklo_ps(x, y), _mm256_unpackhi_ps(x, y));
-        let (z01, z23) = (_mm256_unpacklo_ps(z, zero), _mm256_unpackhi_ps(z, zero));
-        let pairs = [
-            _mm256_shuffle_ps::<0x44>(xy01, z01),
-            _mm256_shuffle_ps::<0xEE>(xy01, z01),
-            _mm256_shuffle_ps::<0x44>(xy23, z23),
-            _mm256_shuffle_ps::<0xEE>(xy23, z23),
-        ];
-        let point = |q: __m128| Vec3A::from_vec4(Vec4::from(q));
-        std::array::from_fn(|i| {
-            let pair = pairs[i % 4];
-            point(if i < 4 { _mm256_castps256_ps128(pair) } else { _mm256_extractf128_ps::<1>(pair) })
-        })
+        let reduce = |r: __m256, f: fn(f32, f32) -> f32| {
+            // SAFETY: eight `f32`s are an `__m256`.
+            unsafe { std::mem::transmute::<__m256, [f32; LANES]>(r) }.into_iter().reduce(f).unwrap_or(0.0)
+        };
+        let whole = Bounds::between(
+            Vec3A::new(reduce(lo[0], f32::min), reduce(lo[1], f32::min), reduce(lo[2], f32::min)),
+            Vec3A::new(reduce(hi[0], f32::max), reduce(hi[1], f32::max), reduce(hi[2], f32::max)),
+        );
+        whole.union(edges)
     }
 }

@@ -2,6 +2,8 @@
 //! Pure data and math; no Bevy.
 
 pub mod anim;
+#[cfg(target_arch = "x86_64")]
+mod avx2;
 pub mod bind;
 pub mod bones;
 pub mod character;

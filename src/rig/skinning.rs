@@ -212,6 +212,11 @@ impl Bounds {
     /// The box around no point.
     pub const EMPTY: Self = Self { lo: Vec3A::splat(f32::INFINITY), hi: Vec3A::splat(f32::NEG_INFINITY) };
 
+    /// The box between two corners (the empty box when `lo` exceeds `hi`).
+    pub fn between(lo: Vec3A, hi: Vec3A) -> Self {
+        Self { lo, hi }
+    }
+
     /// This box grown to hold `p`.
     #[inline]
     pub fn with(self, p: Vec3A) -> Self {
