@@ -71,18 +71,10 @@ impl LaneBlocks {
         let row = |v: usize| &influences[offsets[v] as usize..offsets[v + 1] as usize];
         for first in (0..vertex_count).step_by(LANES) {
             let lanes = first..(first + LANES).min(vertex_count);
-            let start = blocks.joints.len();
-            blocks.joints.extend(lanes.clone().flat_map(|v| row(v).iter().map(|i| i.joint)));
-            blocks.joints[start..].sort_unstable();
-            let mut unique = start;
-            for k in start..blocks.joints.len() {
-                if unique == start || blocks.joints[unique - 1] != blocks.joints[k] {
-                    blocks.joints[unique] = blocks.joints[k];
-                    unique += 1;
-                }
-            }
-            blocks.joints.truncate(unique);
-            for &joint in &blocks.joints[start..] {
+            let mut joints: Vec<u16> = lanes.clone().flat_map(|v| row(v).iter().map(|i| i.joint)).collect();
+            joints.sort_unstable();
+            joints.dedup();
+            for &joint in &joints {
                 let weight_of = |lane: usize| {
                     let v = first + lane;
                     let row = if v < lanes.end { row(v) } else { &[] };
@@ -90,6 +82,7 @@ impl LaneBlocks {
                 };
                 blocks.weights.push(LaneWeights(std::array::from_fn(weight_of)));
             }
+            blocks.joints.extend(joints);
             blocks.joint_starts.push(blocks.joints.len() as u32);
         }
         blocks
