@@ -1,6 +1,6 @@
 //! The fast linear-blend-skinning kernel. On x86-64 with AVX2 and FMA (detected at run
-//! time), the vertices are skinned in blocks of eight that share few joints
-//! ([`LaneBlocks`], built with the weights), one vertex a lane of a 256-bit register: each
+//! time), the vertices are skinned in blocks of eight consecutive ones ([`LaneBlocks`],
+//! built with the weights), one vertex a lane of a 256-bit register: each
 //! of a block's joints transforms all eight bind positions at once, weighted lane by lane
 //! (`pᵥ = Σⱼ wᵥⱼ (Pⱼ bᵥ)`), so a joint's matrix is read once for eight vertices. Elsewhere
 //! each vertex blends its own matrices with glam's `Vec4`, grouped by influence count.
@@ -171,6 +171,20 @@ mod avx2 {
         std::array::from_fn(|e| c[e / 3 * 4 + e % 3])
     }
 
+    /// Eight floats as a register (lane i: float i).
+    #[inline]
+    fn register(lanes: [f32; LANES]) -> __m256 {
+        // SAFETY: eight `f32`s are an `__m256`, any bits a valid one.
+        unsafe { std::mem::transmute(lanes) }
+    }
+
+    /// A register's eight floats.
+    #[inline]
+    fn floats(r: __m256) -> [f32; LANES] {
+        // SAFETY: as in `register`.
+        unsafe { std::mem::transmute(r) }
+    }
+
     /// Each block on 256-bit registers, one vertex a lane: each of the block's joints
     /// transforms all eight bind positions (its matrix's elements broadcast once) and adds
     /// them in with each lane's weight; twelve multiply-adds a joint for eight vertices.
@@ -198,16 +212,14 @@ mod avx2 {
             let [x, y, z] = if whole {
                 deinterleave(&bind[lanes.clone()])
             } else {
-                let lane = |i: usize| bind.get(lanes.start + i).copied().unwrap_or(Vec3::ZERO);
-                let (x, y, z) = (|i| lane(i).x, |i| lane(i).y, |i| lane(i).z);
-                let set = |c: &dyn Fn(usize) -> f32| _mm256_setr_ps(c(0), c(1), c(2), c(3), c(4), c(5), c(6), c(7));
-                [set(&x), set(&y), set(&z)]
+                let points: [Vec3; LANES] =
+                    std::array::from_fn(|i| bind.get(lanes.start + i).copied().unwrap_or(Vec3::ZERO));
+                [points.map(|p| p.x), points.map(|p| p.y), points.map(|p| p.z)].map(register)
             };
             let mut p = [_mm256_setzero_ps(); 3];
             let joints = blocks.joint_starts[b] as usize..blocks.joint_starts[b + 1] as usize;
             for (&j, w) in blocks.joints[joints.clone()].iter().zip(&blocks.weights[joints]) {
-                // SAFETY: `LaneWeights` is eight `f32`s, as `__m256` is.
-                let w: __m256 = unsafe { std::mem::transmute(w.0) };
+                let w = register(w.0);
                 let m = elements(&palette[j as usize]).map(|c| _mm256_set1_ps(c));
                 for (r, p) in p.iter_mut().enumerate() {
                     let row =
@@ -221,11 +233,7 @@ mod avx2 {
                 }
                 interleave(p, &mut out[lanes.start - first..lanes.end - first]);
             } else {
-                let mut lane = [[0.0f32; LANES]; 3];
-                for (lane, p) in lane.iter_mut().zip(p) {
-                    // SAFETY: eight `f32`s are an `__m256`.
-                    *lane = unsafe { std::mem::transmute::<__m256, [f32; LANES]>(p) };
-                }
+                let lane = p.map(floats);
                 for (i, v) in lanes.enumerate().filter(|(_, v)| (first..end).contains(v)) {
                     let q = Vec3A::new(lane[0][i], lane[1][i], lane[2][i]);
                     out[v - first] = q.into();
@@ -233,10 +241,7 @@ mod avx2 {
                 }
             }
         }
-        let reduce = |r: __m256, f: fn(f32, f32) -> f32| {
-            // SAFETY: eight `f32`s are an `__m256`.
-            unsafe { std::mem::transmute::<__m256, [f32; LANES]>(r) }.into_iter().reduce(f).unwrap_or(0.0)
-        };
+        let reduce = |r: __m256, f: fn(f32, f32) -> f32| floats(r).into_iter().reduce(f).unwrap_or(0.0);
         let whole = Bounds::between(
             Vec3A::new(reduce(lo[0], f32::min), reduce(lo[1], f32::min), reduce(lo[2], f32::min)),
             Vec3A::new(reduce(hi[0], f32::max), reduce(hi[1], f32::max), reduce(hi[2], f32::max)),
