@@ -26,6 +26,15 @@ pub fn deinterleave(points: &[Vec3]) -> [__m256; 3] {
     ]
 }
 
+/// Up to eight points as x, y and z registers (lane i: point i), zero in the lanes past
+/// them.
+#[inline]
+#[target_feature(enable = "avx2,fma")]
+pub fn deinterleave_some(points: &[Vec3]) -> [__m256; 3] {
+    let p: [Vec3; 8] = std::array::from_fn(|i| points.get(i).copied().unwrap_or_default());
+    [p.map(|p| p.x), p.map(|p| p.y), p.map(|p| p.z)].map(register)
+}
+
 /// The inverse of [`deinterleave`]: x, y and z registers written as eight points.
 #[inline]
 #[target_feature(enable = "avx2,fma")]
@@ -45,4 +54,18 @@ pub fn interleave([x, y, z]: [__m256; 3], points: &mut [Vec3]) {
     Vec4::from(_mm256_extractf128_ps::<1>(m03)).write_to_slice(&mut f[12..]);
     Vec4::from(_mm256_extractf128_ps::<1>(m14)).write_to_slice(&mut f[16..]);
     Vec4::from(_mm256_extractf128_ps::<1>(m25)).write_to_slice(&mut f[20..]);
+}
+
+/// Eight floats as a register (lane i: float i).
+#[inline]
+pub fn register(lanes: [f32; 8]) -> __m256 {
+    // SAFETY: eight `f32`s are an `__m256`, any bits a valid one.
+    unsafe { std::mem::transmute(lanes) }
+}
+
+/// A register's eight floats.
+#[inline]
+pub fn floats(r: __m256) -> [f32; 8] {
+    // SAFETY: as in `register`.
+    unsafe { std::mem::transmute(r) }
 }

@@ -1,6 +1,7 @@
 //! A skin's influences: one joint's weight on a vertex, and the layouts the fast kernels
-//! read: the vertices grouped by how many influences they have (dual quaternions), and in
-//! blocks of eight consecutive ones with the joints they name (linear blend).
+//! read: the vertices grouped by how many influences they have (the portable paths), and in
+//! blocks of eight consecutive ones with the joints they name (the AVX2 kernels, linear
+//! blend and dual quaternions).
 
 /// One joint's influence on a vertex.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -27,9 +28,6 @@ pub struct FixedGroup {
 pub struct InfluenceGroups {
     pub fixed: [FixedGroup; 4],
     pub wide: Vec<u32>,
-    /// For each of `wide`, the joint of the first of its row's heaviest influences (the one
-    /// whose hemisphere dual quaternion skinning blends in).
-    pub wide_pivots: Vec<u16>,
     /// One past the largest joint any influence names (0 for no influence).
     pub joint_bound: usize,
     /// The same vertices in blocks of [`LANES`] consecutive ones.
@@ -61,6 +59,31 @@ pub struct LaneBlocks {
     /// For each of a block's joints, its weight on each lane's vertex (0 where it has none,
     /// and in the lanes past the last vertex).
     pub weights: Vec<LaneWeights>,
+    /// Each vertex's pivot: the joint of the first of its row's heaviest influences, in
+    /// whose hemisphere dual quaternion skinning blends (0 for a vertex with none).
+    pub pivots: Vec<u16>,
+    /// The first [`PIVOT_ROWS`] distinct pivots, in order of first use: the rows of the dual
+    /// quaternion kernel's table of hemispheres (SMPL has 24 pivots).
+    pub pivot_rows: Vec<u16>,
+    /// Each vertex's pivot's index in `pivot_rows` (0 where it has none there).
+    pub lane_rows: Vec<u8>,
+    /// For each block, how its lanes find their pivots.
+    pub block_pivots: Vec<BlockPivots>,
+}
+
+/// The most pivots the dual quaternion kernel's table of hemispheres holds (one bit each).
+pub const PIVOT_ROWS: usize = 32;
+
+/// How a block's lanes find their pivots' hemispheres (dual quaternion skinning).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum BlockPivots {
+    /// All eight share the pivot of this row of `pivot_rows` (SMPL: 474 of 862 blocks).
+    Shared(u8),
+    /// Each lane's pivot has its row.
+    Rows,
+    /// Some lane's pivot has none (a skin of more than [`PIVOT_ROWS`] pivots), or the block
+    /// is the mesh's last and partial.
+    Lanes,
 }
 
 impl LaneBlocks {
@@ -85,8 +108,40 @@ impl LaneBlocks {
             blocks.joints.extend(joints);
             blocks.joint_starts.push(blocks.joints.len() as u32);
         }
+        blocks.pivots = (0..vertex_count).map(|v| pivot(row(v))).collect();
+        let lane_rows: Vec<Option<u8>> = blocks.pivots.iter().map(|&p| row_of(&mut blocks.pivot_rows, p)).collect();
+        blocks.block_pivots = lane_rows.chunks(LANES).map(block_pivots).collect();
+        blocks.lane_rows = lane_rows.into_iter().map(|r| r.unwrap_or(0)).collect();
         blocks
     }
+}
+
+/// `pivot`'s row in `rows`, added when new and there is room.
+fn row_of(rows: &mut Vec<u16>, pivot: u16) -> Option<u8> {
+    let at = rows.iter().position(|&p| p == pivot).or_else(|| {
+        (rows.len() < PIVOT_ROWS).then(|| {
+            rows.push(pivot);
+            rows.len() - 1
+        })
+    });
+    at.map(|at| at as u8)
+}
+
+/// How a block whose lanes' pivots have the rows `lanes` finds them.
+fn block_pivots(lanes: &[Option<u8>]) -> BlockPivots {
+    match lanes {
+        [Some(first), ..] if lanes.len() == LANES && lanes.iter().all(|&r| r == Some(*first)) => {
+            BlockPivots::Shared(*first)
+        }
+        _ if lanes.len() == LANES && lanes.iter().all(Option::is_some) => BlockPivots::Rows,
+        _ => BlockPivots::Lanes,
+    }
+}
+
+/// The joint of the first of the row's heaviest influences (0 for an empty row).
+pub fn pivot(row: &[Influence]) -> u16 {
+    let heaviest = row.iter().reduce(|best, i| if i.weight > best.weight { i } else { best });
+    heaviest.map_or(0, |i| i.joint)
 }
 
 impl InfluenceGroups {
@@ -106,11 +161,7 @@ impl InfluenceGroups {
                     group.joints.extend(sorted[..k].iter().map(|i| i.joint));
                     group.weights.extend(sorted[..k].iter().map(|i| i.weight));
                 }
-                _ => {
-                    groups.wide.push(v as u32);
-                    let heaviest = row.iter().fold(row[0], |best, &i| if i.weight > best.weight { i } else { best });
-                    groups.wide_pivots.push(heaviest.joint);
-                }
+                _ => groups.wide.push(v as u32),
             }
         }
         groups

@@ -159,7 +159,7 @@ mod avx2 {
     use glam::{Mat4, Vec3, Vec3A};
 
     use super::LaneBlocks;
-    use crate::rig::avx2::{deinterleave, interleave};
+    use crate::rig::avx2::{deinterleave, deinterleave_some, floats, interleave, register};
     use crate::rig::influences::LANES;
     use crate::rig::skinning::Bounds;
 
@@ -169,20 +169,6 @@ mod avx2 {
     fn elements(m: &Mat4) -> [f32; 12] {
         let c = m.to_cols_array();
         std::array::from_fn(|e| c[e / 3 * 4 + e % 3])
-    }
-
-    /// Eight floats as a register (lane i: float i).
-    #[inline]
-    fn register(lanes: [f32; LANES]) -> __m256 {
-        // SAFETY: eight `f32`s are an `__m256`, any bits a valid one.
-        unsafe { std::mem::transmute(lanes) }
-    }
-
-    /// A register's eight floats.
-    #[inline]
-    fn floats(r: __m256) -> [f32; LANES] {
-        // SAFETY: as in `register`.
-        unsafe { std::mem::transmute(r) }
     }
 
     /// Each block on 256-bit registers, one vertex a lane: each of the block's joints
@@ -212,9 +198,7 @@ mod avx2 {
             let [x, y, z] = if whole {
                 deinterleave(&bind[lanes.clone()])
             } else {
-                let points: [Vec3; LANES] =
-                    std::array::from_fn(|i| bind.get(lanes.start + i).copied().unwrap_or(Vec3::ZERO));
-                [points.map(|p| p.x), points.map(|p| p.y), points.map(|p| p.z)].map(register)
+                deinterleave_some(&bind[lanes.start..lanes.end.min(bind.len())])
             };
             let mut p = [_mm256_setzero_ps(); 3];
             let joints = blocks.joint_starts[b] as usize..blocks.joint_starts[b + 1] as usize;

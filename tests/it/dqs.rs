@@ -116,13 +116,17 @@ fn dual_quaternion_skinning_in_the_ecs_matches_the_kernel() {
 }
 
 /// The SIMD path (where the CPU has AVX2 and FMA) against the portable one on the puppet
-/// and, with the data, every character of the courses, posed.
+/// and, with the data, every character of the courses and SMPL, posed.
 #[test]
 fn the_dual_quaternion_kernel_paths_agree() {
     use marionette::rig::dqs::skin_dq_portable;
     let mut assets = vec![marionette::formats::puppet::embedded_puppet()];
     if let Some(data) = crate::common::optional_data_dir() {
-        for f in ["mit6837/Model1.skel", "mit6837/Model3.skel", "homer/homer.json", "cse169/project1/dragon.skel"] {
+        let files = ["mit6837/Model1.skel", "mit6837/Model2.skel", "mit6837/Model3.skel", "mit6837/Model4.skel"]
+            .into_iter()
+            .chain(["cse169/project1/wasp.skel", "cse169/project1/dragon.skel", "cse169/project2/tube.skel"])
+            .chain(["homer/homer.json"]);
+        for f in files {
             assets.push(marionette::formats::load_character(&data.join(f)).unwrap());
         }
         let (model, _) = marionette::formats::smpl::load_smpl_dir(&data.join("smpl")).unwrap();
@@ -135,11 +139,59 @@ fn the_dual_quaternion_kernel_paths_agree() {
         let palette =
             marionette::rig::fk::posed_palette(&asset.skeleton, &asset.bind_world_to_joint, &pose, Mat4::IDENTITY);
         let dq = dq(&palette);
-        let (mut a, mut b) = (vec![Vec3::ZERO; asset.vertex_count()], vec![Vec3::ZERO; asset.vertex_count()]);
+        let nan = vec![Vec3::splat(f32::NAN); asset.vertex_count()];
+        let (mut a, mut b) = (nan.clone(), nan);
         skin_dq(&asset.skin.bind_positions, &asset.skin.weights, &dq, &mut a);
         skin_dq_portable(&asset.skin.bind_positions, &asset.skin.weights, &dq, &mut b);
         let scale = b.iter().fold(1.0f32, |m, p| m.max(p.abs().max_element()));
         let worst = a.iter().zip(&b).map(|(x, y)| (*x - *y).abs().max_element()).fold(0.0f32, f32::max);
         assert!(worst <= 1e-5 * scale, "{}: worst {worst:e}", asset.name);
     }
+}
+
+/// The SIMD path against the portable one on rows of 1 to 13 influences over 40 joints:
+/// blocks whose lanes share a pivot, blocks whose pivots all have a row of the table of
+/// hemispheres, blocks with a pivot beyond it (more than 32 pivots), and a partial last
+/// block. Outputs start as NaN, so a vertex left unwritten fails.
+#[test]
+fn the_dual_quaternion_kernel_matches_the_portable_path_on_rows_of_1_to_13_influences() {
+    use marionette::rig::dqs::skin_dq_portable;
+    use marionette::rig::influences::BlockPivots;
+    let mut state = 0x2545_f491_4f6c_dd1du64;
+    let mut next = move || {
+        state ^= state << 13;
+        state ^= state >> 7;
+        state ^= state << 17;
+        (state >> 40) as f32 / (1u64 << 24) as f32
+    };
+    let joints = 40;
+    let palette: Vec<Mat4> = (0..joints)
+        .map(|_| {
+            let q = Quat::from_euler(glam::EulerRot::XYZ, next() * 6.0, next() * 6.0, next() * 6.0);
+            Mat4::from_rotation_translation(q, Vec3::new(next(), next(), next()) * 4.0)
+        })
+        .collect();
+    let n = 2003;
+    let bind: Vec<Vec3> = (0..n).map(|_| Vec3::new(next(), next(), next()) * 2.0 - 1.0).collect();
+    let rows: Vec<Vec<(usize, f32)>> = (0..n)
+        .map(|v| match v {
+            // The first 64: one pivot a block (joint 3 the heaviest of two).
+            0..64 => vec![(3, 0.7), (v % 5 + 4, 0.3)],
+            // Then pivots among the first 20 joints, then any of the 40.
+            _ => {
+                (0..1 + v % 13).map(|k| ((v * 7 + k * 11) % if v < 1000 { 20 } else { joints }, 0.1 + next())).collect()
+            }
+        })
+        .collect();
+    let (weights, _) = SkinWeights::from_rows(rows, joints).unwrap();
+    let kinds = &weights.groups().blocks.block_pivots;
+    assert!(kinds.iter().any(|k| matches!(k, BlockPivots::Shared(_))), "a block of one pivot");
+    assert!(kinds.contains(&BlockPivots::Rows) && kinds.contains(&BlockPivots::Lanes), "{kinds:?}");
+    let dq = dq(&palette);
+    let (mut a, mut b) = (vec![Vec3::splat(f32::NAN); n], vec![Vec3::splat(f32::NAN); n]);
+    skin_dq(&bind, &weights, &dq, &mut a);
+    skin_dq_portable(&bind, &weights, &dq, &mut b);
+    let scale = b.iter().fold(1.0f32, |m, p| m.max(p.abs().max_element()));
+    let worst = a.iter().zip(&b).map(|(x, y)| (*x - *y).abs().max_element()).fold(0.0f32, f32::max);
+    assert!(worst <= 1e-5 * scale, "worst {worst:e} (scale {scale})");
 }
