@@ -97,6 +97,34 @@ fn kernel_skin_positions(bencher: Bencher, kernel: &str) {
         .bench_local(|| run(&body.skin.bind_positions, &body.skin.weights, &palette, divan::black_box(&mut out)));
 }
 
+/// Unit vectors for the normals of `body` (from its centre out), for timing and tests of the
+/// kernels that skin normals: their values do not change the work.
+fn outward_normals(body: &CharacterAsset) -> Vec<Vec3> {
+    let centre = body.skin.bind_positions.iter().sum::<Vec3>() / body.vertex_count().max(1) as f32;
+    body.skin.bind_positions.iter().map(|p| (*p - centre).normalize_or(Vec3::Y)).collect()
+}
+
+/// The skinning kernels on the SMPL body, positions and normals (one blend of each vertex's
+/// matrices for both), in vertices per second: `oracle` (the plain loop), `fast` (AVX2 +
+/// FMA), `portable`. Against `kernel_skin_positions`, what skinning the normals costs.
+#[divan::bench(args = ["oracle", "fast", "portable"])]
+fn kernel_skin_positions_and_normals(bencher: Bencher, kernel: &str) {
+    use marionette::rig::lbs::{Normals, skin_with_normals, skin_with_normals_portable};
+    let body = smpl_body();
+    let palette = posed_palette(&body);
+    let bind_normals = outward_normals(&body);
+    let (mut out, mut normals) = (vec![Vec3::ZERO; body.vertex_count()], vec![Vec3::ZERO; body.vertex_count()]);
+    let (bind, weights) = (&body.skin.bind_positions, &body.skin.weights);
+    bencher.counter(divan::counter::ItemsCount::new(body.vertex_count())).bench_local(|| {
+        let n = Normals { bind: &bind_normals, out: divan::black_box(&mut normals) };
+        match kernel {
+            "oracle" => marionette::rig::skinning::skin_positions_and_normals(bind, weights, &palette, &mut out, n),
+            "fast" => _ = skin_with_normals(bind, weights, &palette, divan::black_box(&mut out), n),
+            _ => _ = skin_with_normals_portable(bind, weights, &palette, divan::black_box(&mut out), n),
+        }
+    });
+}
+
 /// Dual quaternion skinning on the SMPL body, positions only, against which the LBS kernel
 /// above is the yardstick (the issue asks for within 1.5×): `kernel` alone, as the LBS
 /// kernel is timed with its palette made, and `with_palette` with the palette's conversion

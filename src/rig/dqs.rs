@@ -234,13 +234,15 @@ mod avx2 {
             }
             // The bind positions read after the blend: eleven registers fewer held through it.
             let p = if whole {
-                deinterleave(&bind[lanes.clone()])
+                // SAFETY: this kernel runs on AVX2 (its contract).
+                unsafe { deinterleave(&bind[lanes.clone()]) }
             } else {
                 deinterleave_some(&bind[lanes.start..lanes.end.min(bind.len())])
             };
             let moved = normalise_and_apply(blend, p);
             if whole {
-                interleave(moved, &mut out[lanes]);
+                // SAFETY: this kernel runs on AVX2 (its contract).
+                unsafe { interleave(moved, &mut out[lanes]) };
             } else {
                 let lane = moved.map(floats);
                 for (i, v) in lanes.enumerate() {

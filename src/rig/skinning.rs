@@ -190,6 +190,37 @@ pub fn skin_positions(bind_positions: &[Vec3], weights: &SkinWeights, palette: &
     }
 }
 
+/// Normals skinned with the positions: the bind pose's, and where the skinned ones go
+/// (`out[v] = (Σ wᵢ · palette[jᵢ])₃ₓ₃ · bind[v]`, as ozz's `SkinningJob` does, not
+/// normalised; for palettes that scale unevenly, the caller passes the inverse transposes'
+/// palette for normals, as ozz asks).
+pub struct Normals<'a> {
+    pub bind: &'a [Vec3],
+    pub out: &'a mut [Vec3],
+}
+
+/// [`skin_positions`] with normals, the plain loop: each normal turned by each influence's
+/// matrix (its 3×3 part) and the results blended with the weights (not normalised). The
+/// oracle of [`lbs::skin_with_normals`](super::lbs::skin_with_normals).
+///
+/// # Panics
+/// As [`skin_positions`], or when the normals' lengths differ from the positions'.
+pub fn skin_positions_and_normals(
+    bind_positions: &[Vec3],
+    weights: &SkinWeights,
+    palette: &[Mat4],
+    out: &mut [Vec3],
+    normals: Normals,
+) {
+    skin_positions(bind_positions, weights, palette, out);
+    assert!(normals.bind.len() == out.len() && normals.out.len() == out.len(), "one normal per vertex");
+    let offsets = &weights.offsets;
+    for (v, (n, o)) in normals.bind.iter().zip(normals.out.iter_mut()).enumerate() {
+        let row = &weights.influences[offsets[v] as usize..offsets[v + 1] as usize];
+        *o = row.iter().map(|inf| inf.weight * palette[inf.joint as usize].transform_vector3(*n)).sum();
+    }
+}
+
 /// The axis-aligned box `(min, max)` around `points` (both zero for none).
 pub fn bounds(points: &[Vec3]) -> (Vec3, Vec3) {
     bounds_of(points.iter().copied())

@@ -1,7 +1,7 @@
 //! The fast skinning kernel (`rig::lbs`, AVX2 and portable paths) against the plain loop it
 //! replaces (`skinning::skin_positions`, the oracle): within 1e-5 on every data set and on
-//! synthetic rows of 1 to 13 influences; the box each grows as it writes is the box of
-//! what it wrote.
+//! synthetic rows of 1 to 13 influences, positions alone and with normals; the box each
+//! grows as it writes is the box of what it wrote.
 
 use glam::{Mat4, Quat, Vec3};
 use marionette::rig::lbs::{skin, skin_bounded, skin_portable};
@@ -32,6 +32,33 @@ fn assert_kernel_matches_oracle(name: &str, bind: &[Vec3], weights: &SkinWeights
         assert!(worst <= 1e-5 * scale, "{name} ({path}): worst difference {worst:e} (mesh scale {scale})");
         // The box grown as the vertices are written is the box of what was written.
         assert_eq!(grown.pair(), bounds(&out), "{name} ({path}): bounds");
+    }
+    assert_normals_match_oracle(name, bind, weights, palette);
+}
+
+/// The kernel that skins normals with the positions (both paths) against the plain loop:
+/// positions, normals and box. Outputs start as NaN, so a vertex left unwritten fails.
+fn assert_normals_match_oracle(name: &str, bind: &[Vec3], weights: &SkinWeights, palette: &[Mat4]) {
+    use marionette::rig::lbs::{Normals, skin_with_normals, skin_with_normals_portable};
+    let n = bind.len();
+    let centre = bind.iter().sum::<Vec3>() / n.max(1) as f32;
+    let bind_normals: Vec<Vec3> = bind.iter().map(|p| (*p - centre).normalize_or(Vec3::Y)).collect();
+    let (mut expected, mut expected_normals) = (vec![Vec3::ZERO; n], vec![Vec3::ZERO; n]);
+    let normals = Normals { bind: &bind_normals, out: &mut expected_normals };
+    marionette::rig::skinning::skin_positions_and_normals(bind, weights, palette, &mut expected, normals);
+    let scale = expected.iter().fold(1.0f32, |m, p| m.max(p.abs().max_element()));
+    type WithNormals = fn(&[Vec3], &SkinWeights, &[Mat4], &mut [Vec3], Normals) -> Bounds;
+    for (path, run) in [("dispatch", skin_with_normals as WithNormals), ("portable", skin_with_normals_portable)] {
+        let (mut out, mut out_normals) = (vec![Vec3::splat(f32::NAN); n], vec![Vec3::splat(f32::NAN); n]);
+        let grown = run(bind, weights, palette, &mut out, Normals { bind: &bind_normals, out: &mut out_normals });
+        let worst =
+            |a: &[Vec3], b: &[Vec3]| a.iter().zip(b).map(|(a, b)| (*a - *b).abs().max_element()).fold(0.0f32, f32::max);
+        let (positions, normals) = (worst(&expected, &out), worst(&expected_normals, &out_normals));
+        assert!(positions <= 1e-5 * scale, "{name} ({path}, with normals): positions {positions:e}");
+        // Normals are unit vectors turned by blends of palette matrices (scaled in the
+        // synthetic set by up to 1.5): 1e-5 of their size.
+        assert!(normals <= 1e-5 * 2.0, "{name} ({path}): normals {normals:e}");
+        assert_eq!(grown.pair(), bounds(&out), "{name} ({path}, with normals): bounds");
     }
 }
 
