@@ -69,9 +69,7 @@ pub fn skin_with_normals(
     out: &mut [Vec3],
     normals: Normals,
 ) -> Bounds {
-    assert_eq!(bind_positions.len(), weights.vertex_count(), "one weight row per vertex");
-    assert_eq!(out.len(), bind_positions.len(), "one output per vertex");
-    assert!(normals.bind.len() == out.len() && normals.out.len() == out.len(), "one normal per vertex");
+    assert_lengths(bind_positions, weights, out, Some(&normals));
     let groups = weights.groups();
     assert!(groups.joint_bound <= palette.len(), "an influence names a joint beyond the palette");
     #[cfg(target_arch = "x86_64")]
@@ -80,6 +78,16 @@ pub fn skin_with_normals(
         return unsafe { avx2::skin_blocks_with_normals(bind_positions, &groups.blocks, palette, out, normals) };
     }
     skin_portable_chunk(bind_positions, weights, palette, 0, out, Some(normals))
+}
+
+/// What the whole-mesh entry points assert: one weight row, one output and (when given)
+/// one normal in and one out per bind position.
+fn assert_lengths(bind_positions: &[Vec3], weights: &SkinWeights, out: &[Vec3], normals: Option<&Normals>) {
+    assert_eq!(bind_positions.len(), weights.vertex_count(), "one weight row per vertex");
+    assert_eq!(out.len(), bind_positions.len(), "one output per vertex");
+    if let Some(normals) = normals {
+        assert!(normals.bind.len() == out.len() && normals.out.len() == out.len(), "one normal per vertex");
+    }
 }
 
 /// [`skin_with_normals`] without the AVX2 path.
@@ -93,9 +101,7 @@ pub fn skin_with_normals_portable(
     out: &mut [Vec3],
     normals: Normals,
 ) -> Bounds {
-    assert_eq!(bind_positions.len(), weights.vertex_count(), "one weight row per vertex");
-    assert_eq!(out.len(), bind_positions.len(), "one output per vertex");
-    assert!(normals.bind.len() == out.len() && normals.out.len() == out.len(), "one normal per vertex");
+    assert_lengths(bind_positions, weights, out, Some(&normals));
     skin_portable_chunk(bind_positions, weights, palette, 0, out, Some(normals))
 }
 
@@ -104,8 +110,7 @@ pub fn skin_with_normals_portable(
 /// # Panics
 /// As [`skin`].
 pub fn skin_portable(bind_positions: &[Vec3], weights: &SkinWeights, palette: &[Mat4], out: &mut [Vec3]) -> Bounds {
-    assert_eq!(bind_positions.len(), weights.vertex_count(), "one weight row per vertex");
-    assert_eq!(out.len(), bind_positions.len(), "one output per vertex");
+    assert_lengths(bind_positions, weights, out, None);
     skin_portable_chunk(bind_positions, weights, palette, 0, out, None)
 }
 
