@@ -16,6 +16,7 @@ use std::sync::{Arc, OnceLock};
 use bevy::prelude::*;
 use divan::Bencher;
 use marionette::rig::fk::forward_kinematics;
+use marionette::rig::simd::Simd;
 use marionette::rig::skinning::{flat_shade, skin_positions};
 use marionette::rig::{CharacterAsset, JointRotation};
 use marionette::scene::*;
@@ -78,23 +79,33 @@ fn smpl_body() -> Arc<CharacterAsset> {
 type Kernel = fn(&[Vec3], &marionette::rig::SkinWeights, &[Mat4], &mut [Vec3]);
 
 /// The skinning kernels on the SMPL body, positions only, in vertices per second:
-/// `oracle` (the plain loop), `fast` (AVX2 + FMA where the CPU has them, in blocks of eight
-/// vertices), `portable` (glam `Vec4`, vertex by vertex).
-#[divan::bench(args = ["oracle", "fast", "portable"])]
+/// `oracle` (the plain loop), `fast` (the best level this CPU runs: AVX2 + FMA in blocks of
+/// eight vertices, built with AVX-512 VL where the CPU has it), `avx2` (the same without
+/// AVX-512), `portable` (glam `Vec4`, vertex by vertex).
+#[divan::bench(args = ["oracle", "fast", "avx2", "portable"])]
 fn kernel_skin_positions(bencher: Bencher, kernel: &str) {
+    use marionette::rig::lbs::skin_using;
     let body = smpl_body();
     let palette = posed_palette(&body);
     let mut out = vec![Vec3::ZERO; body.vertex_count()];
-    let run: Kernel = match kernel {
-        "oracle" => skin_positions,
-        "fast" => marionette::rig::lbs::skin,
-        _ => |b, w, p, o| {
-            marionette::rig::lbs::skin_portable(b, w, p, o);
-        },
+    let Some(simd) = level(kernel) else { return };
+    let (bind, weights) = (&body.skin.bind_positions, &body.skin.weights);
+    bencher.counter(divan::counter::ItemsCount::new(body.vertex_count())).bench_local(|| match simd {
+        None => skin_positions(bind, weights, &palette, divan::black_box(&mut out)),
+        Some(simd) => _ = skin_using(simd, bind, weights, &palette, divan::black_box(&mut out)),
+    });
+}
+
+/// The kernel level a benchmark's argument names (`oracle`: none, the plain loop); none at
+/// all (the benchmark is skipped) where this CPU does not run it.
+fn level(kernel: &str) -> Option<Option<Simd>> {
+    let simd = match kernel {
+        "oracle" => return Some(None),
+        "fast" => Simd::best(),
+        "avx2" => Simd::Avx2,
+        _ => Simd::Portable,
     };
-    bencher
-        .counter(divan::counter::ItemsCount::new(body.vertex_count()))
-        .bench_local(|| run(&body.skin.bind_positions, &body.skin.weights, &palette, divan::black_box(&mut out)));
+    simd.is_available().then_some(Some(simd))
 }
 
 /// Unit vectors for the normals of `body` (from its centre out), for timing and tests of the
@@ -105,44 +116,46 @@ fn outward_normals(body: &CharacterAsset) -> Vec<Vec3> {
 }
 
 /// The skinning kernels on the SMPL body, positions and normals (one blend of each vertex's
-/// matrices for both), in vertices per second: `oracle` (the plain loop), `fast` (AVX2 +
-/// FMA), `portable`. Against `kernel_skin_positions`, what skinning the normals costs.
-#[divan::bench(args = ["oracle", "fast", "portable"])]
+/// matrices for both), in vertices per second, the levels as in `kernel_skin_positions`.
+/// Against it, what skinning the normals costs.
+#[divan::bench(args = ["oracle", "fast", "avx2", "portable"])]
 fn kernel_skin_positions_and_normals(bencher: Bencher, kernel: &str) {
-    use marionette::rig::lbs::{Normals, skin_with_normals, skin_with_normals_portable};
+    use marionette::rig::lbs::{Normals, skin_with_normals_using};
     let body = smpl_body();
     let palette = posed_palette(&body);
     let bind_normals = outward_normals(&body);
     let (mut out, mut normals) = (vec![Vec3::ZERO; body.vertex_count()], vec![Vec3::ZERO; body.vertex_count()]);
     let (bind, weights) = (&body.skin.bind_positions, &body.skin.weights);
+    let Some(simd) = level(kernel) else { return };
     bencher.counter(divan::counter::ItemsCount::new(body.vertex_count())).bench_local(|| {
         let n = Normals { bind: &bind_normals, out: divan::black_box(&mut normals) };
-        match kernel {
-            "oracle" => marionette::rig::skinning::skin_positions_and_normals(bind, weights, &palette, &mut out, n),
-            "fast" => _ = skin_with_normals(bind, weights, &palette, divan::black_box(&mut out), n),
-            _ => _ = skin_with_normals_portable(bind, weights, &palette, divan::black_box(&mut out), n),
+        match simd {
+            None => marionette::rig::skinning::skin_positions_and_normals(bind, weights, &palette, &mut out, n),
+            Some(simd) => _ = skin_with_normals_using(simd, bind, weights, &palette, divan::black_box(&mut out), n),
         }
     });
 }
 
 /// Dual quaternion skinning on the SMPL body, positions only, against which the LBS kernel
 /// above and ozz's LBS (the ozz harness) are the yardsticks (the issue asks for at least
-/// ozz's LBS speed): `kernel` alone, as the LBS kernel is timed with its palette made, and
-/// `with_palette` with the palette's conversion to dual quaternions (24 joints).
-#[divan::bench(args = ["kernel", "with_palette"])]
+/// ozz's LBS speed): `kernel` alone (the best level this CPU runs), as the LBS kernel is
+/// timed with its palette made; `avx2`, the same without AVX-512; and `with_palette`, the
+/// best with the palette's conversion to dual quaternions (24 joints).
+#[divan::bench(args = ["kernel", "avx2", "with_palette"])]
 fn kernel_skin_dual_quaternion(bencher: Bencher, part: &str) {
-    use marionette::rig::dqs::{dual_quaternion_palette, skin_dq};
+    use marionette::rig::dqs::{dual_quaternion_palette, skin_dq_using};
     let body = smpl_body();
     let palette = posed_palette(&body);
     let mut dq = Vec::new();
     dual_quaternion_palette(&palette, &mut dq);
     let mut out = vec![Vec3::ZERO; body.vertex_count()];
     let with_palette = part == "with_palette";
+    let Some(Some(simd)) = level(if part == "avx2" { "avx2" } else { "fast" }) else { return };
     bencher.counter(divan::counter::ItemsCount::new(body.vertex_count())).bench_local(|| {
         if with_palette {
             dual_quaternion_palette(&palette, &mut dq);
         }
-        skin_dq(&body.skin.bind_positions, &body.skin.weights, &dq, divan::black_box(&mut out));
+        skin_dq_using(simd, &body.skin.bind_positions, &body.skin.weights, &dq, divan::black_box(&mut out));
     });
 }
 

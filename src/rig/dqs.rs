@@ -8,6 +8,7 @@
 use glam::{Mat4, Quat, Vec3, Vec4};
 
 use super::influences::FixedGroup;
+use super::simd::Simd;
 use super::skinning::SkinWeights;
 
 pub use super::skinning::SkinningMethod;
@@ -61,16 +62,32 @@ pub fn dual_quaternion_palette(palette: &[Mat4], out: &mut Vec<DualQuat>) {
 /// When the lengths of `bind_positions`, `weights` and `out` differ, or an influence names
 /// a joint beyond the palette.
 pub fn skin_dq(bind_positions: &[Vec3], weights: &SkinWeights, palette: &[DualQuat], out: &mut [Vec3]) {
+    skin_dq_using(Simd::best(), bind_positions, weights, palette, out);
+}
+
+/// [`skin_dq`] at a given level of the kernel (`Simd::Portable`: vertex by vertex, what
+/// other CPUs run and the SIMD levels' oracle).
+///
+/// # Panics
+/// As [`skin_dq`], or when the CPU does not run `simd`.
+pub fn skin_dq_using(
+    simd: Simd,
+    bind_positions: &[Vec3],
+    weights: &SkinWeights,
+    palette: &[DualQuat],
+    out: &mut [Vec3],
+) {
     assert_eq!(bind_positions.len(), weights.vertex_count(), "one weight row per vertex");
     assert_eq!(out.len(), bind_positions.len(), "one output per vertex");
     let groups = weights.groups();
     assert!(groups.joint_bound <= palette.len(), "an influence names a joint beyond the palette");
+    assert!(simd.is_available(), "this CPU does not run {simd:?}");
     #[cfg(target_arch = "x86_64")]
-    if std::arch::is_x86_feature_detected!("avx2") && std::arch::is_x86_feature_detected!("fma") {
+    if simd != Simd::Portable {
         HEMISPHERES.with_borrow_mut(|hemispheres| {
             hemisphere_bits(palette, &groups.blocks.pivot_rows, hemispheres);
-            // SAFETY: the CPU has AVX2 and FMA (checked above).
-            unsafe { avx2::skin_blocks(bind_positions, &groups.blocks, palette, hemispheres, out) };
+            // SAFETY: the CPU runs `simd` (checked above).
+            unsafe { avx2::skin_blocks(simd, bind_positions, &groups.blocks, palette, hemispheres, out) };
         });
         return;
     }
@@ -96,13 +113,8 @@ fn hemisphere_bits(palette: &[DualQuat], pivot_rows: &[u16], bits: &mut Vec<u32>
     }));
 }
 
-/// [`skin_dq`] without the AVX2 path (what other CPUs run; the SIMD path's oracle).
-///
-/// # Panics
-/// As [`skin_dq`].
-pub fn skin_dq_portable(bind_positions: &[Vec3], weights: &SkinWeights, palette: &[DualQuat], out: &mut [Vec3]) {
-    assert_eq!(bind_positions.len(), weights.vertex_count(), "one weight row per vertex");
-    assert_eq!(out.len(), bind_positions.len(), "one output per vertex");
+/// The portable path: vertex by vertex, grouped by influence count.
+fn skin_dq_portable(bind_positions: &[Vec3], weights: &SkinWeights, palette: &[DualQuat], out: &mut [Vec3]) {
     let groups = weights.groups();
     fixed_rows::<1>(bind_positions, &groups.fixed[0], palette, out);
     fixed_rows::<2>(bind_positions, &groups.fixed[1], palette, out);
@@ -160,9 +172,10 @@ mod avx2 {
     use glam::{Vec3, Vec4};
 
     use super::DualQuat;
-    use crate::rig::avx2::{deinterleave, deinterleave_some, floats, interleave, register};
+    use crate::rig::avx2::{deinterleave, deinterleave_some, floats, for_both_levels, interleave, register};
     use crate::rig::influences::{BlockPivots, LANES, LaneBlocks};
 
+    for_both_levels! {
     /// Each block on 256-bit registers, one vertex a lane: each of the block's joints
     /// broadcasts its dual quaternion and adds it into the eight blends with each lane's
     /// weight (eight multiply-adds for eight vertices), the weight's sign flipped where the
@@ -173,81 +186,90 @@ mod avx2 {
     /// blocks read and write their positions in order; the mesh's last block, when partial,
     /// lane by lane.
     ///
+    /// (Indices are checked: a joint beyond the palette panics.)
+    pub unsafe fn skin_blocks = skin_blocks_body(
+        bind: &[Vec3],
+        blocks: &LaneBlocks,
+        palette: &[DualQuat],
+        hemispheres: &[u32],
+        out: &mut [Vec3],
+    )
+    }
+
+    /// [`skin_blocks`]' body.
+    ///
     /// # Safety
-    /// The CPU must have AVX2 and FMA. (Indices are checked: a joint beyond the palette
-    /// panics.)
-    #[target_feature(enable = "avx2,fma")]
-    pub unsafe fn skin_blocks(
+    /// The CPU must have AVX2 and FMA.
+    #[inline(always)]
+    unsafe fn skin_blocks_body(
         bind: &[Vec3],
         blocks: &LaneBlocks,
         palette: &[DualQuat],
         hemispheres: &[u32],
         out: &mut [Vec3],
     ) {
-        let n = bind.len();
-        let (zero, sign) = (_mm256_setzero_ps(), _mm256_set1_ps(-0.0));
-        let add = |blend: &mut [__m256; 8], w: __m256, q: &DualQuat| {
-            let (real, dual) = (q.real.to_array(), q.dual.to_array());
-            for c in 0..4 {
-                blend[c] = _mm256_fmadd_ps(w, _mm256_set1_ps(real[c]), blend[c]);
-                blend[4 + c] = _mm256_fmadd_ps(w, _mm256_set1_ps(dual[c]), blend[4 + c]);
-            }
-        };
-        for b in 0..n.div_ceil(LANES) {
-            let lanes = b * LANES..((b + 1) * LANES).min(n);
-            let whole = lanes.len() == LANES;
-            let mut blend = [zero; 8];
-            let joints = blocks.joint_starts[b] as usize..blocks.joint_starts[b + 1] as usize;
-            let influences = blocks.joints[joints.clone()].iter().zip(&blocks.weights[joints]);
-            match blocks.block_pivots[b] {
-                BlockPivots::Shared(row) => {
-                    for (&j, w) in influences {
-                        let flip = f32::from_bits((hemispheres[j as usize] >> row & 1) << 31);
-                        add(&mut blend, _mm256_xor_ps(register(w.0), _mm256_set1_ps(flip)), &palette[j as usize]);
-                    }
+        // SAFETY: the CPU has AVX2 and FMA (this function's contract).
+        unsafe {
+            let n = bind.len();
+            let (zero, sign) = (_mm256_setzero_ps(), _mm256_set1_ps(-0.0));
+            let add = |blend: &mut [__m256; 8], w: __m256, q: &DualQuat| {
+                let (real, dual) = (q.real.to_array(), q.dual.to_array());
+                for c in 0..4 {
+                    blend[c] = _mm256_fmadd_ps(w, _mm256_set1_ps(real[c]), blend[c]);
+                    blend[4 + c] = _mm256_fmadd_ps(w, _mm256_set1_ps(dual[c]), blend[4 + c]);
                 }
-                BlockPivots::Rows => {
-                    // Lane i's bit moved to the sign: a left shift by 31 less its row.
-                    let rows: [u8; LANES] = blocks.lane_rows[lanes.clone()].try_into().expect("eight lanes");
-                    let rows = _mm256_cvtepu8_epi32(_mm_cvtsi64_si128(i64::from_le_bytes(rows)));
-                    let shifts = _mm256_sub_epi32(_mm256_set1_epi32(31), rows);
-                    for (&j, w) in influences {
-                        let bits = _mm256_sllv_epi32(_mm256_set1_epi32(hemispheres[j as usize] as i32), shifts);
-                        let flip = _mm256_and_ps(_mm256_castsi256_ps(bits), sign);
-                        add(&mut blend, _mm256_xor_ps(register(w.0), flip), &palette[j as usize]);
-                    }
-                }
-                BlockPivots::Lanes => {
-                    let unit = Vec4::W;
-                    let pivots = lanes_of(std::array::from_fn(|i| {
-                        let pivot = blocks.pivots.get(lanes.start + i).map(|&j| j as usize);
-                        pivot.and_then(|j| palette.get(j)).map_or(&unit, |q| &q.real)
-                    }));
-                    for (&j, w) in influences {
-                        let q = &palette[j as usize];
-                        // q and -q are one rotation: the weight takes the sign of dot(q.real, pivot).
-                        let real = q.real.to_array().map(|c| _mm256_set1_ps(c));
-                        let behind = _mm256_cmp_ps::<_CMP_LT_OQ>(dot8(&real, &pivots), zero);
-                        add(&mut blend, _mm256_xor_ps(register(w.0), _mm256_and_ps(behind, sign)), q);
-                    }
-                }
-            }
-            // The bind positions read after the blend: with their three registers held through
-            // it, an accumulator spilled to memory (a tenth of the kernel's time).
-            let p = if whole {
-                // SAFETY: this kernel runs on AVX2 (its contract).
-                unsafe { deinterleave(&bind[lanes.clone()]) }
-            } else {
-                deinterleave_some(&bind[lanes.clone()])
             };
-            let moved = normalise_and_apply(blend, p);
-            if whole {
-                // SAFETY: this kernel runs on AVX2 (its contract).
-                unsafe { interleave(moved, &mut out[lanes]) };
-            } else {
-                let lane = moved.map(floats);
-                for (i, v) in lanes.enumerate() {
-                    out[v] = Vec3::new(lane[0][i], lane[1][i], lane[2][i]);
+            for b in 0..n.div_ceil(LANES) {
+                let lanes = b * LANES..((b + 1) * LANES).min(n);
+                let whole = lanes.len() == LANES;
+                let mut blend = [zero; 8];
+                let joints = blocks.joint_starts[b] as usize..blocks.joint_starts[b + 1] as usize;
+                let influences = blocks.joints[joints.clone()].iter().zip(&blocks.weights[joints]);
+                match blocks.block_pivots[b] {
+                    BlockPivots::Shared(row) => {
+                        for (&j, w) in influences {
+                            let flip = f32::from_bits((hemispheres[j as usize] >> row & 1) << 31);
+                            add(&mut blend, _mm256_xor_ps(register(w.0), _mm256_set1_ps(flip)), &palette[j as usize]);
+                        }
+                    }
+                    BlockPivots::Rows => {
+                        // Lane i's bit moved to the sign: a left shift by 31 less its row.
+                        let rows: [u8; LANES] = blocks.lane_rows[lanes.clone()].try_into().expect("eight lanes");
+                        let rows = _mm256_cvtepu8_epi32(_mm_cvtsi64_si128(i64::from_le_bytes(rows)));
+                        let shifts = _mm256_sub_epi32(_mm256_set1_epi32(31), rows);
+                        for (&j, w) in influences {
+                            let bits = _mm256_sllv_epi32(_mm256_set1_epi32(hemispheres[j as usize] as i32), shifts);
+                            let flip = _mm256_and_ps(_mm256_castsi256_ps(bits), sign);
+                            add(&mut blend, _mm256_xor_ps(register(w.0), flip), &palette[j as usize]);
+                        }
+                    }
+                    BlockPivots::Lanes => {
+                        let unit = Vec4::W;
+                        let pivots = lanes_of(std::array::from_fn(|i| {
+                            let pivot = blocks.pivots.get(lanes.start + i).map(|&j| j as usize);
+                            pivot.and_then(|j| palette.get(j)).map_or(&unit, |q| &q.real)
+                        }));
+                        for (&j, w) in influences {
+                            let q = &palette[j as usize];
+                            // q and -q are one rotation: the weight takes the sign of dot(q.real, pivot).
+                            let real = q.real.to_array().map(|c| _mm256_set1_ps(c));
+                            let behind = _mm256_cmp_ps::<_CMP_LT_OQ>(dot8(&real, &pivots), zero);
+                            add(&mut blend, _mm256_xor_ps(register(w.0), _mm256_and_ps(behind, sign)), q);
+                        }
+                    }
+                }
+                // The bind positions read after the blend: with their three registers held through
+                // it, an accumulator spilled to memory (a tenth of the kernel's time).
+                let p =
+                    if whole { deinterleave(&bind[lanes.clone()]) } else { deinterleave_some(&bind[lanes.clone()]) };
+                let moved = normalise_and_apply(blend, p);
+                if whole {
+                    interleave(moved, &mut out[lanes]);
+                } else {
+                    let lane = moved.map(floats);
+                    for (i, v) in lanes.enumerate() {
+                        out[v] = Vec3::new(lane[0][i], lane[1][i], lane[2][i]);
+                    }
                 }
             }
         }

@@ -9,6 +9,7 @@
 use glam::{Mat4, Vec3, Vec3A, Vec4};
 
 use super::influences::{FixedGroup, LaneBlocks};
+use super::simd::Simd;
 pub use super::skinning::Normals;
 use super::skinning::{Bounds, SkinWeights};
 
@@ -28,8 +29,7 @@ pub fn skin(bind_positions: &[Vec3], weights: &SkinWeights, palette: &[Mat4], ou
 /// # Panics
 /// As [`skin`].
 pub fn skin_bounded(bind_positions: &[Vec3], weights: &SkinWeights, palette: &[Mat4], out: &mut [Vec3]) -> Bounds {
-    assert_eq!(out.len(), bind_positions.len(), "one output per vertex");
-    skin_chunk(bind_positions, weights, palette, 0, out)
+    skin_using(Simd::best(), bind_positions, weights, palette, out)
 }
 
 /// Skins the vertices `first..first + out.len()` into `out` (a large mesh is skinned in
@@ -46,14 +46,41 @@ pub fn skin_chunk(
     first: usize,
     out: &mut [Vec3],
 ) -> Bounds {
+    skin_chunk_using(Simd::best(), bind_positions, weights, palette, first, out)
+}
+
+/// [`skin_bounded`] at a given level of the kernel (the tests run each the CPU has).
+///
+/// # Panics
+/// As [`skin`], or when the CPU does not run `simd`.
+pub fn skin_using(
+    simd: Simd,
+    bind_positions: &[Vec3],
+    weights: &SkinWeights,
+    palette: &[Mat4],
+    out: &mut [Vec3],
+) -> Bounds {
+    assert_lengths(bind_positions, weights, out, None);
+    skin_chunk_using(simd, bind_positions, weights, palette, 0, out)
+}
+
+fn skin_chunk_using(
+    simd: Simd,
+    bind_positions: &[Vec3],
+    weights: &SkinWeights,
+    palette: &[Mat4],
+    first: usize,
+    out: &mut [Vec3],
+) -> Bounds {
     assert_eq!(bind_positions.len(), weights.vertex_count(), "one weight row per vertex");
     assert!(first + out.len() <= bind_positions.len(), "the chunk lies inside the mesh");
     let groups = weights.groups();
     assert!(groups.joint_bound <= palette.len(), "an influence names a joint beyond the palette");
+    assert!(simd.is_available(), "this CPU does not run {simd:?}");
     #[cfg(target_arch = "x86_64")]
-    if std::arch::is_x86_feature_detected!("avx2") && std::arch::is_x86_feature_detected!("fma") {
-        // SAFETY: the CPU has AVX2 and FMA (checked above).
-        return unsafe { avx2::skin_blocks(bind_positions, &groups.blocks, palette, first, out) };
+    if simd != Simd::Portable {
+        // SAFETY: the CPU runs `simd` (checked above).
+        return unsafe { avx2::skin_blocks(simd, bind_positions, &groups.blocks, palette, first, out) };
     }
     skin_portable_chunk(bind_positions, weights, palette, first, out, None)
 }
@@ -69,13 +96,29 @@ pub fn skin_with_normals(
     out: &mut [Vec3],
     normals: Normals,
 ) -> Bounds {
+    skin_with_normals_using(Simd::best(), bind_positions, weights, palette, out, normals)
+}
+
+/// [`skin_with_normals`] at a given level of the kernel.
+///
+/// # Panics
+/// As [`skin_with_normals`], or when the CPU does not run `simd`.
+pub fn skin_with_normals_using(
+    simd: Simd,
+    bind_positions: &[Vec3],
+    weights: &SkinWeights,
+    palette: &[Mat4],
+    out: &mut [Vec3],
+    normals: Normals,
+) -> Bounds {
     assert_lengths(bind_positions, weights, out, Some(&normals));
     let groups = weights.groups();
     assert!(groups.joint_bound <= palette.len(), "an influence names a joint beyond the palette");
+    assert!(simd.is_available(), "this CPU does not run {simd:?}");
     #[cfg(target_arch = "x86_64")]
-    if std::arch::is_x86_feature_detected!("avx2") && std::arch::is_x86_feature_detected!("fma") {
-        // SAFETY: the CPU has AVX2 and FMA (checked above).
-        return unsafe { avx2::skin_blocks_with_normals(bind_positions, &groups.blocks, palette, out, normals) };
+    if simd != Simd::Portable {
+        // SAFETY: the CPU runs `simd` (checked above).
+        return unsafe { avx2::skin_blocks_with_normals(simd, bind_positions, &groups.blocks, palette, out, normals) };
     }
     skin_portable_chunk(bind_positions, weights, palette, 0, out, Some(normals))
 }
@@ -88,30 +131,6 @@ fn assert_lengths(bind_positions: &[Vec3], weights: &SkinWeights, out: &[Vec3], 
     if let Some(normals) = normals {
         assert!(normals.bind.len() == out.len() && normals.out.len() == out.len(), "one normal per vertex");
     }
-}
-
-/// [`skin_with_normals`] without the AVX2 path.
-///
-/// # Panics
-/// As [`skin_with_normals`].
-pub fn skin_with_normals_portable(
-    bind_positions: &[Vec3],
-    weights: &SkinWeights,
-    palette: &[Mat4],
-    out: &mut [Vec3],
-    normals: Normals,
-) -> Bounds {
-    assert_lengths(bind_positions, weights, out, Some(&normals));
-    skin_portable_chunk(bind_positions, weights, palette, 0, out, Some(normals))
-}
-
-/// [`skin_bounded`] without the AVX2 path, on any target (what other CPUs run).
-///
-/// # Panics
-/// As [`skin`].
-pub fn skin_portable(bind_positions: &[Vec3], weights: &SkinWeights, palette: &[Mat4], out: &mut [Vec3]) -> Bounds {
-    assert_lengths(bind_positions, weights, out, None);
-    skin_portable_chunk(bind_positions, weights, palette, 0, out, None)
 }
 
 /// The portable path: each vertex blends its matrices (`M = Σ wᵢ Pᵢ`) with glam's `Vec4`
@@ -217,7 +236,9 @@ mod avx2 {
     use glam::{Mat4, Vec3, Vec3A};
 
     use super::{LaneBlocks, Normals};
-    use crate::rig::avx2::{deinterleave, deinterleave_some, floats, interleave, register};
+    use crate::rig::avx2::{
+        deinterleave, deinterleave_some, floats, for_both_levels, interleave, lane_points, register,
+    };
     use crate::rig::influences::LANES;
     use crate::rig::skinning::Bounds;
 
@@ -229,68 +250,80 @@ mod avx2 {
         std::array::from_fn(|e| c[e / 3 * 4 + e % 3])
     }
 
-    /// Each block on 256-bit registers, one vertex a lane: each of the block's joints
-    /// transforms all eight bind positions (its matrix's elements broadcast once) and adds
-    /// them in with each lane's weight; twelve multiply-adds a joint for eight vertices.
-    /// Blocks that lie wholly in the chunk read and write their eight positions in order;
-    /// the chunk's first and last blocks (when it does not start or end on a multiple of
-    /// eight) and the mesh's last go lane by lane.
+    for_both_levels! {
+        /// Each block on 256-bit registers, one vertex a lane: each of the block's joints
+        /// transforms all eight bind positions (its matrix's elements broadcast once) and adds
+        /// them in with each lane's weight; twelve multiply-adds a joint for eight vertices.
+        /// Blocks that lie wholly in the chunk read and write their eight positions in order;
+        /// the chunk's first and last blocks (when it does not start or end on a multiple of
+        /// eight) and the mesh's last go lane by lane.
+        ///
+        /// (Indices are checked: a joint beyond the palette or a vertex beyond the buffers
+        /// panics.)
+        pub unsafe fn skin_blocks = skin_blocks_body(
+            bind: &[Vec3],
+            blocks: &LaneBlocks,
+            palette: &[Mat4],
+            first: usize,
+            out: &mut [Vec3],
+        ) -> Bounds
+    }
+
+    /// [`skin_blocks`]' body.
     ///
     /// # Safety
-    /// The CPU must have AVX2 and FMA. (Indices are checked: a joint beyond the palette or a
-    /// vertex beyond the buffers panics.)
-    #[target_feature(enable = "avx2,fma")]
-    pub unsafe fn skin_blocks(
+    /// The CPU must have AVX2 and FMA.
+    #[inline(always)]
+    unsafe fn skin_blocks_body(
         bind: &[Vec3],
         blocks: &LaneBlocks,
         palette: &[Mat4],
         first: usize,
         out: &mut [Vec3],
     ) -> Bounds {
-        let end = first + out.len();
-        let (mut lo, mut hi) = ([_mm256_set1_ps(f32::INFINITY); 3], [_mm256_set1_ps(f32::NEG_INFINITY); 3]);
-        let mut edges = Bounds::EMPTY;
-        for b in first / LANES..end.div_ceil(LANES) {
-            let lanes = b * LANES..(b + 1) * LANES;
-            let whole = first <= lanes.start && lanes.end <= end;
-            let [x, y, z] = if whole {
-                // SAFETY: this kernel runs on AVX2 (its contract).
-                unsafe { deinterleave(&bind[lanes.clone()]) }
-            } else {
-                deinterleave_some(&bind[lanes.start..lanes.end.min(bind.len())])
-            };
-            let mut p = [_mm256_setzero_ps(); 3];
-            let joints = blocks.joint_starts[b] as usize..blocks.joint_starts[b + 1] as usize;
-            for (&j, w) in blocks.joints[joints.clone()].iter().zip(&blocks.weights[joints]) {
-                let w = register(w.0);
-                let m = elements(&palette[j as usize]).map(|c| _mm256_set1_ps(c));
-                for (r, p) in p.iter_mut().enumerate() {
-                    let row =
-                        _mm256_fmadd_ps(m[r], x, _mm256_fmadd_ps(m[3 + r], y, _mm256_fmadd_ps(m[6 + r], z, m[9 + r])));
-                    *p = _mm256_fmadd_ps(w, row, *p);
+        // SAFETY: the CPU has AVX2 and FMA (this function's contract).
+        unsafe {
+            let end = first + out.len();
+            let (mut lo, mut hi) = ([_mm256_set1_ps(f32::INFINITY); 3], [_mm256_set1_ps(f32::NEG_INFINITY); 3]);
+            let mut edges = Bounds::EMPTY;
+            for b in first / LANES..end.div_ceil(LANES) {
+                let lanes = b * LANES..(b + 1) * LANES;
+                let whole = first <= lanes.start && lanes.end <= end;
+                let [x, y, z] = if whole {
+                    deinterleave(&bind[lanes.clone()])
+                } else {
+                    deinterleave_some(&bind[lanes.start..lanes.end.min(bind.len())])
+                };
+                let mut p = [_mm256_setzero_ps(); 3];
+                let joints = blocks.joint_starts[b] as usize..blocks.joint_starts[b + 1] as usize;
+                for (&j, w) in blocks.joints[joints.clone()].iter().zip(&blocks.weights[joints]) {
+                    let w = register(w.0);
+                    let m = elements(&palette[j as usize]).map(|c| _mm256_set1_ps(c));
+                    for (r, p) in p.iter_mut().enumerate() {
+                        let row = _mm256_fmadd_ps(
+                            m[r],
+                            x,
+                            _mm256_fmadd_ps(m[3 + r], y, _mm256_fmadd_ps(m[6 + r], z, m[9 + r])),
+                        );
+                        *p = _mm256_fmadd_ps(w, row, *p);
+                    }
+                }
+                if whole {
+                    for k in 0..3 {
+                        (lo[k], hi[k]) = (_mm256_min_ps(lo[k], p[k]), _mm256_max_ps(hi[k], p[k]));
+                    }
+                    interleave(p, &mut out[lanes.start - first..lanes.end - first]);
+                } else {
+                    let lane = p.map(floats);
+                    for (i, v) in lanes.enumerate().filter(|(_, v)| (first..end).contains(v)) {
+                        let q = Vec3A::new(lane[0][i], lane[1][i], lane[2][i]);
+                        out[v - first] = q.into();
+                        edges = edges.with(q);
+                    }
                 }
             }
-            if whole {
-                for k in 0..3 {
-                    (lo[k], hi[k]) = (_mm256_min_ps(lo[k], p[k]), _mm256_max_ps(hi[k], p[k]));
-                }
-                // SAFETY: this kernel runs on AVX2 (its contract).
-                unsafe { interleave(p, &mut out[lanes.start - first..lanes.end - first]) };
-            } else {
-                let lane = p.map(floats);
-                for (i, v) in lanes.enumerate().filter(|(_, v)| (first..end).contains(v)) {
-                    let q = Vec3A::new(lane[0][i], lane[1][i], lane[2][i]);
-                    out[v - first] = q.into();
-                    edges = edges.with(q);
-                }
-            }
+            lanes_bounds(lo, hi).union(edges)
         }
-        let reduce = |r: __m256, f: fn(f32, f32) -> f32| floats(r).into_iter().reduce(f).unwrap_or(0.0);
-        let whole = Bounds::between(
-            Vec3A::new(reduce(lo[0], f32::min), reduce(lo[1], f32::min), reduce(lo[2], f32::min)),
-            Vec3A::new(reduce(hi[0], f32::max), reduce(hi[1], f32::max), reduce(hi[2], f32::max)),
-        );
-        whole.union(edges)
     }
 
     /// The box between eight lanes of lower and eight of upper corners.
@@ -303,67 +336,72 @@ mod avx2 {
         )
     }
 
+    for_both_levels! {
     /// [`skin_blocks`] of a whole mesh with its normals: each lane's matrix is blended
     /// first (`Σⱼ wⱼ Pⱼ`, twelve multiply-adds a joint for eight vertices), then turns the
     /// eight positions and the eight normals once. (Transforming by each joint, as
     /// `skin_blocks` does for positions alone, needs more registers than there are with the
     /// normals: 46 µs a SMPL body against this order's 22.)
+    pub unsafe fn skin_blocks_with_normals = skin_blocks_with_normals_body(
+        bind: &[Vec3],
+        blocks: &LaneBlocks,
+        palette: &[Mat4],
+        out: &mut [Vec3],
+        normals: Normals,
+    ) -> Bounds
+    }
+
+    /// [`skin_blocks_with_normals`]' body.
     ///
     /// # Safety
-    /// As [`skin_blocks`].
-    #[target_feature(enable = "avx2,fma")]
-    pub unsafe fn skin_blocks_with_normals(
+    /// The CPU must have AVX2 and FMA.
+    #[inline(always)]
+    unsafe fn skin_blocks_with_normals_body(
         bind: &[Vec3],
         blocks: &LaneBlocks,
         palette: &[Mat4],
         out: &mut [Vec3],
         normals: Normals,
     ) -> Bounds {
-        let (lanes_read, n) = (
-            |points: &[Vec3], lanes: std::ops::Range<usize>| match points.get(lanes.clone()) {
-                // SAFETY: this kernel runs on AVX2 (its contract).
-                Some(whole) => unsafe { deinterleave(whole) },
-                None => deinterleave_some(&points[lanes.start..points.len()]),
-            },
-            bind.len(),
-        );
-        let (mut lo, mut hi) = ([_mm256_set1_ps(f32::INFINITY); 3], [_mm256_set1_ps(f32::NEG_INFINITY); 3]);
-        let mut last = Bounds::EMPTY;
-        for b in 0..n.div_ceil(LANES) {
-            let lanes = b * LANES..(b + 1) * LANES;
-            let mut m = [_mm256_setzero_ps(); 12];
-            let joints = blocks.joint_starts[b] as usize..blocks.joint_starts[b + 1] as usize;
-            for (&j, w) in blocks.joints[joints.clone()].iter().zip(&blocks.weights[joints]) {
-                let w = register(w.0);
-                for (m, e) in m.iter_mut().zip(elements(&palette[j as usize])) {
-                    *m = _mm256_fmadd_ps(w, _mm256_set1_ps(e), *m);
+        // SAFETY: the CPU has AVX2 and FMA (this function's contract).
+        unsafe {
+            let n = bind.len();
+            let (mut lo, mut hi) = ([_mm256_set1_ps(f32::INFINITY); 3], [_mm256_set1_ps(f32::NEG_INFINITY); 3]);
+            let mut last = Bounds::EMPTY;
+            for b in 0..n.div_ceil(LANES) {
+                let lanes = b * LANES..(b + 1) * LANES;
+                let mut m = [_mm256_setzero_ps(); 12];
+                let joints = blocks.joint_starts[b] as usize..blocks.joint_starts[b + 1] as usize;
+                for (&j, w) in blocks.joints[joints.clone()].iter().zip(&blocks.weights[joints]) {
+                    let w = register(w.0);
+                    for (m, e) in m.iter_mut().zip(elements(&palette[j as usize])) {
+                        *m = _mm256_fmadd_ps(w, _mm256_set1_ps(e), *m);
+                    }
+                }
+                let [x, y, z] = lane_points(bind, lanes.clone());
+                let p: [__m256; 3] = std::array::from_fn(|r| {
+                    _mm256_fmadd_ps(m[r], x, _mm256_fmadd_ps(m[3 + r], y, _mm256_fmadd_ps(m[6 + r], z, m[9 + r])))
+                });
+                let [x, y, z] = lane_points(normals.bind, lanes.clone());
+                let normal: [__m256; 3] = std::array::from_fn(|r| {
+                    _mm256_fmadd_ps(m[r], x, _mm256_fmadd_ps(m[3 + r], y, _mm256_mul_ps(m[6 + r], z)))
+                });
+                if lanes.end <= n {
+                    for k in 0..3 {
+                        (lo[k], hi[k]) = (_mm256_min_ps(lo[k], p[k]), _mm256_max_ps(hi[k], p[k]));
+                    }
+                    interleave(p, &mut out[lanes.clone()]);
+                    interleave(normal, &mut normals.out[lanes]);
+                } else {
+                    let (p, normal) = (p.map(floats), normal.map(floats));
+                    for (i, v) in lanes.take_while(|&v| v < n).enumerate() {
+                        let q = Vec3A::new(p[0][i], p[1][i], p[2][i]);
+                        (out[v], normals.out[v]) = (q.into(), Vec3::new(normal[0][i], normal[1][i], normal[2][i]));
+                        last = last.with(q);
+                    }
                 }
             }
-            let [x, y, z] = lanes_read(bind, lanes.clone());
-            let p: [__m256; 3] = std::array::from_fn(|r| {
-                _mm256_fmadd_ps(m[r], x, _mm256_fmadd_ps(m[3 + r], y, _mm256_fmadd_ps(m[6 + r], z, m[9 + r])))
-            });
-            let [x, y, z] = lanes_read(normals.bind, lanes.clone());
-            let normal: [__m256; 3] = std::array::from_fn(|r| {
-                _mm256_fmadd_ps(m[r], x, _mm256_fmadd_ps(m[3 + r], y, _mm256_mul_ps(m[6 + r], z)))
-            });
-            if lanes.end <= n {
-                for k in 0..3 {
-                    (lo[k], hi[k]) = (_mm256_min_ps(lo[k], p[k]), _mm256_max_ps(hi[k], p[k]));
-                }
-                // SAFETY: this kernel runs on AVX2 (its contract).
-                unsafe { interleave(p, &mut out[lanes.clone()]) };
-                // SAFETY: this kernel runs on AVX2 (its contract).
-                unsafe { interleave(normal, &mut normals.out[lanes]) };
-            } else {
-                let (p, normal) = (p.map(floats), normal.map(floats));
-                for (i, v) in lanes.take_while(|&v| v < n).enumerate() {
-                    let q = Vec3A::new(p[0][i], p[1][i], p[2][i]);
-                    (out[v], normals.out[v]) = (q.into(), Vec3::new(normal[0][i], normal[1][i], normal[2][i]));
-                    last = last.with(q);
-                }
-            }
+            lanes_bounds(lo, hi).union(last)
         }
-        lanes_bounds(lo, hi).union(last)
     }
 }

@@ -21,6 +21,7 @@ pub mod mirror;
 pub mod node_clip;
 pub mod pose;
 pub mod retarget;
+pub mod simd;
 pub mod skeleton;
 pub mod skinning;
 pub mod smpl;

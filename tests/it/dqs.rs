@@ -4,7 +4,7 @@
 use std::sync::Arc;
 
 use glam::{Mat4, Quat, Vec3};
-use marionette::rig::dqs::{DualQuat, SkinningMethod, dual_quaternion_palette, skin_dq};
+use marionette::rig::dqs::{DualQuat, SkinningMethod, dual_quaternion_palette, skin_dq, skin_dq_using};
 use marionette::rig::lbs::skin;
 use marionette::rig::{JointRotation, SkinWeights};
 
@@ -119,7 +119,6 @@ fn dual_quaternion_skinning_in_the_ecs_matches_the_kernel() {
 /// and, with the data, every character of the courses and SMPL, posed.
 #[test]
 fn the_dual_quaternion_kernel_paths_agree() {
-    use marionette::rig::dqs::skin_dq_portable;
     let mut assets = vec![marionette::formats::puppet::embedded_puppet()];
     if let Some(data) = crate::common::optional_data_dir() {
         let files = ["mit6837/Model1.skel", "mit6837/Model2.skel", "mit6837/Model3.skel", "mit6837/Model4.skel"]
@@ -138,14 +137,23 @@ fn the_dual_quaternion_kernel_paths_agree() {
             (0..n).map(|i| JointRotation::euler_xyz(0.2 * i as f32, -0.1, 0.15 * i as f32)).collect();
         let palette =
             marionette::rig::fk::posed_palette(&asset.skeleton, &asset.bind_world_to_joint, &pose, Mat4::IDENTITY);
-        let dq = dq(&palette);
-        let nan = vec![Vec3::splat(f32::NAN); asset.vertex_count()];
-        let (mut a, mut b) = (nan.clone(), nan);
-        skin_dq(&asset.skin.bind_positions, &asset.skin.weights, &dq, &mut a);
-        skin_dq_portable(&asset.skin.bind_positions, &asset.skin.weights, &dq, &mut b);
-        let scale = b.iter().fold(1.0f32, |m, p| m.max(p.abs().max_element()));
-        let worst = a.iter().zip(&b).map(|(x, y)| (*x - *y).abs().max_element()).fold(0.0f32, f32::max);
-        assert!(worst <= 1e-5 * scale, "{}: worst {worst:e}", asset.name);
+        assert_simd_levels_match_portable(&asset.name, &asset.skin.bind_positions, &asset.skin.weights, &dq(&palette));
+    }
+}
+
+/// Each SIMD level of the kernel this CPU runs (AVX2, and AVX-512 VL where it has it)
+/// against the portable path, within 1e-5 of the mesh's size. Outputs start as NaN, so a
+/// vertex left unwritten fails.
+fn assert_simd_levels_match_portable(name: &str, bind: &[Vec3], weights: &SkinWeights, dq: &[DualQuat]) {
+    use marionette::rig::simd::Simd;
+    let mut expected = vec![Vec3::splat(f32::NAN); bind.len()];
+    skin_dq_using(Simd::Portable, bind, weights, dq, &mut expected);
+    let scale = expected.iter().fold(1.0f32, |m, p| m.max(p.abs().max_element()));
+    for simd in Simd::available().filter(|&s| s != Simd::Portable) {
+        let mut out = vec![Vec3::splat(f32::NAN); bind.len()];
+        skin_dq_using(simd, bind, weights, dq, &mut out);
+        let worst = out.iter().zip(&expected).map(|(x, y)| (*x - *y).abs().max_element()).fold(0.0f32, f32::max);
+        assert!(worst <= 1e-5 * scale, "{name} ({simd:?}): worst {worst:e} (scale {scale})");
     }
 }
 
@@ -155,7 +163,6 @@ fn the_dual_quaternion_kernel_paths_agree() {
 /// block. Outputs start as NaN, so a vertex left unwritten fails.
 #[test]
 fn the_dual_quaternion_kernel_matches_the_portable_path_on_rows_of_1_to_13_influences() {
-    use marionette::rig::dqs::skin_dq_portable;
     use marionette::rig::influences::BlockPivots;
     let mut state = 0x2545_f491_4f6c_dd1du64;
     let mut next = move || {
@@ -187,11 +194,5 @@ fn the_dual_quaternion_kernel_matches_the_portable_path_on_rows_of_1_to_13_influ
     let kinds = &weights.groups().blocks.block_pivots;
     assert!(kinds.iter().any(|k| matches!(k, BlockPivots::Shared(_))), "a block of one pivot");
     assert!(kinds.contains(&BlockPivots::Rows) && kinds.contains(&BlockPivots::Lanes), "{kinds:?}");
-    let dq = dq(&palette);
-    let (mut a, mut b) = (vec![Vec3::splat(f32::NAN); n], vec![Vec3::splat(f32::NAN); n]);
-    skin_dq(&bind, &weights, &dq, &mut a);
-    skin_dq_portable(&bind, &weights, &dq, &mut b);
-    let scale = b.iter().fold(1.0f32, |m, p| m.max(p.abs().max_element()));
-    let worst = a.iter().zip(&b).map(|(x, y)| (*x - *y).abs().max_element()).fold(0.0f32, f32::max);
-    assert!(worst <= 1e-5 * scale, "worst {worst:e} (scale {scale})");
+    assert_simd_levels_match_portable("rows of 1 to 13", &bind, &weights, &dq(&palette));
 }

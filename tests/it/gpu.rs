@@ -82,7 +82,13 @@ fn oracle(asset: &CharacterAsset, pose: &[JointRotation], method: SkinningMethod
     } else {
         let mut dq = Vec::new();
         marionette::rig::dqs::dual_quaternion_palette(&palette, &mut dq);
-        marionette::rig::dqs::skin_dq_portable(&skin.bind_positions, &skin.weights, &dq, &mut out);
+        marionette::rig::dqs::skin_dq_using(
+            marionette::rig::simd::Simd::Portable,
+            &skin.bind_positions,
+            &skin.weights,
+            &dq,
+            &mut out,
+        );
     }
     out
 }

@@ -4,7 +4,8 @@
 //! grows as it writes is the box of what it wrote.
 
 use glam::{Mat4, Quat, Vec3};
-use marionette::rig::lbs::{skin, skin_bounded, skin_portable};
+use marionette::rig::lbs::{skin, skin_using};
+use marionette::rig::simd::Simd;
 use marionette::rig::skinning::{Bounds, bounds, skin_positions};
 use marionette::rig::{CharacterAsset, JointRotation, SkinWeights};
 
@@ -17,29 +18,28 @@ fn posed_palette(asset: &CharacterAsset) -> Vec<Mat4> {
     marionette::rig::fk::posed_palette(&asset.skeleton, &asset.bind_world_to_joint, &pose, placement)
 }
 
-/// Both paths of the kernel agree with the oracle within `1e-5` (relative to the mesh's size).
-type Kernel = fn(&[Vec3], &SkinWeights, &[Mat4], &mut [Vec3]) -> Bounds;
-
+/// Each level of the kernel this CPU runs (AVX-512 VL, AVX2, portable) agrees with the
+/// oracle within `1e-5` (relative to the mesh's size).
 fn assert_kernel_matches_oracle(name: &str, bind: &[Vec3], weights: &SkinWeights, palette: &[Mat4]) {
     let n = bind.len();
     let mut expected = vec![Vec3::ZERO; n];
     skin_positions(bind, weights, palette, &mut expected);
     let scale = expected.iter().fold(1.0f32, |m, p| m.max(p.abs().max_element()));
-    for (path, run) in [("dispatch", skin_bounded as Kernel), ("portable", skin_portable)] {
+    for path in Simd::available() {
         let mut out = vec![Vec3::splat(f32::NAN); n];
-        let grown = run(bind, weights, palette, &mut out);
+        let grown = skin_using(path, bind, weights, palette, &mut out);
         let worst = expected.iter().zip(&out).map(|(a, b)| (*a - *b).abs().max_element()).fold(0.0f32, f32::max);
-        assert!(worst <= 1e-5 * scale, "{name} ({path}): worst difference {worst:e} (mesh scale {scale})");
+        assert!(worst <= 1e-5 * scale, "{name} ({path:?}): worst difference {worst:e} (mesh scale {scale})");
         // The box grown as the vertices are written is the box of what was written.
-        assert_eq!(grown.pair(), bounds(&out), "{name} ({path}): bounds");
+        assert_eq!(grown.pair(), bounds(&out), "{name} ({path:?}): bounds");
     }
     assert_normals_match_oracle(name, bind, weights, palette);
 }
 
-/// The kernel that skins normals with the positions (both paths) against the plain loop:
+/// The kernel that skins normals with the positions (each level) against the plain loop:
 /// positions, normals and box. Outputs start as NaN, so a vertex left unwritten fails.
 fn assert_normals_match_oracle(name: &str, bind: &[Vec3], weights: &SkinWeights, palette: &[Mat4]) {
-    use marionette::rig::lbs::{Normals, skin_with_normals, skin_with_normals_portable};
+    use marionette::rig::lbs::{Normals, skin_with_normals_using};
     let n = bind.len();
     let centre = bind.iter().sum::<Vec3>() / n.max(1) as f32;
     let bind_normals: Vec<Vec3> = bind.iter().map(|p| (*p - centre).normalize_or(Vec3::Y)).collect();
@@ -47,18 +47,18 @@ fn assert_normals_match_oracle(name: &str, bind: &[Vec3], weights: &SkinWeights,
     let normals = Normals { bind: &bind_normals, out: &mut expected_normals };
     marionette::rig::skinning::skin_positions_and_normals(bind, weights, palette, &mut expected, normals);
     let scale = expected.iter().fold(1.0f32, |m, p| m.max(p.abs().max_element()));
-    type WithNormals = fn(&[Vec3], &SkinWeights, &[Mat4], &mut [Vec3], Normals) -> Bounds;
-    for (path, run) in [("dispatch", skin_with_normals as WithNormals), ("portable", skin_with_normals_portable)] {
+    for path in Simd::available() {
         let (mut out, mut out_normals) = (vec![Vec3::splat(f32::NAN); n], vec![Vec3::splat(f32::NAN); n]);
-        let grown = run(bind, weights, palette, &mut out, Normals { bind: &bind_normals, out: &mut out_normals });
+        let normals = Normals { bind: &bind_normals, out: &mut out_normals };
+        let grown = skin_with_normals_using(path, bind, weights, palette, &mut out, normals);
         let worst =
             |a: &[Vec3], b: &[Vec3]| a.iter().zip(b).map(|(a, b)| (*a - *b).abs().max_element()).fold(0.0f32, f32::max);
         let (positions, normals) = (worst(&expected, &out), worst(&expected_normals, &out_normals));
-        assert!(positions <= 1e-5 * scale, "{name} ({path}, with normals): positions {positions:e}");
+        assert!(positions <= 1e-5 * scale, "{name} ({path:?}, with normals): positions {positions:e}");
         // Normals are unit vectors turned by blends of palette matrices (scaled in the
         // synthetic set by up to 1.5): 1e-5 of their size.
-        assert!(normals <= 1e-5 * 2.0, "{name} ({path}): normals {normals:e}");
-        assert_eq!(grown.pair(), bounds(&out), "{name} ({path}, with normals): bounds");
+        assert!(normals <= 1e-5 * 2.0, "{name} ({path:?}): normals {normals:e}");
+        assert_eq!(grown.pair(), bounds(&out), "{name} ({path:?}, with normals): bounds");
     }
 }
 
