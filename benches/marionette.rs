@@ -438,3 +438,29 @@ fn skin_phase_parts(bencher: Bencher, part: &str) {
             .for_each(|(s, v)| *s = bytemuck::cast(v)),
     });
 }
+
+/// The LBS kernel over `bodies` SMPL bodies of their own β (their own bind positions and
+/// output, shared weights) in turn on one core, in vertices per second: against one body
+/// skinned again and again (the kernel's speed, all in cache), what a crowd's memory costs
+/// the kernel alone. (The puppet stands in without `MARIONETTE_DATA`.)
+#[divan::bench(args = [1, 64, 256])]
+fn kernel_skin_crowd_one_core(bencher: Bencher, bodies: usize) {
+    let model = std::env::var_os("MARIONETTE_DATA")
+        .map(|d| std::path::PathBuf::from(d).join("smpl"))
+        .and_then(|dir| marionette::formats::smpl::load_smpl_dir(&dir).ok());
+    let assets: Vec<Arc<CharacterAsset>> = (0..bodies)
+        .map(|i| match &model {
+            Some((model, _)) => Arc::new(model.asset("smpl", &[0.01 * i as f32, -0.5]).expect("a body")),
+            None => asset(),
+        })
+        .collect();
+    let palettes: Vec<Vec<Mat4>> = assets.iter().map(|a| posed_palette(a)).collect();
+    let mut outs: Vec<Vec<Vec3>> = assets.iter().map(|a| vec![Vec3::ZERO; a.vertex_count()]).collect();
+    let vertices = assets.iter().map(|a| a.vertex_count()).sum::<usize>();
+    bencher.counter(divan::counter::ItemsCount::new(vertices)).bench_local(|| {
+        for ((asset, palette), out) in assets.iter().zip(&palettes).zip(&mut outs) {
+            let skin = &asset.skin;
+            marionette::rig::lbs::skin(&skin.bind_positions, &skin.weights, palette, divan::black_box(out));
+        }
+    });
+}
