@@ -81,6 +81,8 @@ pub struct Measured {
     pub debug_assertions: bool,
     /// Bevy's pipelined rendering (off: each phase is timed in order).
     pub pipelined_rendering: bool,
+    /// The level of the skinning kernels this CPU ran (`Avx512Vl`, `Avx2` or `Portable`).
+    pub kernel_level: String,
 }
 
 impl Measured {
@@ -90,6 +92,7 @@ impl Measured {
             profile: env!("MARIONETTE_BUILD_PROFILE").to_string(),
             debug_assertions: cfg!(debug_assertions),
             pipelined_rendering,
+            kernel_level: format!("{:?}", crate::rig::simd::Simd::best()),
         }
     }
 }
@@ -204,9 +207,10 @@ pub fn table(r: &BenchReport) -> String {
         format!("{} profile", m.profile)
     };
     let how = format!(
-        "measured on {} cores, {profile}, pipelined rendering {}\n",
+        "measured on {} cores, {profile}, pipelined rendering {}, kernels at level {}\n",
         m.cores,
-        if m.pipelined_rendering { "on" } else { "off" }
+        if m.pipelined_rendering { "on" } else { "off" },
+        m.kernel_level
     );
     how + &format!(
         "{} × {} ({} vertices each), {} frames, skinned {}\n\

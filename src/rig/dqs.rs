@@ -52,7 +52,8 @@ pub fn dual_quaternion_palette(palette: &[Mat4], out: &mut Vec<DualQuat>) {
     out.extend(palette.iter().map(DualQuat::from_rigid));
 }
 
-/// Skins bind-pose vertices with dual quaternions. On x86-64 with AVX2 and FMA, in the
+/// Skins bind-pose vertices with dual quaternions, at the best level of the kernel the CPU
+/// runs ([`Simd::best`]). On x86-64 with AVX2 and FMA, in the
 /// linear blend kernel's blocks of eight consecutive vertices, one a lane: each of a
 /// block's joints adds its dual quaternion into all eight blends at once, its weight's sign
 /// flipped lane by lane into the hemisphere of that vertex's pivot; then the eight blends

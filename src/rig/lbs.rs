@@ -4,6 +4,8 @@
 //! of a block's joints transforms all eight bind positions at once, weighted lane by lane
 //! (`pᵥ = Σⱼ wᵥⱼ (Pⱼ bᵥ)`), so a joint's matrix is read once for eight vertices. Elsewhere
 //! each vertex blends its own matrices with glam's `Vec4`, grouped by influence count.
+//! The SIMD kernels are built twice ([`Simd`]: with AVX-512 VL as well, where the CPU has
+//! it); the `_using` entry points run any level the CPU has.
 //! [`skin_positions`](super::skinning::skin_positions) stays as the plain oracle.
 
 use glam::{Mat4, Vec3, Vec3A, Vec4};
@@ -64,6 +66,7 @@ pub fn skin_using(
     skin_chunk_using(simd, bind_positions, weights, palette, 0, out)
 }
 
+/// [`skin_chunk`] at a given level of the kernel.
 fn skin_chunk_using(
     simd: Simd,
     bind_positions: &[Vec3],

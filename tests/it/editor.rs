@@ -254,6 +254,8 @@ fn bench_finds_the_smpl_bodies_it_is_given_or_says_why_not() {
     assert_eq!(report["kind"], "puppet");
     assert!(report["measured"]["cores"].as_u64() >= Some(1));
     assert_eq!(report["measured"]["pipelined_rendering"], false);
+    let level = format!("{:?}", marionette::rig::simd::Simd::best());
+    assert_eq!(report["measured"]["kernel_level"], level.as_str());
     for phase in ["sampling", "fk", "skin", "extract", "upload", "render_world", "frame"] {
         let p = &report["phases_ms"][phase];
         assert!(p["p95"].as_f64() >= p["p50"].as_f64(), "{phase}: {p}");
