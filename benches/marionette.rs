@@ -412,30 +412,25 @@ fn ik_solve_dragon_tail(bencher: Bencher) {
 
 /// The passes of one SMPL body's share of the crowd's skin phase and upload, each alone,
 /// in vertices per second: the kernel, the bounds of its output, packing the other
-/// attributes (a colour change), and interleaving positions and attributes as the render
-/// world writes them into the mesh's slot.
-#[divan::bench(args = ["kernel", "bounds", "pack", "interleave"])]
+/// attributes (a colour change), and copying the positions as the render world writes them
+/// into the mesh's slot.
+#[divan::bench(args = ["kernel", "bounds", "pack", "copy"])]
 fn skin_phase_parts(bencher: Bencher, part: &str) {
-    use marionette::scene::upload::{SkinUpload, interleaved};
+    use marionette::scene::upload::SkinAttributes;
     let body = smpl_body();
     let palette = posed_palette(&body);
     let skin = &body.skin;
     let mut positions = vec![Vec3::ZERO; skin.bind_positions.len()];
     marionette::rig::lbs::skin(&skin.bind_positions, &skin.weights, &palette, &mut positions);
     let colors = vec![[0.8, 0.7, 0.6, 1.0]; positions.len()];
-    let mut upload = SkinUpload::default();
-    upload.pack_attributes(&skin.texcoords, &colors);
-    assert_eq!(upload.floats, 4, "the body has no texture coordinates");
+    let mut attributes = SkinAttributes::default();
     let mut out = positions.clone();
-    let mut slot = vec![[0u8; 16]; positions.len()];
+    let mut slot = vec![0u8; std::mem::size_of_val(positions.as_slice())];
     bencher.counter(divan::counter::ItemsCount::new(positions.len())).bench_local(|| match part {
         "kernel" => marionette::rig::lbs::skin(&skin.bind_positions, &skin.weights, &palette, &mut out),
         "bounds" => drop(divan::black_box(marionette::rig::skinning::bounds(&positions))),
-        "pack" => upload.pack_attributes(&skin.texcoords, &colors),
-        _ => slot
-            .iter_mut()
-            .zip(interleaved::<4>(&positions, &upload.attributes))
-            .for_each(|(s, v)| *s = bytemuck::cast(v)),
+        "pack" => attributes.pack(&skin.texcoords, &colors),
+        _ => slot.copy_from_slice(bytemuck::cast_slice(divan::black_box(&positions))),
     });
 }
 

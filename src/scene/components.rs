@@ -20,6 +20,7 @@ use crate::rig::{CharacterAsset, DofLimits, JointRotation};
     Visibility,
     RestOverrides,
     super::handoff::SkinUpload,
+    super::handoff::SkinAttributes,
     SkinOnGpu,
     super::handoff::GpuSkinJob
 )]

@@ -1,13 +1,12 @@
 //! GPU skinning (the 6.837 assignment's "accelerate SSD using shaders"): a compute shader
 //! (`gpu_skinning.wgsl`) takes the same palette and bind data as the CPU kernels and writes
-//! the skinned positions into the packed vertices, which are copied into the mesh's slot of
-//! the vertex buffer. Chosen per character ([`SkinOnGpu`](super::SkinOnGpu), the inspector,
+//! the skinned positions, which are copied into the mesh's slot of the vertex buffer (the
+//! positions are the whole of it: the material reads the other attributes). Chosen per character ([`SkinOnGpu`](super::SkinOnGpu), the inspector,
 //! the scene file); the CPU path stays the default.
 //!
 //! The main world hands over each re-posed character's palette ([`GpuSkinJob`]); the render
 //! world keeps, per character, the bind positions and influences on the GPU (uploaded once
-//! per asset), the packed vertices as a template (texture coordinates and colours; written
-//! again only when they change), and dispatches one invocation per vertex.
+//! per asset), and dispatches one invocation per vertex.
 //!
 //! Flat normals need no pass: the skin material lights each triangle with its own normal.
 //! Culling is off for these skins ([`NoFrustumCulling`]): the main world has no skinned
@@ -31,38 +30,20 @@ use bevy::render::renderer::{RenderDevice, RenderQueue};
 use bevy::render::{Extract, ExtractSchedule, Render, RenderApp, RenderSystems};
 
 use super::components::{Character, SkinOnGpu, SkinScratch};
-use super::upload::pack_vertices;
 use crate::rig::CharacterAsset;
 use crate::rig::dqs::{self, SkinningMethod};
 
 pub use super::handoff::{GpuSkinInput, GpuSkinJob};
 
-/// Hands over the character's palette (from `scratch`, as `method` takes it) in its
-/// job, and a new template when the colours changed or there was none.
-pub fn hand_over(
-    job: &mut GpuSkinJob,
-    character: &Character,
-    method: SkinningMethod,
-    scratch: &mut SkinScratch,
-    recolored: bool,
-) {
-    let skin = &character.asset.skin;
-    let kept = job.0.as_ref().filter(|job| !recolored && Arc::ptr_eq(&job.asset, &character.asset));
-    let (template, floats) = match kept {
-        Some(job) => (job.template.clone(), job.floats),
-        None => {
-            let mut template = Vec::new();
-            let floats = pack_vertices(&skin.bind_positions, &skin.texcoords, &scratch.colors, &mut template);
-            (Arc::new(template), floats)
-        }
-    };
+/// Hands over the character's palette (from `scratch`, as `method` takes it) in its job.
+pub fn hand_over(job: &mut GpuSkinJob, character: &Character, method: SkinningMethod, scratch: &mut SkinScratch) {
     let palette = if method.is_linear() {
         scratch.palette.clone()
     } else {
         dqs::dual_quaternion_palette(&scratch.palette, &mut scratch.dual_quaternions);
         scratch.dual_quaternions.iter().map(|q| Mat4::from_cols(q.real, q.dual, Vec4::ZERO, Vec4::ZERO)).collect()
     };
-    job.0 = Some(GpuSkinInput { asset: character.asset.clone(), palette: Arc::new(palette), method, template, floats });
+    job.0 = Some(GpuSkinInput { asset: character.asset.clone(), palette: Arc::new(palette), method });
 }
 
 /// The compute path: culling off for GPU-skinned skins, extraction of the jobs, the
@@ -114,9 +95,8 @@ struct SkinningPipeline {
 
 /// One character's buffers on the GPU.
 struct SkinBuffers {
-    /// The asset they were made from, and the template last written into `vertices`.
+    /// The asset they were made from.
     asset: Arc<CharacterAsset>,
-    template: Arc<Vec<f32>>,
     params: Buffer,
     palette: Buffer,
     vertices: Buffer,
@@ -161,26 +141,15 @@ fn dispatch_gpu_skinning(
             return *waited < MAX_WAIT_FRAMES;
         };
         let vertex_count = input.asset.vertex_count();
-        let bytes = (input.template.len() * 4) as u64;
-        if (slice.range.end - slice.range.start) as usize != vertex_count
-            || input.template.len() != vertex_count * input.floats
-        {
+        if (slice.range.end - slice.range.start) as usize != vertex_count {
             return false;
         }
         let skin = match gpu.skins.get_mut(entity) {
             Some(skin) if Arc::ptr_eq(&skin.asset, &input.asset) => skin,
             _ => gpu.skins.entry(*entity).insert_entry(SkinBuffers::new(&device, pipeline, input)).into_mut(),
         };
-        if !Arc::ptr_eq(&skin.template, &input.template) {
-            queue.write_buffer(&skin.vertices, 0, bytemuck::cast_slice(&input.template));
-            skin.template = input.template.clone();
-        }
         let method = u32::from(!input.method.is_linear());
-        queue.write_buffer(
-            &skin.params,
-            0,
-            bytemuck::cast_slice(&[vertex_count as u32, input.floats as u32, method, 0]),
-        );
+        queue.write_buffer(&skin.params, 0, bytemuck::cast_slice(&[vertex_count as u32, method, 0, 0]));
         queue.write_buffer(&skin.palette, 0, bytemuck::cast_slice(input.palette.as_slice()));
         {
             let mut pass =
@@ -190,12 +159,15 @@ fn dispatch_gpu_skinning(
             let (x, y) = workgroups(vertex_count);
             pass.dispatch_workgroups(x, y, 1);
         }
-        let offset = u64::from(slice.range.start) * input.floats as u64 * 4;
+        let (offset, bytes) = (u64::from(slice.range.start) * VERTEX_BYTES, vertex_count as u64 * VERTEX_BYTES);
         encoder.copy_buffer_to_buffer(&skin.vertices, 0, slice.buffer, offset, bytes);
         false
     });
     queue.submit([encoder.finish()]);
 }
+
+/// Bytes of a skin vertex in the vertex buffer (its position).
+const VERTEX_BYTES: u64 = super::handoff::SKIN_VERTEX_BYTES as u64;
 
 /// Vertices per workgroup (the shader's `@workgroup_size`).
 const WORKGROUP: usize = 64;
@@ -255,7 +227,7 @@ impl SkinningPipeline {
 
 impl SkinBuffers {
     /// The asset's bind positions and influences on the GPU, and room for the palette and
-    /// the packed vertices.
+    /// the skinned positions.
     fn new(device: &RenderDevice, pipeline: &SkinningPipeline, input: &GpuSkinInput) -> Self {
         let skin = &input.asset.skin;
         // A skin without vertices still gets buffers a binding accepts (not empty ones).
@@ -284,26 +256,29 @@ impl SkinBuffers {
         let influences = with_data("influences", bytemuck::cast_slice(&influences));
         let params = empty("skinning params", 16, BufferUsages::UNIFORM);
         let palette = empty("palette", input.palette.len() * 64, BufferUsages::STORAGE);
-        let vertices =
-            empty("skinned vertices", input.template.len() * 4, BufferUsages::STORAGE | BufferUsages::COPY_SRC);
+        let vertices = empty(
+            "skinned positions",
+            input.asset.vertex_count() * VERTEX_BYTES as usize,
+            BufferUsages::STORAGE | BufferUsages::COPY_SRC,
+        );
         let entries = [&params, &palette, &bind, &offsets, &influences, &vertices]
             .into_iter()
             .enumerate()
             .map(|(binding, buffer)| BindGroupEntry { binding: binding as u32, resource: buffer.as_entire_binding() })
             .collect::<Vec<_>>();
         let bind_group = device.create_bind_group("marionette gpu skinning", &pipeline.layout, &entries);
-        Self { asset: input.asset.clone(), template: Arc::new(Vec::new()), params, palette, vertices, bind_group }
+        Self { asset: input.asset.clone(), params, palette, vertices, bind_group }
     }
 }
 
-/// Reads back a mesh's packed vertices from its slot of the vertex buffer (render world;
-/// blocks until the GPU has finished). For tests that compare the GPU path with the CPU.
-pub fn read_back_mesh_vertices(render_world: &World, mesh: AssetId<Mesh>, floats: usize) -> Option<Vec<f32>> {
+/// Reads back a mesh's positions from its slot of the vertex buffer (render world; blocks
+/// until the GPU has finished). For tests that compare the GPU path with the CPU.
+pub fn read_back_mesh_positions(render_world: &World, mesh: AssetId<Mesh>) -> Option<Vec<Vec3>> {
     let allocator = render_world.get_resource::<MeshAllocator>()?;
     let device = render_world.get_resource::<RenderDevice>()?;
     let queue = render_world.get_resource::<RenderQueue>()?;
     let slice = allocator.mesh_vertex_slice(&mesh)?;
-    let bytes = u64::from(slice.range.end - slice.range.start) * floats as u64 * 4;
+    let bytes = u64::from(slice.range.end - slice.range.start) * VERTEX_BYTES;
     let staging = device.create_buffer(&BufferDescriptor {
         label: Some("read back"),
         size: bytes,
@@ -311,7 +286,7 @@ pub fn read_back_mesh_vertices(render_world: &World, mesh: AssetId<Mesh>, floats
         mapped_at_creation: false,
     });
     let mut encoder = device.create_command_encoder(&CommandEncoderDescriptor { label: Some("read back") });
-    encoder.copy_buffer_to_buffer(slice.buffer, u64::from(slice.range.start) * floats as u64 * 4, &staging, 0, bytes);
+    encoder.copy_buffer_to_buffer(slice.buffer, u64::from(slice.range.start) * VERTEX_BYTES, &staging, 0, bytes);
     queue.submit([encoder.finish()]);
     let (sender, receiver) = std::sync::mpsc::channel();
     staging.slice(..).map_async(MapMode::Read, move |result| {
@@ -319,6 +294,6 @@ pub fn read_back_mesh_vertices(render_world: &World, mesh: AssetId<Mesh>, floats
     });
     device.poll(PollType::wait_indefinitely()).ok()?;
     receiver.recv().ok()?.ok()?;
-    let floats = bytemuck::cast_slice::<u8, f32>(&staging.slice(..).get_mapped_range()).to_vec();
-    Some(floats)
+    let positions = bytemuck::cast_slice::<u8, Vec3>(&staging.slice(..).get_mapped_range()).to_vec();
+    Some(positions)
 }

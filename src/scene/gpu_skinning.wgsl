@@ -1,17 +1,15 @@
 // GPU skinning: one invocation per vertex. It takes the same palette and bind data as the
-// CPU kernels (`rig::lbs`, `rig::dqs`) and writes the skinned position into the packed
-// vertex (position first, then what the template holds: texture coordinates, colour), which
-// is then copied into the mesh's slot of the vertex buffer. Normals need no pass: the skin
+// CPU kernels (`rig::lbs`, `rig::dqs`) and writes the skinned position, which is then
+// copied into the mesh's slot of the vertex buffer (positions only: the skin material reads
+// texture coordinates and colours from a buffer of its own). Normals need no pass: the skin
 // material lights each triangle with its own normal, from the screen-space derivatives of
 // the position.
 
 struct Params {
     vertex_count: u32,
-    // Floats per packed vertex (7 or 9).
-    floats: u32,
     // 0: linear blend; 1: dual quaternion (palette holds real, dual per joint).
     method: u32,
-    _pad: u32,
+    _pad: vec2<u32>,
 }
 
 @group(0) @binding(0) var<uniform> params: Params;
@@ -22,7 +20,8 @@ struct Params {
 // The influences of vertex v are influences[offsets[v] .. offsets[v + 1]]: (joint, weight bits).
 @group(0) @binding(3) var<storage, read> offsets: array<u32>;
 @group(0) @binding(4) var<storage, read> influences: array<vec2<u32>>;
-@group(0) @binding(5) var<storage, read_write> vertices: array<f32>;
+// Three floats per vertex.
+@group(0) @binding(5) var<storage, read_write> positions: array<f32>;
 
 fn linear_blend(first: u32, last: u32, p: vec3<f32>) -> vec3<f32> {
     var m = mat4x4<f32>(vec4(0.0), vec4(0.0), vec4(0.0), vec4(0.0));
@@ -80,8 +79,7 @@ fn skin(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_workgroups) g
     } else {
         moved = dual_quaternion(first, last, p);
     }
-    let o = v * params.floats;
-    vertices[o] = moved.x;
-    vertices[o + 1u] = moved.y;
-    vertices[o + 2u] = moved.z;
+    positions[3u * v] = moved.x;
+    positions[3u * v + 1u] = moved.y;
+    positions[3u * v + 2u] = moved.z;
 }

@@ -93,28 +93,20 @@ fn surface_mesh(skin: &crate::rig::Skin, surface: &crate::rig::material::Surface
         .iter()
         .map(|t| t.map(|i| i - first))
         .collect();
-    let texcoords = skin.texcoords.get(first as usize..end as usize).unwrap_or(&[]);
-    empty_skin_mesh(&triangles, (end - first) as usize, texcoords)
+    empty_skin_mesh(&triangles, (end - first) as usize)
 }
 
-/// A render mesh of the skin's own vertices and triangles: positions and colours (four
-/// bytes, [`SKIN_COLOR`](super::handoff::SKIN_COLOR)), no
-/// normals (the skin material lights each triangle with its own normal, from the
-/// derivatives of the position). Its vertex data is what `upload::pack_vertices` packs.
-pub fn empty_skin_mesh(triangles: &[[u32; 3]], vertex_count: usize, texcoords: &[Vec2]) -> Mesh {
-    // Only the render world keeps it: the skinning system writes vertices straight into its
+/// A render mesh of the skin's own vertices and triangles, positions only: no normals (the
+/// skin material lights each triangle with its own normal, from the derivatives of the
+/// position), and texture coordinates and colours in the material's own buffer
+/// ([`SkinAttributes`](super::handoff::SkinAttributes)), so that a moving character hands
+/// the GPU 12 bytes a vertex.
+pub fn empty_skin_mesh(triangles: &[[u32; 3]], vertex_count: usize) -> Mesh {
+    // Only the render world keeps it: the skinning system writes positions straight into its
     // GPU slot (see `upload`), never into this asset.
-    let mut mesh = Mesh::new(PrimitiveTopology::TriangleList, RenderAssetUsages::RENDER_WORLD)
+    Mesh::new(PrimitiveTopology::TriangleList, RenderAssetUsages::RENDER_WORLD)
         .with_inserted_attribute(Mesh::ATTRIBUTE_POSITION, vec![[0.0f32; 3]; vertex_count])
-        .with_inserted_attribute(
-            super::handoff::SKIN_COLOR,
-            bevy::mesh::VertexAttributeValues::Unorm8x4(vec![[255; 4]; vertex_count]),
-        )
-        .with_inserted_indices(Indices::U32(triangles.iter().flatten().copied().collect()));
-    if !texcoords.is_empty() {
-        mesh.insert_attribute(Mesh::ATTRIBUTE_UV_0, texcoords.iter().map(|t| t.to_array()).collect::<Vec<_>>());
-    }
-    mesh
+        .with_inserted_indices(Indices::U32(triangles.iter().flatten().copied().collect()))
 }
 
 /// Despawns a character, its joints leaves first and its skin mesh entity. Bevy's

@@ -4,7 +4,7 @@ use bevy::camera::primitives::Aabb;
 use bevy::prelude::*;
 
 use super::components::*;
-use super::handoff::{GpuSkinJob, SkinUpload};
+use super::handoff::{GpuSkinJob, SkinAttributes, SkinUpload};
 use crate::rig::JointRotation;
 use crate::rig::fk::forward_kinematics_with_rest;
 use crate::rig::skinning::{Bounds, bounds, heat_colors, joint_colors, weight_colors};
@@ -113,10 +113,10 @@ pub fn compute_joint_to_world(
 /// Skins characters marked dirty, in model space and in parallel on Bevy's compute task
 /// pool: palette `current · bind` from the matrix stack's output (`JointScratch`) and the
 /// asset's shared inverse binds, the LBS or DQ kernel of the bind vertices and their
-/// bounds; the colours when they changed, packed for the GPU (the render world
-/// interleaves them with the positions, see `upload`). Characters skinned on the GPU hand
-/// over the palette instead (reads `JointScratch`, `Character`; writes `SkinScratch`,
-/// `SkinUpload`, `GpuSkinJob`).
+/// bounds; the colours and texture coordinates when the colours changed, packed for the
+/// skin material (see `SkinAttributes`). Characters skinned on the GPU hand over the
+/// palette instead (reads `JointScratch`, `Character`; writes `SkinScratch`, `SkinUpload`,
+/// `SkinAttributes`, `GpuSkinJob`).
 pub fn skin_changed_characters(
     mut characters: Query<(
         &Character,
@@ -127,6 +127,7 @@ pub fn skin_changed_characters(
         &PoseDirty,
         &mut SkinScratch,
         &mut SkinUpload,
+        &mut SkinAttributes,
         &mut GpuSkinJob,
         &JointScratch,
     )>,
@@ -135,7 +136,7 @@ pub fn skin_changed_characters(
     // the others (Bevy's default of one batch a thread left the phase a third longer).
     let batches = bevy::ecs::batching::BatchingStrategy::new().batches_per_thread(8);
     characters.par_iter_mut().batching_strategy(batches).for_each(
-        |(character, view, method, on_gpu, heat, dirty, mut scratch, mut upload, mut job, joints)| {
+        |(character, view, method, on_gpu, heat, dirty, mut scratch, mut upload, mut attributes, mut job, joints)| {
             if *dirty == PoseDirty::default() {
                 return;
             }
@@ -154,6 +155,7 @@ pub fn skin_changed_characters(
             let recolored = dirty.colors || scratch.colors.len() != skin.bind_positions.len();
             if recolored {
                 vertex_colors(character, view, heat.0, &mut scratch.colors);
+                attributes.pack(&skin.texcoords, &scratch.colors);
             }
             // The compute shader writes one mesh's slot: characters drawn in several
             // surfaces are skinned here.
@@ -165,7 +167,7 @@ pub fn skin_changed_characters(
                 } else if moved {
                     scratch.bounds = scratch.influence_hull_bounds(&character.asset);
                 }
-                super::gpu_skinning::hand_over(&mut job, character, method.0, scratch, recolored);
+                super::gpu_skinning::hand_over(&mut job, character, method.0, scratch);
                 return;
             }
             if job.0.is_some() {
@@ -173,13 +175,8 @@ pub fn skin_changed_characters(
             }
             if moved {
                 skin_on_cpu(skin, method.0, scratch);
-            }
-            // Colours and texture coordinates are packed again only when they changed; the
-            // render world interleaves them with the new positions as it writes the mesh.
-            if recolored || upload.vertex_count() != skin.bind_positions.len() {
-                upload.pack_attributes(&skin.texcoords, &scratch.colors);
-            } else if moved {
-                upload.set_changed();
+                // Marks the upload changed: the render world takes the new positions.
+                upload.vertex_count = skin.bind_positions.len();
             }
         },
     );

@@ -1,11 +1,12 @@
 //! Handing skinned vertices to the GPU without Bevy's whole-mesh path: the skinning system
-//! skins each re-posed character's positions into its `SkinScratch` and packs the other
-//! attributes (texture coordinates where the skin has them, colour) into its
-//! [`SkinUpload`] only when they change; the render world takes the changed ones (`Arc`s,
-//! no copy) and interleaves them, in the skin mesh's own layout, straight into the staging
-//! memory of the mesh's slot of the vertex buffer. The skin mesh asset itself is never
-//! modified after it is made, so Bevy neither clones it into the render world nor re-packs
-//! it each frame, and indices stay as they were uploaded.
+//! skins each re-posed character's positions into its `SkinScratch` and marks its
+//! [`SkinUpload`] changed; the render world takes the changed ones (an `Arc`, no copy) and
+//! copies them straight into the staging memory of the mesh's slot of the vertex buffer,
+//! which holds positions only (12 bytes a vertex): texture coordinates and colours are the
+//! skin material's own buffer ([`SkinAttributes`](super::handoff::SkinAttributes)), written
+//! only when they change. The skin mesh asset itself is never modified after it is made,
+//! so Bevy neither clones it into the render world nor re-packs it each frame, and indices
+//! stay as they were uploaded.
 
 use std::collections::HashMap;
 use std::sync::Arc;
@@ -18,43 +19,41 @@ use bevy::render::{Extract, ExtractSchedule, Render, RenderApp, RenderSystems};
 
 use super::components::{Character, SkinScratch};
 
-pub use super::handoff::{SKIN_VERTEX_BYTES, SkinUpload, interleaved, pack_vertices};
+pub use super::handoff::{SKIN_VERTEX_BYTES, SkinAttributes, SkinUpload};
 
-/// Bytes handed to the GPU in the last frame (the vertices of the uploads that changed,
-/// and the palettes of characters skinned on the GPU), for benchmarks and readouts.
+/// Bytes handed to the GPU in the last frame (the positions of the uploads that changed,
+/// the attributes that changed, and the palettes of characters skinned on the GPU), for
+/// benchmarks and readouts.
 #[derive(Resource, Default, Debug)]
 pub struct HandedOn(pub usize);
 
-/// Counts the vertices that changed and, for characters skinned on the GPU, their
-/// palettes (reads `SkinUpload`, `GpuSkinJob`; writes `HandedOn`).
+/// Counts the positions and attributes that changed and, for characters skinned on the
+/// GPU, their palettes (reads `SkinUpload`, `SkinAttributes`, `GpuSkinJob`; writes
+/// `HandedOn`).
 fn count_handed_on(
     changed: Query<&SkinUpload, Changed<SkinUpload>>,
+    recolored: Query<&SkinAttributes, Changed<SkinAttributes>>,
     gpu_jobs: Query<&super::handoff::GpuSkinJob, Changed<super::handoff::GpuSkinJob>>,
     mut handed: ResMut<HandedOn>,
 ) {
     let palettes: usize =
         gpu_jobs.iter().filter_map(|j| j.0.as_ref()).map(|j| std::mem::size_of_val(j.palette.as_slice())).sum();
-    handed.0 = changed.iter().map(SkinUpload::byte_len).sum::<usize>() + palettes;
+    let attributes: usize = recolored.iter().map(|a| std::mem::size_of_val(a.0.as_slice())).sum();
+    handed.0 = changed.iter().map(SkinUpload::byte_len).sum::<usize>() + attributes + palettes;
 }
 
-/// An upload waiting for its mesh's slot: the character's skinned positions and packed
-/// attributes, the floats per vertex, the range of vertices that mesh shows, and the
-/// frames waited.
+/// An upload waiting for its mesh's slot: the character's skinned positions, the range of
+/// them that mesh shows, and the frames waited.
 struct Pending {
     positions: Arc<Vec<Vec3>>,
-    attributes: Arc<Vec<f32>>,
-    floats: usize,
     range: std::ops::Range<u32>,
     waited: u32,
 }
 
 impl Pending {
-    /// The positions and attributes of this part's vertices; none when they do not hold
-    /// all of them (or `floats` is no layout of [`pack_vertices`]).
-    fn part(&self) -> Option<(&[Vec3], &[f32])> {
-        let (start, end) = (self.range.start as usize, self.range.end as usize);
-        let rest = [4, 6].contains(&self.floats).then(|| self.floats - 3)?;
-        Some((self.positions.get(start..end)?, self.attributes.get(start * rest..end * rest)?))
+    /// The positions of this part's vertices; none when they do not hold all of them.
+    fn part(&self) -> Option<&[Vec3]> {
+        self.positions.get(self.range.start as usize..self.range.end as usize)
     }
 }
 
@@ -89,19 +88,18 @@ fn extract_skin_uploads(
     mut pending: ResMut<PendingUploads>,
 ) {
     for (character, upload, scratch) in &skins {
-        if upload.attributes.is_empty() {
+        if upload.vertex_count == 0 {
             continue;
         }
         for part in &character.skins {
-            let (positions, attributes) = (scratch.positions.clone(), upload.attributes.clone());
-            let (floats, range) = (upload.floats, part.vertices.clone());
-            pending.0.insert(part.mesh.id(), Pending { positions, attributes, floats, range, waited: 0 });
+            let (positions, range) = (scratch.positions.clone(), part.vertices.clone());
+            pending.0.insert(part.mesh.id(), Pending { positions, range, waited: 0 });
         }
     }
 }
 
-/// Writes each pending upload into its mesh's slot of the vertex buffer, interleaved in
-/// the staging memory the queue copies from, after Bevy has allocated and filled the slots
+/// Copies each pending upload into its mesh's slot of the vertex buffer, through the
+/// staging memory the queue copies from, after Bevy has allocated and filled the slots
 /// of new meshes (reads `MeshAllocator`; writes GPU buffers). Slots that follow one another
 /// in a buffer (a crowd's meshes, allocated in turn) are written through one staging
 /// allocation: each allocation costs about as much as filling a body's slot.
@@ -131,31 +129,23 @@ struct SlotWrite<'a> {
     /// Bytes into the buffer.
     offset: u64,
     positions: &'a [Vec3],
-    attributes: &'a [f32],
-    floats: usize,
 }
 
 impl<'a> SlotWrite<'a> {
     /// The write of `upload` into `slice`; none when its vertices do not fill the slot
     /// exactly.
     fn of(slice: MeshBufferSlice<'a>, upload: &'a Pending) -> Option<Self> {
-        let (positions, attributes) = upload.part()?;
+        let positions = upload.part()?;
         (positions.len() == (slice.range.end - slice.range.start) as usize).then(|| Self {
             buffer: slice.buffer,
-            offset: u64::from(slice.range.start) * upload.floats as u64 * 4,
+            offset: u64::from(slice.range.start) * SKIN_VERTEX_BYTES as u64,
             positions,
-            attributes,
-            floats: upload.floats,
         })
-    }
-
-    fn bytes(&self) -> usize {
-        self.positions.len() * self.floats * 4
     }
 
     /// The byte after the slot.
     fn end(&self) -> u64 {
-        self.offset + self.bytes() as u64
+        self.offset + std::mem::size_of_val(self.positions) as u64
     }
 }
 
@@ -169,12 +159,7 @@ fn write_run(queue: &RenderQueue, run: &[SlotWrite]) {
     };
     for write in run {
         let at = (write.offset - first.offset) as usize;
-        let slot = view.slice(at..at + write.bytes());
-        let (positions, attributes) = (write.positions, write.attributes);
-        match write.floats {
-            4 => slot.into_chunks::<16>().0.write_iter(interleaved::<4>(positions, attributes).map(bytemuck::cast)),
-            6 => slot.into_chunks::<24>().0.write_iter(interleaved::<6>(positions, attributes).map(bytemuck::cast)),
-            _ => {}
-        }
+        let bytes: &[u8] = bytemuck::cast_slice(write.positions);
+        view.slice(at..at + bytes.len()).copy_from_slice(bytes);
     }
 }

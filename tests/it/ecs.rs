@@ -34,11 +34,9 @@ pub fn spawn(app: &mut App, asset: Arc<CharacterAsset>, placement: Placement) ->
 /// The positions and colours a character hands to the GPU (its skinned positions and the
 /// colours decoded from its packed attributes).
 fn uploaded_vertices(app: &App, character: Entity) -> (Vec<[f32; 3]>, Vec<[f32; 4]>) {
-    let upload = app.world().get::<marionette::scene::upload::SkinUpload>(character).unwrap();
+    let attributes = app.world().get::<marionette::scene::upload::SkinAttributes>(character).unwrap();
     let positions = &app.world().get::<marionette::scene::SkinScratch>(character).unwrap().positions;
-    // The colour is the last four bytes of each vertex (unorm8x4).
-    let color = |word: f32| word.to_bits().to_le_bytes().map(|b| f32::from(b) / 255.0);
-    let colors = upload.attributes.chunks(upload.floats - 3).map(|a| color(a[a.len() - 1]));
+    let colors = (0..attributes.0.len()).map(|k| attributes.color(k).unwrap());
     positions.iter().map(|p| p.to_array()).zip(colors).unzip()
 }
 
@@ -194,41 +192,31 @@ fn moving_a_character_uploads_nothing_and_posing_one_uploads_only_its_own() {
     assert_eq!(modified, 0, "no mesh asset is modified");
 }
 
-/// The packed vertices, as the render world interleaves them into the mesh's slot, are byte
-/// for byte what Bevy would pack from a mesh holding the same positions and colours (the
-/// skin mesh's layout).
+/// The skin mesh's vertex buffer is its positions alone, byte for byte what the render world
+/// copies into the mesh's slot (12 bytes a vertex); texture coordinates and colours are
+/// packed apart, three words a vertex, as the skin's vertex shader reads them (u and v as
+/// float bits, the colour as `unpack4x8unorm` takes it: red in the low byte).
 #[test]
-fn packed_vertices_match_bevys_vertex_buffer() {
-    use marionette::scene::upload::{SkinUpload, interleaved, pack_vertices};
+fn skin_vertex_buffer_holds_positions_and_attributes_are_packed_apart() {
+    use marionette::scene::upload::{SKIN_VERTEX_BYTES, SkinAttributes};
     let triangles = [[0u32, 1, 2], [2, 1, 3]];
     let positions = [Vec3::new(0.0, 1.0, 2.0), Vec3::X, Vec3::new(-1.5, 0.25, 8.0), Vec3::splat(3.0)];
-    let colors = [[0.1, 0.2, 0.3, 1.0], [1.0, 0.0, 0.5, 1.0], [0.0; 4], [0.7, 0.7, 0.7, 1.0]];
-    // Each channel to the nearest of 255 steps, worked out here.
-    let bytes: Vec<[u8; 4]> = colors.iter().map(|c| c.map(|x: f32| (x * 255.0).round() as u8)).collect();
-    let color_values = || bevy::mesh::VertexAttributeValues::Unorm8x4(bytes.clone());
-    let skin_color = marionette::scene::handoff::SKIN_COLOR;
-    let mut mesh = marionette::scene::spawn::empty_skin_mesh(&triangles, positions.len(), &[]);
+    let mut mesh = marionette::scene::spawn::empty_skin_mesh(&triangles, positions.len());
     mesh.insert_attribute(Mesh::ATTRIBUTE_POSITION, positions.map(|p| p.to_array()).to_vec());
-    mesh.insert_attribute(skin_color, color_values());
-    // As the render world writes them: the positions interleaved with the packed attributes.
-    let mut upload = SkinUpload::default();
-    upload.pack_attributes(&[], &colors);
-    let written: Vec<[u8; 16]> = interleaved::<4>(&positions, &upload.attributes).map(bytemuck::cast).collect();
-    assert_eq!(written.as_flattened(), mesh.create_packed_vertex_buffer_data());
-    assert_eq!(upload.byte_len(), positions.len() * marionette::scene::upload::SKIN_VERTEX_BYTES);
-    let mut packed = Vec::new();
-    assert_eq!(pack_vertices(&positions, &[], &colors, &mut packed), 4);
-    assert_eq!(bytemuck::cast_slice::<f32, u8>(&packed), mesh.create_packed_vertex_buffer_data());
-    // A textured skin: its texture coordinates go where Bevy puts them.
-    let uv = [Vec2::new(0.0, 0.5), Vec2::new(1.0, 0.25), Vec2::ZERO, Vec2::ONE];
-    let mut textured = marionette::scene::spawn::empty_skin_mesh(&triangles, positions.len(), &uv);
-    textured.insert_attribute(Mesh::ATTRIBUTE_POSITION, positions.map(|p| p.to_array()).to_vec());
-    textured.insert_attribute(skin_color, color_values());
-    upload.pack_attributes(&uv, &colors);
-    let written: Vec<[u8; 24]> = interleaved::<6>(&positions, &upload.attributes).map(bytemuck::cast).collect();
-    assert_eq!(written.as_flattened(), textured.create_packed_vertex_buffer_data());
-    assert_eq!(pack_vertices(&positions, &uv, &colors, &mut packed), 6);
-    assert_eq!(bytemuck::cast_slice::<f32, u8>(&packed), textured.create_packed_vertex_buffer_data());
+    assert_eq!(bytemuck::cast_slice::<Vec3, u8>(&positions), mesh.create_packed_vertex_buffer_data());
+    assert_eq!(mesh.get_vertex_size() as usize, SKIN_VERTEX_BYTES);
+    let colors = [[0.2, 0.6, 1.0, 1.0], [1.0, 0.0, 0.5, 1.0], [0.0; 4], [-0.5, 0.2, 0.6, 1.5]];
+    // Each channel clamped and to the nearest of 255 steps (0.2 → 51, 0.6 → 153, 0.5 →
+    // 127.5 → 128), worked out here.
+    let words = [0xffff_9933u32, 0xff80_00ff, 0, 0xff99_3300];
+    let mut attributes = SkinAttributes::default();
+    attributes.pack(&[], &colors);
+    assert_eq!(attributes.0, words.map(|w| [0, 0, w]));
+    let uv = [Vec2::new(0.0, 0.5), Vec2::new(1.0, 0.25), Vec2::ZERO, Vec2::new(-2.0, 7.5)];
+    attributes.pack(&uv, &colors);
+    let expected: Vec<[u32; 3]> = uv.iter().zip(words).map(|(t, w)| [t.x.to_bits(), t.y.to_bits(), w]).collect();
+    assert_eq!(attributes.0, expected);
+    assert_eq!(attributes.color(1), Some([1.0, 0.0, 128.0 / 255.0, 1.0]));
 }
 
 #[test]

@@ -1,44 +1,99 @@
 //! The material every skin is drawn with: `StandardMaterial` (white, so vertex colours show
-//! as they are) extended with a fragment shader that lights each triangle with its own
-//! normal, from the derivatives of the world position. The skinning system then writes
-//! only shared vertex positions (and colours when they change): no unshared corners and
-//! no normals on the CPU or in the upload.
+//! as they are) extended with a vertex shader that takes texture coordinates and colours
+//! from the material's own buffer (the skin's [`SkinAttributes`], written only when they
+//! change) beside the positions of the mesh's vertex buffer, and a fragment shader that
+//! lights each triangle with its own normal, from the derivatives of the world position.
+//! The skinning system then hands the GPU only shared vertex positions when a character
+//! moves: no unshared corners, no normals, no colours.
 
 use bevy::asset::embedded_asset;
-use bevy::pbr::{ExtendedMaterial, MaterialExtension, MaterialPlugin};
+use bevy::mesh::MeshVertexBufferLayoutRef;
+use bevy::pbr::{ExtendedMaterial, MaterialExtension, MaterialExtensionKey, MaterialExtensionPipeline, MaterialPlugin};
 use bevy::prelude::*;
-use bevy::render::render_resource::AsBindGroup;
+use bevy::render::render_resource::{AsBindGroup, RenderPipelineDescriptor, SpecializedMeshPipelineError};
+use bevy::render::storage::ShaderBuffer;
 use bevy::shader::ShaderRef;
 
 use crate::rig::material::Sampler;
+use crate::scene::handoff::SkinAttributes;
 
-/// The extension: the flat-normal fragment shader and the normal map's scale.
+/// The extension: the skin's attributes, the flat-normal fragment shader and the normal
+/// map's scale.
 #[derive(Asset, AsBindGroup, Reflect, Debug, Clone)]
 pub struct FlatNormals {
     /// glTF's `normalTexture.scale` in x (the map's x and y are multiplied by it); y, z, w
     /// unused (a uniform of 16 bytes).
     #[uniform(100)]
     pub normal_scale: Vec4,
-}
-
-impl Default for FlatNormals {
-    fn default() -> Self {
-        Self { normal_scale: Vec4::new(1.0, 0.0, 0.0, 0.0) }
-    }
+    /// The skin surface's texture coordinates and colours, three words a vertex (see
+    /// [`SkinAttributes`]).
+    #[storage(101, read_only)]
+    pub attributes: Handle<ShaderBuffer>,
 }
 
 impl MaterialExtension for FlatNormals {
+    fn vertex_shader() -> ShaderRef {
+        "embedded://marionette/editor/present/skin_vertex.wgsl".into()
+    }
+
+    fn prepass_vertex_shader() -> ShaderRef {
+        "embedded://marionette/editor/present/skin_vertex.wgsl".into()
+    }
+
     fn fragment_shader() -> ShaderRef {
         "embedded://marionette/editor/present/flat_normals.wgsl".into()
+    }
+
+    /// Every pass reads texture coordinates and colours (the prepasses too: a masked
+    /// material's shadow is cut by its texture's alpha), which the mesh's layout (positions
+    /// only) does not name: the vertex shader takes them from the attributes' buffer.
+    fn specialize(
+        _pipeline: &MaterialExtensionPipeline,
+        descriptor: &mut RenderPipelineDescriptor,
+        _layout: &MeshVertexBufferLayoutRef,
+        _key: MaterialExtensionKey<Self>,
+    ) -> Result<(), SpecializedMeshPipelineError> {
+        let defs = ["VERTEX_UVS", "VERTEX_UVS_A", "VERTEX_COLORS"];
+        descriptor.vertex.shader_defs.extend(defs.map(Into::into));
+        if let Some(fragment) = descriptor.fragment.as_mut() {
+            fragment.shader_defs.extend(defs.map(Into::into));
+        }
+        Ok(())
     }
 }
 
 /// The skin material type.
 pub type SkinMaterialAsset = ExtendedMaterial<StandardMaterial, FlatNormals>;
 
-/// One material for every skin without a texture.
-#[derive(Resource)]
-pub struct SkinMaterial(pub Handle<SkinMaterialAsset>);
+/// A skin surface's buffer of attributes: the character's packed ones for `vertices` where
+/// they are packed, else room for them (written when they are).
+pub fn attribute_buffer(attributes: &SkinAttributes, vertices: &std::ops::Range<u32>) -> ShaderBuffer {
+    let count = (vertices.end - vertices.start) as usize;
+    // A binding needs at least one element.
+    let mut words = vec![[0u32; 3]; count.max(1)];
+    if let Some(packed) = attributes.0.get(vertices.start as usize..vertices.end as usize) {
+        words[..count].copy_from_slice(packed);
+    }
+    ShaderBuffer::new(bytemuck::cast_slice(&words), bevy::asset::RenderAssetUsages::default())
+}
+
+/// Writes a surface's packed attributes into its buffer, which keeps its size (so the GPU
+/// buffer is written in place and the material's bind group stays).
+pub fn write_attributes(buffer: &mut ShaderBuffer, attributes: &SkinAttributes, vertices: &std::ops::Range<u32>) {
+    if let Some(packed) = attributes.0.get(vertices.start as usize..vertices.end as usize)
+        && let Some(data) = buffer.data.as_mut()
+        && data.len() >= std::mem::size_of_val(packed)
+    {
+        data[..std::mem::size_of_val(packed)].copy_from_slice(bytemuck::cast_slice(packed));
+    }
+}
+
+/// The material of skins without one of their own, and of any skin while it shows weights
+/// or heat (only the vertex colours show), reading `attributes`.
+pub fn plain_skin_material(attributes: Handle<ShaderBuffer>) -> SkinMaterialAsset {
+    let base = StandardMaterial { base_color: Color::WHITE, perceptual_roughness: 0.75, ..default() };
+    ExtendedMaterial { base, extension: FlatNormals { normal_scale: Vec4::new(1.0, 0.0, 0.0, 0.0), attributes } }
+}
 
 /// The skin textures on the GPU, by texture (a file's path, or the key of an image a
 /// character's file holds), colour space and sampler: each uploaded once.
@@ -91,12 +146,13 @@ fn image_of(picture: &crate::rig::Picture, srgb: bool, sampler: Sampler) -> Imag
     image
 }
 
-/// The skin material of one of an asset's materials; `image` gives a texture's image
-/// (sRGB or not), or none when it cannot be read. Skins have no tangents: the shader
-/// bends its flat normals by the normal map (times its scale) in a frame from the
-/// derivatives.
+/// The skin material of one of an asset's materials, reading `attributes`; `image` gives a
+/// texture's image (sRGB or not), or none when it cannot be read. Skins have no tangents:
+/// the shader bends its flat normals by the normal map (times its scale) in a frame from
+/// the derivatives.
 pub fn skin_material_of(
     m: &crate::rig::material::Material,
+    attributes: Handle<ShaderBuffer>,
     image: &mut impl FnMut(&crate::rig::SkinTexture, bool, Sampler) -> Option<Handle<Image>>,
 ) -> SkinMaterialAsset {
     use crate::rig::material::AlphaMode as Alpha;
@@ -134,7 +190,8 @@ pub fn skin_material_of(
         ),
         ..default()
     };
-    ExtendedMaterial { base, extension: FlatNormals { normal_scale: Vec4::new(m.normal_scale, 0.0, 0.0, 0.0) } }
+    let normal_scale = Vec4::new(m.normal_scale, 0.0, 0.0, 0.0);
+    ExtendedMaterial { base, extension: FlatNormals { normal_scale, attributes } }
 }
 
 pub struct SkinMaterialPlugin;
@@ -142,13 +199,7 @@ pub struct SkinMaterialPlugin;
 impl Plugin for SkinMaterialPlugin {
     fn build(&self, app: &mut App) {
         embedded_asset!(app, "flat_normals.wgsl");
-        app.init_resource::<SkinTextures>()
-            .add_plugins(MaterialPlugin::<SkinMaterialAsset>::default())
-            .add_systems(Startup, setup_skin_material);
+        embedded_asset!(app, "skin_vertex.wgsl");
+        app.init_resource::<SkinTextures>().add_plugins(MaterialPlugin::<SkinMaterialAsset>::default());
     }
-}
-
-fn setup_skin_material(mut commands: Commands, mut materials: ResMut<Assets<SkinMaterialAsset>>) {
-    let base = StandardMaterial { base_color: Color::WHITE, perceptual_roughness: 0.75, ..default() };
-    commands.insert_resource(SkinMaterial(materials.add(ExtendedMaterial { base, extension: FlatNormals::default() })));
 }

@@ -10,7 +10,7 @@ use crate::editor::edits::history;
 use crate::editor::interact::camera::{FramingAspect, OrbitCamera, apply_orbit_camera};
 use crate::editor::interact::ik_drag;
 use crate::editor::present::draw;
-use crate::editor::present::skin_material::SkinMaterial;
+use crate::editor::present::skin_material::{self, SkinMaterialAsset, SkinTextures};
 use crate::editor::present::stage::{
     StageExtent, StageSettings, apply_stage_settings, draw_grid_and_axes, fit_stage_to_scene, spawn_stage,
 };
@@ -18,7 +18,9 @@ use crate::editor::scene_doc::document::{Library, NextCharacterId, PendingScene,
 use crate::editor::state::{Messages, Selection, StartupEdits, StartupPaths, UnloadedCharacters};
 use crate::formats::scene::{CameraDoc, CharacterId, DisplayDoc};
 use crate::rig::SkinTexture;
+use crate::scene::handoff::SkinAttributes;
 use crate::scene::{Character, CharacterView, HeatJoint, SkinMesh};
+use bevy::render::storage::ShaderBuffer;
 
 /// The live scene without drawing: opening documents, edits and their history, SMPL
 /// playback, each character's view in step with its options (used by the window, the
@@ -85,6 +87,7 @@ impl Plugin for ViewPlugin {
                 PostUpdate,
                 (
                     attach_skin_material,
+                    write_skin_attributes,
                     show_weights_in_plain_material,
                     apply_display_mode,
                     apply_stage_settings,
@@ -414,24 +417,26 @@ pub fn sync_character_views(
     }
 }
 
-/// Gives new skin meshes their material: the asset's for their surface (its textures
-/// decoded once), or the shared one (writes `MeshMaterial3d`, `OwnMaterial`).
+/// Gives new skin meshes their materials, both reading the surface's own buffer of
+/// attributes: the plain one, and the asset's for their surface (its textures decoded once)
+/// where it has one (writes `MeshMaterial3d`, `SkinMaterials`).
 #[allow(clippy::too_many_arguments)]
 fn attach_skin_material(
     mut commands: Commands,
-    material: Res<SkinMaterial>,
-    mut textures: ResMut<crate::editor::present::skin_material::SkinTextures>,
+    mut textures: ResMut<SkinTextures>,
     mut images: ResMut<Assets<Image>>,
-    mut materials: ResMut<Assets<crate::editor::present::skin_material::SkinMaterialAsset>>,
+    mut materials: ResMut<Assets<SkinMaterialAsset>>,
+    mut buffers: ResMut<Assets<ShaderBuffer>>,
     mut messages: ResMut<Messages>,
-    characters: Query<&Character>,
+    characters: Query<(&Character, &SkinAttributes)>,
     new_skins: Query<(Entity, &SkinMesh), Added<SkinMesh>>,
 ) {
     for (entity, skin) in &new_skins {
-        let Ok(character) = characters.get(skin.character) else { continue };
-        let own =
-            character.skins.get(skin.part).and_then(|p| p.material).and_then(|m| character.asset.materials.get(m));
-        let handle = match own {
+        let Ok((character, attributes)) = characters.get(skin.character) else { continue };
+        let Some(part) = character.skins.get(skin.part) else { continue };
+        let buffer = buffers.add(skin_material::attribute_buffer(attributes, &part.vertices));
+        let plain = materials.add(skin_material::plain_skin_material(buffer.clone()));
+        let own = match part.material.and_then(|m| character.asset.materials.get(m)) {
             Some(m) => {
                 let mut image = |texture: &SkinTexture, srgb: bool, sampler| match picture_of(texture) {
                     Ok(picture) => Some(textures.image(texture, &picture, srgb, sampler, &mut images)),
@@ -440,31 +445,53 @@ fn attach_skin_material(
                         None
                     }
                 };
-                materials.add(crate::editor::present::skin_material::skin_material_of(m, &mut image))
+                materials.add(skin_material::skin_material_of(m, buffer.clone(), &mut image))
             }
-            None => material.0.clone(),
+            None => plain.clone(),
         };
-        commands.entity(entity).insert((MeshMaterial3d(handle.clone()), OwnMaterial(handle)));
+        commands.entity(entity).insert((MeshMaterial3d(own.clone()), SkinMaterials { own, plain, attributes: buffer }));
     }
 }
 
-/// A skin mesh's own material, which weight colours and heat maps set aside for the
-/// shared one (so that only the vertex colours show).
+/// A skin mesh's materials: its own, and the plain one that weight colours and heat maps
+/// set it aside for (so that only the vertex colours show); and the buffer of attributes
+/// both read.
 #[derive(Component)]
-pub struct OwnMaterial(pub Handle<crate::editor::present::skin_material::SkinMaterialAsset>);
+pub struct SkinMaterials {
+    pub own: Handle<SkinMaterialAsset>,
+    pub plain: Handle<SkinMaterialAsset>,
+    pub attributes: Handle<ShaderBuffer>,
+}
 
-/// Draws skins in the shared material while they show weights or heat, else in their own
+/// Writes each recoloured character's attributes into its surfaces' buffers (reads
+/// `SkinAttributes`, `SkinMaterials`; writes `ShaderBuffer` assets).
+fn write_skin_attributes(
+    characters: Query<(&Character, &SkinAttributes), Changed<SkinAttributes>>,
+    skins: Query<&SkinMaterials>,
+    mut buffers: ResMut<Assets<ShaderBuffer>>,
+) {
+    for (character, attributes) in &characters {
+        for part in &character.skins {
+            if let Ok(materials) = skins.get(part.entity)
+                && let Some(mut buffer) = buffers.get_mut(&materials.attributes)
+            {
+                skin_material::write_attributes(&mut buffer, attributes, &part.vertices);
+            }
+        }
+    }
+}
+
+/// Draws skins in their plain material while they show weights or heat, else in their own
 /// (reads `CharacterView`, `HeatJoint`; writes `MeshMaterial3d`).
 fn show_weights_in_plain_material(
     characters: Query<(&Character, &CharacterView, &HeatJoint), Or<(Changed<CharacterView>, Changed<HeatJoint>)>>,
-    material: Res<SkinMaterial>,
-    mut skins: Query<(&OwnMaterial, &mut MeshMaterial3d<crate::editor::present::skin_material::SkinMaterialAsset>)>,
+    mut skins: Query<(&SkinMaterials, &mut MeshMaterial3d<SkinMaterialAsset>)>,
 ) {
     for (character, view, heat) in &characters {
         let plain = view.weight_colors || heat.0.is_some();
         for part in &character.skins {
-            if let Ok((own, mut drawn)) = skins.get_mut(part.entity) {
-                let wanted = if plain { &material.0 } else { &own.0 };
+            if let Ok((materials, mut drawn)) = skins.get_mut(part.entity) {
+                let wanted = if plain { &materials.plain } else { &materials.own };
                 if drawn.0 != *wanted {
                     drawn.0 = wanted.clone();
                 }
