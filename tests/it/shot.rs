@@ -1,7 +1,8 @@
 //! The picture: lights, background and lens as `render` draws them. The sun from the left
 //! lights the characters' left halves, from the right their right halves; a transparent
 //! picture is clear around the characters and opaque on them; an orthographic front view
-//! draws a character at one size whatever the camera's distance; supersampling averages.
+//! draws a character at one size whatever the camera's distance; supersampling averages;
+//! each character is drawn in its own colours.
 
 use std::path::{Path, PathBuf};
 use std::process::Command;
@@ -157,4 +158,38 @@ fn a_contact_sheet_shows_every_kept_pose_in_a_grid() {
     }
     assert!(cell(3).pixels().all(|p| p.0[3] == 0), "the fourth cell is empty");
     assert!(cell(0).pixels().any(|p| p.0[3] == 255), "a cell shows the puppet");
+}
+
+/// Each character's colours reach the picture from its skin material's own buffer (the
+/// vertex buffer holds positions only): a puppet tinted red beside one tinted blue (skinned
+/// on the GPU), in the default light: red outweighs green and blue twice over in the left
+/// one's pixels, blue outweighs red and green in the right one's. (Reading the wrong word
+/// of the buffer for the colour fails it.)
+#[test]
+fn each_characters_colours_reach_the_picture_from_its_own_buffer() {
+    use bevy::math::Vec3;
+    use marionette::formats::scene::PlacementDoc;
+    let dir = scratch("shot-tints");
+    let mut doc = puppet_lit_from(30.0);
+    doc.stage = StageDoc::default();
+    let mut red = CharacterDoc::new(SourceDoc::Embedded("puppet".into()), "red");
+    red.view.tint = [1.0, 0.0, 0.0];
+    red.placement = PlacementDoc::new(Vec3::new(-0.7, 0.0, 0.0), 0.0, 1.0);
+    let mut blue = CharacterDoc::new(SourceDoc::Embedded("puppet".into()), "blue");
+    blue.view.tint = [0.0, 0.0, 1.0];
+    blue.placement = PlacementDoc::new(Vec3::new(0.7, 0.0, 0.0), 0.0, 1.0);
+    blue.gpu_skinning = true;
+    doc.characters = vec![red, blue];
+    let flags = ["--transparent", "--view", "front"];
+    let picture = render(&scene_file(&dir, "tints.ron", &doc), &flags, &dir.join("tints.png"));
+    let (x0, x1, ..) = silhouette(&picture);
+    let middle = (x0 + x1) / 2;
+    let mut sums = [[0u64; 3]; 2];
+    for (x, _, p) in picture.enumerate_pixels().filter(|p| p.2.0[3] == 255) {
+        let side = usize::from(x > middle);
+        (0..3).for_each(|c| sums[side][c] += u64::from(p.0[c]));
+    }
+    let [[r, g, b], [r2, g2, b2]] = sums;
+    assert!(r > 2 * g.max(b), "the left puppet is red: {:?}", sums[0]);
+    assert!(b2 > 2 * r2.max(g2), "the right puppet is blue: {:?}", sums[1]);
 }
