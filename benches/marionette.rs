@@ -434,12 +434,16 @@ fn skin_phase_parts(bencher: Bencher, part: &str) {
     });
 }
 
-/// The LBS kernel over `bodies` SMPL bodies of their own β (their own bind positions and
-/// output, shared weights) in turn on one core, in vertices per second: against one body
-/// skinned again and again (the kernel's speed, all in cache), what a crowd's memory costs
-/// the kernel alone. (The puppet stands in without `MARIONETTE_DATA`.)
-#[divan::bench(args = [1, 64, 256])]
-fn kernel_skin_crowd_one_core(bencher: Bencher, bodies: usize) {
+/// A crowd for the kernel alone: each body, its posed palette and room for its output.
+struct Crowd {
+    assets: Vec<Arc<CharacterAsset>>,
+    palettes: Vec<Vec<Mat4>>,
+    outs: Vec<Vec<Vec3>>,
+}
+
+/// SMPL bodies of their own β (their own bind positions and output, shared weights), or
+/// puppets without `MARIONETTE_DATA`.
+fn crowd_of_bodies(bodies: usize) -> Crowd {
     let model = std::env::var_os("MARIONETTE_DATA")
         .map(|d| std::path::PathBuf::from(d).join("smpl"))
         .and_then(|dir| marionette::formats::smpl::load_smpl_dir(&dir).ok());
@@ -449,13 +453,47 @@ fn kernel_skin_crowd_one_core(bencher: Bencher, bodies: usize) {
             None => asset(),
         })
         .collect();
-    let palettes: Vec<Vec<Mat4>> = assets.iter().map(|a| posed_palette(a)).collect();
-    let mut outs: Vec<Vec<Vec3>> = assets.iter().map(|a| vec![Vec3::ZERO; a.vertex_count()]).collect();
+    let palettes = assets.iter().map(|a| posed_palette(a)).collect();
+    let outs = assets.iter().map(|a| vec![Vec3::ZERO; a.vertex_count()]).collect();
+    Crowd { assets, palettes, outs }
+}
+
+/// The LBS kernel over `bodies` SMPL bodies of their own β in turn on one core, in vertices
+/// per second: against one body skinned again and again (the kernel's speed, all in cache),
+/// what a crowd's memory costs the kernel alone.
+#[divan::bench(args = [1, 64, 256])]
+fn kernel_skin_crowd_one_core(bencher: Bencher, bodies: usize) {
+    let Crowd { assets, palettes, mut outs } = crowd_of_bodies(bodies);
     let vertices = assets.iter().map(|a| a.vertex_count()).sum::<usize>();
     bencher.counter(divan::counter::ItemsCount::new(vertices)).bench_local(|| {
         for ((asset, palette), out) in assets.iter().zip(&palettes).zip(&mut outs) {
             let skin = &asset.skin;
             marionette::rig::lbs::skin(&skin.bind_positions, &skin.weights, palette, divan::black_box(out));
         }
+    });
+}
+
+/// The same crowd on every core, split as the skin phase splits it (Bevy's compute task
+/// pool, a few bodies a task): the kernel's speed over a crowd on this machine, memory and
+/// scheduling included, without the rest of the frame.
+#[divan::bench(args = [64, 256])]
+fn kernel_skin_crowd_all_cores(bencher: Bencher, bodies: usize) {
+    let pool = bevy::tasks::ComputeTaskPool::get_or_init(bevy::tasks::TaskPool::new);
+    let Crowd { assets, palettes, mut outs } = crowd_of_bodies(bodies);
+    let vertices = assets.iter().map(|a| a.vertex_count()).sum::<usize>();
+    let per_task = bodies.div_ceil(pool.thread_num().max(1) * 8);
+    bencher.counter(divan::counter::ItemsCount::new(vertices)).bench_local(|| {
+        pool.scope(|scope| {
+            for ((assets, palettes), outs) in
+                assets.chunks(per_task).zip(palettes.chunks(per_task)).zip(outs.chunks_mut(per_task))
+            {
+                scope.spawn(async move {
+                    for ((asset, palette), out) in assets.iter().zip(palettes).zip(outs) {
+                        let skin = &asset.skin;
+                        marionette::rig::lbs::skin(&skin.bind_positions, &skin.weights, palette, out);
+                    }
+                });
+            }
+        });
     });
 }
