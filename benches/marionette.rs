@@ -475,14 +475,24 @@ fn kernel_skin_crowd_one_core(bencher: Bencher, bodies: usize) {
 
 /// The same crowd on every core, split as the skin phase splits it (Bevy's compute task
 /// pool, a few bodies a task): the kernel's speed over a crowd on this machine, memory and
-/// scheduling included, without the rest of the frame.
-#[divan::bench(args = [64, 256])]
-fn kernel_skin_crowd_all_cores(bencher: Bencher, bodies: usize) {
+/// scheduling included, without the rest of the frame. `warm`: each run right after the
+/// last (the crowd's memory in the caches that hold it); `cold`: each run after 320 MB of
+/// other memory was written, more than every cache here (as drawing on llvmpipe between
+/// frames leaves them).
+#[divan::bench(args = ["64 warm", "64 cold", "256 warm", "256 cold"], sample_size = 1, sample_count = 60)]
+fn kernel_skin_crowd_all_cores(bencher: Bencher, case: &str) {
+    let (bodies, cold) = case.split_once(' ').map(|(n, c)| (n.parse::<usize>().unwrap(), c == "cold")).unwrap();
     let pool = bevy::tasks::ComputeTaskPool::get_or_init(bevy::tasks::TaskPool::new);
     let Crowd { assets, palettes, mut outs } = crowd_of_bodies(bodies);
     let vertices = assets.iter().map(|a| a.vertex_count()).sum::<usize>();
     let per_task = bodies.div_ceil(pool.thread_num().max(1) * 8);
-    bencher.counter(divan::counter::ItemsCount::new(vertices)).bench_local(|| {
+    let mut other = if cold { vec![0u8; 320 << 20] } else { Vec::new() };
+    let mut pass = 0u8;
+    let evict = || {
+        pass = pass.wrapping_add(1);
+        other.iter_mut().step_by(64).for_each(|b| *b = pass);
+    };
+    bencher.counter(divan::counter::ItemsCount::new(vertices)).with_inputs(evict).bench_local_values(|()| {
         pool.scope(|scope| {
             for ((assets, palettes), outs) in
                 assets.chunks(per_task).zip(palettes.chunks(per_task)).zip(outs.chunks_mut(per_task))
