@@ -1,8 +1,9 @@
 //! GPU skinning (the 6.837 assignment's "accelerate SSD using shaders"): a compute shader
 //! (`gpu_skinning.wgsl`) takes the same palette and bind data as the CPU kernels and writes
 //! the skinned positions, which are copied into the mesh's slot of the vertex buffer (the
-//! positions are the whole of it: the material reads the other attributes). Chosen per character ([`SkinOnGpu`](super::SkinOnGpu), the inspector,
-//! the scene file); the CPU path stays the default.
+//! positions are the whole of it: the material reads the other attributes). Chosen per
+//! character ([`SkinOnGpu`](super::SkinOnGpu), the inspector, the scene file); the CPU path
+//! stays the default.
 //!
 //! The main world hands over each re-posed character's palette ([`GpuSkinJob`]); the render
 //! world keeps, per character, the bind positions and influences on the GPU (uploaded once

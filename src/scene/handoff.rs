@@ -52,11 +52,9 @@ impl SkinAttributes {
     /// When there are texture coordinates, but not one per colour.
     pub fn pack(&mut self, texcoords: &[Vec2], colors: &[[f32; 4]]) {
         assert!(texcoords.is_empty() || texcoords.len() == colors.len(), "texture coordinates for every vertex");
-        let words = &mut self.0;
-        words.clear();
-        let uv = |k: usize| texcoords.get(k).map_or([0, 0], |t| [t.x.to_bits(), t.y.to_bits()]);
-        words.extend(colors.iter().enumerate().map(|(k, c)| {
-            let [u, v] = uv(k);
+        self.0.clear();
+        self.0.extend(colors.iter().enumerate().map(|(k, c)| {
+            let [u, v] = texcoords.get(k).map_or([0, 0], |t| [t.x.to_bits(), t.y.to_bits()]);
             [u, v, u32::from_le_bytes(color_bytes(*c))]
         }));
     }

@@ -17,10 +17,11 @@ use bevy::shader::ShaderRef;
 use crate::rig::material::Sampler;
 use crate::scene::handoff::SkinAttributes;
 
-/// The extension: the skin's attributes, the flat-normal fragment shader and the normal
-/// map's scale.
+/// The extension of `StandardMaterial` for skins: the vertex shader that reads the skin's
+/// attributes beside its positions, the flat-normal fragment shader and the normal map's
+/// scale.
 #[derive(Asset, AsBindGroup, Reflect, Debug, Clone)]
-pub struct FlatNormals {
+pub struct SkinExtension {
     /// glTF's `normalTexture.scale` in x (the map's x and y are multiplied by it); y, z, w
     /// unused (a uniform of 16 bytes).
     #[uniform(100)]
@@ -31,7 +32,7 @@ pub struct FlatNormals {
     pub attributes: Handle<ShaderBuffer>,
 }
 
-impl MaterialExtension for FlatNormals {
+impl MaterialExtension for SkinExtension {
     fn vertex_shader() -> ShaderRef {
         "embedded://marionette/editor/present/skin_vertex.wgsl".into()
     }
@@ -63,28 +64,29 @@ impl MaterialExtension for FlatNormals {
 }
 
 /// The skin material type.
-pub type SkinMaterialAsset = ExtendedMaterial<StandardMaterial, FlatNormals>;
+pub type SkinMaterialAsset = ExtendedMaterial<StandardMaterial, SkinExtension>;
 
-/// A skin surface's buffer of attributes: the character's packed ones for `vertices` where
-/// they are packed, else room for them (written when they are).
+/// A skin surface's buffer of attributes, room for those of `vertices` (at least one
+/// vertex's: a binding needs one element), holding the character's packed ones where they
+/// are packed already.
 pub fn attribute_buffer(attributes: &SkinAttributes, vertices: &std::ops::Range<u32>) -> ShaderBuffer {
-    let count = (vertices.end - vertices.start) as usize;
-    // A binding needs at least one element.
-    let mut words = vec![[0u32; 3]; count.max(1)];
-    if let Some(packed) = attributes.0.get(vertices.start as usize..vertices.end as usize) {
-        words[..count].copy_from_slice(packed);
-    }
-    ShaderBuffer::new(bytemuck::cast_slice(&words), bevy::asset::RenderAssetUsages::default())
+    let count = (vertices.end - vertices.start).max(1) as usize;
+    let words = vec![[0u32; 3]; count];
+    let mut buffer = ShaderBuffer::new(bytemuck::cast_slice(&words), bevy::asset::RenderAssetUsages::default());
+    write_attributes(&mut buffer, attributes, vertices);
+    buffer
 }
 
 /// Writes a surface's packed attributes into its buffer, which keeps its size (so the GPU
-/// buffer is written in place and the material's bind group stays).
+/// buffer is written in place and the material's bind group stays); nothing while they
+/// are not packed.
 pub fn write_attributes(buffer: &mut ShaderBuffer, attributes: &SkinAttributes, vertices: &std::ops::Range<u32>) {
-    if let Some(packed) = attributes.0.get(vertices.start as usize..vertices.end as usize)
-        && let Some(data) = buffer.data.as_mut()
-        && data.len() >= std::mem::size_of_val(packed)
-    {
-        data[..std::mem::size_of_val(packed)].copy_from_slice(bytemuck::cast_slice(packed));
+    let packed: &[u8] = match attributes.0.get(vertices.start as usize..vertices.end as usize) {
+        Some(words) => bytemuck::cast_slice(words),
+        None => return,
+    };
+    if let Some(room) = buffer.data.as_mut().and_then(|data| data.get_mut(..packed.len())) {
+        room.copy_from_slice(packed);
     }
 }
 
@@ -92,7 +94,7 @@ pub fn write_attributes(buffer: &mut ShaderBuffer, attributes: &SkinAttributes, 
 /// or heat (only the vertex colours show), reading `attributes`.
 pub fn plain_skin_material(attributes: Handle<ShaderBuffer>) -> SkinMaterialAsset {
     let base = StandardMaterial { base_color: Color::WHITE, perceptual_roughness: 0.75, ..default() };
-    ExtendedMaterial { base, extension: FlatNormals { normal_scale: Vec4::new(1.0, 0.0, 0.0, 0.0), attributes } }
+    ExtendedMaterial { base, extension: SkinExtension { normal_scale: Vec4::new(1.0, 0.0, 0.0, 0.0), attributes } }
 }
 
 /// The skin textures on the GPU, by texture (a file's path, or the key of an image a
@@ -191,7 +193,7 @@ pub fn skin_material_of(
         ..default()
     };
     let normal_scale = Vec4::new(m.normal_scale, 0.0, 0.0, 0.0);
-    ExtendedMaterial { base, extension: FlatNormals { normal_scale, attributes } }
+    ExtendedMaterial { base, extension: SkinExtension { normal_scale, attributes } }
 }
 
 pub struct SkinMaterialPlugin;
