@@ -219,6 +219,28 @@ fn skin_vertex_buffer_holds_positions_and_attributes_are_packed_apart() {
     assert_eq!(attributes.color(1), Some([1.0, 0.0, 128.0 / 255.0, 1.0]));
 }
 
+/// Each skin surface's buffer holds its own vertices' attributes, its first vertex at the
+/// buffer's start: made before the attributes are packed (room, zero) and written when they
+/// are, in place; a surface without vertices still gets one vertex's room (a binding needs
+/// one element).
+#[test]
+fn each_surface_buffer_holds_its_own_vertices_attributes() {
+    use marionette::editor::present::skin_material::{attribute_buffer, write_attributes};
+    use marionette::scene::upload::SkinAttributes;
+    let colors: Vec<[f32; 4]> = (0..5).map(|k| [k as f32 / 4.0, 1.0, 0.0, 1.0]).collect();
+    let uv: Vec<Vec2> = (0..5).map(|k| Vec2::new(k as f32, -(k as f32))).collect();
+    let mut attributes = SkinAttributes::default();
+    let second = 2..5;
+    let mut buffer = attribute_buffer(&attributes, &second);
+    assert_eq!(buffer.data.as_deref(), Some(&[0u8; 36][..]), "room for three vertices, zero");
+    attributes.pack(&uv, &colors);
+    write_attributes(&mut buffer, &attributes, &second);
+    let bytes = |words: &[[u32; 3]]| bytemuck::cast_slice::<[u32; 3], u8>(words).to_vec();
+    assert_eq!(buffer.data, Some(bytes(&attributes.0[2..5])), "the second surface's own vertices");
+    assert_eq!(attribute_buffer(&attributes, &(0..2)).data, Some(bytes(&attributes.0[0..2])));
+    assert_eq!(attribute_buffer(&attributes, &(5..5)).data, Some(vec![0; 12]));
+}
+
 #[test]
 fn only_changed_characters_are_reskinned_and_skins_are_shared() {
     let asset = Arc::new(embedded_puppet());
