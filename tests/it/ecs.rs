@@ -219,26 +219,41 @@ fn skin_vertex_buffer_holds_positions_and_attributes_are_packed_apart() {
     assert_eq!(attributes.color(1), Some([1.0, 0.0, 128.0 / 255.0, 1.0]));
 }
 
-/// Each skin surface's buffer holds its own vertices' attributes, its first vertex at the
-/// buffer's start: made before the attributes are packed (room, zero) and written when they
-/// are, in place; a surface without vertices still gets one vertex's room (a binding needs
-/// one element).
+/// The one buffer of every skin's attributes: surfaces laid out one after another in the
+/// order given (each from its first vertex, its mesh's tag), each written from its own
+/// character's vertices, nothing while they are not packed; more vertices than its room
+/// grow it, to spare; fewer keep it.
 #[test]
-fn each_surface_buffer_holds_its_own_vertices_attributes() {
-    use marionette::editor::present::skin_material::{attribute_buffer, write_attributes};
+fn skins_share_one_attribute_buffer_each_surface_at_its_place() {
+    use marionette::editor::present::skin_material::SkinAttributeStore;
     use marionette::scene::upload::SkinAttributes;
-    let colors: Vec<[f32; 4]> = (0..5).map(|k| [k as f32 / 4.0, 1.0, 0.0, 1.0]).collect();
-    let uv: Vec<Vec2> = (0..5).map(|k| Vec2::new(k as f32, -(k as f32))).collect();
-    let mut attributes = SkinAttributes::default();
-    let second = 2..5;
-    let mut buffer = attribute_buffer(&attributes, &second);
-    assert_eq!(buffer.data.as_deref(), Some(&[0u8; 36][..]), "room for three vertices, zero");
-    attributes.pack(&uv, &colors);
-    write_attributes(&mut buffer, &attributes, &second);
+    let mut world = World::new();
+    let (a, b) = (world.spawn_empty().id(), world.spawn_empty().id());
+    let attributes = |n: usize, red: f32| {
+        let mut packed = SkinAttributes::default();
+        let colors: Vec<[f32; 4]> = (0..n).map(|k| [red, k as f32 / 8.0, 0.0, 1.0]).collect();
+        let uv: Vec<Vec2> = (0..n).map(|k| Vec2::new(k as f32, red)).collect();
+        packed.pack(&uv, &colors);
+        packed
+    };
+    let (first, second) = (attributes(5, 1.0), attributes(4, 0.0));
+    let mut store = SkinAttributeStore::default();
+    assert!(store.lay_out(&[(a, 3), (b, 4)]), "no room yet: it grows");
+    assert_eq!((store.first(a), store.first(b)), (Some(0), Some(3)));
+    let mut buffer = store.empty_buffer();
+    let room = buffer.data.as_ref().unwrap().len();
+    assert!(room >= 7 * 12, "room for both: {room} bytes");
+    store.write(&mut buffer, a, &SkinAttributes::default(), &(2..5));
+    assert!(buffer.data.as_ref().unwrap().iter().all(|&byte| byte == 0), "not packed yet: nothing written");
+    store.write(&mut buffer, a, &first, &(2..5));
+    store.write(&mut buffer, b, &second, &(0..4));
     let bytes = |words: &[[u32; 3]]| bytemuck::cast_slice::<[u32; 3], u8>(words).to_vec();
-    assert_eq!(buffer.data, Some(bytes(&attributes.0[2..5])), "the second surface's own vertices");
-    assert_eq!(attribute_buffer(&attributes, &(0..2)).data, Some(bytes(&attributes.0[0..2])));
-    assert_eq!(attribute_buffer(&attributes, &(5..5)).data, Some(vec![0; 12]));
+    let data = buffer.data.as_ref().unwrap();
+    assert_eq!(data[..36], bytes(&first.0[2..5]), "a's surface: its character's vertices 2 to 4");
+    assert_eq!(data[36..84], bytes(&second.0), "b's surface after it");
+    assert!(data[84..].iter().all(|&byte| byte == 0));
+    assert!(!store.lay_out(&[(b, 4)]), "fewer vertices: the same room");
+    assert_eq!(store.first(b), Some(0));
 }
 
 #[test]

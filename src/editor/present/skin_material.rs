@@ -1,7 +1,8 @@
 //! The material every skin is drawn with: `StandardMaterial` (white, so vertex colours show
 //! as they are) extended with a vertex shader that takes texture coordinates and colours
-//! from the material's own buffer (the skin's [`SkinAttributes`], written only when they
-//! change) beside the positions of the mesh's vertex buffer, and a fragment shader that
+//! from one buffer every skin material reads (each skin's [`SkinAttributes`], written only
+//! when they change; [`SkinAttributeStore`]) beside the positions of the mesh's vertex
+//! buffer, and a fragment shader that
 //! lights each triangle with its own normal, from the derivatives of the world position.
 //! The skinning system then hands the GPU only shared vertex positions when a character
 //! moves: no unshared corners, no normals, no colours.
@@ -26,8 +27,9 @@ pub struct SkinExtension {
     /// unused (a uniform of 16 bytes).
     #[uniform(100)]
     pub normal_scale: Vec4,
-    /// The skin surface's texture coordinates and colours, three words a vertex (see
-    /// [`SkinAttributes`]).
+    /// Every skin surface's texture coordinates and colours, three words a vertex (see
+    /// [`SkinAttributes`]), each surface from its mesh's `MeshTag` on
+    /// ([`SkinAttributeStore`]).
     #[storage(101, read_only)]
     pub attributes: Handle<ShaderBuffer>,
 }
@@ -66,33 +68,91 @@ impl MaterialExtension for SkinExtension {
 /// The skin material type.
 pub type SkinMaterialAsset = ExtendedMaterial<StandardMaterial, SkinExtension>;
 
-/// A skin surface's buffer of attributes, room for those of `vertices` (at least one
-/// vertex's: a binding needs one element), holding the character's packed ones where they
-/// are packed already.
-pub fn attribute_buffer(attributes: &SkinAttributes, vertices: &std::ops::Range<u32>) -> ShaderBuffer {
-    let count = (vertices.end - vertices.start).max(1) as usize;
-    let words = vec![[0u32; 3]; count];
-    let mut buffer = ShaderBuffer::new(bytemuck::cast_slice(&words), bevy::asset::RenderAssetUsages::default());
-    write_attributes(&mut buffer, attributes, vertices);
-    buffer
+/// One material for every skin without one of its own, and for any skin while it shows
+/// weights or heat (only the vertex colours show).
+#[derive(Resource)]
+pub struct SkinMaterial(pub Handle<SkinMaterialAsset>);
+
+/// Every skin surface's attributes in one buffer that all skin materials read, so that
+/// skins of one material still share it (and are drawn together): each surface's first
+/// vertex in the buffer is its mesh's `MeshTag`. The default has no room and no buffer
+/// yet (see [`Self::empty_buffer`]).
+#[derive(Resource, Default)]
+pub struct SkinAttributeStore {
+    pub buffer: Handle<ShaderBuffer>,
+    /// Each skin entity's first vertex in the buffer.
+    firsts: std::collections::HashMap<Entity, u32>,
+    /// Vertices the buffer has room for.
+    capacity: u32,
 }
 
-/// Writes a surface's packed attributes into its buffer, which keeps its size (so the GPU
-/// buffer is written in place and the material's bind group stays); nothing while they
-/// are not packed.
-pub fn write_attributes(buffer: &mut ShaderBuffer, attributes: &SkinAttributes, vertices: &std::ops::Range<u32>) {
-    let packed: &[u8] = match attributes.0.get(vertices.start as usize..vertices.end as usize) {
-        Some(words) => bytemuck::cast_slice(words),
-        None => return,
-    };
-    if let Some(room) = buffer.data.as_mut().and_then(|data| data.get_mut(..packed.len())) {
-        room.copy_from_slice(packed);
+impl SkinAttributeStore {
+    /// Bytes a vertex takes in the buffer.
+    const VERTEX_BYTES: usize = std::mem::size_of::<[u32; 3]>();
+
+    /// Lays the surfaces (each skin entity with its character's vertices) out one after
+    /// another in the order given; true when they no longer fit the buffer, whose room is
+    /// then grown (to spare, so that characters added later seldom grow it again): the
+    /// caller makes it anew ([`Self::empty_buffer`]).
+    pub fn lay_out(&mut self, surfaces: &[(Entity, u32)]) -> bool {
+        self.firsts.clear();
+        let mut next = 0u32;
+        for &(entity, vertices) in surfaces {
+            self.firsts.insert(entity, next);
+            next += vertices;
+        }
+        let grown = next > self.capacity;
+        if grown {
+            self.capacity = next.next_power_of_two().max(4096);
+        }
+        grown
+    }
+
+    /// A buffer of the store's room (at least one vertex: a binding needs one element), zero.
+    pub fn empty_buffer(&self) -> ShaderBuffer {
+        let bytes = vec![0; self.capacity.max(1) as usize * Self::VERTEX_BYTES];
+        ShaderBuffer::new(&bytes, bevy::asset::RenderAssetUsages::default())
+    }
+
+    /// The first vertex of a skin entity's surface in the buffer, once laid out.
+    pub fn first(&self, skin: Entity) -> Option<u32> {
+        self.firsts.get(&skin).copied()
+    }
+
+    /// Writes a surface's packed attributes (those of its character's `vertices`) at its
+    /// place in the buffer; nothing while they are not packed or it has no place.
+    pub fn write(
+        &self,
+        buffer: &mut ShaderBuffer,
+        skin: Entity,
+        attributes: &SkinAttributes,
+        vertices: &std::ops::Range<u32>,
+    ) {
+        let Some(words) = attributes.0.get(vertices.start as usize..vertices.end as usize) else { return };
+        let Some(first) = self.first(skin) else { return };
+        let at = first as usize * Self::VERTEX_BYTES;
+        let packed: &[u8] = bytemuck::cast_slice(words);
+        if let Some(room) = buffer.data.as_mut().and_then(|data| data.get_mut(at..at + packed.len())) {
+            room.copy_from_slice(packed);
+        }
     }
 }
 
-/// The material of skins without one of their own, and of any skin while it shows weights
-/// or heat (only the vertex colours show), reading `attributes`.
-pub fn plain_skin_material(attributes: Handle<ShaderBuffer>) -> SkinMaterialAsset {
+/// The store with a buffer of one vertex (laid out when the first skin comes), and the
+/// shared plain material reading it.
+fn setup_skin_material(
+    mut commands: Commands,
+    mut buffers: ResMut<Assets<ShaderBuffer>>,
+    mut materials: ResMut<Assets<SkinMaterialAsset>>,
+) {
+    let mut store = SkinAttributeStore::default();
+    store.buffer = buffers.add(store.empty_buffer());
+    commands.insert_resource(SkinMaterial(materials.add(plain_skin_material(store.buffer.clone()))));
+    commands.insert_resource(store);
+}
+
+/// The material of skins without one of their own, reading `attributes`.
+fn plain_skin_material(attributes: Handle<ShaderBuffer>) -> SkinMaterialAsset {
     let base = StandardMaterial { base_color: Color::WHITE, perceptual_roughness: 0.75, ..default() };
     ExtendedMaterial { base, extension: SkinExtension { normal_scale: Vec4::new(1.0, 0.0, 0.0, 0.0), attributes } }
 }
@@ -202,6 +262,8 @@ impl Plugin for SkinMaterialPlugin {
     fn build(&self, app: &mut App) {
         embedded_asset!(app, "flat_normals.wgsl");
         embedded_asset!(app, "skin_vertex.wgsl");
-        app.init_resource::<SkinTextures>().add_plugins(MaterialPlugin::<SkinMaterialAsset>::default());
+        app.init_resource::<SkinTextures>()
+            .add_plugins(MaterialPlugin::<SkinMaterialAsset>::default())
+            .add_systems(Startup, setup_skin_material);
     }
 }

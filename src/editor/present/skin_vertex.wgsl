@@ -1,8 +1,9 @@
 // The skin's vertex shader, for the main pass and the prepasses (shadows): the mesh's
 // vertex buffer holds positions only (12 bytes a vertex, all the CPU hands on when a
-// character moves); texture coordinates and colours come from the material's own buffer,
-// written only when they change. Its vertex k is the mesh's k-th: the draw's vertex index
-// less the mesh's first in the vertex buffer.
+// character moves); texture coordinates and colours come from the one buffer of every
+// skin's attributes, written only when they change. A mesh's surface starts there at its
+// tag (MeshTag); its vertex k is the mesh's k-th: the draw's vertex index less the mesh's
+// first in the vertex buffer.
 #import bevy_pbr::{
     mesh_bindings::mesh,
     mesh_functions,
@@ -14,7 +15,7 @@
 #import bevy_pbr::forward_io::VertexOutput
 #endif
 
-// Per vertex three words: u and v (float bits; zero where the skin has none), then the
+// Every skin surface's attributes, per vertex three words: u and v (float bits; zero where the skin has none), then the
 // colour (unorm8x4, red in the low byte).
 @group(#{MATERIAL_BIND_GROUP}) @binding(101) var<storage, read> attributes: array<u32>;
 
@@ -30,7 +31,8 @@ fn vertex(vertex: Vertex) -> VertexOutput {
     let world_from_local = mesh_functions::get_world_from_local(vertex.instance_index);
     out.world_position = mesh_functions::mesh_position_local_to_world(world_from_local, vec4(vertex.position, 1.0));
     out.position = position_world_to_clip(out.world_position.xyz);
-    let k = 3u * (vertex.index - mesh[vertex.instance_index].first_vertex_index);
+    let instance = mesh[vertex.instance_index];
+    let k = 3u * (instance.tag + vertex.index - instance.first_vertex_index);
 #ifdef VERTEX_UVS_A
     out.uv = vec2(bitcast<f32>(attributes[k]), bitcast<f32>(attributes[k + 1u]));
 #endif

@@ -10,7 +10,7 @@ use crate::editor::edits::history;
 use crate::editor::interact::camera::{FramingAspect, OrbitCamera, apply_orbit_camera};
 use crate::editor::interact::ik_drag;
 use crate::editor::present::draw;
-use crate::editor::present::skin_material::{self, SkinMaterialAsset, SkinTextures};
+use crate::editor::present::skin_material::{self, SkinAttributeStore, SkinMaterial, SkinMaterialAsset, SkinTextures};
 use crate::editor::present::stage::{
     StageExtent, StageSettings, apply_stage_settings, draw_grid_and_axes, fit_stage_to_scene, spawn_stage,
 };
@@ -20,6 +20,7 @@ use crate::formats::scene::{CameraDoc, CharacterId, DisplayDoc};
 use crate::rig::SkinTexture;
 use crate::scene::handoff::SkinAttributes;
 use crate::scene::{Character, CharacterView, HeatJoint, SkinMesh};
+use bevy::mesh::MeshTag;
 use bevy::render::storage::ShaderBuffer;
 
 /// The live scene without drawing: opening documents, edits and their history, SMPL
@@ -87,7 +88,7 @@ impl Plugin for ViewPlugin {
                 PostUpdate,
                 (
                     attach_skin_material,
-                    write_skin_attributes,
+                    store_skin_attributes,
                     show_weights_in_plain_material,
                     apply_display_mode,
                     apply_stage_settings,
@@ -417,26 +418,26 @@ pub fn sync_character_views(
     }
 }
 
-/// Gives new skin meshes their materials, both reading the surface's own buffer of
-/// attributes: the plain one, and the asset's for their surface (its textures decoded once)
-/// where it has one (writes `MeshMaterial3d`, `SkinMaterials`).
+/// Gives new skin meshes their material: the asset's for their surface (its textures
+/// decoded once), or the shared one; both read the skins' attributes from the one buffer
+/// (writes `MeshMaterial3d`, `OwnMaterial`).
 #[allow(clippy::too_many_arguments)]
 fn attach_skin_material(
     mut commands: Commands,
+    material: Res<SkinMaterial>,
+    store: Res<SkinAttributeStore>,
     mut textures: ResMut<SkinTextures>,
     mut images: ResMut<Assets<Image>>,
     mut materials: ResMut<Assets<SkinMaterialAsset>>,
-    mut buffers: ResMut<Assets<ShaderBuffer>>,
     mut messages: ResMut<Messages>,
-    characters: Query<(&Character, &SkinAttributes)>,
+    characters: Query<&Character>,
     new_skins: Query<(Entity, &SkinMesh), Added<SkinMesh>>,
 ) {
     for (entity, skin) in &new_skins {
-        let Ok((character, attributes)) = characters.get(skin.character) else { continue };
-        let Some(part) = character.skins.get(skin.part) else { continue };
-        let buffer = buffers.add(skin_material::attribute_buffer(attributes, &part.vertices));
-        let plain = materials.add(skin_material::plain_skin_material(buffer.clone()));
-        let own = match part.material.and_then(|m| character.asset.materials.get(m)) {
+        let Ok(character) = characters.get(skin.character) else { continue };
+        let own =
+            character.skins.get(skin.part).and_then(|p| p.material).and_then(|m| character.asset.materials.get(m));
+        let handle = match own {
             Some(m) => {
                 let mut image = |texture: &SkinTexture, srgb: bool, sampler| match picture_of(texture) {
                     Ok(picture) => Some(textures.image(texture, &picture, srgb, sampler, &mut images)),
@@ -445,53 +446,80 @@ fn attach_skin_material(
                         None
                     }
                 };
-                materials.add(skin_material::skin_material_of(m, buffer.clone(), &mut image))
+                materials.add(skin_material::skin_material_of(m, store.buffer.clone(), &mut image))
             }
-            None => plain.clone(),
+            None => material.0.clone(),
         };
-        commands.entity(entity).insert((MeshMaterial3d(own.clone()), SkinMaterials { own, plain, attributes: buffer }));
+        commands.entity(entity).insert((MeshMaterial3d(handle.clone()), OwnMaterial(handle)));
     }
 }
 
-/// A skin mesh's materials: its own, and the plain one that weight colours and heat maps
-/// set it aside for (so that only the vertex colours show); and the buffer of attributes
-/// both read.
+/// A skin mesh's own material, which weight colours and heat maps set aside for the
+/// shared one (so that only the vertex colours show).
 #[derive(Component)]
-pub struct SkinMaterials {
-    pub own: Handle<SkinMaterialAsset>,
-    pub plain: Handle<SkinMaterialAsset>,
-    pub attributes: Handle<ShaderBuffer>,
-}
+pub struct OwnMaterial(pub Handle<SkinMaterialAsset>);
 
-/// Writes each recoloured character's attributes into its surfaces' buffers (reads
-/// `SkinAttributes`, `SkinMaterials`; writes `ShaderBuffer` assets).
-fn write_skin_attributes(
-    characters: Query<(&Character, &SkinAttributes), Changed<SkinAttributes>>,
-    skins: Query<&SkinMaterials>,
+/// Keeps the skins' attributes in the one buffer the skin materials read: when skins come
+/// or go, every surface is laid out anew (its place is its mesh's `MeshTag`; when they no
+/// longer fit, a larger buffer replaces it in every skin material), else only the
+/// recoloured characters' attributes are written, in place (reads `Character`,
+/// `SkinAttributes`, `SkinMesh`; writes `SkinAttributeStore`, its buffer, the skin
+/// materials, `MeshTag`).
+#[allow(clippy::too_many_arguments)]
+fn store_skin_attributes(
+    mut commands: Commands,
+    mut store: ResMut<SkinAttributeStore>,
     mut buffers: ResMut<Assets<ShaderBuffer>>,
+    mut materials: ResMut<Assets<SkinMaterialAsset>>,
+    characters: Query<(&Character, Ref<SkinAttributes>)>,
+    skins: Query<(Entity, &SkinMesh, Option<&MeshTag>)>,
+    added: Query<(), Added<SkinMesh>>,
+    mut removed: RemovedComponents<SkinMesh>,
 ) {
-    for (character, attributes) in &characters {
-        for part in &character.skins {
-            if let Ok(materials) = skins.get(part.entity)
-                && let Some(mut buffer) = buffers.get_mut(&materials.attributes)
-            {
-                skin_material::write_attributes(&mut buffer, attributes, &part.vertices);
+    let relaid = !added.is_empty() || removed.read().count() > 0;
+    let vertices_of = |skin: &SkinMesh| {
+        let (character, _) = characters.get(skin.character).ok()?;
+        Some(character.skins.get(skin.part)?.vertices.clone())
+    };
+    if relaid {
+        let mut surfaces: Vec<(Entity, u32)> =
+            skins.iter().filter_map(|(e, skin, _)| Some((e, vertices_of(skin)?.len() as u32))).collect();
+        surfaces.sort_unstable();
+        if store.lay_out(&surfaces) {
+            // A new asset (and GPU buffer) that each material binds once it is prepared.
+            store.buffer = buffers.add(store.empty_buffer());
+            for (_, material) in materials.iter_mut() {
+                material.extension.attributes = store.buffer.clone();
             }
+        }
+        for (entity, _, tag) in &skins {
+            if let Some(first) = store.first(entity).filter(|&f| tag.is_none_or(|t| t.0 != f)) {
+                commands.entity(entity).insert(MeshTag(first));
+            }
+        }
+    }
+    let Some(mut buffer) = buffers.get_mut(&store.buffer) else { return };
+    for (entity, skin, _) in &skins {
+        let Ok((character, attributes)) = characters.get(skin.character) else { continue };
+        if relaid || attributes.is_changed() {
+            let Some(part) = character.skins.get(skin.part) else { continue };
+            store.write(&mut buffer, entity, &attributes, &part.vertices);
         }
     }
 }
 
-/// Draws skins in their plain material while they show weights or heat, else in their own
+/// Draws skins in the shared material while they show weights or heat, else in their own
 /// (reads `CharacterView`, `HeatJoint`; writes `MeshMaterial3d`).
 fn show_weights_in_plain_material(
     characters: Query<(&Character, &CharacterView, &HeatJoint), Or<(Changed<CharacterView>, Changed<HeatJoint>)>>,
-    mut skins: Query<(&SkinMaterials, &mut MeshMaterial3d<SkinMaterialAsset>)>,
+    material: Res<SkinMaterial>,
+    mut skins: Query<(&OwnMaterial, &mut MeshMaterial3d<SkinMaterialAsset>)>,
 ) {
     for (character, view, heat) in &characters {
         let plain = view.weight_colors || heat.0.is_some();
         for part in &character.skins {
-            if let Ok((materials, mut drawn)) = skins.get_mut(part.entity) {
-                let wanted = if plain { &materials.plain } else { &materials.own };
+            if let Ok((own, mut drawn)) = skins.get_mut(part.entity) {
+                let wanted = if plain { &material.0 } else { &own.0 };
                 if drawn.0 != *wanted {
                     drawn.0 = wanted.clone();
                 }
