@@ -98,7 +98,7 @@ fn surface_mesh(skin: &crate::rig::Skin, surface: &crate::rig::material::Surface
 
 /// A render mesh of the skin's own vertices and triangles, positions only: no normals (the
 /// skin material lights each triangle with its own normal, from the derivatives of the
-/// position), and texture coordinates and colours in the material's own buffer
+/// position), and texture coordinates and colours in the skin materials' buffer
 /// ([`SkinAttributes`](super::handoff::SkinAttributes)), so that a moving character hands
 /// the GPU 12 bytes a vertex.
 pub fn empty_skin_mesh(triangles: &[[u32; 3]], vertex_count: usize) -> Mesh {

@@ -2,8 +2,8 @@
 //! skins each re-posed character's positions into its `SkinScratch` and marks its
 //! [`SkinUpload`] changed; the render world takes the changed ones (an `Arc`, no copy) and
 //! copies them straight into the staging memory of the mesh's slot of the vertex buffer,
-//! which holds positions only (12 bytes a vertex): texture coordinates and colours are the
-//! skin material's own buffer ([`SkinAttributes`](super::handoff::SkinAttributes)), written
+//! which holds positions only (12 bytes a vertex): texture coordinates and colours are in
+//! the skin materials' buffer ([`SkinAttributes`](super::handoff::SkinAttributes)), written
 //! only when they change. The skin mesh asset itself is never modified after it is made,
 //! so Bevy neither clones it into the render world nor re-packs it each frame, and indices
 //! stay as they were uploaded.

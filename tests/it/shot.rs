@@ -160,9 +160,9 @@ fn a_contact_sheet_shows_every_kept_pose_in_a_grid() {
     assert!(cell(0).pixels().any(|p| p.0[3] == 255), "a cell shows the puppet");
 }
 
-/// Each character's colours reach the picture from its skin material's own buffer (the
-/// vertex buffer holds positions only): a puppet tinted red beside one tinted blue (skinned
-/// on the GPU), in the default light: red outweighs green and blue twice over in the left
+/// Each character's colours reach the picture from the skin materials' buffer, at its own
+/// place (the vertex buffer holds positions only): a puppet tinted red beside one tinted
+/// blue (skinned on the GPU, both in the one plain material), in the default light: red outweighs green and blue twice over in the left
 /// one's pixels, blue outweighs red and green in the right one's. (Reading the wrong word
 /// of the buffer for the colour fails it.)
 #[test]
