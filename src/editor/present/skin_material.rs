@@ -2,10 +2,9 @@
 //! as they are) extended with a vertex shader that takes texture coordinates and colours
 //! from one buffer every skin material reads (each skin's [`SkinAttributes`], written only
 //! when they change; [`SkinAttributeStore`]) beside the positions of the mesh's vertex
-//! buffer, and a fragment shader that
-//! lights each triangle with its own normal, from the derivatives of the world position.
-//! The skinning system then hands the GPU only shared vertex positions when a character
-//! moves: no unshared corners, no normals, no colours.
+//! buffer, and a fragment shader that lights each triangle with its own normal, from the
+//! derivatives of the world position. The skinning system then hands the GPU only shared
+//! vertex positions when a character moves: no unshared corners, no normals, no colours.
 
 use bevy::asset::embedded_asset;
 use bevy::mesh::MeshVertexBufferLayoutRef;

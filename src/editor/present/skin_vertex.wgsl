@@ -15,8 +15,8 @@
 #import bevy_pbr::forward_io::VertexOutput
 #endif
 
-// Every skin surface's attributes, per vertex three words: u and v (float bits; zero where the skin has none), then the
-// colour (unorm8x4, red in the low byte).
+// Every skin surface's attributes, per vertex three words: u and v (float bits; zero
+// where the skin has none), then the colour (unorm8x4, red in the low byte).
 @group(#{MATERIAL_BIND_GROUP}) @binding(101) var<storage, read> attributes: array<u32>;
 
 struct Vertex {

@@ -472,18 +472,14 @@ fn store_skin_attributes(
     mut buffers: ResMut<Assets<ShaderBuffer>>,
     mut materials: ResMut<Assets<SkinMaterialAsset>>,
     characters: Query<(&Character, Ref<SkinAttributes>)>,
-    skins: Query<(Entity, &SkinMesh, Option<&MeshTag>)>,
+    tags: Query<Option<&MeshTag>, With<SkinMesh>>,
     added: Query<(), Added<SkinMesh>>,
     mut removed: RemovedComponents<SkinMesh>,
 ) {
     let relaid = !added.is_empty() || removed.read().count() > 0;
-    let vertices_of = |skin: &SkinMesh| {
-        let (character, _) = characters.get(skin.character).ok()?;
-        Some(character.skins.get(skin.part)?.vertices.clone())
-    };
     if relaid {
         let mut surfaces: Vec<(Entity, u32)> =
-            skins.iter().filter_map(|(e, skin, _)| Some((e, vertices_of(skin)?.len() as u32))).collect();
+            characters.iter().flat_map(|(c, _)| c.skins.iter().map(|p| (p.entity, p.vertices.len() as u32))).collect();
         surfaces.sort_unstable();
         if store.lay_out(&surfaces) {
             // A new asset (and GPU buffer) that each material binds once it is prepared.
@@ -492,18 +488,23 @@ fn store_skin_attributes(
                 material.extension.attributes = store.buffer.clone();
             }
         }
-        for (entity, _, tag) in &skins {
-            if let Some(first) = store.first(entity).filter(|&f| tag.is_none_or(|t| t.0 != f)) {
+        for (entity, _) in surfaces {
+            let first = store.first(entity);
+            if let (Ok(tag), Some(first)) = (tags.get(entity), first)
+                && tag.is_none_or(|t| t.0 != first)
+            {
                 commands.entity(entity).insert(MeshTag(first));
             }
         }
     }
+    let mut written = characters.iter().filter(|(_, attributes)| relaid || attributes.is_changed()).peekable();
+    if written.peek().is_none() {
+        return;
+    }
     let Some(mut buffer) = buffers.get_mut(&store.buffer) else { return };
-    for (entity, skin, _) in &skins {
-        let Ok((character, attributes)) = characters.get(skin.character) else { continue };
-        if relaid || attributes.is_changed() {
-            let Some(part) = character.skins.get(skin.part) else { continue };
-            store.write(&mut buffer, entity, &attributes, &part.vertices);
+    for (character, attributes) in written {
+        for part in &character.skins {
+            store.write(&mut buffer, part.entity, &attributes, &part.vertices);
         }
     }
 }
