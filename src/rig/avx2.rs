@@ -3,6 +3,8 @@
 //! The point shuffles are `unsafe` functions always inlined rather than `target_feature`
 //! ones (which may not be `inline(always)`): with three kernels calling them, LLVM stopped
 //! inlining `interleave`, and the call cost the LBS kernel a tenth of its time.
+//! [`for_both_levels`] builds a kernel for AVX2 and again with AVX-512 VL (the DQ kernel;
+//! the linear blend kernels have sixteen-lane AVX-512 versions of their own).
 
 use std::arch::x86_64::*;
 

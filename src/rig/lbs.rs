@@ -4,8 +4,11 @@
 //! of a block's joints transforms all eight bind positions at once, weighted lane by lane
 //! (`pᵥ = Σⱼ wᵥⱼ (Pⱼ bᵥ)`), so a joint's matrix is read once for eight vertices. Elsewhere
 //! each vertex blends its own matrices with glam's `Vec4`, grouped by influence count.
-//! The SIMD kernels are built twice ([`Simd`]: with AVX-512 VL as well, where the CPU has
-//! it); the `_using` entry points run any level the CPU has.
+//! With AVX-512 F, the blocks are sixteen vertices wide
+//! ([`WideLaneBlocks`](super::influences::WideLaneBlocks)) on 512-bit registers: a joint's
+//! multiply-adds serve twice the vertices, and the pair of blocks of eight they replace
+//! share most joints (SMPL: 37 % fewer multiply-adds). [`Simd`] names the levels; the
+//! `_using` entry points run any level the CPU has.
 //! [`skin_positions`](super::skinning::skin_positions) stays as the plain oracle.
 
 use glam::{Mat4, Vec3, Vec3A, Vec4};
@@ -67,7 +70,10 @@ pub fn skin_using(
 }
 
 /// [`skin_chunk`] at a given level of the kernel.
-fn skin_chunk_using(
+///
+/// # Panics
+/// As [`skin_chunk`], or when the CPU does not run `simd`.
+pub fn skin_chunk_using(
     simd: Simd,
     bind_positions: &[Vec3],
     weights: &SkinWeights,
@@ -81,9 +87,14 @@ fn skin_chunk_using(
     assert!(groups.joint_bound <= palette.len(), "an influence names a joint beyond the palette");
     assert!(simd.is_available(), "this CPU does not run {simd:?}");
     #[cfg(target_arch = "x86_64")]
-    if simd != Simd::Portable {
+    match simd {
         // SAFETY: the CPU runs `simd` (checked above).
-        return unsafe { avx2::skin_blocks(simd, bind_positions, &groups.blocks, palette, first, out) };
+        Simd::Avx512Vl => {
+            return unsafe { avx512::skin_blocks(bind_positions, &groups.wide_blocks, palette, first, out) };
+        }
+        // SAFETY: as above.
+        Simd::Avx2 => return unsafe { avx2::skin_blocks(bind_positions, &groups.blocks, palette, first, out) },
+        Simd::Portable => {}
     }
     skin_portable_chunk(bind_positions, weights, palette, first, out, None)
 }
@@ -119,9 +130,18 @@ pub fn skin_with_normals_using(
     assert!(groups.joint_bound <= palette.len(), "an influence names a joint beyond the palette");
     assert!(simd.is_available(), "this CPU does not run {simd:?}");
     #[cfg(target_arch = "x86_64")]
-    if simd != Simd::Portable {
+    match simd {
         // SAFETY: the CPU runs `simd` (checked above).
-        return unsafe { avx2::skin_blocks_with_normals(simd, bind_positions, &groups.blocks, palette, out, normals) };
+        Simd::Avx512Vl => {
+            return unsafe {
+                avx512::skin_blocks_with_normals(bind_positions, &groups.wide_blocks, palette, out, normals)
+            };
+        }
+        // SAFETY: as above.
+        Simd::Avx2 => {
+            return unsafe { avx2::skin_blocks_with_normals(bind_positions, &groups.blocks, palette, out, normals) };
+        }
+        Simd::Portable => {}
     }
     skin_portable_chunk(bind_positions, weights, palette, 0, out, Some(normals))
 }
@@ -232,52 +252,40 @@ fn skin_wide(
     bounds
 }
 
+/// A palette matrix's twelve elements as a block reads them: element `e` is column `e / 3`,
+/// row `e % 3` (the fourth row of an affine matrix is not needed).
+#[cfg(target_arch = "x86_64")]
+#[inline(always)]
+fn elements(m: &Mat4) -> [f32; 12] {
+    let c = m.to_cols_array();
+    std::array::from_fn(|e| c[e / 3 * 4 + e % 3])
+}
+
 #[cfg(target_arch = "x86_64")]
 mod avx2 {
     use std::arch::x86_64::*;
 
     use glam::{Mat4, Vec3, Vec3A};
 
-    use super::{LaneBlocks, Normals};
-    use crate::rig::avx2::{
-        deinterleave, deinterleave_some, floats, for_both_levels, interleave, lane_points, register,
-    };
+    use super::{LaneBlocks, Normals, elements};
+    use crate::rig::avx2::{deinterleave, deinterleave_some, floats, interleave, lane_points, register};
     use crate::rig::influences::LANES;
     use crate::rig::skinning::Bounds;
 
-    /// A palette matrix's twelve elements as a block reads them: element `e` is column
-    /// `e / 3`, row `e % 3` (the fourth row of an affine matrix is not needed).
-    #[inline]
-    fn elements(m: &Mat4) -> [f32; 12] {
-        let c = m.to_cols_array();
-        std::array::from_fn(|e| c[e / 3 * 4 + e % 3])
-    }
-
-    for_both_levels! {
-        /// Each block on 256-bit registers, one vertex a lane: each of the block's joints
-        /// transforms all eight bind positions (its matrix's elements broadcast once) and adds
-        /// them in with each lane's weight; twelve multiply-adds a joint for eight vertices.
-        /// Blocks that lie wholly in the chunk read and write their eight positions in order;
-        /// the chunk's first and last blocks (when it does not start or end on a multiple of
-        /// eight) and the mesh's last go lane by lane.
-        ///
-        /// (Indices are checked: a joint beyond the palette or a vertex beyond the buffers
-        /// panics.)
-        pub unsafe fn skin_blocks = skin_blocks_body(
-            bind: &[Vec3],
-            blocks: &LaneBlocks,
-            palette: &[Mat4],
-            first: usize,
-            out: &mut [Vec3],
-        ) -> Bounds
-    }
-
-    /// [`skin_blocks`]' body.
+    /// Each block on 256-bit registers, one vertex a lane: each of the block's joints
+    /// transforms all eight bind positions (its matrix's elements broadcast once) and adds
+    /// them in with each lane's weight; twelve multiply-adds a joint for eight vertices.
+    /// Blocks that lie wholly in the chunk read and write their eight positions in order;
+    /// the chunk's first and last blocks (when it does not start or end on a multiple of
+    /// eight) and the mesh's last go lane by lane.
+    ///
+    /// (Indices are checked: a joint beyond the palette or a vertex beyond the buffers
+    /// panics.)
     ///
     /// # Safety
     /// The CPU must have AVX2 and FMA.
-    #[inline(always)]
-    unsafe fn skin_blocks_body(
+    #[target_feature(enable = "avx2,fma")]
+    pub unsafe fn skin_blocks(
         bind: &[Vec3],
         blocks: &LaneBlocks,
         palette: &[Mat4],
@@ -339,27 +347,16 @@ mod avx2 {
         )
     }
 
-    for_both_levels! {
     /// [`skin_blocks`] of a whole mesh with its normals: each lane's matrix is blended
     /// first (`Σⱼ wⱼ Pⱼ`, twelve multiply-adds a joint for eight vertices), then turns the
     /// eight positions and the eight normals once. (Transforming by each joint, as
     /// `skin_blocks` does for positions alone, needs more registers than there are with the
     /// normals: 46 µs a SMPL body against this order's 22.)
-    pub unsafe fn skin_blocks_with_normals = skin_blocks_with_normals_body(
-        bind: &[Vec3],
-        blocks: &LaneBlocks,
-        palette: &[Mat4],
-        out: &mut [Vec3],
-        normals: Normals,
-    ) -> Bounds
-    }
-
-    /// [`skin_blocks_with_normals`]' body.
     ///
     /// # Safety
     /// The CPU must have AVX2 and FMA.
-    #[inline(always)]
-    unsafe fn skin_blocks_with_normals_body(
+    #[target_feature(enable = "avx2,fma")]
+    pub unsafe fn skin_blocks_with_normals(
         bind: &[Vec3],
         blocks: &LaneBlocks,
         palette: &[Mat4],
@@ -406,5 +403,141 @@ mod avx2 {
             }
             lanes_bounds(lo, hi).union(last)
         }
+    }
+}
+
+/// The AVX-512 kernels: [`avx2`]'s, sixteen vertices a block on 512-bit registers.
+#[cfg(target_arch = "x86_64")]
+mod avx512 {
+    use std::arch::x86_64::*;
+
+    use glam::{Mat4, Vec3, Vec3A};
+
+    use super::{Normals, elements};
+    use crate::rig::avx512::{deinterleave, deinterleave_some, floats, interleave, lane_points, register};
+    use crate::rig::influences::{WIDE_LANES, WideLaneBlocks};
+    use crate::rig::skinning::Bounds;
+
+    /// [`super::avx2::skin_blocks`] sixteen vertices a block: each of the block's joints
+    /// transforms the sixteen bind positions (its matrix's elements broadcast inside the
+    /// multiply-adds) and adds them in with each lane's weight. Blocks wholly in the chunk
+    /// read and write their positions in order; the chunk's edges and the mesh's last block
+    /// go lane by lane.
+    ///
+    /// # Safety
+    /// The CPU must have AVX-512 F, AVX2 and FMA.
+    #[target_feature(enable = "avx512f,avx2,fma")]
+    pub unsafe fn skin_blocks(
+        bind: &[Vec3],
+        blocks: &WideLaneBlocks,
+        palette: &[Mat4],
+        first: usize,
+        out: &mut [Vec3],
+    ) -> Bounds {
+        let end = first + out.len();
+        let (mut lo, mut hi) = ([_mm512_set1_ps(f32::INFINITY); 3], [_mm512_set1_ps(f32::NEG_INFINITY); 3]);
+        let mut edges = Bounds::EMPTY;
+        for b in first / WIDE_LANES..end.div_ceil(WIDE_LANES) {
+            let lanes = b * WIDE_LANES..(b + 1) * WIDE_LANES;
+            let whole = first <= lanes.start && lanes.end <= end;
+            let [x, y, z] = if whole {
+                // SAFETY: the CPU has AVX-512 F (this function's contract).
+                unsafe { deinterleave(&bind[lanes.clone()]) }
+            } else {
+                deinterleave_some(&bind[lanes.start..lanes.end.min(bind.len())])
+            };
+            let mut p = [_mm512_setzero_ps(); 3];
+            let joints = blocks.joint_starts[b] as usize..blocks.joint_starts[b + 1] as usize;
+            for (&j, w) in blocks.joints[joints.clone()].iter().zip(&blocks.weights[joints]) {
+                let w = register(w.0);
+                let m = elements(&palette[j as usize]).map(|c| _mm512_set1_ps(c));
+                for (r, p) in p.iter_mut().enumerate() {
+                    let row =
+                        _mm512_fmadd_ps(m[r], x, _mm512_fmadd_ps(m[3 + r], y, _mm512_fmadd_ps(m[6 + r], z, m[9 + r])));
+                    *p = _mm512_fmadd_ps(w, row, *p);
+                }
+            }
+            if whole {
+                for k in 0..3 {
+                    (lo[k], hi[k]) = (_mm512_min_ps(lo[k], p[k]), _mm512_max_ps(hi[k], p[k]));
+                }
+                // SAFETY: as above.
+                unsafe { interleave(p, &mut out[lanes.start - first..lanes.end - first]) };
+            } else {
+                let lane = p.map(floats);
+                for (i, v) in lanes.enumerate().filter(|(_, v)| (first..end).contains(v)) {
+                    let q = Vec3A::new(lane[0][i], lane[1][i], lane[2][i]);
+                    out[v - first] = q.into();
+                    edges = edges.with(q);
+                }
+            }
+        }
+        lanes_bounds(lo, hi).union(edges)
+    }
+
+    /// [`super::avx2::skin_blocks_with_normals`] sixteen vertices a block.
+    ///
+    /// # Safety
+    /// The CPU must have AVX-512 F, AVX2 and FMA.
+    #[target_feature(enable = "avx512f,avx2,fma")]
+    pub unsafe fn skin_blocks_with_normals(
+        bind: &[Vec3],
+        blocks: &WideLaneBlocks,
+        palette: &[Mat4],
+        out: &mut [Vec3],
+        normals: Normals,
+    ) -> Bounds {
+        let n = bind.len();
+        let (mut lo, mut hi) = ([_mm512_set1_ps(f32::INFINITY); 3], [_mm512_set1_ps(f32::NEG_INFINITY); 3]);
+        let mut last = Bounds::EMPTY;
+        for b in 0..n.div_ceil(WIDE_LANES) {
+            let lanes = b * WIDE_LANES..(b + 1) * WIDE_LANES;
+            let mut m = [_mm512_setzero_ps(); 12];
+            let joints = blocks.joint_starts[b] as usize..blocks.joint_starts[b + 1] as usize;
+            for (&j, w) in blocks.joints[joints.clone()].iter().zip(&blocks.weights[joints]) {
+                let w = register(w.0);
+                for (m, e) in m.iter_mut().zip(elements(&palette[j as usize])) {
+                    *m = _mm512_fmadd_ps(w, _mm512_set1_ps(e), *m);
+                }
+            }
+            // SAFETY: the CPU has AVX-512 F (this function's contract).
+            let [x, y, z] = unsafe { lane_points(bind, lanes.clone()) };
+            let p: [__m512; 3] = std::array::from_fn(|r| {
+                _mm512_fmadd_ps(m[r], x, _mm512_fmadd_ps(m[3 + r], y, _mm512_fmadd_ps(m[6 + r], z, m[9 + r])))
+            });
+            // SAFETY: as above.
+            let [x, y, z] = unsafe { lane_points(normals.bind, lanes.clone()) };
+            let normal: [__m512; 3] = std::array::from_fn(|r| {
+                _mm512_fmadd_ps(m[r], x, _mm512_fmadd_ps(m[3 + r], y, _mm512_mul_ps(m[6 + r], z)))
+            });
+            if lanes.end <= n {
+                for k in 0..3 {
+                    (lo[k], hi[k]) = (_mm512_min_ps(lo[k], p[k]), _mm512_max_ps(hi[k], p[k]));
+                }
+                // SAFETY: as above.
+                unsafe {
+                    interleave(p, &mut out[lanes.clone()]);
+                    interleave(normal, &mut normals.out[lanes]);
+                }
+            } else {
+                let (p, normal) = (p.map(floats), normal.map(floats));
+                for (i, v) in lanes.take_while(|&v| v < n).enumerate() {
+                    let q = Vec3A::new(p[0][i], p[1][i], p[2][i]);
+                    (out[v], normals.out[v]) = (q.into(), Vec3::new(normal[0][i], normal[1][i], normal[2][i]));
+                    last = last.with(q);
+                }
+            }
+        }
+        lanes_bounds(lo, hi).union(last)
+    }
+
+    /// The box between sixteen lanes of lower and sixteen of upper corners.
+    #[inline(always)]
+    fn lanes_bounds(lo: [__m512; 3], hi: [__m512; 3]) -> Bounds {
+        let reduce = |r: __m512, f: fn(f32, f32) -> f32| floats(r).into_iter().reduce(f).unwrap_or(0.0);
+        Bounds::between(
+            Vec3A::new(reduce(lo[0], f32::min), reduce(lo[1], f32::min), reduce(lo[2], f32::min)),
+            Vec3A::new(reduce(hi[0], f32::max), reduce(hi[1], f32::max), reduce(hi[2], f32::max)),
+        )
     }
 }

@@ -4,6 +4,8 @@
 pub mod anim;
 #[cfg(target_arch = "x86_64")]
 mod avx2;
+#[cfg(target_arch = "x86_64")]
+mod avx512;
 pub mod bind;
 pub mod bones;
 pub mod character;

@@ -1,14 +1,13 @@
-//! The instruction sets the fast skinning kernels are compiled for. Each SIMD kernel is
-//! one body compiled twice (AVX2 + FMA, and with AVX-512 F and VL as well), chosen at run
-//! time; [`Simd::best`] is what the CPU has, and every level it has can be asked for by
-//! name (the tests check each against the plain loop).
+//! The instruction sets the fast skinning kernels are compiled for, chosen at run time:
+//! [`Simd::best`] is what the CPU has, and every level it has can be asked for by name (the
+//! tests check each against the plain loop).
 
 /// A level of the skinning kernels, best first.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Simd {
-    /// The AVX2 kernels built with AVX-512 F and VL as well: still eight lanes of 256
-    /// bits, but each palette element is broadcast inside the multiply-add that reads it,
-    /// and there are 32 registers instead of 16.
+    /// AVX-512: the linear blend kernels sixteen vertices a block on 512-bit registers;
+    /// the dual quaternion kernel is the AVX2 one built with AVX-512 F and VL as well (each
+    /// palette element broadcast inside the multiply-add that reads it, 32 registers).
     Avx512Vl,
     /// Eight lanes of 256 bits, AVX2 and FMA.
     Avx2,

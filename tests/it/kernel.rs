@@ -4,7 +4,7 @@
 //! grows as it writes is the box of what it wrote.
 
 use glam::{Mat4, Quat, Vec3};
-use marionette::rig::lbs::{skin, skin_using};
+use marionette::rig::lbs::{skin_chunk_using, skin_using};
 use marionette::rig::simd::Simd;
 use marionette::rig::skinning::{Bounds, bounds, skin_positions};
 use marionette::rig::{CharacterAsset, JointRotation, SkinWeights};
@@ -87,17 +87,20 @@ fn the_kernel_matches_the_oracle_on_rows_of_1_to_13_influences() {
     let (weights, _) = SkinWeights::from_rows(rows, joints).unwrap();
     assert!(weights.groups().fixed.iter().all(|g| !g.vertices.is_empty()) && !weights.groups().wide.is_empty());
     assert_kernel_matches_oracle("synthetic", &bind, &weights, &palette);
-    // In chunks (how a large mesh is split across threads): the same output exactly.
-    let mut whole = vec![Vec3::ZERO; n];
-    skin(&bind, &weights, &palette, &mut whole);
-    let mut chunked = vec![Vec3::splat(f32::NAN); n];
-    let boxes = chunked
-        .chunks_mut(300)
-        .enumerate()
-        .map(|(k, chunk)| marionette::rig::lbs::skin_chunk(&bind, &weights, &palette, k * 300, chunk));
-    let grown = boxes.fold(Bounds::EMPTY, Bounds::union);
-    assert_eq!(chunked, whole);
-    assert_eq!(grown.pair(), bounds(&whole));
+    // In chunks of 300 (how a large mesh is split across threads; blocks cut at their
+    // edges at each level's width): the same output exactly, at every level.
+    for simd in Simd::available() {
+        let mut whole = vec![Vec3::ZERO; n];
+        skin_using(simd, &bind, &weights, &palette, &mut whole);
+        let mut chunked = vec![Vec3::splat(f32::NAN); n];
+        let boxes = chunked
+            .chunks_mut(300)
+            .enumerate()
+            .map(|(k, chunk)| skin_chunk_using(simd, &bind, &weights, &palette, k * 300, chunk));
+        let grown = boxes.fold(Bounds::EMPTY, Bounds::union);
+        assert_eq!(chunked, whole, "{simd:?}");
+        assert_eq!(grown.pair(), bounds(&whole), "{simd:?}");
+    }
 }
 
 #[test]
