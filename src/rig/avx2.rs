@@ -84,6 +84,30 @@ pub unsafe fn interleave([x, y, z]: [__m256; 3], points: &mut [Vec3]) {
     }
 }
 
+/// How far ahead of the block it skins a kernel asks for bind positions and output (in
+/// vertices). In a crowd each body's positions are cold (drawing on llvmpipe evicts the
+/// caches between frames) and the hardware prefetcher starts late on each body's short run:
+/// asking 128 vertices ahead took 8 % off the crowd's cold kernel at 64 bodies on both
+/// cores and 13 % at 256 (medians of three interleaved runs: 0.75 -> 0.69 ms, 2.82 ->
+/// 2.46 ms).
+pub const PREFETCH_AHEAD: usize = 128;
+
+/// Asks for the cache lines of the `lanes` vertices [`PREFETCH_AHEAD`] past bind position
+/// `bind_at` and output `out_at` (the output's to be written). Only hints: an address past
+/// either buffer is never read.
+#[inline(always)]
+pub fn prefetch_ahead(bind: &[Vec3], bind_at: usize, out: &[Vec3], out_at: usize, lanes: usize) {
+    let bind = bind.as_ptr().wrapping_add(bind_at + PREFETCH_AHEAD) as *const i8;
+    let out = out.as_ptr().wrapping_add(out_at + PREFETCH_AHEAD) as *const i8;
+    for line in (0..lanes * std::mem::size_of::<Vec3>()).step_by(64) {
+        // SAFETY: prefetches are hints that never fault (SSE, part of x86-64).
+        unsafe {
+            _mm_prefetch::<_MM_HINT_T0>(bind.wrapping_add(line));
+            _mm_prefetch::<_MM_HINT_ET0>(out.wrapping_add(line));
+        }
+    }
+}
+
 /// Eight floats as a register (lane i: float i).
 #[inline]
 pub fn register(lanes: [f32; 8]) -> __m256 {

@@ -268,7 +268,9 @@ mod avx2 {
     use glam::{Mat4, Vec3, Vec3A};
 
     use super::{LaneBlocks, Normals, elements};
-    use crate::rig::avx2::{deinterleave, deinterleave_some, floats, interleave, lane_points, register};
+    use crate::rig::avx2::{
+        deinterleave, deinterleave_some, floats, interleave, lane_points, prefetch_ahead, register,
+    };
     use crate::rig::influences::LANES;
     use crate::rig::skinning::Bounds;
 
@@ -300,6 +302,7 @@ mod avx2 {
             for b in first / LANES..end.div_ceil(LANES) {
                 let lanes = b * LANES..(b + 1) * LANES;
                 let whole = first <= lanes.start && lanes.end <= end;
+                prefetch_ahead(bind, lanes.start, out, lanes.start.saturating_sub(first), LANES);
                 let [x, y, z] = if whole {
                     deinterleave(&bind[lanes.clone()])
                 } else {
@@ -414,6 +417,7 @@ mod avx512 {
     use glam::{Mat4, Vec3, Vec3A};
 
     use super::{Normals, elements};
+    use crate::rig::avx2::prefetch_ahead;
     use crate::rig::avx512::{deinterleave, deinterleave_some, floats, interleave, lane_points, register};
     use crate::rig::influences::{WIDE_LANES, WideLaneBlocks};
     use crate::rig::skinning::Bounds;
@@ -440,6 +444,7 @@ mod avx512 {
         for b in first / WIDE_LANES..end.div_ceil(WIDE_LANES) {
             let lanes = b * WIDE_LANES..(b + 1) * WIDE_LANES;
             let whole = first <= lanes.start && lanes.end <= end;
+            prefetch_ahead(bind, lanes.start, out, lanes.start.saturating_sub(first), WIDE_LANES);
             let [x, y, z] = if whole {
                 // SAFETY: the CPU has AVX-512 F (this function's contract).
                 unsafe { deinterleave(&bind[lanes.clone()]) }
