@@ -434,6 +434,46 @@ fn skin_phase_parts(bencher: Bencher, part: &str) {
     });
 }
 
+/// Where a skin needs normals (a glTF normal map bends them), on one SMPL body: the
+/// positions alone, the positions with the bind normals skinned by the same blend
+/// (`lbs::skin_with_normals`), and the positions with smooth normals derived from them (each
+/// vertex's triangles' area-weighted normals summed, then normalised), in vertices per
+/// second.
+#[divan::bench(args = ["positions", "skinned normals", "derived normals"])]
+fn skin_normals_skinned_or_derived(bencher: Bencher, way: &str) {
+    use marionette::rig::lbs::{Normals, skin, skin_with_normals};
+    let body = smpl_body();
+    let palette = posed_palette(&body);
+    let skin_ = &body.skin;
+    let n = skin_.bind_positions.len();
+    let mut bind_normals = vec![Vec3::ZERO; n];
+    derive_normals(&skin_.bind_positions, &skin_.triangles, &mut bind_normals);
+    let (mut out, mut normals) = (vec![Vec3::ZERO; n], vec![Vec3::ZERO; n]);
+    bencher.counter(divan::counter::ItemsCount::new(n)).bench_local(|| match way {
+        "positions" => skin(&skin_.bind_positions, &skin_.weights, &palette, &mut out),
+        "skinned normals" => {
+            let normals = Normals { bind: &bind_normals, out: &mut normals };
+            skin_with_normals(&skin_.bind_positions, &skin_.weights, &palette, &mut out, normals);
+        }
+        _ => {
+            skin(&skin_.bind_positions, &skin_.weights, &palette, &mut out);
+            derive_normals(&out, &skin_.triangles, &mut normals);
+        }
+    });
+}
+
+/// Smooth normals from positions: each triangle's cross product (twice its area along its
+/// normal) added to its corners, then each sum normalised.
+fn derive_normals(positions: &[Vec3], triangles: &[[u32; 3]], out: &mut [Vec3]) {
+    out.fill(Vec3::ZERO);
+    for t in triangles {
+        let [a, b, c] = t.map(|i| positions[i as usize]);
+        let n = (b - a).cross(c - a);
+        t.iter().for_each(|&i| out[i as usize] += n);
+    }
+    out.iter_mut().for_each(|n| *n = n.normalize_or_zero());
+}
+
 /// A crowd for the kernel alone: each body, its posed palette and room for its output.
 struct Crowd {
     assets: Vec<Arc<CharacterAsset>>,
