@@ -94,6 +94,17 @@ def acc(i, **fields):
     return lambda d, b: d["accessors"][i].update(fields)
 
 
+def with_normals(d, b, values):
+    """Gives the primitive a NORMAL accessor of these nine floats."""
+    while len(b) % 4:
+        b.append(0)
+    d["bufferViews"].append({"buffer": 0, "byteOffset": len(b), "byteLength": 36})
+    b.extend(struct.pack("<9f", *values))
+    d["accessors"].append({"bufferView": len(d["bufferViews"]) - 1, "componentType": FLOAT, "count": 3, "type": "VEC3"})
+    d["meshes"][0]["primitives"][0]["attributes"]["NORMAL"] = len(d["accessors"]) - 1
+    d["buffers"][0]["byteLength"] = len(b)
+
+
 CASES = {
     # The gltf crate panicked on these (exit 101), or its arithmetic overflowed.
     "gltf-indices-float": acc(1, componentType=FLOAT),
@@ -123,6 +134,7 @@ CASES = {
     "gltf-node-matrix-singular": lambda d, b: d["nodes"][1].update(matrix=[0.0] * 16),
     "gltf-weight-negative": lambda d, b: put_floats(d, b, 3, 1, [1.5, -0.5]),
     "gltf-weight-nan": lambda d, b: put_floats(d, b, 3, 1, [math.nan, 1.0]),
+    "gltf-normal-nan": lambda d, b: with_normals(d, b, [0, 0, 1, 0, 0, 1, 0, math.nan, 1]),
 }
 
 

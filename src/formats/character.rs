@@ -213,8 +213,7 @@ fn load_cse169_skin(name: String, skeleton: Skeleton, path: &Path) -> Result<Cha
         Some(_) => file.texcoords.iter().map(|t| glam::Vec2::new(t.x, 1.0 - t.y)).collect(),
         None => Vec::new(),
     };
-    let skin =
-        Skin { bind_positions: file.positions, triangles: file.triangles, weights, texcoords, colors: Vec::new() };
+    let skin = Skin { texcoords, ..Skin::untextured(file.positions, file.triangles, weights) };
     let asset = CharacterAsset::with_inverse_binds(name, skeleton, skin, inverse_binds, warnings)
         .map_err(|e| FormatError::rig(path, e))?;
     let materials = texture

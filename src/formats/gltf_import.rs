@@ -463,6 +463,12 @@ impl<'a> File<'a> {
             )));
         }
         let count = points.len();
+        let normals: Vec<Vec3> = reader.read_normals().into_iter().flatten().map(Vec3::from).collect();
+        if let Some(v) = normals.iter().position(|n| !n.is_finite()) {
+            return Err(self.error(format!("{at}.attributes.NORMAL: expected finite numbers, found vertex {v}'s")));
+        }
+        // Zero where the primitive has none (or fewer than positions): lit flat there.
+        let normals = normals.into_iter().chain(std::iter::repeat(Vec3::ZERO)).take(count);
         let indices: Vec<u32> = match reader.read_indices() {
             Some(i) => i.into_u32().collect(),
             None => (0..count as u32).collect(),
@@ -474,10 +480,15 @@ impl<'a> File<'a> {
         match *bound {
             Bound::Rigid { joint, to_bind } => {
                 skin.bind_positions.extend(points.iter().map(|&p| to_bind.transform_point3(p)));
+                let turn = normal_matrix(&to_bind);
+                skin.normals.extend(normals.map(|n| turn * n));
                 rows.extend(std::iter::repeat_n(vec![(joint, 1.0)], count));
                 return Ok(());
             }
-            Bound::Skinned(_) => skin.bind_positions.extend(points),
+            Bound::Skinned(_) => {
+                skin.bind_positions.extend(points);
+                skin.normals.extend(normals);
+            }
         }
         let Bound::Skinned(joints) = *bound else { unreachable!("rigid primitives returned") };
         let mut influences: Vec<Vec<(usize, f32)>> = vec![Vec::new(); count];
@@ -787,4 +798,11 @@ fn buffers<'a>(gltf: &gltf::Gltf, bin: Option<&'a [u8]>, path: &Path) -> Result<
             Ok(data)
         })
         .collect()
+}
+
+/// The matrix that turns normals as `m` turns points: the inverse transpose of its 3×3
+/// part (the part itself where that cannot be inverted).
+fn normal_matrix(m: &Mat4) -> glam::Mat3 {
+    let part = glam::Mat3::from_mat4(*m);
+    if part.determinant().abs() > f32::MIN_POSITIVE { part.inverse().transpose() } else { part }
 }

@@ -30,6 +30,7 @@ pub struct Looks {
     colors: Vec<[f32; 4]>,
     textured: bool,
     colored: bool,
+    normal_mapped: bool,
 }
 
 /// Where a file's bytes are: its buffers and its path (for images beside it).
@@ -62,6 +63,7 @@ impl Looks {
                 None => {
                     let material = material(source, images, &primitive.material(), warnings)?;
                     self.textured |= material.textures().next().is_some();
+                    self.normal_mapped |= material.normal_texture.is_some();
                     self.materials.push(material);
                     self.ours.insert(index, self.materials.len() - 1);
                     self.materials.len() - 1
@@ -90,8 +92,12 @@ impl Looks {
     }
 
     /// Gives `skin` the coordinates and colours (when a material is textured, when a
-    /// primitive has colours), one per vertex.
+    /// primitive has colours), one per vertex, and keeps its normals only when a material
+    /// has a normal map.
     pub fn finish(&mut self, skin: &mut Skin) {
+        if !self.normal_mapped {
+            skin.normals = Vec::new();
+        }
         let n = skin.bind_positions.len();
         if self.textured {
             self.texcoords.resize(n, Vec2::ZERO);

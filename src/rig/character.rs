@@ -22,12 +22,17 @@ pub struct Skin {
     pub texcoords: Vec<glam::Vec2>,
     /// Vertex colours (linear RGBA, glTF's `COLOR_0`), one per vertex (empty: white).
     pub colors: Vec<[f32; 4]>,
+    /// Bind-pose normals, one per vertex (glTF's `NORMAL`, zero where a primitive has none),
+    /// kept only for a skin whose material has a normal map: such a skin's normals are
+    /// skinned with its positions and bent by the map. Empty: the skin is lit with each
+    /// triangle's own normal, taken from its positions where it is drawn.
+    pub normals: Vec<Vec3>,
 }
 
 impl Skin {
     /// A skin of positions, triangles and weights, without texture coordinates or colours.
     pub fn untextured(bind_positions: Vec<Vec3>, triangles: Vec<[u32; 3]>, weights: SkinWeights) -> Self {
-        Self { bind_positions, triangles, weights, texcoords: Vec::new(), colors: Vec::new() }
+        Self { bind_positions, triangles, weights, texcoords: Vec::new(), colors: Vec::new(), normals: Vec::new() }
     }
 
     /// Checks that weights and triangles fit the vertices.
@@ -35,6 +40,9 @@ impl Skin {
         let count = self.bind_positions.len();
         if self.weights.vertex_count() != count {
             return Err(RigError::WeightCountMismatch { mesh: count, weights: self.weights.vertex_count() });
+        }
+        if !self.normals.is_empty() && self.normals.len() != count {
+            return Err(RigError::NormalCountMismatch { mesh: count, normals: self.normals.len() });
         }
         for (t, tri) in self.triangles.iter().enumerate() {
             if let Some(&index) = tri.iter().find(|&&i| i as usize >= count) {

@@ -68,4 +68,6 @@ pub enum RigError {
     WeightCountMismatch { mesh: usize, weights: usize },
     #[error("triangle {triangle} uses vertex {index}, but the mesh has {count}")]
     TriangleIndexOutOfRange { triangle: usize, index: u32, count: usize },
+    #[error("the mesh has {mesh} vertices but {normals} normals")]
+    NormalCountMismatch { mesh: usize, normals: usize },
 }

@@ -198,6 +198,9 @@ pub struct SkinScratch {
     /// The skinned vertices, model space; shared with the render world while it writes
     /// them into the mesh (see [`reclaimed`](super::handoff::reclaimed)).
     pub positions: Arc<Vec<Vec3>>,
+    /// The skinned normals (not normalised) of a skin that has normals (`Skin::normals`),
+    /// shared like the positions; empty otherwise.
+    pub normals: Arc<Vec<Vec3>>,
     /// The vertex colours.
     pub colors: Vec<[f32; 4]>,
     /// The skinned vertices' box.

@@ -275,11 +275,25 @@ impl SkinBuffers {
 /// Reads back a mesh's positions from its slot of the vertex buffer (render world; blocks
 /// until the GPU has finished). For tests that compare the GPU path with the CPU.
 pub fn read_back_mesh_positions(render_world: &World, mesh: AssetId<Mesh>) -> Option<Vec<Vec3>> {
+    read_back_mesh_vertices(render_world, mesh, VERTEX_BYTES)
+}
+
+/// Reads back a skin mesh with normals: its positions and its normals.
+pub fn read_back_mesh_positions_and_normals(
+    render_world: &World,
+    mesh: AssetId<Mesh>,
+) -> Option<(Vec<Vec3>, Vec<Vec3>)> {
+    let both = read_back_mesh_vertices(render_world, mesh, 2 * VERTEX_BYTES)?;
+    Some(both.chunks_exact(2).map(|v| (v[0], v[1])).unzip())
+}
+
+/// A mesh's slot of `vertex_bytes` a vertex, as three floats at a time.
+fn read_back_mesh_vertices(render_world: &World, mesh: AssetId<Mesh>, vertex_bytes: u64) -> Option<Vec<Vec3>> {
     let allocator = render_world.get_resource::<MeshAllocator>()?;
     let device = render_world.get_resource::<RenderDevice>()?;
     let queue = render_world.get_resource::<RenderQueue>()?;
     let slice = allocator.mesh_vertex_slice(&mesh)?;
-    let bytes = u64::from(slice.range.end - slice.range.start) * VERTEX_BYTES;
+    let bytes = u64::from(slice.range.end - slice.range.start) * vertex_bytes;
     let staging = device.create_buffer(&BufferDescriptor {
         label: Some("read back"),
         size: bytes,
@@ -287,7 +301,7 @@ pub fn read_back_mesh_positions(render_world: &World, mesh: AssetId<Mesh>) -> Op
         mapped_at_creation: false,
     });
     let mut encoder = device.create_command_encoder(&CommandEncoderDescriptor { label: Some("read back") });
-    encoder.copy_buffer_to_buffer(slice.buffer, u64::from(slice.range.start) * VERTEX_BYTES, &staging, 0, bytes);
+    encoder.copy_buffer_to_buffer(slice.buffer, u64::from(slice.range.start) * vertex_bytes, &staging, 0, bytes);
     queue.submit([encoder.finish()]);
     let (sender, receiver) = std::sync::mpsc::channel();
     staging.slice(..).map_async(MapMode::Read, move |result| {

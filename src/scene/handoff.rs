@@ -17,6 +17,9 @@ use crate::rig::dqs::SkinningMethod;
 /// [`SkinAttributes`], handed on only when they change.
 pub const SKIN_VERTEX_BYTES: usize = 3 * 4;
 
+/// The same for a skin with normals (a normal-mapped glTF skin): position and normal.
+pub const SKIN_VERTEX_WITH_NORMAL_BYTES: usize = 2 * SKIN_VERTEX_BYTES;
+
 /// A colour as the skin's attributes hold it: each channel clamped to 0–1, to the nearest
 /// of 255 steps (the shader unpacks it with `unpack4x8unorm`).
 pub fn color_bytes(c: [f32; 4]) -> [u8; 4] {
@@ -29,12 +32,14 @@ pub fn color_bytes(c: [f32; 4]) -> [u8; 4] {
 pub struct SkinUpload {
     /// The vertices skinned (the positions the render world takes).
     pub vertex_count: usize,
+    /// Whether their normals go with them.
+    pub with_normals: bool,
 }
 
 impl SkinUpload {
-    /// Bytes of the mesh's vertex buffer the positions fill.
+    /// Bytes of the mesh's vertex buffer the positions (and normals) fill.
     pub fn byte_len(&self) -> usize {
-        self.vertex_count * SKIN_VERTEX_BYTES
+        self.vertex_count * if self.with_normals { SKIN_VERTEX_WITH_NORMAL_BYTES } else { SKIN_VERTEX_BYTES }
     }
 }
 

@@ -93,20 +93,25 @@ fn surface_mesh(skin: &crate::rig::Skin, surface: &crate::rig::material::Surface
         .iter()
         .map(|t| t.map(|i| i - first))
         .collect();
-    empty_skin_mesh(&triangles, (end - first) as usize)
+    empty_skin_mesh(&triangles, (end - first) as usize, !skin.normals.is_empty())
 }
 
 /// A render mesh of the skin's own vertices and triangles, positions only: no normals (the
 /// skin material lights each triangle with its own normal, from the derivatives of the
 /// position), and texture coordinates and colours in the skin materials' buffer
 /// ([`SkinAttributes`](super::handoff::SkinAttributes)), so that a moving character hands
-/// the GPU 12 bytes a vertex.
-pub fn empty_skin_mesh(triangles: &[[u32; 3]], vertex_count: usize) -> Mesh {
+/// the GPU 12 bytes a vertex. A skin `with_normals` (a normal-mapped one) has them after
+/// each position: 24 bytes a vertex.
+pub fn empty_skin_mesh(triangles: &[[u32; 3]], vertex_count: usize, with_normals: bool) -> Mesh {
     // Only the render world keeps it: the skinning system writes positions straight into its
     // GPU slot (see `upload`), never into this asset.
-    Mesh::new(PrimitiveTopology::TriangleList, RenderAssetUsages::RENDER_WORLD)
+    let mesh = Mesh::new(PrimitiveTopology::TriangleList, RenderAssetUsages::RENDER_WORLD)
         .with_inserted_attribute(Mesh::ATTRIBUTE_POSITION, vec![[0.0f32; 3]; vertex_count])
-        .with_inserted_indices(Indices::U32(triangles.iter().flatten().copied().collect()))
+        .with_inserted_indices(Indices::U32(triangles.iter().flatten().copied().collect()));
+    match with_normals {
+        true => mesh.with_inserted_attribute(Mesh::ATTRIBUTE_NORMAL, vec![[0.0f32; 3]; vertex_count]),
+        false => mesh,
+    }
 }
 
 /// Despawns a character, its joints leaves first and its skin mesh entity. Bevy's

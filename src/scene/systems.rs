@@ -157,9 +157,9 @@ pub fn skin_changed_characters(
                 vertex_colors(character, view, heat.0, &mut scratch.colors);
                 attributes.pack(&skin.texcoords, &scratch.colors);
             }
-            // The compute shader writes one mesh's slot: characters drawn in several
-            // surfaces are skinned here.
-            if on_gpu.0 && character.skins.len() == 1 {
+            // The compute shader writes one mesh's positions: characters drawn in several
+            // surfaces, or with normals, are skinned here.
+            if on_gpu.0 && character.skins.len() == 1 && skin.normals.is_empty() {
                 // The first skin is done here as well: its positions frame the scene and
                 // stand the characters on the floor when it opens.
                 if never_skinned {
@@ -177,18 +177,27 @@ pub fn skin_changed_characters(
                 skin_on_cpu(skin, method.0, scratch);
                 // Marks the upload changed: the render world takes the new positions.
                 upload.vertex_count = skin.bind_positions.len();
+                upload.with_normals = !skin.normals.is_empty();
             }
         },
     );
 }
 
-/// The LBS or DQ kernel of the skin into `scratch.positions`, and their bounds (grown as
-/// the linear kernel writes them).
+/// The LBS or DQ kernel of the skin into `scratch.positions` (and its normals into
+/// `scratch.normals` where it has them), and their bounds (grown as the linear kernel
+/// writes them). The DQ kernel skins positions only: a DQ-skinned skin's normals are zero,
+/// which its material lights flat.
 fn skin_on_cpu(skin: &crate::rig::Skin, method: dqs::SkinningMethod, scratch: &mut SkinScratch) {
-    let SkinScratch { palette, dual_quaternions, positions, .. } = scratch;
+    let SkinScratch { palette, dual_quaternions, positions, normals, .. } = scratch;
     let positions = super::handoff::reclaimed(positions);
     positions.resize(skin.bind_positions.len(), Vec3::ZERO);
-    scratch.bounds = if method.is_linear() {
+    let normals = super::handoff::reclaimed(normals);
+    normals.clear();
+    normals.resize(skin.normals.len(), Vec3::ZERO);
+    scratch.bounds = if method.is_linear() && !normals.is_empty() {
+        let normals = lbs::Normals { bind: &skin.normals, out: normals };
+        lbs::skin_with_normals(&skin.bind_positions, &skin.weights, palette, positions, normals).pair()
+    } else if method.is_linear() {
         skin_in_chunks(skin, palette, positions).pair()
     } else {
         dqs::dual_quaternion_palette(palette, dual_quaternions);

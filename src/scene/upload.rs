@@ -2,7 +2,8 @@
 //! skins each re-posed character's positions into its `SkinScratch` and marks its
 //! [`SkinUpload`] changed; the render world takes the changed ones (an `Arc`, no copy) and
 //! copies them straight into the staging memory of the mesh's slot of the vertex buffer,
-//! which holds positions only (12 bytes a vertex): texture coordinates and colours are in
+//! which holds positions only (12 bytes a vertex; a normal-mapped skin's normal after each
+//! position, 24): texture coordinates and colours are in
 //! the skin materials' buffer ([`SkinAttributes`](super::handoff::SkinAttributes)), written
 //! only when they change. The skin mesh asset itself is never modified after it is made,
 //! so Bevy neither clones it into the render world nor re-packs it each frame, and indices
@@ -19,7 +20,7 @@ use bevy::render::{Extract, ExtractSchedule, Render, RenderApp, RenderSystems};
 
 use super::components::{Character, SkinScratch};
 
-pub use super::handoff::{SKIN_VERTEX_BYTES, SkinAttributes, SkinUpload};
+pub use super::handoff::{SKIN_VERTEX_BYTES, SKIN_VERTEX_WITH_NORMAL_BYTES, SkinAttributes, SkinUpload};
 
 /// Bytes handed to the GPU in the last frame (the positions of the uploads that changed,
 /// the attributes that changed, and the palettes of characters skinned on the GPU), for
@@ -42,10 +43,11 @@ fn count_handed_on(
     handed.0 = changed.iter().map(SkinUpload::byte_len).sum::<usize>() + attributes + palettes;
 }
 
-/// An upload waiting for its mesh's slot: the character's skinned positions, the range of
-/// them that mesh shows, and the frames waited.
+/// An upload waiting for its mesh's slot: the character's skinned positions (and normals,
+/// empty where it has none), the range of them that mesh shows, and the frames waited.
 struct Pending {
     positions: Arc<Vec<Vec3>>,
+    normals: Arc<Vec<Vec3>>,
     range: std::ops::Range<u32>,
     waited: u32,
 }
@@ -54,6 +56,12 @@ impl Pending {
     /// The positions of this part's vertices; none when they do not hold all of them.
     fn part(&self) -> Option<&[Vec3]> {
         self.positions.get(self.range.start as usize..self.range.end as usize)
+    }
+
+    /// The normals of this part's vertices: none when the skin has none, or they do not
+    /// hold all of them.
+    fn part_normals(&self) -> Option<&[Vec3]> {
+        self.normals.get(self.range.start as usize..self.range.end as usize).filter(|n| !n.is_empty())
     }
 }
 
@@ -93,7 +101,8 @@ fn extract_skin_uploads(
         }
         for part in &character.skins {
             let (positions, range) = (scratch.positions.clone(), part.vertices.clone());
-            pending.0.insert(part.mesh.id(), Pending { positions, range, waited: 0 });
+            let normals = if upload.with_normals { scratch.normals.clone() } else { Arc::default() };
+            pending.0.insert(part.mesh.id(), Pending { positions, normals, range, waited: 0 });
         }
     }
 }
@@ -129,23 +138,46 @@ struct SlotWrite<'a> {
     /// Bytes into the buffer.
     offset: u64,
     positions: &'a [Vec3],
+    /// The normals after each position, where the mesh has them.
+    normals: Option<&'a [Vec3]>,
 }
 
 impl<'a> SlotWrite<'a> {
     /// The write of `upload` into `slice`; none when its vertices do not fill the slot
     /// exactly.
     fn of(slice: MeshBufferSlice<'a>, upload: &'a Pending) -> Option<Self> {
-        let positions = upload.part()?;
-        (positions.len() == (slice.range.end - slice.range.start) as usize).then(|| Self {
-            buffer: slice.buffer,
-            offset: u64::from(slice.range.start) * SKIN_VERTEX_BYTES as u64,
-            positions,
-        })
+        let (positions, normals) = (upload.part()?, upload.part_normals());
+        let write = Self { buffer: slice.buffer, offset: 0, positions, normals };
+        (positions.len() == (slice.range.end - slice.range.start) as usize)
+            .then(|| Self { offset: u64::from(slice.range.start) * write.vertex_bytes(), ..write })
+    }
+
+    /// Bytes a vertex takes in the slot.
+    fn vertex_bytes(&self) -> u64 {
+        (if self.normals.is_some() { SKIN_VERTEX_WITH_NORMAL_BYTES } else { SKIN_VERTEX_BYTES }) as u64
     }
 
     /// The byte after the slot.
     fn end(&self) -> u64 {
-        self.offset + std::mem::size_of_val(self.positions) as u64
+        self.offset + self.positions.len() as u64 * self.vertex_bytes()
+    }
+
+    /// Fills the slot's staging bytes: the positions as they are, or each followed by its
+    /// normal (interleaved through a small buffer on the stack).
+    fn fill(&self, mut slot: wgpu_types::WriteOnly<[u8]>) {
+        let Some(normals) = self.normals else {
+            slot.copy_from_slice(bytemuck::cast_slice(self.positions));
+            return;
+        };
+        const STEP: usize = 256;
+        let mut vertices = [[Vec3::ZERO; 2]; STEP];
+        for (k, (positions, normals)) in self.positions.chunks(STEP).zip(normals.chunks(STEP)).enumerate() {
+            let vertices = &mut vertices[..positions.len()];
+            vertices.iter_mut().zip(positions.iter().zip(normals)).for_each(|(v, (&p, &n))| *v = [p, n]);
+            let at = k * STEP * SKIN_VERTEX_WITH_NORMAL_BYTES;
+            let bytes: &[u8] = bytemuck::cast_slice(vertices);
+            slot.slice(at..at + bytes.len()).copy_from_slice(bytes);
+        }
     }
 }
 
@@ -163,9 +195,8 @@ fn write_run(queue: &RenderQueue, run: &[SlotWrite]) {
     let mut rest = view.slice(..);
     let mut slots = Vec::with_capacity(run.len());
     for write in run {
-        let positions: &[u8] = bytemuck::cast_slice(write.positions);
-        let (slot, tail) = rest.split_at(positions.len());
-        slots.push((positions, SlotBytes(slot)));
+        let (slot, tail) = rest.split_at((write.end() - write.offset) as usize);
+        slots.push((write, SlotBytes(slot)));
         rest = tail;
     }
     let pool = bevy::tasks::ComputeTaskPool::get();
@@ -175,8 +206,8 @@ fn write_run(queue: &RenderQueue, run: &[SlotWrite]) {
         while slots.peek().is_some() {
             let batch: Vec<_> = slots.by_ref().take(per_task).collect();
             scope.spawn(async move {
-                for (positions, SlotBytes(mut slot)) in batch {
-                    slot.copy_from_slice(positions);
+                for (write, SlotBytes(slot)) in batch {
+                    write.fill(slot);
                 }
             });
         }

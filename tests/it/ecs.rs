@@ -201,7 +201,7 @@ fn skin_vertex_buffer_holds_positions_and_attributes_are_packed_apart() {
     use marionette::scene::upload::{SKIN_VERTEX_BYTES, SkinAttributes};
     let triangles = [[0u32, 1, 2], [2, 1, 3]];
     let positions = [Vec3::new(0.0, 1.0, 2.0), Vec3::X, Vec3::new(-1.5, 0.25, 8.0), Vec3::splat(3.0)];
-    let mut mesh = marionette::scene::spawn::empty_skin_mesh(&triangles, positions.len());
+    let mut mesh = marionette::scene::spawn::empty_skin_mesh(&triangles, positions.len(), false);
     mesh.insert_attribute(Mesh::ATTRIBUTE_POSITION, positions.map(|p| p.to_array()).to_vec());
     assert_eq!(bytemuck::cast_slice::<Vec3, u8>(&positions), mesh.create_packed_vertex_buffer_data());
     assert_eq!(mesh.get_vertex_size() as usize, SKIN_VERTEX_BYTES);

@@ -621,3 +621,29 @@ fn keyframes_on_a_folded_root_go_out_in_its_frame() {
     }
     assert!(worst < 1e-4, "worst {worst:e} of the size");
 }
+
+/// A normal-mapped glTF skin keeps its file's normals, one per vertex: the Blender pair's
+/// walker given a normal map has its NORMAL as the `gltf` crate reads it from the file;
+/// the waver beside it (no normal map) and both in the file as it is (none) keep none.
+#[test]
+fn a_normal_mapped_skin_keeps_its_files_normals() {
+    let pair = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/blender_pair.glb");
+    let glb = std::fs::read(&pair).unwrap();
+    let bumpy = crate::common::glb_with_json(&glb, |json| {
+        json["materials"][0]["normalTexture"] = serde_json::json!({ "index": 0 });
+    });
+    let path = crate::common::scratch("normal-mapped").join("bumpy.glb");
+    std::fs::write(&path, &bumpy).unwrap();
+    let characters = marionette::formats::gltf_import::load_gltf(&path).unwrap();
+    let file = gltf::Gltf::from_slice(&bumpy).unwrap();
+    let blob = file.blob.as_deref().unwrap();
+    let walker = file.meshes().find(|m| m.name() == Some("walker")).unwrap();
+    let primitive = walker.primitives().next().unwrap();
+    let normals: Vec<Vec3> = primitive.reader(|_| Some(blob)).read_normals().unwrap().map(Vec3::from).collect();
+    assert_eq!(characters[0].asset.name, "walker");
+    assert_eq!(characters[0].asset.skin.normals.len(), characters[0].asset.vertex_count());
+    assert_eq!(characters[0].asset.skin.normals, normals);
+    assert!(characters[1].asset.skin.normals.is_empty(), "the waver has no normal map");
+    let plain = marionette::formats::gltf_import::load_gltf(&pair).unwrap();
+    assert!(plain.iter().all(|c| c.asset.skin.normals.is_empty()), "no normal map, no normals");
+}

@@ -9,7 +9,7 @@ use bevy::render::RenderApp;
 use bevy::render::pipelined_rendering::PipelinedRenderingPlugin;
 use marionette::rig::dqs::SkinningMethod;
 use marionette::rig::{CharacterAsset, JointRotation};
-use marionette::scene::gpu_skinning::{GpuSkinJob, read_back_mesh_positions};
+use marionette::scene::gpu_skinning::{GpuSkinJob, read_back_mesh_positions, read_back_mesh_positions_and_normals};
 use marionette::scene::*;
 
 /// Our plugins with Bevy's renderer and no window (no pipelining: a frame's GPU work is
@@ -69,6 +69,57 @@ fn gpu_skinning_matches_the_cpu_oracles() {
     assert!(app.world().get::<GpuSkinJob>(entity).unwrap().0.is_none());
     let upload = app.world().get::<marionette::scene::upload::SkinUpload>(entity).unwrap();
     assert_eq!(upload.vertex_count, assets[0].vertex_count());
+}
+
+/// A skin with normals (a normal-mapped glTF skin's) hands its skinned normals on after
+/// each position: the puppet given normals, posed, read back from its slot within 1e-5 of
+/// the plain loop's positions and normals, also when it asks for the GPU (whose compute
+/// shader writes positions only: such a skin stays on the CPU); skinned by dual
+/// quaternions, its positions are DQ's and its normals zero (lit flat).
+#[test]
+fn a_skin_with_normals_lands_positions_and_normals_in_its_slot() {
+    let mut puppet = marionette::formats::puppet::embedded_puppet();
+    let skin = &mut puppet.skin;
+    skin.normals =
+        (0..skin.bind_positions.len()).map(|v| Vec3::new(v as f32, 1.0, -0.5 * v as f32).normalize()).collect();
+    let asset = Arc::new(puppet);
+    let pose = pose_of(&asset);
+    let palette =
+        marionette::rig::fk::posed_palette(&asset.skeleton, &asset.bind_world_to_joint, &pose, Mat4::IDENTITY);
+    let (mut positions, mut normals) = (vec![Vec3::ZERO; asset.vertex_count()], vec![Vec3::ZERO; asset.vertex_count()]);
+    let out = marionette::rig::skinning::Normals { bind: &asset.skin.normals, out: &mut normals };
+    let skin = &asset.skin;
+    marionette::rig::skinning::skin_positions_and_normals(
+        &skin.bind_positions,
+        &skin.weights,
+        &palette,
+        &mut positions,
+        out,
+    );
+    let mut app = render_app();
+    let on_cpu = spawn_posed(&mut app, asset.clone(), &pose);
+    let asks_gpu = spawn_posed(&mut app, asset.clone(), &pose);
+    app.world_mut().entity_mut(asks_gpu).insert(SkinOnGpu(true));
+    let dq = spawn_posed(&mut app, asset.clone(), &pose);
+    app.world_mut().entity_mut(dq).insert(CharacterSkinning(SkinningMethod::DualQuaternion));
+    let read_back = |app: &App, entity: Entity| {
+        let mesh = app.world().get::<Character>(entity)?.skins[0].mesh.id();
+        read_back_mesh_positions_and_normals(app.sub_app(RenderApp).world(), mesh)
+    };
+    let landed = |app: &App, entity: Entity| {
+        read_back(app, entity).is_some_and(|(p, n)| {
+            p.len() == positions.len() && relative_error(&p, &positions) <= 1e-5 && relative_error(&n, &normals) <= 1e-5
+        })
+    };
+    let ready = (0..600).any(|_| {
+        app.update();
+        landed(&app, on_cpu) && landed(&app, asks_gpu)
+    });
+    assert!(ready, "positions and normals reached both slots");
+    assert!(app.world().get::<GpuSkinJob>(asks_gpu).unwrap().0.is_none(), "a skin with normals stays on the CPU");
+    let (dq_positions, dq_normals) = read_back(&app, dq).expect("the DQ-skinned skin's slot");
+    assert!(relative_error(&dq_positions, &oracle(&asset, &pose, SkinningMethod::DualQuaternion)) <= 1e-5);
+    assert!(dq_normals.iter().all(|n| *n == Vec3::ZERO), "DQ skins positions only");
 }
 
 /// The CPU oracles the fast kernels are checked against: the plain LBS loop, and the

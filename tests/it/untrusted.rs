@@ -125,6 +125,10 @@ const GLTF_CASES: &[(&str, &str)] = &[
         "gltf-weight-nan.glb",
         "at $.meshes[0].primitives[0].attributes.WEIGHTS_0: expected weights that are finite and not negative, found NaN at vertex 1",
     ),
+    (
+        "gltf-normal-nan.glb",
+        "at $.meshes[0].primitives[0].attributes.NORMAL: expected finite numbers, found vertex 2's",
+    ),
 ];
 
 #[test]

@@ -5,6 +5,8 @@
 //! buffer, and a fragment shader that lights each triangle with its own normal, from the
 //! derivatives of the world position. The skinning system then hands the GPU only shared
 //! vertex positions when a character moves: no unshared corners, no normals, no colours.
+//! A normal-mapped skin's mesh has its skinned normals after each position: the shader
+//! lights it with them (interpolated), bent by the map.
 
 use bevy::asset::embedded_asset;
 use bevy::mesh::MeshVertexBufferLayoutRef;
@@ -18,8 +20,8 @@ use crate::rig::material::Sampler;
 use crate::scene::handoff::SkinAttributes;
 
 /// The extension of `StandardMaterial` for skins: the vertex shader that reads the skin's
-/// attributes beside its positions, the flat-normal fragment shader and the normal map's
-/// scale.
+/// attributes beside its positions, the fragment shader (flat normals, or the skin's own)
+/// and the normal map's scale.
 #[derive(Asset, AsBindGroup, Reflect, Debug, Clone)]
 pub struct SkinExtension {
     /// glTF's `normalTexture.scale` in x (the map's x and y are multiplied by it); y, z, w
@@ -209,8 +211,8 @@ fn image_of(picture: &crate::rig::Picture, srgb: bool, sampler: Sampler) -> Imag
 
 /// The skin material of one of an asset's materials, reading `attributes`; `image` gives a
 /// texture's image (sRGB or not), or none when it cannot be read. Skins have no tangents:
-/// the shader bends its flat normals by the normal map (times its scale) in a frame from
-/// the derivatives.
+/// the shader bends their normals (skinned ones where the skin has them, else flat) by the
+/// normal map (times its scale) in a frame from the derivatives.
 pub fn skin_material_of(
     m: &crate::rig::material::Material,
     attributes: Handle<ShaderBuffer>,

@@ -1,7 +1,8 @@
 // The skin's vertex shader, for the main pass and the prepasses (shadows): the mesh's
 // vertex buffer holds positions only (12 bytes a vertex, all the CPU hands on when a
-// character moves); texture coordinates and colours come from the one buffer of every
-// skin's attributes, written only when they change. A mesh's surface starts there at its
+// character moves), or positions and normals for a normal-mapped skin; texture
+// coordinates and colours come from the one buffer of every skin's attributes, written
+// only when they change. A mesh's surface starts there at its
 // tag (MeshTag); its vertex k is the mesh's k-th: the draw's vertex index less the mesh's
 // first in the vertex buffer.
 #import bevy_pbr::{
@@ -23,7 +24,24 @@ struct Vertex {
     @builtin(instance_index) instance_index: u32,
     @builtin(vertex_index) index: u32,
     @location(0) position: vec3<f32>,
+#ifdef VERTEX_NORMALS
+#ifdef PREPASS_PIPELINE
+    @location(3) normal: vec3<f32>,
+#else
+    @location(1) normal: vec3<f32>,
+#endif
+#endif
 };
+
+// The vertex's skinned normal in the world (zero where it has none: lit flat); zero for a
+// mesh without normals, whose triangles are lit with their own.
+fn skinned_world_normal(vertex: Vertex) -> vec3<f32> {
+#ifdef VERTEX_NORMALS
+    return mesh_functions::mesh_normal_local_to_world(vertex.normal, vertex.instance_index);
+#else
+    return vec3(0.0);
+#endif
+}
 
 @vertex
 fn vertex(vertex: Vertex) -> VertexOutput {
@@ -45,8 +63,7 @@ fn vertex(vertex: Vertex) -> VertexOutput {
     out.position.z = min(out.position.z, 1.0);
 #endif
 #ifdef NORMAL_PREPASS_OR_DEFERRED_PREPASS
-    // Unused: skins are lit with each triangle's own normal.
-    out.world_normal = vec3(0.0, 1.0, 0.0);
+    out.world_normal = skinned_world_normal(vertex);
 #endif
 #ifdef MOTION_VECTOR_PREPASS
     // Last frame's skinned position is not kept: the mesh's own motion only.
@@ -56,8 +73,7 @@ fn vertex(vertex: Vertex) -> VertexOutput {
     );
 #endif
 #else
-    // Unused: the fragment shader lights each triangle with its own normal.
-    out.world_normal = vec3(0.0, 1.0, 0.0);
+    out.world_normal = skinned_world_normal(vertex);
 #endif
 #ifdef VERTEX_OUTPUT_INSTANCE_INDEX
     out.instance_index = vertex.instance_index;
