@@ -49,20 +49,6 @@ pub fn deinterleave_some(points: &[Vec3]) -> [__m256; 3] {
     [p.map(|p| p.x), p.map(|p| p.y), p.map(|p| p.z)].map(register)
 }
 
-/// The points of a block's `lanes` as x, y and z registers: all eight where they are all
-/// there, else those up to the end (zero past them).
-///
-/// # Safety
-/// As [`deinterleave`].
-#[inline(always)]
-pub unsafe fn lane_points(points: &[Vec3], lanes: std::ops::Range<usize>) -> [__m256; 3] {
-    match points.get(lanes.clone()) {
-        // SAFETY: this function's contract.
-        Some(whole) => unsafe { deinterleave(whole) },
-        None => deinterleave_some(&points[lanes.start..points.len()]),
-    }
-}
-
 /// The inverse of [`deinterleave`]: x, y and z registers written as eight points.
 ///
 /// # Safety

@@ -104,20 +104,6 @@ pub fn deinterleave_some(points: &[Vec3]) -> [__m512; 3] {
     [p.map(|p| p.x), p.map(|p| p.y), p.map(|p| p.z)].map(register)
 }
 
-/// The points of a block's `lanes` as x, y and z registers: all sixteen where they are all
-/// there, else those up to the end (zero past them).
-///
-/// # Safety
-/// As [`deinterleave`].
-#[inline(always)]
-pub unsafe fn lane_points(points: &[Vec3], lanes: std::ops::Range<usize>) -> [__m512; 3] {
-    match points.get(lanes.clone()) {
-        // SAFETY: this function's contract.
-        Some(whole) => unsafe { deinterleave(whole) },
-        None => deinterleave_some(&points[lanes.start..points.len()]),
-    }
-}
-
 /// Sixteen floats as a register (lane i: float i).
 #[inline(always)]
 pub fn register(lanes: [f32; LANES]) -> __m512 {

@@ -1,7 +1,7 @@
 //! A skin's influences: one joint's weight on a vertex, and the layouts the fast kernels
-//! read: the vertices grouped by how many influences they have (the portable paths), and in
+//! read: the vertices grouped by how many influences they have (the portable paths), in
 //! blocks of eight consecutive ones with the joints they name (the AVX2 kernels, linear
-//! blend and dual quaternions).
+//! blend and dual quaternions), and in blocks of sixteen (the AVX-512 linear blend ones).
 
 /// One joint's influence on a vertex.
 #[derive(Debug, Clone, Copy, PartialEq)]

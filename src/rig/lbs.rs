@@ -1,5 +1,5 @@
 //! The fast linear-blend-skinning kernel. On x86-64 with AVX2 and FMA (detected at run
-//! time), the vertices are skinned in blocks of eight consecutive ones ([`LaneBlocks`],
+//! time), the vertices are skinned in blocks of eight consecutive ones ([`LaneBlocks`](super::influences::LaneBlocks),
 //! built with the weights), one vertex a lane of a 256-bit register: each
 //! of a block's joints transforms all eight bind positions at once, weighted lane by lane
 //! (`pᵥ = Σⱼ wᵥⱼ (Pⱼ bᵥ)`), so a joint's matrix is read once for eight vertices. Elsewhere
@@ -13,7 +13,7 @@
 
 use glam::{Mat4, Vec3, Vec3A, Vec4};
 
-use super::influences::{FixedGroup, LaneBlocks};
+use super::influences::FixedGroup;
 use super::simd::Simd;
 pub use super::skinning::Normals;
 use super::skinning::{Bounds, SkinWeights};
@@ -90,10 +90,10 @@ pub fn skin_chunk_using(
     match simd {
         // SAFETY: the CPU runs `simd` (checked above).
         Simd::Avx512Vl => {
-            return unsafe { avx512::skin_blocks(bind_positions, &groups.wide_blocks, palette, first, out) };
+            return unsafe { blocks::skin_blocks_avx512(bind_positions, &groups.wide_blocks, palette, first, out) };
         }
         // SAFETY: as above.
-        Simd::Avx2 => return unsafe { avx2::skin_blocks(bind_positions, &groups.blocks, palette, first, out) },
+        Simd::Avx2 => return unsafe { blocks::skin_blocks_avx2(bind_positions, &groups.blocks, palette, first, out) },
         Simd::Portable => {}
     }
     skin_portable_chunk(bind_positions, weights, palette, first, out, None)
@@ -134,12 +134,14 @@ pub fn skin_with_normals_using(
         // SAFETY: the CPU runs `simd` (checked above).
         Simd::Avx512Vl => {
             return unsafe {
-                avx512::skin_blocks_with_normals(bind_positions, &groups.wide_blocks, palette, out, normals)
+                blocks::skin_blocks_with_normals_avx512(bind_positions, &groups.wide_blocks, palette, out, normals)
             };
         }
         // SAFETY: as above.
         Simd::Avx2 => {
-            return unsafe { avx2::skin_blocks_with_normals(bind_positions, &groups.blocks, palette, out, normals) };
+            return unsafe {
+                blocks::skin_blocks_with_normals_avx2(bind_positions, &groups.blocks, palette, out, normals)
+            };
         }
         Simd::Portable => {}
     }
@@ -252,42 +254,27 @@ fn skin_wide(
     bounds
 }
 
-/// A palette matrix's twelve elements as a block reads them: element `e` is column `e / 3`,
-/// row `e % 3` (the fourth row of an affine matrix is not needed).
+/// The SIMD kernels: one generic body each over [`Lanes`], built for AVX2 + FMA (eight
+/// vertices a block) and for AVX-512 F (sixteen).
 #[cfg(target_arch = "x86_64")]
-#[inline(always)]
-fn elements(m: &Mat4) -> [f32; 12] {
-    let c = m.to_cols_array();
-    std::array::from_fn(|e| c[e / 3 * 4 + e % 3])
-}
-
-#[cfg(target_arch = "x86_64")]
-mod avx2 {
+mod blocks {
     use std::arch::x86_64::*;
 
     use glam::{Mat4, Vec3, Vec3A};
 
-    use super::{LaneBlocks, Normals, elements};
-    use crate::rig::avx2::{
-        deinterleave, deinterleave_some, floats, interleave, lane_points, prefetch_ahead, register,
-    };
-    use crate::rig::influences::LANES;
+    use super::Normals;
+    use crate::rig::avx2::prefetch_ahead;
+    use crate::rig::influences::{LaneBlocks, WideLaneBlocks};
+    use crate::rig::lanes::{Blocks, Lanes};
     use crate::rig::skinning::Bounds;
 
-    /// Each block on 256-bit registers, one vertex a lane: each of the block's joints
-    /// transforms all eight bind positions (its matrix's elements broadcast once) and adds
-    /// them in with each lane's weight; twelve multiply-adds a joint for eight vertices.
-    /// Blocks that lie wholly in the chunk read and write their eight positions in order;
-    /// the chunk's first and last blocks (when it does not start or end on a multiple of
-    /// eight) and the mesh's last go lane by lane.
-    ///
-    /// (Indices are checked: a joint beyond the palette or a vertex beyond the buffers
-    /// panics.)
+    /// Linear blend skinning of the vertices `first..first + out.len()` on 256-bit
+    /// registers, eight vertices a block ([`skin_blocks`]).
     ///
     /// # Safety
     /// The CPU must have AVX2 and FMA.
     #[target_feature(enable = "avx2,fma")]
-    pub unsafe fn skin_blocks(
+    pub unsafe fn skin_blocks_avx2(
         bind: &[Vec3],
         blocks: &LaneBlocks,
         palette: &[Mat4],
@@ -295,42 +282,118 @@ mod avx2 {
         out: &mut [Vec3],
     ) -> Bounds {
         // SAFETY: the CPU has AVX2 and FMA (this function's contract).
+        unsafe { skin_blocks::<__m256>(bind, blocks, palette, first, out) }
+    }
+
+    /// The same on 512-bit registers, sixteen vertices a block.
+    ///
+    /// # Safety
+    /// The CPU must have AVX-512 F, AVX2 and FMA.
+    #[target_feature(enable = "avx512f,avx2,fma")]
+    pub unsafe fn skin_blocks_avx512(
+        bind: &[Vec3],
+        blocks: &WideLaneBlocks,
+        palette: &[Mat4],
+        first: usize,
+        out: &mut [Vec3],
+    ) -> Bounds {
+        // SAFETY: the CPU has AVX-512 F (this function's contract).
+        unsafe { skin_blocks::<__m512>(bind, blocks, palette, first, out) }
+    }
+
+    /// A whole mesh with its normals on 256-bit registers ([`skin_blocks_with_normals`]).
+    ///
+    /// # Safety
+    /// The CPU must have AVX2 and FMA.
+    #[target_feature(enable = "avx2,fma")]
+    pub unsafe fn skin_blocks_with_normals_avx2(
+        bind: &[Vec3],
+        blocks: &LaneBlocks,
+        palette: &[Mat4],
+        out: &mut [Vec3],
+        normals: Normals,
+    ) -> Bounds {
+        // SAFETY: the CPU has AVX2 and FMA (this function's contract).
+        unsafe { skin_blocks_with_normals::<__m256>(bind, blocks, palette, out, normals) }
+    }
+
+    /// The same on 512-bit registers.
+    ///
+    /// # Safety
+    /// The CPU must have AVX-512 F, AVX2 and FMA.
+    #[target_feature(enable = "avx512f,avx2,fma")]
+    pub unsafe fn skin_blocks_with_normals_avx512(
+        bind: &[Vec3],
+        blocks: &WideLaneBlocks,
+        palette: &[Mat4],
+        out: &mut [Vec3],
+        normals: Normals,
+    ) -> Bounds {
+        // SAFETY: the CPU has AVX-512 F (this function's contract).
+        unsafe { skin_blocks_with_normals::<__m512>(bind, blocks, palette, out, normals) }
+    }
+
+    /// A palette matrix's twelve elements as a block reads them: element `e` is column
+    /// `e / 3`, row `e % 3` (the fourth row of an affine matrix is not needed). (With
+    /// AVX-512, each broadcast of one folds into the multiply-add that reads it.)
+    #[inline(always)]
+    fn elements(m: &Mat4) -> [f32; 12] {
+        let c = m.to_cols_array();
+        std::array::from_fn(|e| c[e / 3 * 4 + e % 3])
+    }
+
+    /// Each block on `L`'s registers, one vertex a lane: each of the block's joints
+    /// transforms all its bind positions (its matrix's elements broadcast once) and adds them
+    /// in with each lane's weight; twelve multiply-adds a joint for the block. Blocks that
+    /// lie wholly in the chunk read and write their positions in order; the chunk's first
+    /// and last blocks (when it does not start or end on a block's edge) and the mesh's last
+    /// go lane by lane.
+    ///
+    /// (Indices are checked: a joint beyond the palette or a vertex beyond the buffers
+    /// panics.)
+    ///
+    /// # Safety
+    /// The CPU must have `L`'s features.
+    #[inline(always)]
+    unsafe fn skin_blocks<L: Lanes>(
+        bind: &[Vec3],
+        blocks: &L::Blocks,
+        palette: &[Mat4],
+        first: usize,
+        out: &mut [Vec3],
+    ) -> Bounds {
+        // SAFETY: the CPU has `L`'s features (this function's contract).
         unsafe {
             let end = first + out.len();
-            let (mut lo, mut hi) = ([_mm256_set1_ps(f32::INFINITY); 3], [_mm256_set1_ps(f32::NEG_INFINITY); 3]);
+            let (mut lo, mut hi) = ([L::splat(f32::INFINITY); 3], [L::splat(f32::NEG_INFINITY); 3]);
             let mut edges = Bounds::EMPTY;
-            for b in first / LANES..end.div_ceil(LANES) {
-                let lanes = b * LANES..(b + 1) * LANES;
+            for b in first / L::LANES..end.div_ceil(L::LANES) {
+                let lanes = b * L::LANES..(b + 1) * L::LANES;
                 let whole = first <= lanes.start && lanes.end <= end;
-                prefetch_ahead(bind, lanes.start, out, lanes.start.saturating_sub(first), LANES);
+                prefetch_ahead(bind, lanes.start, out, lanes.start.saturating_sub(first), L::LANES);
                 let [x, y, z] = if whole {
-                    deinterleave(&bind[lanes.clone()])
+                    L::points(&bind[lanes.clone()])
                 } else {
-                    deinterleave_some(&bind[lanes.start..lanes.end.min(bind.len())])
+                    L::some_points(&bind[lanes.start..lanes.end.min(bind.len())])
                 };
-                let mut p = [_mm256_setzero_ps(); 3];
-                let joints = blocks.joint_starts[b] as usize..blocks.joint_starts[b + 1] as usize;
-                for (&j, w) in blocks.joints[joints.clone()].iter().zip(&blocks.weights[joints]) {
-                    let w = register(w.0);
-                    let m = elements(&palette[j as usize]).map(|c| _mm256_set1_ps(c));
+                let mut p = [L::splat(0.0); 3];
+                let (joints, weights) = blocks.block(b);
+                for (&j, w) in joints.iter().zip(weights) {
+                    let w = L::weights(w);
+                    let m = elements(&palette[j as usize]).map(|e| L::splat(e));
                     for (r, p) in p.iter_mut().enumerate() {
-                        let row = _mm256_fmadd_ps(
-                            m[r],
-                            x,
-                            _mm256_fmadd_ps(m[3 + r], y, _mm256_fmadd_ps(m[6 + r], z, m[9 + r])),
-                        );
-                        *p = _mm256_fmadd_ps(w, row, *p);
+                        let row = L::fmadd(m[r], x, L::fmadd(m[3 + r], y, L::fmadd(m[6 + r], z, m[9 + r])));
+                        *p = L::fmadd(w, row, *p);
                     }
                 }
                 if whole {
                     for k in 0..3 {
-                        (lo[k], hi[k]) = (_mm256_min_ps(lo[k], p[k]), _mm256_max_ps(hi[k], p[k]));
+                        (lo[k], hi[k]) = (L::min(lo[k], p[k]), L::max(hi[k], p[k]));
                     }
-                    interleave(p, &mut out[lanes.start - first..lanes.end - first]);
+                    L::write_points(p, &mut out[lanes.start - first..lanes.end - first]);
                 } else {
-                    let lane = p.map(floats);
                     for (i, v) in lanes.enumerate().filter(|(_, v)| (first..end).contains(v)) {
-                        let q = Vec3A::new(lane[0][i], lane[1][i], lane[2][i]);
+                        let q = Vec3A::new(p[0].lane(i), p[1].lane(i), p[2].lane(i));
                         out[v - first] = q.into();
                         edges = edges.with(q);
                     }
@@ -340,66 +403,56 @@ mod avx2 {
         }
     }
 
-    /// The box between eight lanes of lower and eight of upper corners.
-    #[inline]
-    fn lanes_bounds(lo: [__m256; 3], hi: [__m256; 3]) -> Bounds {
-        let reduce = |r: __m256, f: fn(f32, f32) -> f32| floats(r).into_iter().reduce(f).unwrap_or(0.0);
-        Bounds::between(
-            Vec3A::new(reduce(lo[0], f32::min), reduce(lo[1], f32::min), reduce(lo[2], f32::min)),
-            Vec3A::new(reduce(hi[0], f32::max), reduce(hi[1], f32::max), reduce(hi[2], f32::max)),
-        )
-    }
-
     /// [`skin_blocks`] of a whole mesh with its normals: each lane's matrix is blended
-    /// first (`Σⱼ wⱼ Pⱼ`, twelve multiply-adds a joint for eight vertices), then turns the
-    /// eight positions and the eight normals once. (Transforming by each joint, as
-    /// `skin_blocks` does for positions alone, needs more registers than there are with the
-    /// normals: 46 µs a SMPL body against this order's 22.)
+    /// first (`Σⱼ wⱼ Pⱼ`, twelve multiply-adds a joint for the block), then turns the block's
+    /// positions and normals once. (Transforming by each joint, as `skin_blocks` does for
+    /// positions alone, needs more registers than AVX2 has with the normals: 46 µs a SMPL
+    /// body against this order's 22.)
     ///
     /// # Safety
-    /// The CPU must have AVX2 and FMA.
-    #[target_feature(enable = "avx2,fma")]
-    pub unsafe fn skin_blocks_with_normals(
+    /// The CPU must have `L`'s features.
+    #[inline(always)]
+    unsafe fn skin_blocks_with_normals<L: Lanes>(
         bind: &[Vec3],
-        blocks: &LaneBlocks,
+        blocks: &L::Blocks,
         palette: &[Mat4],
         out: &mut [Vec3],
         normals: Normals,
     ) -> Bounds {
-        // SAFETY: the CPU has AVX2 and FMA (this function's contract).
+        // SAFETY: the CPU has `L`'s features (this function's contract).
         unsafe {
             let n = bind.len();
-            let (mut lo, mut hi) = ([_mm256_set1_ps(f32::INFINITY); 3], [_mm256_set1_ps(f32::NEG_INFINITY); 3]);
+            let (mut lo, mut hi) = ([L::splat(f32::INFINITY); 3], [L::splat(f32::NEG_INFINITY); 3]);
             let mut last = Bounds::EMPTY;
-            for b in 0..n.div_ceil(LANES) {
-                let lanes = b * LANES..(b + 1) * LANES;
-                let mut m = [_mm256_setzero_ps(); 12];
-                let joints = blocks.joint_starts[b] as usize..blocks.joint_starts[b + 1] as usize;
-                for (&j, w) in blocks.joints[joints.clone()].iter().zip(&blocks.weights[joints]) {
-                    let w = register(w.0);
+            for b in 0..n.div_ceil(L::LANES) {
+                let lanes = b * L::LANES..(b + 1) * L::LANES;
+                let mut m = [L::splat(0.0); 12];
+                let (joints, weights) = blocks.block(b);
+                for (&j, w) in joints.iter().zip(weights) {
+                    let w = L::weights(w);
+                    // Each element broadcast where it is used: twelve held at once spill
+                    // AVX2's sixteen registers beside the twelve sums (22 -> 27 µs a SMPL body).
                     for (m, e) in m.iter_mut().zip(elements(&palette[j as usize])) {
-                        *m = _mm256_fmadd_ps(w, _mm256_set1_ps(e), *m);
+                        *m = L::fmadd(w, L::splat(e), *m);
                     }
                 }
-                let [x, y, z] = lane_points(bind, lanes.clone());
-                let p: [__m256; 3] = std::array::from_fn(|r| {
-                    _mm256_fmadd_ps(m[r], x, _mm256_fmadd_ps(m[3 + r], y, _mm256_fmadd_ps(m[6 + r], z, m[9 + r])))
-                });
-                let [x, y, z] = lane_points(normals.bind, lanes.clone());
-                let normal: [__m256; 3] = std::array::from_fn(|r| {
-                    _mm256_fmadd_ps(m[r], x, _mm256_fmadd_ps(m[3 + r], y, _mm256_mul_ps(m[6 + r], z)))
-                });
+                let [x, y, z] = lane_points::<L>(bind, lanes.clone());
+                let p: [L; 3] =
+                    std::array::from_fn(|r| L::fmadd(m[r], x, L::fmadd(m[3 + r], y, L::fmadd(m[6 + r], z, m[9 + r]))));
+                let [x, y, z] = lane_points::<L>(normals.bind, lanes.clone());
+                let normal: [L; 3] =
+                    std::array::from_fn(|r| L::fmadd(m[r], x, L::fmadd(m[3 + r], y, L::mul(m[6 + r], z))));
                 if lanes.end <= n {
                     for k in 0..3 {
-                        (lo[k], hi[k]) = (_mm256_min_ps(lo[k], p[k]), _mm256_max_ps(hi[k], p[k]));
+                        (lo[k], hi[k]) = (L::min(lo[k], p[k]), L::max(hi[k], p[k]));
                     }
-                    interleave(p, &mut out[lanes.clone()]);
-                    interleave(normal, &mut normals.out[lanes]);
+                    L::write_points(p, &mut out[lanes.clone()]);
+                    L::write_points(normal, &mut normals.out[lanes]);
                 } else {
-                    let (p, normal) = (p.map(floats), normal.map(floats));
                     for (i, v) in lanes.take_while(|&v| v < n).enumerate() {
-                        let q = Vec3A::new(p[0][i], p[1][i], p[2][i]);
-                        (out[v], normals.out[v]) = (q.into(), Vec3::new(normal[0][i], normal[1][i], normal[2][i]));
+                        let q = Vec3A::new(p[0].lane(i), p[1].lane(i), p[2].lane(i));
+                        out[v] = q.into();
+                        normals.out[v] = Vec3::new(normal[0].lane(i), normal[1].lane(i), normal[2].lane(i));
                         last = last.with(q);
                     }
                 }
@@ -407,139 +460,25 @@ mod avx2 {
             lanes_bounds(lo, hi).union(last)
         }
     }
-}
 
-/// The AVX-512 kernels: [`avx2`]'s, sixteen vertices a block on 512-bit registers.
-#[cfg(target_arch = "x86_64")]
-mod avx512 {
-    use std::arch::x86_64::*;
-
-    use glam::{Mat4, Vec3, Vec3A};
-
-    use super::{Normals, elements};
-    use crate::rig::avx2::prefetch_ahead;
-    use crate::rig::avx512::{deinterleave, deinterleave_some, floats, interleave, lane_points, register};
-    use crate::rig::influences::{WIDE_LANES, WideLaneBlocks};
-    use crate::rig::skinning::Bounds;
-
-    /// [`super::avx2::skin_blocks`] sixteen vertices a block: each of the block's joints
-    /// transforms the sixteen bind positions (its matrix's elements broadcast inside the
-    /// multiply-adds) and adds them in with each lane's weight. Blocks wholly in the chunk
-    /// read and write their positions in order; the chunk's edges and the mesh's last block
-    /// go lane by lane.
+    /// The points of a block's `lanes` as x, y and z registers: all of them where they are
+    /// all there, else those up to the end (zero past them).
     ///
     /// # Safety
-    /// The CPU must have AVX-512 F, AVX2 and FMA.
-    #[target_feature(enable = "avx512f,avx2,fma")]
-    pub unsafe fn skin_blocks(
-        bind: &[Vec3],
-        blocks: &WideLaneBlocks,
-        palette: &[Mat4],
-        first: usize,
-        out: &mut [Vec3],
-    ) -> Bounds {
-        let end = first + out.len();
-        let (mut lo, mut hi) = ([_mm512_set1_ps(f32::INFINITY); 3], [_mm512_set1_ps(f32::NEG_INFINITY); 3]);
-        let mut edges = Bounds::EMPTY;
-        for b in first / WIDE_LANES..end.div_ceil(WIDE_LANES) {
-            let lanes = b * WIDE_LANES..(b + 1) * WIDE_LANES;
-            let whole = first <= lanes.start && lanes.end <= end;
-            prefetch_ahead(bind, lanes.start, out, lanes.start.saturating_sub(first), WIDE_LANES);
-            let [x, y, z] = if whole {
-                // SAFETY: the CPU has AVX-512 F (this function's contract).
-                unsafe { deinterleave(&bind[lanes.clone()]) }
-            } else {
-                deinterleave_some(&bind[lanes.start..lanes.end.min(bind.len())])
-            };
-            let mut p = [_mm512_setzero_ps(); 3];
-            let joints = blocks.joint_starts[b] as usize..blocks.joint_starts[b + 1] as usize;
-            for (&j, w) in blocks.joints[joints.clone()].iter().zip(&blocks.weights[joints]) {
-                let w = register(w.0);
-                let m = elements(&palette[j as usize]).map(|c| _mm512_set1_ps(c));
-                for (r, p) in p.iter_mut().enumerate() {
-                    let row =
-                        _mm512_fmadd_ps(m[r], x, _mm512_fmadd_ps(m[3 + r], y, _mm512_fmadd_ps(m[6 + r], z, m[9 + r])));
-                    *p = _mm512_fmadd_ps(w, row, *p);
-                }
-            }
-            if whole {
-                for k in 0..3 {
-                    (lo[k], hi[k]) = (_mm512_min_ps(lo[k], p[k]), _mm512_max_ps(hi[k], p[k]));
-                }
-                // SAFETY: as above.
-                unsafe { interleave(p, &mut out[lanes.start - first..lanes.end - first]) };
-            } else {
-                let lane = p.map(floats);
-                for (i, v) in lanes.enumerate().filter(|(_, v)| (first..end).contains(v)) {
-                    let q = Vec3A::new(lane[0][i], lane[1][i], lane[2][i]);
-                    out[v - first] = q.into();
-                    edges = edges.with(q);
-                }
-            }
-        }
-        lanes_bounds(lo, hi).union(edges)
-    }
-
-    /// [`super::avx2::skin_blocks_with_normals`] sixteen vertices a block.
-    ///
-    /// # Safety
-    /// The CPU must have AVX-512 F, AVX2 and FMA.
-    #[target_feature(enable = "avx512f,avx2,fma")]
-    pub unsafe fn skin_blocks_with_normals(
-        bind: &[Vec3],
-        blocks: &WideLaneBlocks,
-        palette: &[Mat4],
-        out: &mut [Vec3],
-        normals: Normals,
-    ) -> Bounds {
-        let n = bind.len();
-        let (mut lo, mut hi) = ([_mm512_set1_ps(f32::INFINITY); 3], [_mm512_set1_ps(f32::NEG_INFINITY); 3]);
-        let mut last = Bounds::EMPTY;
-        for b in 0..n.div_ceil(WIDE_LANES) {
-            let lanes = b * WIDE_LANES..(b + 1) * WIDE_LANES;
-            let mut m = [_mm512_setzero_ps(); 12];
-            let joints = blocks.joint_starts[b] as usize..blocks.joint_starts[b + 1] as usize;
-            for (&j, w) in blocks.joints[joints.clone()].iter().zip(&blocks.weights[joints]) {
-                let w = register(w.0);
-                for (m, e) in m.iter_mut().zip(elements(&palette[j as usize])) {
-                    *m = _mm512_fmadd_ps(w, _mm512_set1_ps(e), *m);
-                }
-            }
-            // SAFETY: the CPU has AVX-512 F (this function's contract).
-            let [x, y, z] = unsafe { lane_points(bind, lanes.clone()) };
-            let p: [__m512; 3] = std::array::from_fn(|r| {
-                _mm512_fmadd_ps(m[r], x, _mm512_fmadd_ps(m[3 + r], y, _mm512_fmadd_ps(m[6 + r], z, m[9 + r])))
-            });
-            // SAFETY: as above.
-            let [x, y, z] = unsafe { lane_points(normals.bind, lanes.clone()) };
-            let normal: [__m512; 3] = std::array::from_fn(|r| {
-                _mm512_fmadd_ps(m[r], x, _mm512_fmadd_ps(m[3 + r], y, _mm512_mul_ps(m[6 + r], z)))
-            });
-            if lanes.end <= n {
-                for k in 0..3 {
-                    (lo[k], hi[k]) = (_mm512_min_ps(lo[k], p[k]), _mm512_max_ps(hi[k], p[k]));
-                }
-                // SAFETY: as above.
-                unsafe {
-                    interleave(p, &mut out[lanes.clone()]);
-                    interleave(normal, &mut normals.out[lanes]);
-                }
-            } else {
-                let (p, normal) = (p.map(floats), normal.map(floats));
-                for (i, v) in lanes.take_while(|&v| v < n).enumerate() {
-                    let q = Vec3A::new(p[0][i], p[1][i], p[2][i]);
-                    (out[v], normals.out[v]) = (q.into(), Vec3::new(normal[0][i], normal[1][i], normal[2][i]));
-                    last = last.with(q);
-                }
-            }
-        }
-        lanes_bounds(lo, hi).union(last)
-    }
-
-    /// The box between sixteen lanes of lower and sixteen of upper corners.
+    /// The CPU must have `L`'s features.
     #[inline(always)]
-    fn lanes_bounds(lo: [__m512; 3], hi: [__m512; 3]) -> Bounds {
-        let reduce = |r: __m512, f: fn(f32, f32) -> f32| floats(r).into_iter().reduce(f).unwrap_or(0.0);
+    unsafe fn lane_points<L: Lanes>(points: &[Vec3], lanes: std::ops::Range<usize>) -> [L; 3] {
+        match points.get(lanes.clone()) {
+            // SAFETY: this function's contract.
+            Some(whole) => unsafe { L::points(whole) },
+            None => L::some_points(&points[lanes.start..points.len()]),
+        }
+    }
+
+    /// The box between a register of lower and one of upper corners.
+    #[inline(always)]
+    fn lanes_bounds<L: Lanes>(lo: [L; 3], hi: [L; 3]) -> Bounds {
+        let reduce = |r: L, f: fn(f32, f32) -> f32| (0..L::LANES).map(|i| r.lane(i)).reduce(f).unwrap_or(0.0);
         Bounds::between(
             Vec3A::new(reduce(lo[0], f32::min), reduce(lo[1], f32::min), reduce(lo[2], f32::min)),
             Vec3A::new(reduce(hi[0], f32::max), reduce(hi[1], f32::max), reduce(hi[2], f32::max)),

@@ -16,6 +16,8 @@ pub mod humanoid;
 pub mod ik;
 pub mod influences;
 pub mod keyframe_splines;
+#[cfg(target_arch = "x86_64")]
+mod lanes;
 pub mod lbs;
 pub mod material;
 pub mod matrix_stack;
