@@ -224,8 +224,8 @@ mod avx2 {
                 let lanes = b * LANES..((b + 1) * LANES).min(n);
                 let whole = lanes.len() == LANES;
                 let mut blend = [zero; 8];
-                let joints = blocks.joint_starts[b] as usize..blocks.joint_starts[b + 1] as usize;
-                let influences = blocks.joints[joints.clone()].iter().zip(&blocks.weights[joints]);
+                let (joints, weights) = blocks.joints.block(b);
+                let influences = joints.iter().zip(weights);
                 match blocks.block_pivots[b] {
                     BlockPivots::Shared(row) => {
                         for (&j, w) in influences {

@@ -45,22 +45,17 @@ pub const LANES: usize = 8;
 pub struct LaneWeights(pub [f32; LANES]);
 
 /// The vertices in blocks of [`LANES`] consecutive ones (block `b`: vertices `8b..8b + 8`)
-/// with the joints their influences name between them: a kernel transforms all eight by
-/// each of the block's joints at once (the joint's matrix read once for eight vertices),
-/// reading and writing the block's positions in order. Neighbouring vertices of a mesh
-/// share most of their joints (SMPL's 6,890 vertices of four influences: 862 blocks of 6.9
-/// joints). Sorting vertices by their joints makes blocks of fewer (4.7), but reads and
-/// writes them out of order, which in a crowd's cold cache cost more than it saved.
+/// with the joints their influences name between them ([`JointBlocks`]), and what the dual
+/// quaternion kernel needs besides: a kernel transforms all eight by each of the block's
+/// joints at once (the joint's matrix read once for eight vertices), reading and writing
+/// the block's positions in order. Neighbouring vertices of a mesh share most of their
+/// joints (SMPL's 6,890 vertices of four influences: 862 blocks of 6.9 joints). Sorting
+/// vertices by their joints makes blocks of fewer (4.7), but reads and writes them out of
+/// order, which in a crowd's cold cache cost more than it saved.
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct LaneBlocks {
-    /// Block `b`'s joints and their weights are `joint_starts[b]..joint_starts[b + 1]` of
-    /// `joints` and `weights`.
-    pub joint_starts: Vec<u32>,
-    /// Each block's joints, ascending.
-    pub joints: Vec<u16>,
-    /// For each of a block's joints, its weight on each lane's vertex (0 where it has none,
-    /// and in the lanes past the last vertex).
-    pub weights: Vec<LaneWeights>,
+    /// Each block's joints and their weights on its lanes.
+    pub joints: JointBlocks<LaneWeights>,
     /// Each vertex's pivot: the joint of the first of its row's heaviest influences, in
     /// whose hemisphere dual quaternion skinning blends (0 for a vertex with none).
     pub pivots: Vec<u16>,
@@ -93,9 +88,7 @@ impl LaneBlocks {
     pub fn build(offsets: &[u32], influences: &[Influence]) -> Self {
         let vertex_count = offsets.len().saturating_sub(1);
         let row = |v: usize| &influences[offsets[v] as usize..offsets[v + 1] as usize];
-        let (joint_starts, joints, weights) = block_joints::<LANES>(offsets, influences);
-        let mut blocks =
-            Self { joint_starts, joints, weights: weights.into_iter().map(LaneWeights).collect(), ..Self::default() };
+        let mut blocks = Self { joints: JointBlocks::build::<LANES>(offsets, influences), ..Self::default() };
         blocks.pivots = (0..vertex_count).map(|v| pivot(row(v))).collect();
         let lane_rows: Vec<Option<u8>> = blocks.pivots.iter().map(|&p| row_of(&mut blocks.pivot_rows, p)).collect();
         blocks.block_pivots = lane_rows.chunks(LANES).map(block_pivots).collect();
@@ -112,14 +105,29 @@ pub const WIDE_LANES: usize = 16;
 #[repr(C, align(64))]
 pub struct WideLaneWeights(pub [f32; WIDE_LANES]);
 
+impl From<[f32; LANES]> for LaneWeights {
+    fn from(lanes: [f32; LANES]) -> Self {
+        Self(lanes)
+    }
+}
+
+impl From<[f32; WIDE_LANES]> for WideLaneWeights {
+    fn from(lanes: [f32; WIDE_LANES]) -> Self {
+        Self(lanes)
+    }
+}
+
 /// The vertices in blocks of [`WIDE_LANES`] consecutive ones (block `b`: vertices
-/// `16b..16b + 16`) with the joints their influences name between them, as [`LaneBlocks`]
-/// but twice as wide, for the AVX-512 linear blend kernels: a joint's sixteen weights cost
+/// `16b..16b + 16`), for the AVX-512 linear blend kernels: a joint's sixteen weights cost
 /// one multiply-add where two blocks of eight cost two, and two neighbouring blocks of eight
 /// share most of their joints (SMPL: 431 blocks of 8.6 joints against 862 of 6.9, 37 %
 /// fewer multiply-adds).
-#[derive(Debug, Clone, PartialEq, Default)]
-pub struct WideLaneBlocks {
+pub type WideLaneBlocks = JointBlocks<WideLaneWeights>;
+
+/// Vertices in blocks of consecutive ones, as many as a `W` holds weights (block `b`:
+/// vertices `Lb..Lb + L`), with the joints their influences name between them.
+#[derive(Debug, Clone, PartialEq)]
+pub struct JointBlocks<W> {
     /// Block `b`'s joints and their weights are `joint_starts[b]..joint_starts[b + 1]` of
     /// `joints` and `weights`.
     pub joint_starts: Vec<u32>,
@@ -127,41 +135,49 @@ pub struct WideLaneBlocks {
     pub joints: Vec<u16>,
     /// For each of a block's joints, its weight on each lane's vertex (0 where it has none,
     /// and in the lanes past the last vertex).
-    pub weights: Vec<WideLaneWeights>,
+    pub weights: Vec<W>,
 }
 
-impl WideLaneBlocks {
-    /// Blocks the rows `influences[offsets[v]..offsets[v + 1]]`.
-    pub fn build(offsets: &[u32], influences: &[Influence]) -> Self {
-        let (joint_starts, joints, weights) = block_joints::<WIDE_LANES>(offsets, influences);
-        Self { joint_starts, joints, weights: weights.into_iter().map(WideLaneWeights).collect() }
+impl<W> Default for JointBlocks<W> {
+    fn default() -> Self {
+        Self { joint_starts: vec![0], joints: Vec::new(), weights: Vec::new() }
     }
 }
 
-/// The rows `influences[offsets[v]..offsets[v + 1]]` in blocks of `L` consecutive vertices:
-/// where each block's joints start (one past the last block's end, too), the joints of each
-/// block ascending, and each of them's weight on each of the block's lanes.
-fn block_joints<const L: usize>(offsets: &[u32], influences: &[Influence]) -> (Vec<u32>, Vec<u16>, Vec<[f32; L]>) {
-    let (mut starts, mut all_joints, mut weights) = (vec![0], Vec::new(), Vec::new());
-    let vertex_count = offsets.len().saturating_sub(1);
-    let row = |v: usize| &influences[offsets[v] as usize..offsets[v + 1] as usize];
-    for first in (0..vertex_count).step_by(L) {
-        let lanes = first..(first + L).min(vertex_count);
-        let mut joints: Vec<u16> = lanes.clone().flat_map(|v| row(v).iter().map(|i| i.joint)).collect();
-        joints.sort_unstable();
-        joints.dedup();
-        for &joint in &joints {
-            let weight_of = |lane: usize| {
-                let v = first + lane;
-                let row = if v < lanes.end { row(v) } else { &[] };
-                row.iter().filter(|i| i.joint == joint).map(|i| i.weight).sum()
-            };
-            weights.push(std::array::from_fn(weight_of));
+impl<W> JointBlocks<W> {
+    /// Blocks the rows `influences[offsets[v]..offsets[v + 1]]`, `L` vertices a block.
+    pub fn build<const L: usize>(offsets: &[u32], influences: &[Influence]) -> Self
+    where
+        W: From<[f32; L]>,
+    {
+        let mut blocks = Self::default();
+        let vertex_count = offsets.len().saturating_sub(1);
+        let row = |v: usize| &influences[offsets[v] as usize..offsets[v + 1] as usize];
+        for first in (0..vertex_count).step_by(L) {
+            let lanes = first..(first + L).min(vertex_count);
+            let mut joints: Vec<u16> = lanes.clone().flat_map(|v| row(v).iter().map(|i| i.joint)).collect();
+            joints.sort_unstable();
+            joints.dedup();
+            for &joint in &joints {
+                let weight_of = |lane: usize| {
+                    let v = first + lane;
+                    let row = if v < lanes.end { row(v) } else { &[] };
+                    row.iter().filter(|i| i.joint == joint).map(|i| i.weight).sum()
+                };
+                blocks.weights.push(W::from(std::array::from_fn(weight_of)));
+            }
+            blocks.joints.extend(joints);
+            blocks.joint_starts.push(blocks.joints.len() as u32);
         }
-        all_joints.extend(joints);
-        starts.push(all_joints.len() as u32);
+        blocks
     }
-    (starts, all_joints, weights)
+
+    /// Block `b`'s joints and each one's weights on its lanes.
+    #[inline(always)]
+    pub fn block(&self, b: usize) -> (&[u16], &[W]) {
+        let joints = self.joint_starts[b] as usize..self.joint_starts[b + 1] as usize;
+        (&self.joints[joints.clone()], &self.weights[joints])
+    }
 }
 
 /// `pivot`'s row in `rows`, added when new and there is room.
@@ -197,7 +213,7 @@ impl InfluenceGroups {
     pub fn build(offsets: &[u32], influences: &[Influence]) -> Self {
         let mut groups = Self {
             blocks: LaneBlocks::build(offsets, influences),
-            wide_blocks: WideLaneBlocks::build(offsets, influences),
+            wide_blocks: JointBlocks::build::<WIDE_LANES>(offsets, influences),
             ..Self::default()
         };
         for (v, w) in offsets.windows(2).enumerate() {

@@ -1,13 +1,13 @@
 //! The registers the linear blend kernels are written over, one vertex a lane: `__m256`
-//! (eight lanes, AVX2 and FMA) and `__m512` (sixteen, AVX-512 F), with the blocks of as
-//! many vertices each reads ([`LaneBlocks`], [`WideLaneBlocks`]). One generic body of each
+//! (eight lanes, AVX2 and FMA) and `__m512` (sixteen, AVX-512 F), each with the weights of
+//! its blocks ([`JointBlocks`](super::influences::JointBlocks)). One generic body of each
 //! kernel serves both widths (x86-64 only).
 
 use std::arch::x86_64::*;
 
 use glam::Vec3;
 
-use super::influences::{LaneBlocks, LaneWeights, WideLaneBlocks, WideLaneWeights};
+use super::influences::{LaneWeights, WideLaneWeights};
 
 /// A register of [`Self::LANES`] floats as the kernels use it.
 ///
@@ -20,8 +20,6 @@ pub unsafe trait Lanes: Copy {
     const LANES: usize;
     /// One joint's weights on a block's vertices.
     type Weights;
-    /// The blocks of [`Self::LANES`] vertices.
-    type Blocks: Blocks<Self::Weights>;
 
     /// `x` in every lane.
     unsafe fn splat(x: f32) -> Self;
@@ -45,33 +43,10 @@ pub unsafe trait Lanes: Copy {
     unsafe fn write_points(p: [Self; 3], out: &mut [Vec3]);
 }
 
-/// Blocks of consecutive vertices with the joints they name: block `b`'s joints and each
-/// one's weights on its lanes.
-pub trait Blocks<W> {
-    fn block(&self, b: usize) -> (&[u16], &[W]);
-}
-
-impl Blocks<LaneWeights> for LaneBlocks {
-    #[inline(always)]
-    fn block(&self, b: usize) -> (&[u16], &[LaneWeights]) {
-        let joints = self.joint_starts[b] as usize..self.joint_starts[b + 1] as usize;
-        (&self.joints[joints.clone()], &self.weights[joints])
-    }
-}
-
-impl Blocks<WideLaneWeights> for WideLaneBlocks {
-    #[inline(always)]
-    fn block(&self, b: usize) -> (&[u16], &[WideLaneWeights]) {
-        let joints = self.joint_starts[b] as usize..self.joint_starts[b + 1] as usize;
-        (&self.joints[joints.clone()], &self.weights[joints])
-    }
-}
-
 // SAFETY: each method uses AVX2 / FMA intrinsics only (see the trait).
 unsafe impl Lanes for __m256 {
     const LANES: usize = 8;
     type Weights = LaneWeights;
-    type Blocks = LaneBlocks;
 
     #[inline(always)]
     unsafe fn splat(x: f32) -> Self {
@@ -119,7 +94,6 @@ unsafe impl Lanes for __m256 {
 unsafe impl Lanes for __m512 {
     const LANES: usize = 16;
     type Weights = WideLaneWeights;
-    type Blocks = WideLaneBlocks;
 
     #[inline(always)]
     unsafe fn splat(x: f32) -> Self {

@@ -1,10 +1,10 @@
 //! The fast linear-blend-skinning kernel. On x86-64 with AVX2 and FMA (detected at run
-//! time), the vertices are skinned in blocks of eight consecutive ones ([`LaneBlocks`](super::influences::LaneBlocks),
-//! built with the weights), one vertex a lane of a 256-bit register: each
-//! of a block's joints transforms all eight bind positions at once, weighted lane by lane
-//! (`pᵥ = Σⱼ wᵥⱼ (Pⱼ bᵥ)`), so a joint's matrix is read once for eight vertices. Elsewhere
-//! each vertex blends its own matrices with glam's `Vec4`, grouped by influence count.
-//! With AVX-512 F, the blocks are sixteen vertices wide
+//! time), the vertices are skinned in blocks of eight consecutive ones
+//! ([`LaneBlocks`](super::influences::LaneBlocks), built with the weights), one vertex a
+//! lane of a 256-bit register: each of a block's joints transforms all eight bind
+//! positions at once, weighted lane by lane (`pᵥ = Σⱼ wᵥⱼ (Pⱼ bᵥ)`), so a joint's matrix is
+//! read once for eight vertices. Elsewhere each vertex blends its own matrices with glam's
+//! `Vec4`, grouped by influence count. With AVX-512 F, the blocks are sixteen vertices wide
 //! ([`WideLaneBlocks`](super::influences::WideLaneBlocks)) on 512-bit registers: a joint's
 //! multiply-adds serve twice the vertices, and the pair of blocks of eight they replace
 //! share most joints (SMPL: 37 % fewer multiply-adds). [`Simd`] names the levels; the
@@ -93,7 +93,9 @@ pub fn skin_chunk_using(
             return unsafe { blocks::skin_blocks_avx512(bind_positions, &groups.wide_blocks, palette, first, out) };
         }
         // SAFETY: as above.
-        Simd::Avx2 => return unsafe { blocks::skin_blocks_avx2(bind_positions, &groups.blocks, palette, first, out) },
+        Simd::Avx2 => {
+            return unsafe { blocks::skin_blocks_avx2(bind_positions, &groups.blocks.joints, palette, first, out) };
+        }
         Simd::Portable => {}
     }
     skin_portable_chunk(bind_positions, weights, palette, first, out, None)
@@ -140,7 +142,7 @@ pub fn skin_with_normals_using(
         // SAFETY: as above.
         Simd::Avx2 => {
             return unsafe {
-                blocks::skin_blocks_with_normals_avx2(bind_positions, &groups.blocks, palette, out, normals)
+                blocks::skin_blocks_with_normals_avx2(bind_positions, &groups.blocks.joints, palette, out, normals)
             };
         }
         Simd::Portable => {}
@@ -264,8 +266,8 @@ mod blocks {
 
     use super::Normals;
     use crate::rig::avx2::prefetch_ahead;
-    use crate::rig::influences::{LaneBlocks, WideLaneBlocks};
-    use crate::rig::lanes::{Blocks, Lanes};
+    use crate::rig::influences::{JointBlocks, LaneWeights, WideLaneBlocks};
+    use crate::rig::lanes::Lanes;
     use crate::rig::skinning::Bounds;
 
     /// Linear blend skinning of the vertices `first..first + out.len()` on 256-bit
@@ -276,7 +278,7 @@ mod blocks {
     #[target_feature(enable = "avx2,fma")]
     pub unsafe fn skin_blocks_avx2(
         bind: &[Vec3],
-        blocks: &LaneBlocks,
+        blocks: &JointBlocks<LaneWeights>,
         palette: &[Mat4],
         first: usize,
         out: &mut [Vec3],
@@ -308,7 +310,7 @@ mod blocks {
     #[target_feature(enable = "avx2,fma")]
     pub unsafe fn skin_blocks_with_normals_avx2(
         bind: &[Vec3],
-        blocks: &LaneBlocks,
+        blocks: &JointBlocks<LaneWeights>,
         palette: &[Mat4],
         out: &mut [Vec3],
         normals: Normals,
@@ -357,7 +359,7 @@ mod blocks {
     #[inline(always)]
     unsafe fn skin_blocks<L: Lanes>(
         bind: &[Vec3],
-        blocks: &L::Blocks,
+        blocks: &JointBlocks<L::Weights>,
         palette: &[Mat4],
         first: usize,
         out: &mut [Vec3],
@@ -414,7 +416,7 @@ mod blocks {
     #[inline(always)]
     unsafe fn skin_blocks_with_normals<L: Lanes>(
         bind: &[Vec3],
-        blocks: &L::Blocks,
+        blocks: &JointBlocks<L::Weights>,
         palette: &[Mat4],
         out: &mut [Vec3],
         normals: Normals,
