@@ -44,10 +44,10 @@ fn count_handed_on(
 }
 
 /// An upload waiting for its mesh's slot: the character's skinned positions (and normals,
-/// empty where it has none), the range of them that mesh shows, and the frames waited.
+/// where it has them), the range of them that mesh shows, and the frames waited.
 struct Pending {
     positions: Arc<Vec<Vec3>>,
-    normals: Arc<Vec<Vec3>>,
+    normals: Option<Arc<Vec<Vec3>>>,
     range: std::ops::Range<u32>,
     waited: u32,
 }
@@ -61,7 +61,7 @@ impl Pending {
     /// The normals of this part's vertices: none when the skin has none, or they do not
     /// hold all of them.
     fn part_normals(&self) -> Option<&[Vec3]> {
-        self.normals.get(self.range.start as usize..self.range.end as usize).filter(|n| !n.is_empty())
+        self.normals.as_ref()?.get(self.range.start as usize..self.range.end as usize)
     }
 }
 
@@ -101,7 +101,7 @@ fn extract_skin_uploads(
         }
         for part in &character.skins {
             let (positions, range) = (scratch.positions.clone(), part.vertices.clone());
-            let normals = if upload.with_normals { scratch.normals.clone() } else { Arc::default() };
+            let normals = upload.with_normals.then(|| scratch.normals.clone());
             pending.0.insert(part.mesh.id(), Pending { positions, normals, range, waited: 0 });
         }
     }
