@@ -192,7 +192,6 @@ fn skin_on_cpu(skin: &crate::rig::Skin, method: dqs::SkinningMethod, scratch: &m
     let positions = super::handoff::reclaimed(positions);
     positions.resize(skin.bind_positions.len(), Vec3::ZERO);
     let normals = super::handoff::reclaimed(normals);
-    normals.clear();
     normals.resize(skin.normals.len(), Vec3::ZERO);
     scratch.bounds = if method.is_linear() && !normals.is_empty() {
         let normals = lbs::Normals { bind: &skin.normals, out: normals };
@@ -200,6 +199,7 @@ fn skin_on_cpu(skin: &crate::rig::Skin, method: dqs::SkinningMethod, scratch: &m
     } else if method.is_linear() {
         skin_in_chunks(skin, palette, positions).pair()
     } else {
+        normals.fill(Vec3::ZERO);
         dqs::dual_quaternion_palette(palette, dual_quaternions);
         dqs::skin_dq(&skin.bind_positions, &skin.weights, dual_quaternions, positions);
         bounds(positions)
