@@ -94,11 +94,7 @@ pub struct SkinningPlugin;
 
 impl Plugin for SkinningPlugin {
     fn build(&self, app: &mut App) {
-        app.add_plugins((upload::SkinUploadPlugin, gpu_skinning::GpuSkinningPlugin)).add_systems(
-            PostUpdate,
-            (systems::skin_changed_characters, systems::finish_skinned_characters)
-                .chain()
-                .in_set(MarionetteSystems::Skin),
-        );
+        app.add_plugins((upload::SkinUploadPlugin, gpu_skinning::GpuSkinningPlugin))
+            .add_systems(PostUpdate, systems::skin_changed_characters.in_set(MarionetteSystems::Skin));
     }
 }

@@ -115,8 +115,10 @@ pub fn compute_joint_to_world(
 /// asset's shared inverse binds, the LBS or DQ kernel of the bind vertices and their
 /// bounds; the colours and texture coordinates when the colours changed, packed for the
 /// skin material (see `SkinAttributes`). Characters skinned on the GPU hand over the
-/// palette instead (reads `JointScratch`, `Character`; writes `SkinScratch`, `SkinUpload`,
-/// `SkinAttributes`, `GpuSkinJob`).
+/// palette instead. Then [`finish_skinned_characters`], in the same system: a system of
+/// its own cost the phase a hand-over between threads each frame (reads `JointScratch`,
+/// `Character`; writes `SkinScratch`, `SkinUpload`, `SkinAttributes`, `GpuSkinJob`,
+/// `PoseDirty`, the skins' `Aabb`).
 pub fn skin_changed_characters(
     mut characters: Query<(
         &Character,
@@ -124,13 +126,14 @@ pub fn skin_changed_characters(
         &CharacterSkinning,
         &SkinOnGpu,
         &HeatJoint,
-        &PoseDirty,
+        &mut PoseDirty,
         &mut SkinScratch,
         &mut SkinUpload,
         &mut SkinAttributes,
         &mut GpuSkinJob,
         &JointScratch,
     )>,
+    mut skin_bounds: Query<&mut Aabb, With<SkinMesh>>,
 ) {
     // Batches of a few characters, so that a thread held up elsewhere leaves its share to
     // the others (Bevy's default of one batch a thread left the phase a third longer).
@@ -181,6 +184,8 @@ pub fn skin_changed_characters(
             }
         },
     );
+    let finished = characters.iter_mut().map(|(c, v, _, _, h, d, s, ..)| (c, v, h, d, s));
+    finish_skinned_characters(finished, &mut skin_bounds);
 }
 
 /// The LBS or DQ kernel of the skin into `scratch.positions` (and its normals into
@@ -226,13 +231,14 @@ fn skin_in_chunks(skin: &crate::rig::Skin, palette: &[Mat4], out: &mut [Vec3]) -
 }
 
 /// Keeps each re-skinned character's bounds right (so culling follows the deformed mesh),
-/// notes what its colours were made from and clears `PoseDirty` (reads `SkinScratch`;
-/// writes `Aabb`).
-pub fn finish_skinned_characters(
-    mut characters: Query<(&Character, &CharacterView, &HeatJoint, &mut PoseDirty, &mut SkinScratch)>,
-    mut skin_bounds: Query<&mut Aabb, With<SkinMesh>>,
+/// notes what its colours were made from and clears `PoseDirty`.
+fn finish_skinned_characters<'a>(
+    characters: impl Iterator<
+        Item = (&'a Character, &'a CharacterView, &'a HeatJoint, Mut<'a, PoseDirty>, Mut<'a, SkinScratch>),
+    >,
+    skin_bounds: &mut Query<&mut Aabb, With<SkinMesh>>,
 ) {
-    for (character, view, heat, mut dirty, mut scratch) in &mut characters {
+    for (character, view, heat, mut dirty, mut scratch) in characters {
         if *dirty == PoseDirty::default() {
             continue;
         }
