@@ -438,12 +438,15 @@ fn skin_phase_parts(bencher: Bencher, part: &str) {
 /// positions alone, the positions with the bind normals skinned by the same blend
 /// (`lbs::skin_with_normals`), and the positions with smooth normals derived from them (each
 /// vertex's triangles' area-weighted normals summed, then normalised), in vertices per
-/// second.
-#[divan::bench(args = ["positions", "skinned normals", "derived normals"])]
+/// second; and the same two ways of the dual quaternion kernel.
+#[divan::bench(args = ["positions", "skinned normals", "derived normals", "DQ positions", "DQ skinned normals"])]
 fn skin_normals_skinned_or_derived(bencher: Bencher, way: &str) {
+    use marionette::rig::dqs::{dual_quaternion_palette, skin_dq, skin_dq_with_normals};
     use marionette::rig::lbs::{Normals, skin, skin_with_normals};
     let body = smpl_body();
     let palette = posed_palette(&body);
+    let mut dq = Vec::new();
+    dual_quaternion_palette(&palette, &mut dq);
     let skin_ = &body.skin;
     let n = skin_.bind_positions.len();
     let mut bind_normals = vec![Vec3::ZERO; n];
@@ -454,6 +457,11 @@ fn skin_normals_skinned_or_derived(bencher: Bencher, way: &str) {
         "skinned normals" => {
             let normals = Normals { bind: &bind_normals, out: &mut normals };
             skin_with_normals(&skin_.bind_positions, &skin_.weights, &palette, &mut out, normals);
+        }
+        "DQ positions" => skin_dq(&skin_.bind_positions, &skin_.weights, &dq, &mut out),
+        "DQ skinned normals" => {
+            let normals = Normals { bind: &bind_normals, out: &mut normals };
+            skin_dq_with_normals(&skin_.bind_positions, &skin_.weights, &dq, &mut out, normals);
         }
         _ => {
             skin(&skin_.bind_positions, &skin_.weights, &palette, &mut out);

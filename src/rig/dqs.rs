@@ -9,7 +9,7 @@ use glam::{Mat4, Quat, Vec3, Vec4};
 
 use super::influences::FixedGroup;
 use super::simd::Simd;
-use super::skinning::SkinWeights;
+use super::skinning::{Normals, SkinWeights};
 
 pub use super::skinning::SkinningMethod;
 
@@ -66,6 +66,21 @@ pub fn skin_dq(bind_positions: &[Vec3], weights: &SkinWeights, palette: &[DualQu
     skin_dq_using(Simd::best(), bind_positions, weights, palette, out);
 }
 
+/// [`skin_dq`] with normals: each vertex's normal turned by the rotation of the same
+/// normalised blend that moves its position (a unit normal stays unit).
+///
+/// # Panics
+/// As [`skin_dq`], or when there is not one bind normal and one output normal per vertex.
+pub fn skin_dq_with_normals(
+    bind_positions: &[Vec3],
+    weights: &SkinWeights,
+    palette: &[DualQuat],
+    out: &mut [Vec3],
+    normals: Normals,
+) {
+    skin_dq_with_normals_using(Simd::best(), bind_positions, weights, palette, out, normals);
+}
+
 /// [`skin_dq`] at a given level of the kernel (`Simd::Portable`: vertex by vertex, what
 /// other CPUs run and the SIMD levels' oracle).
 ///
@@ -78,6 +93,34 @@ pub fn skin_dq_using(
     palette: &[DualQuat],
     out: &mut [Vec3],
 ) {
+    skin_dq_at(simd, bind_positions, weights, palette, out, None);
+}
+
+/// [`skin_dq_with_normals`] at a given level of the kernel.
+///
+/// # Panics
+/// As [`skin_dq_with_normals`], or when the CPU does not run `simd`.
+pub fn skin_dq_with_normals_using(
+    simd: Simd,
+    bind_positions: &[Vec3],
+    weights: &SkinWeights,
+    palette: &[DualQuat],
+    out: &mut [Vec3],
+    normals: Normals,
+) {
+    assert!(normals.bind.len() == out.len() && normals.out.len() == out.len(), "one normal per vertex");
+    skin_dq_at(simd, bind_positions, weights, palette, out, Some(normals));
+}
+
+/// The kernel at level `simd`, with normals or without.
+fn skin_dq_at(
+    simd: Simd,
+    bind_positions: &[Vec3],
+    weights: &SkinWeights,
+    palette: &[DualQuat],
+    out: &mut [Vec3],
+    mut normals: Option<Normals>,
+) {
     assert_eq!(bind_positions.len(), weights.vertex_count(), "one weight row per vertex");
     assert_eq!(out.len(), bind_positions.len(), "one output per vertex");
     let groups = weights.groups();
@@ -88,11 +131,11 @@ pub fn skin_dq_using(
         HEMISPHERES.with_borrow_mut(|hemispheres| {
             hemisphere_bits(palette, &groups.blocks.pivot_rows, hemispheres);
             // SAFETY: the CPU runs `simd` (checked above).
-            unsafe { avx2::skin_blocks(simd, bind_positions, &groups.blocks, palette, hemispheres, out) };
+            unsafe { avx2::skin_blocks(simd, bind_positions, &groups.blocks, palette, hemispheres, out, normals) };
         });
         return;
     }
-    skin_dq_portable(bind_positions, weights, palette, out);
+    skin_dq_portable(bind_positions, weights, palette, out, &mut normals);
 }
 
 #[cfg(target_arch = "x86_64")]
@@ -115,41 +158,65 @@ fn hemisphere_bits(palette: &[DualQuat], pivot_rows: &[u16], bits: &mut Vec<u32>
 }
 
 /// The portable path: vertex by vertex, grouped by influence count.
-fn skin_dq_portable(bind_positions: &[Vec3], weights: &SkinWeights, palette: &[DualQuat], out: &mut [Vec3]) {
+fn skin_dq_portable(
+    bind_positions: &[Vec3],
+    weights: &SkinWeights,
+    palette: &[DualQuat],
+    out: &mut [Vec3],
+    normals: &mut Option<Normals>,
+) {
     let groups = weights.groups();
-    fixed_rows::<1>(bind_positions, &groups.fixed[0], palette, out);
-    fixed_rows::<2>(bind_positions, &groups.fixed[1], palette, out);
-    fixed_rows::<3>(bind_positions, &groups.fixed[2], palette, out);
-    fixed_rows::<4>(bind_positions, &groups.fixed[3], palette, out);
-    skin_wide(bind_positions, weights, &groups.wide, palette, out);
-}
-
-/// Vertices with more than four influences (`vertices`: some of the skin's wide group).
-fn skin_wide(bind_positions: &[Vec3], weights: &SkinWeights, vertices: &[u32], palette: &[DualQuat], out: &mut [Vec3]) {
-    for &v in vertices {
+    fixed_rows::<1>(bind_positions, &groups.fixed[0], palette, out, normals);
+    fixed_rows::<2>(bind_positions, &groups.fixed[1], palette, out, normals);
+    fixed_rows::<3>(bind_positions, &groups.fixed[2], palette, out, normals);
+    fixed_rows::<4>(bind_positions, &groups.fixed[3], palette, out, normals);
+    for &v in &groups.wide {
         let row = weights.of_vertex(v as usize).iter().map(|i| (i.joint, i.weight));
-        out[v as usize] = blend_and_apply(row, palette, bind_positions[v as usize]);
+        apply_to_vertex(blend(row, palette), v as usize, bind_positions, out, normals);
     }
 }
 
-fn fixed_rows<const K: usize>(bind: &[Vec3], group: &FixedGroup, palette: &[DualQuat], out: &mut [Vec3]) {
+fn fixed_rows<const K: usize>(
+    bind: &[Vec3],
+    group: &FixedGroup,
+    palette: &[DualQuat],
+    out: &mut [Vec3],
+    normals: &mut Option<Normals>,
+) {
     let rows = group.joints.chunks_exact(K).zip(group.weights.chunks_exact(K));
     for (&v, (joints, weights)) in group.vertices.iter().zip(rows) {
         let row = joints.iter().copied().zip(weights.iter().copied());
-        out[v as usize] = blend_and_apply(row, palette, bind[v as usize]);
+        apply_to_vertex(blend(row, palette), v as usize, bind, out, normals);
+    }
+}
+
+/// Moves vertex `v` (and turns its normal, where there are normals) by a blend's rotation
+/// and translation.
+#[inline(always)]
+fn apply_to_vertex(
+    (rotation, t): (Quat, Vec3),
+    v: usize,
+    bind: &[Vec3],
+    out: &mut [Vec3],
+    normals: &mut Option<Normals>,
+) {
+    out[v] = rotation * bind[v] + t;
+    if let Some(normals) = normals {
+        normals.out[v] = rotation * normals.bind[v];
     }
 }
 
 /// Blends one vertex's dual quaternions in its heaviest influence's hemisphere (q and -q
-/// are the same rotation), normalises and applies the blend to `p`.
+/// are the same rotation) and normalises the blend: its rotation and translation (none
+/// for a row without influences).
 #[inline(always)]
-fn blend_and_apply(row: impl Iterator<Item = (u16, f32)> + Clone, palette: &[DualQuat], p: Vec3) -> Vec3 {
+fn blend(row: impl Iterator<Item = (u16, f32)> + Clone, palette: &[DualQuat]) -> (Quat, Vec3) {
     // The first of the heaviest influences (as the SIMD path picks it).
     let heaviest = row.clone().fold(None, |best, (j, w)| match best {
         Some((_, bw)) if bw >= w => best,
         _ => Some((j, w)),
     });
-    let Some((heaviest, _)) = heaviest else { return p };
+    let Some((heaviest, _)) = heaviest else { return (Quat::IDENTITY, Vec3::ZERO) };
     let pivot = palette[heaviest as usize].real;
     let (mut real, mut dual) = (Vec4::ZERO, Vec4::ZERO);
     for (j, w) in row {
@@ -163,7 +230,7 @@ fn blend_and_apply(row: impl Iterator<Item = (u16, f32)> + Clone, palette: &[Dua
     // Rotation by the unit quaternion, then the translation 2 (w_r d - w_d r + r × d).
     let (r, d) = (real.truncate(), dual.truncate());
     let t = 2.0 * (real.w * d - dual.w * r + r.cross(d));
-    Quat::from_vec4(real) * p + t
+    (Quat::from_vec4(real), t)
 }
 
 #[cfg(target_arch = "x86_64")]
@@ -175,6 +242,7 @@ mod avx2 {
     use super::DualQuat;
     use crate::rig::avx2::{deinterleave, deinterleave_some, floats, for_both_levels, interleave, register};
     use crate::rig::influences::{BlockPivots, LANES, LaneBlocks};
+    use crate::rig::skinning::Normals;
 
     for_both_levels! {
     /// Each block on 256-bit registers, one vertex a lane: each of the block's joints
@@ -184,8 +252,8 @@ mod avx2 {
     /// `hemispheres` (from [`hemisphere_bits`](super::hemisphere_bits)): one for the whole
     /// block where its lanes share their pivot, shifted out lane by lane where they do not;
     /// for pivots beyond the table, from the dot product with each lane's pivot. Whole
-    /// blocks read and write their positions in order; the mesh's last block, when partial,
-    /// lane by lane.
+    /// blocks read and write their positions (and normals, turned by the blend's rotation)
+    /// in order; the mesh's last block, when partial, lane by lane.
     ///
     /// (Indices are checked: a joint beyond the palette panics.)
     pub unsafe fn skin_blocks = skin_blocks_body(
@@ -194,6 +262,7 @@ mod avx2 {
         palette: &[DualQuat],
         hemispheres: &[u32],
         out: &mut [Vec3],
+        normals: Option<Normals>,
     )
     }
 
@@ -208,6 +277,7 @@ mod avx2 {
         palette: &[DualQuat],
         hemispheres: &[u32],
         out: &mut [Vec3],
+        mut normals: Option<Normals>,
     ) {
         // SAFETY: the CPU has AVX2 and FMA (this function's contract).
         unsafe {
@@ -222,7 +292,6 @@ mod avx2 {
             };
             for b in 0..n.div_ceil(LANES) {
                 let lanes = b * LANES..((b + 1) * LANES).min(n);
-                let whole = lanes.len() == LANES;
                 let mut blend = [zero; 8];
                 let (joints, weights) = blocks.joints.block(b);
                 let influences = joints.iter().zip(weights);
@@ -261,17 +330,32 @@ mod avx2 {
                 }
                 // The bind positions read after the blend: with their three registers held through
                 // it, an accumulator spilled to memory (a tenth of the kernel's time).
-                let p =
-                    if whole { deinterleave(&bind[lanes.clone()]) } else { deinterleave_some(&bind[lanes.clone()]) };
-                let moved = normalise_and_apply(blend, p);
-                if whole {
-                    interleave(moved, &mut out[lanes]);
-                } else {
-                    let lane = moved.map(floats);
-                    for (i, v) in lanes.enumerate() {
-                        out[v] = Vec3::new(lane[0][i], lane[1][i], lane[2][i]);
-                    }
+                let moved = normalise_and_apply(blend, read_lanes(bind, lanes.clone()));
+                write_lanes(moved, out, lanes.clone());
+                if let Some(Normals { bind, out }) = &mut normals {
+                    write_lanes(normalise_and_turn(blend, read_lanes(bind, lanes.clone())), out, lanes);
                 }
+            }
+        }
+    }
+
+    /// The points of `lanes` as x, y and z registers (a partial block's missing lanes zero).
+    #[inline(always)]
+    unsafe fn read_lanes(points: &[Vec3], lanes: std::ops::Range<usize>) -> [__m256; 3] {
+        // SAFETY: the CPU has AVX2 (the caller's contract).
+        if lanes.len() == LANES { unsafe { deinterleave(&points[lanes]) } } else { deinterleave_some(&points[lanes]) }
+    }
+
+    /// x, y and z registers written as the points of `lanes` (a partial block's lane by lane).
+    #[inline(always)]
+    unsafe fn write_lanes(lanes_xyz: [__m256; 3], points: &mut [Vec3], lanes: std::ops::Range<usize>) {
+        if lanes.len() == LANES {
+            // SAFETY: the CPU has AVX2 (the caller's contract).
+            unsafe { interleave(lanes_xyz, &mut points[lanes]) };
+        } else {
+            let lane = lanes_xyz.map(floats);
+            for (i, v) in lanes.enumerate() {
+                points[v] = Vec3::new(lane[0][i], lane[1][i], lane[2][i]);
             }
         }
     }
@@ -299,6 +383,19 @@ mod avx2 {
             moved[c] = _mm256_fmadd_ps(scale, _mm256_add_ps(rxu[c], rest), p[c]);
         }
         moved
+    }
+
+    /// The rotation of eight blends (normalised, as in [`normalise_and_apply`]) turning
+    /// eight vectors: `n + (2 / n²) r × (r × n + w_r n)`.
+    #[inline]
+    #[target_feature(enable = "avx2,fma")]
+    fn normalise_and_turn([rx, ry, rz, wr, ..]: [__m256; 8], n: [__m256; 3]) -> [__m256; 3] {
+        let r = [rx, ry, rz];
+        let scale = _mm256_div_ps(_mm256_set1_ps(2.0), dot8(&[rx, ry, rz, wr], &[rx, ry, rz, wr]));
+        let rxn = cross8(r, n);
+        let u: [__m256; 3] = std::array::from_fn(|c| _mm256_fmadd_ps(wr, n[c], rxn[c]));
+        let rxu = cross8(r, u);
+        std::array::from_fn(|c| _mm256_fmadd_ps(scale, rxu[c], n[c]))
     }
 
     /// Four quaternions, one per lane of each 128-bit half (`a`, `b`, `c`, `d` hold

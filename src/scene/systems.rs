@@ -190,8 +190,7 @@ pub fn skin_changed_characters(
 
 /// The LBS or DQ kernel of the skin into `scratch.positions` (and its normals into
 /// `scratch.normals` where it has them), and their bounds (grown as the linear kernel
-/// writes them). The DQ kernel skins positions only: a DQ-skinned skin's normals are zero,
-/// which its material lights flat.
+/// writes them).
 fn skin_on_cpu(skin: &crate::rig::Skin, method: dqs::SkinningMethod, scratch: &mut SkinScratch) {
     let SkinScratch { palette, dual_quaternions, positions, normals, .. } = scratch;
     let positions = super::handoff::reclaimed(positions);
@@ -204,9 +203,13 @@ fn skin_on_cpu(skin: &crate::rig::Skin, method: dqs::SkinningMethod, scratch: &m
     } else if method.is_linear() {
         skin_in_chunks(skin, palette, positions).pair()
     } else {
-        normals.fill(Vec3::ZERO);
         dqs::dual_quaternion_palette(palette, dual_quaternions);
-        dqs::skin_dq(&skin.bind_positions, &skin.weights, dual_quaternions, positions);
+        if normals.is_empty() {
+            dqs::skin_dq(&skin.bind_positions, &skin.weights, dual_quaternions, positions);
+        } else {
+            let normals = lbs::Normals { bind: &skin.normals, out: normals };
+            dqs::skin_dq_with_normals(&skin.bind_positions, &skin.weights, dual_quaternions, positions, normals);
+        }
         bounds(positions)
     };
 }

@@ -4,8 +4,12 @@
 use std::sync::Arc;
 
 use glam::{Mat4, Quat, Vec3};
-use marionette::rig::dqs::{DualQuat, SkinningMethod, dual_quaternion_palette, skin_dq, skin_dq_using};
+use marionette::rig::dqs::{
+    DualQuat, SkinningMethod, dual_quaternion_palette, skin_dq, skin_dq_using, skin_dq_with_normals,
+    skin_dq_with_normals_using,
+};
 use marionette::rig::lbs::skin;
+use marionette::rig::skinning::Normals;
 use marionette::rig::{JointRotation, SkinWeights};
 
 fn dq(palette: &[Mat4]) -> Vec<DualQuat> {
@@ -42,6 +46,61 @@ fn a_vertex_with_one_influence_moves_as_in_linear_blend_skinning() {
     for (a, b) in lbs.iter().zip(&dqs) {
         assert!(a.distance(*b) < 1e-5, "{a} vs {b}");
     }
+}
+
+/// Unit normals of their own for `count` vertices, pointing every way.
+fn unit_normals(count: usize) -> Vec<Vec3> {
+    (0..count)
+        .map(|v| Vec3::new((v as f32 * 0.37).sin(), 1.0 - (v % 7) as f32 * 0.3, (v as f32 * 1.3).cos()).normalize())
+        .collect()
+}
+
+/// A vertex with one influence has its normal turned by that joint's rotation (the
+/// matrix's 3×3 part, as linear blend skinning turns it), at every level of the kernel.
+#[test]
+fn a_vertex_with_one_influence_has_its_normal_turned_by_its_joint() {
+    let asset = marionette::formats::puppet::embedded_puppet();
+    let n = asset.skeleton.len();
+    let palette: Vec<Mat4> = (0..n)
+        .map(|j| {
+            let q = Quat::from_euler(glam::EulerRot::YXZ, 0.4 * j as f32, 0.25, -0.15 * j as f32);
+            Mat4::from_rotation_translation(q, Vec3::new(-0.2, 0.1 * j as f32, 0.4))
+        })
+        .collect();
+    let count = asset.vertex_count();
+    let joint_of = |v: usize| (v * 5 % n) as u16;
+    let rigid = SkinWeights::rigid(&(0..count).map(joint_of).collect::<Vec<_>>());
+    let bind_normals = unit_normals(count);
+    for simd in marionette::rig::simd::Simd::available() {
+        let (mut positions, mut normals) = (vec![Vec3::NAN; count], vec![Vec3::NAN; count]);
+        let out = Normals { bind: &bind_normals, out: &mut normals };
+        skin_dq_with_normals_using(simd, &asset.skin.bind_positions, &rigid, &dq(&palette), &mut positions, out);
+        for (v, (got, bind)) in normals.iter().zip(&bind_normals).enumerate() {
+            let expected = palette[joint_of(v) as usize].transform_vector3(*bind);
+            assert!(got.distance(expected) < 1e-5, "{simd:?}, vertex {v}: {got} vs {expected}");
+        }
+    }
+}
+
+/// Blending several joints, the normal is turned by a rotation: unit normals stay unit
+/// (linear blend skinning shortens them where its joints disagree).
+#[test]
+fn dual_quaternion_normals_keep_their_length() {
+    let asset = marionette::formats::puppet::embedded_puppet();
+    let pose: Vec<JointRotation> =
+        (0..asset.skeleton.len()).map(|i| JointRotation::euler_xyz(0.5 * i as f32, -0.7, 0.3 * i as f32)).collect();
+    let palette =
+        marionette::rig::fk::posed_palette(&asset.skeleton, &asset.bind_world_to_joint, &pose, Mat4::IDENTITY);
+    let count = asset.vertex_count();
+    let bind_normals = unit_normals(count);
+    let (mut positions, mut normals) = (vec![Vec3::ZERO; count], vec![Vec3::ZERO; count]);
+    let out = Normals { bind: &bind_normals, out: &mut normals };
+    skin_dq_with_normals(&asset.skin.bind_positions, &asset.skin.weights, &dq(&palette), &mut positions, out);
+    let worst = normals.iter().map(|n| (n.length() - 1.0).abs()).fold(0.0f32, f32::max);
+    assert!(worst < 1e-5, "length off by {worst}");
+    let mut alone = vec![Vec3::ZERO; count];
+    skin_dq(&asset.skin.bind_positions, &asset.skin.weights, &dq(&palette), &mut alone);
+    assert_eq!(alone, positions, "the positions are those of the kernel without normals");
 }
 
 /// The area of a closed polygon of points in the plane x = const (shoelace over y, z).
@@ -142,18 +201,34 @@ fn the_dual_quaternion_kernel_paths_agree() {
 }
 
 /// Each SIMD level of the kernel this CPU runs (AVX2, and AVX-512 VL where it has it)
-/// against the portable path, within 1e-5 of the mesh's size. Outputs start as NaN, so a
-/// vertex left unwritten fails.
+/// against the portable path, within 1e-5 of the mesh's size: positions alone, and
+/// positions with unit normals (those within 1e-5). Outputs start as NaN, so a vertex
+/// left unwritten fails.
 fn assert_simd_levels_match_portable(name: &str, bind: &[Vec3], weights: &SkinWeights, dq: &[DualQuat]) {
     use marionette::rig::simd::Simd;
-    let mut expected = vec![Vec3::splat(f32::NAN); bind.len()];
+    let worst =
+        |a: &[Vec3], b: &[Vec3]| a.iter().zip(b).map(|(x, y)| (*x - *y).abs().max_element()).fold(0.0f32, f32::max);
+    let bind_normals = unit_normals(bind.len());
+    let with_normals = |simd| {
+        let (mut positions, mut normals) = (vec![Vec3::NAN; bind.len()], vec![Vec3::NAN; bind.len()]);
+        let out = Normals { bind: &bind_normals, out: &mut normals };
+        skin_dq_with_normals_using(simd, bind, weights, dq, &mut positions, out);
+        (positions, normals)
+    };
+    let mut expected = vec![Vec3::NAN; bind.len()];
     skin_dq_using(Simd::Portable, bind, weights, dq, &mut expected);
+    let (expected_with, expected_normals) = with_normals(Simd::Portable);
+    assert_eq!(expected_with, expected, "{name}: the portable positions, with normals or without");
     let scale = expected.iter().fold(1.0f32, |m, p| m.max(p.abs().max_element()));
     for simd in Simd::available().filter(|&s| s != Simd::Portable) {
-        let mut out = vec![Vec3::splat(f32::NAN); bind.len()];
+        let mut out = vec![Vec3::NAN; bind.len()];
         skin_dq_using(simd, bind, weights, dq, &mut out);
-        let worst = out.iter().zip(&expected).map(|(x, y)| (*x - *y).abs().max_element()).fold(0.0f32, f32::max);
-        assert!(worst <= 1e-5 * scale, "{name} ({simd:?}): worst {worst:e} (scale {scale})");
+        let off = worst(&out, &expected);
+        assert!(off <= 1e-5 * scale, "{name} ({simd:?}): worst {off:e} (scale {scale})");
+        let (positions, normals) = with_normals(simd);
+        assert_eq!(positions, out, "{name} ({simd:?}): positions with normals or without");
+        let off = worst(&normals, &expected_normals);
+        assert!(off <= 1e-5, "{name} ({simd:?}): normals off by {off:e}");
     }
 }
 
