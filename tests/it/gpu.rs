@@ -271,3 +271,94 @@ fn cpu_skinned_vertices_land_in_each_meshs_slot() {
     app.update();
     assert!(all_landed(&app, &poses), "the re-posed character's slot follows it, the others' stay");
 }
+
+/// The skins' attributes on the GPU: laid out whole when skins come (the default scene's
+/// puppets), then a recolour writes only the recoloured character's surface in place.
+/// Shown by spoiling another puppet's bytes in the main world's copy before the recolour:
+/// had the whole buffer been sent again, the GPU would hold the spoiled bytes.
+#[test]
+fn a_recolour_writes_only_its_characters_attributes_on_the_gpu() {
+    use marionette::editor::present::skin_material::SkinAttributeStore;
+    use marionette::scene::upload::SkinAttributes;
+    let mut app = App::new();
+    app.add_plugins(marionette::editor::windowless_plugins().disable::<PipelinedRenderingPlugin>()).add_plugins((
+        RigCorePlugin,
+        SkinningPlugin,
+        marionette::editor::present::view::ViewPlugin,
+    ));
+    app.finish();
+    app.cleanup();
+    // A surface's bytes in the buffer: from its mesh's first vertex, as many as its
+    // attributes.
+    let range_of = |app: &App, character: Entity| {
+        let skin = app.world().get::<Character>(character)?.skins.first()?;
+        let at = app.world().resource::<SkinAttributeStore>().first(skin.entity)? as usize * 12;
+        Some(at..at + skin.vertices.len() * 12)
+    };
+    let packed = |app: &App, character: Entity| {
+        let skin = &app.world().get::<Character>(character).unwrap().skins[0];
+        let words = &app.world().get::<SkinAttributes>(character).unwrap().0;
+        bytemuck::cast_slice(&words[skin.vertices.start as usize..skin.vertices.end as usize]).to_vec()
+    };
+    let on_gpu = |app: &App| {
+        let id = app.world().resource::<SkinAttributeStore>().buffer.id();
+        read_back_shader_buffer(app.sub_app(RenderApp).world(), id)
+    };
+    let landed = |app: &App, character: Entity| {
+        let (bytes, range) = (on_gpu(app), range_of(app, character));
+        bytes.zip(range).is_some_and(|(bytes, range)| bytes.get(range) == Some(&packed(app, character)[..]))
+    };
+    let characters = |app: &mut App| {
+        let world = app.world_mut();
+        world.query_filtered::<Entity, With<Character>>().iter(world).collect::<Vec<_>>()
+    };
+    let mut scene = Vec::new();
+    let all_landed = (0..300).any(|_| {
+        app.update();
+        scene = characters(&mut app);
+        scene.len() >= 2 && scene.iter().all(|&c| landed(&app, c))
+    });
+    assert!(all_landed, "the default scene's attributes on the GPU");
+    let (first, second) = (scene[0], scene[1]);
+    let (before, second_range) = (packed(&app, first), range_of(&app, second).unwrap());
+    let id = app.world().resource::<SkinAttributeStore>().buffer.id();
+    let mut buffers = app.world_mut().resource_mut::<Assets<bevy::render::storage::ShaderBuffer>>();
+    buffers.get_mut_untracked(id).unwrap().data.as_mut().unwrap()[second_range.clone()].fill(0xAB);
+    app.world_mut().get_mut::<CharacterView>(first).unwrap().0.weight_colors = true;
+    for _ in 0..3 {
+        app.update();
+    }
+    assert_ne!(packed(&app, first), before, "weight colours repacked the attributes");
+    assert!(landed(&app, first), "the recoloured puppet's attributes reached the GPU");
+    let gpu = on_gpu(&app).unwrap();
+    assert!(gpu[second_range].iter().any(|&b| b != 0xAB), "the other puppet's were not sent again");
+    assert!(landed(&app, second), "the other puppet's are as they were");
+}
+
+/// A `ShaderBuffer`'s bytes on the GPU (none until it is there).
+fn read_back_shader_buffer(render_world: &World, id: AssetId<bevy::render::storage::ShaderBuffer>) -> Option<Vec<u8>> {
+    use bevy::render::render_resource::{BufferDescriptor, BufferUsages, CommandEncoderDescriptor, MapMode, PollType};
+    let gpu = render_world
+        .get_resource::<bevy::render::render_asset::RenderAssets<bevy::render::storage::GpuShaderBuffer>>()?
+        .get(id)?;
+    let device = render_world.get_resource::<bevy::render::renderer::RenderDevice>()?;
+    let queue = render_world.get_resource::<bevy::render::renderer::RenderQueue>()?;
+    let size = gpu.buffer.size();
+    let staging = device.create_buffer(&BufferDescriptor {
+        label: Some("read back"),
+        size,
+        usage: BufferUsages::MAP_READ | BufferUsages::COPY_DST,
+        mapped_at_creation: false,
+    });
+    let mut encoder = device.create_command_encoder(&CommandEncoderDescriptor { label: Some("read back") });
+    encoder.copy_buffer_to_buffer(&gpu.buffer, 0, &staging, 0, size);
+    queue.submit([encoder.finish()]);
+    let (sender, receiver) = std::sync::mpsc::channel();
+    staging.slice(..).map_async(MapMode::Read, move |result| {
+        let _ = sender.send(result);
+    });
+    device.poll(PollType::wait_indefinitely()).ok()?;
+    receiver.recv().ok()?.ok()?;
+    let bytes = staging.slice(..).get_mapped_range().to_vec();
+    Some(bytes)
+}

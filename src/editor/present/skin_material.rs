@@ -12,8 +12,11 @@ use bevy::asset::embedded_asset;
 use bevy::mesh::MeshVertexBufferLayoutRef;
 use bevy::pbr::{ExtendedMaterial, MaterialExtension, MaterialExtensionKey, MaterialExtensionPipeline, MaterialPlugin};
 use bevy::prelude::*;
+use bevy::render::render_asset::RenderAssets;
 use bevy::render::render_resource::{AsBindGroup, RenderPipelineDescriptor, SpecializedMeshPipelineError};
-use bevy::render::storage::ShaderBuffer;
+use bevy::render::renderer::RenderQueue;
+use bevy::render::storage::{GpuShaderBuffer, ShaderBuffer};
+use bevy::render::{Extract, ExtractSchedule, Render, RenderApp, RenderSystems};
 use bevy::shader::ShaderRef;
 
 use crate::rig::material::Sampler;
@@ -121,22 +124,63 @@ impl SkinAttributeStore {
     }
 
     /// Writes a surface's packed attributes (those of its character's `vertices`) at its
-    /// place in the buffer; nothing while they are not packed or it has no place.
-    pub fn write(
+    /// place in the buffer; returns the place (bytes into the buffer) and the bytes written,
+    /// none while they are not packed or it has no place.
+    pub fn write<'a>(
         &self,
         buffer: &mut ShaderBuffer,
         skin: Entity,
-        attributes: &SkinAttributes,
+        attributes: &'a SkinAttributes,
         vertices: &std::ops::Range<u32>,
-    ) {
-        let Some(words) = attributes.0.get(vertices.start as usize..vertices.end as usize) else { return };
-        let Some(first) = self.first(skin) else { return };
-        let at = first as usize * Self::VERTEX_BYTES;
+    ) -> Option<(u64, &'a [u8])> {
+        let words = attributes.0.get(vertices.start as usize..vertices.end as usize)?;
+        let at = self.first(skin)? as usize * Self::VERTEX_BYTES;
         let packed: &[u8] = bytemuck::cast_slice(words);
-        if let Some(room) = buffer.data.as_mut().and_then(|data| data.get_mut(at..at + packed.len())) {
-            room.copy_from_slice(packed);
-        }
+        buffer.data.as_mut()?.get_mut(at..at + packed.len())?.copy_from_slice(packed);
+        Some((at as u64, packed))
     }
+}
+
+/// The recoloured surfaces' attributes of this frame, for the render world to write into
+/// the store's GPU buffer in place: a recolour changes the main world's copy without
+/// telling the asset it changed, which would send the whole buffer again (every skin's
+/// attributes, 6 MB for 64 SMPL bodies).
+#[derive(Resource, Default, Clone)]
+pub struct AttributeWrites {
+    pub buffer: AssetId<ShaderBuffer>,
+    /// Bytes into the buffer, and the bytes.
+    pub writes: Vec<(u64, Vec<u8>)>,
+}
+
+/// Writes waiting in the render world for the store's buffer on the GPU: by buffer, the
+/// place and bytes, and the frames waited.
+#[derive(Resource, Default)]
+struct PendingAttributeWrites(Vec<(AssetId<ShaderBuffer>, u64, Vec<u8>, u32)>);
+
+/// Frames a write waits for its buffer on the GPU before it is dropped (the buffer is gone).
+const MAX_WAIT_FRAMES: u32 = 600;
+
+/// Takes this frame's [`AttributeWrites`] (reads `AttributeWrites`; writes
+/// `PendingAttributeWrites`).
+fn extract_attribute_writes(main: Extract<Res<AttributeWrites>>, mut pending: ResMut<PendingAttributeWrites>) {
+    pending.0.extend(main.writes.iter().map(|(at, bytes)| (main.buffer, *at, bytes.clone(), 0)));
+}
+
+/// Writes the pending attributes into their buffer once it is on the GPU (reads
+/// `RenderAssets<GpuShaderBuffer>`; writes GPU buffers).
+fn write_attributes_in_place(
+    mut pending: ResMut<PendingAttributeWrites>,
+    buffers: Res<RenderAssets<GpuShaderBuffer>>,
+    queue: Res<RenderQueue>,
+) {
+    pending.0.retain_mut(|(id, at, bytes, waited)| {
+        if let Some(gpu) = buffers.get(*id) {
+            queue.write_buffer(&gpu.buffer, *at, bytes);
+            return false;
+        }
+        *waited += 1;
+        *waited < MAX_WAIT_FRAMES
+    });
 }
 
 /// The store with a buffer of one vertex (laid out when the first skin comes), and the
@@ -264,7 +308,13 @@ impl Plugin for SkinMaterialPlugin {
         embedded_asset!(app, "flat_normals.wgsl");
         embedded_asset!(app, "skin_vertex.wgsl");
         app.init_resource::<SkinTextures>()
+            .init_resource::<AttributeWrites>()
             .add_plugins(MaterialPlugin::<SkinMaterialAsset>::default())
             .add_systems(Startup, setup_skin_material);
+        let Some(render_app) = app.get_sub_app_mut(RenderApp) else { return };
+        render_app
+            .init_resource::<PendingAttributeWrites>()
+            .add_systems(ExtractSchedule, extract_attribute_writes)
+            .add_systems(Render, write_attributes_in_place.in_set(RenderSystems::PrepareResources));
     }
 }

@@ -462,13 +462,15 @@ pub struct OwnMaterial(pub Handle<SkinMaterialAsset>);
 /// Keeps the skins' attributes in the one buffer the skin materials read: when skins come
 /// or go, every surface is laid out anew (its place is its mesh's `MeshTag`; when they no
 /// longer fit, a larger buffer replaces it in every skin material), else only the
-/// recoloured characters' attributes are written, in place (reads `Character`,
-/// `SkinAttributes`, `SkinMesh`; writes `SkinAttributeStore`, its buffer, the skin
-/// materials, `MeshTag`).
+/// recoloured characters' attributes are written, in place: into the main world's copy
+/// and, by the render world, the GPU's (reads `Character`, `SkinAttributes`, `SkinMesh`;
+/// writes `SkinAttributeStore`, its buffer, `AttributeWrites`, the skin materials,
+/// `MeshTag`).
 #[allow(clippy::too_many_arguments)]
 fn store_skin_attributes(
     mut commands: Commands,
     mut store: ResMut<SkinAttributeStore>,
+    mut in_place: ResMut<skin_material::AttributeWrites>,
     mut buffers: ResMut<Assets<ShaderBuffer>>,
     mut materials: ResMut<Assets<SkinMaterialAsset>>,
     characters: Query<(&Character, Ref<SkinAttributes>)>,
@@ -497,14 +499,29 @@ fn store_skin_attributes(
             }
         }
     }
+    in_place.writes.clear();
     let mut written = characters.iter().filter(|(_, attributes)| relaid || attributes.is_changed()).peekable();
     if written.peek().is_none() {
         return;
     }
-    let Some(mut buffer) = buffers.get_mut(&store.buffer) else { return };
-    for (character, attributes) in written {
-        for part in &character.skins {
-            store.write(&mut buffer, part.entity, &attributes, &part.vertices);
+    let surfaces = written.flat_map(|(character, attributes)| {
+        let attributes = attributes.into_inner();
+        character.skins.iter().map(move |part| (part.entity, &part.vertices, attributes))
+    });
+    if relaid {
+        // The whole buffer goes to the GPU: every surface has a new place.
+        let Some(mut buffer) = buffers.get_mut(&store.buffer) else { return };
+        for (entity, vertices, attributes) in surfaces {
+            store.write(&mut buffer, entity, attributes, vertices);
+        }
+        return;
+    }
+    // Only the recoloured surfaces go, written in place by the render world.
+    let Some(buffer) = buffers.get_mut_untracked(&store.buffer) else { return };
+    in_place.buffer = store.buffer.id();
+    for (entity, vertices, attributes) in surfaces {
+        if let Some((at, bytes)) = store.write(buffer, entity, attributes, vertices) {
+            in_place.writes.push((at, bytes.to_vec()));
         }
     }
 }
