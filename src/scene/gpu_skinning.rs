@@ -108,9 +108,6 @@ struct SkinBuffers {
     bind_group: BindGroup,
 }
 
-/// Frames a job waits for its mesh's slot before it is dropped (the mesh is gone).
-const MAX_WAIT_FRAMES: u32 = 600;
-
 /// Takes the jobs that changed; forgets characters that are gone or went back to the CPU
 /// (reads `GpuSkinJob`; writes `GpuSkins`).
 fn extract_gpu_skin_jobs(jobs: Extract<Query<(Entity, &Character, Ref<GpuSkinJob>)>>, mut gpu: ResMut<GpuSkins>) {
@@ -146,7 +143,7 @@ fn dispatch_gpu_skinning(
     gpu.pending.retain(|entity, (mesh, input, waited)| {
         let Some(slice) = allocator.mesh_vertex_slice(mesh) else {
             *waited += 1;
-            return *waited < MAX_WAIT_FRAMES;
+            return *waited < super::handoff::MAX_WAIT_FRAMES;
         };
         let vertex_count = input.asset.vertex_count();
         if (slice.range.end - slice.range.start) as usize != vertex_count {

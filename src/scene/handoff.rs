@@ -12,6 +12,11 @@ use bevy::prelude::*;
 use crate::rig::CharacterAsset;
 use crate::rig::dqs::SkinningMethod;
 
+/// Frames something handed to the render world (an upload, a GPU skinning job, a write of
+/// the skins' attributes) waits for the GPU resource it goes into before it is dropped
+/// (the resource is gone).
+pub const MAX_WAIT_FRAMES: u32 = 600;
+
 /// Bytes per skin vertex handed to the GPU when a character moves: its position (3 × f32),
 /// the whole of the skin mesh's vertex buffer. Texture coordinates and colours live in
 /// [`SkinAttributes`], handed on only when they change.

@@ -70,9 +70,6 @@ impl Pending {
 #[derive(Resource, Default)]
 struct PendingUploads(HashMap<AssetId<Mesh>, Pending>);
 
-/// Frames an upload waits for its mesh's slot before it is dropped (the mesh is gone).
-const MAX_WAIT_FRAMES: u32 = 600;
-
 /// The render-world half: extraction of changed uploads and the buffer writes.
 pub struct SkinUploadPlugin;
 
@@ -122,7 +119,7 @@ fn write_skin_uploads(
         pending.0.drain().partition(|(id, _)| allocator.mesh_vertex_slice(id).is_some());
     pending.0.extend(waiting.into_iter().filter_map(|(id, mut upload)| {
         upload.waited += 1;
-        (upload.waited < MAX_WAIT_FRAMES).then_some((id, upload))
+        (upload.waited < super::handoff::MAX_WAIT_FRAMES).then_some((id, upload))
     }));
     let mut writes: Vec<SlotWrite> =
         ready.iter().filter_map(|(id, upload)| SlotWrite::of(allocator.mesh_vertex_slice(id)?, upload)).collect();

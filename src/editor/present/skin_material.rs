@@ -157,9 +157,6 @@ pub struct AttributeWrites {
 #[derive(Resource, Default)]
 struct PendingAttributeWrites(Vec<(AssetId<ShaderBuffer>, u64, Vec<u8>, u32)>);
 
-/// Frames a write waits for its buffer on the GPU before it is dropped (the buffer is gone).
-const MAX_WAIT_FRAMES: u32 = 600;
-
 /// Takes this frame's [`AttributeWrites`] (reads `AttributeWrites`; writes
 /// `PendingAttributeWrites`).
 fn extract_attribute_writes(main: Extract<Res<AttributeWrites>>, mut pending: ResMut<PendingAttributeWrites>) {
@@ -179,7 +176,7 @@ fn write_attributes_in_place(
             return false;
         }
         *waited += 1;
-        *waited < MAX_WAIT_FRAMES
+        *waited < crate::scene::handoff::MAX_WAIT_FRAMES
     });
 }
 
