@@ -308,11 +308,17 @@ pub fn read_back_mesh_positions_and_normals(
 
 /// A mesh's slot of `vertex_bytes` a vertex, as three floats at a time.
 fn read_back_mesh_vertices(render_world: &World, mesh: AssetId<Mesh>, vertex_bytes: u64) -> Option<Vec<Vec3>> {
-    let allocator = render_world.get_resource::<MeshAllocator>()?;
+    let slice = render_world.get_resource::<MeshAllocator>()?.mesh_vertex_slice(&mesh)?;
+    let bytes = u64::from(slice.range.end - slice.range.start) * vertex_bytes;
+    let read = read_back_buffer(render_world, slice.buffer, u64::from(slice.range.start) * vertex_bytes, bytes)?;
+    Some(bytemuck::cast_slice::<u8, Vec3>(&read).to_vec())
+}
+
+/// Reads back `bytes` of a GPU buffer from byte `at` (render world; blocks until the GPU
+/// has finished). For tests.
+pub fn read_back_buffer(render_world: &World, buffer: &Buffer, at: u64, bytes: u64) -> Option<Vec<u8>> {
     let device = render_world.get_resource::<RenderDevice>()?;
     let queue = render_world.get_resource::<RenderQueue>()?;
-    let slice = allocator.mesh_vertex_slice(&mesh)?;
-    let bytes = u64::from(slice.range.end - slice.range.start) * vertex_bytes;
     let staging = device.create_buffer(&BufferDescriptor {
         label: Some("read back"),
         size: bytes,
@@ -320,7 +326,7 @@ fn read_back_mesh_vertices(render_world: &World, mesh: AssetId<Mesh>, vertex_byt
         mapped_at_creation: false,
     });
     let mut encoder = device.create_command_encoder(&CommandEncoderDescriptor { label: Some("read back") });
-    encoder.copy_buffer_to_buffer(slice.buffer, u64::from(slice.range.start) * vertex_bytes, &staging, 0, bytes);
+    encoder.copy_buffer_to_buffer(buffer, at, &staging, 0, bytes);
     queue.submit([encoder.finish()]);
     let (sender, receiver) = std::sync::mpsc::channel();
     staging.slice(..).map_async(MapMode::Read, move |result| {
@@ -328,6 +334,6 @@ fn read_back_mesh_vertices(render_world: &World, mesh: AssetId<Mesh>, vertex_byt
     });
     device.poll(PollType::wait_indefinitely()).ok()?;
     receiver.recv().ok()?.ok()?;
-    let positions = bytemuck::cast_slice::<u8, Vec3>(&staging.slice(..).get_mapped_range()).to_vec();
-    Some(positions)
+    let read = staging.slice(..).get_mapped_range().to_vec();
+    Some(read)
 }

@@ -337,28 +337,7 @@ fn a_recolour_writes_only_its_characters_attributes_on_the_gpu() {
 
 /// A `ShaderBuffer`'s bytes on the GPU (none until it is there).
 fn read_back_shader_buffer(render_world: &World, id: AssetId<bevy::render::storage::ShaderBuffer>) -> Option<Vec<u8>> {
-    use bevy::render::render_resource::{BufferDescriptor, BufferUsages, CommandEncoderDescriptor, MapMode, PollType};
-    let gpu = render_world
-        .get_resource::<bevy::render::render_asset::RenderAssets<bevy::render::storage::GpuShaderBuffer>>()?
-        .get(id)?;
-    let device = render_world.get_resource::<bevy::render::renderer::RenderDevice>()?;
-    let queue = render_world.get_resource::<bevy::render::renderer::RenderQueue>()?;
-    let size = gpu.buffer.size();
-    let staging = device.create_buffer(&BufferDescriptor {
-        label: Some("read back"),
-        size,
-        usage: BufferUsages::MAP_READ | BufferUsages::COPY_DST,
-        mapped_at_creation: false,
-    });
-    let mut encoder = device.create_command_encoder(&CommandEncoderDescriptor { label: Some("read back") });
-    encoder.copy_buffer_to_buffer(&gpu.buffer, 0, &staging, 0, size);
-    queue.submit([encoder.finish()]);
-    let (sender, receiver) = std::sync::mpsc::channel();
-    staging.slice(..).map_async(MapMode::Read, move |result| {
-        let _ = sender.send(result);
-    });
-    device.poll(PollType::wait_indefinitely()).ok()?;
-    receiver.recv().ok()?.ok()?;
-    let bytes = staging.slice(..).get_mapped_range().to_vec();
-    Some(bytes)
+    use bevy::render::{render_asset::RenderAssets, storage::GpuShaderBuffer};
+    let gpu = render_world.get_resource::<RenderAssets<GpuShaderBuffer>>()?.get(id)?;
+    marionette::scene::gpu_skinning::read_back_buffer(render_world, &gpu.buffer, 0, gpu.buffer.size())
 }
