@@ -145,7 +145,7 @@ impl SkinAttributeStore {
 /// the store's GPU buffer in place: a recolour changes the main world's copy without
 /// telling the asset it changed, which would send the whole buffer again (every skin's
 /// attributes, 6 MB for 64 SMPL bodies).
-#[derive(Resource, Default, Clone)]
+#[derive(Resource, Default)]
 pub struct AttributeWrites {
     pub buffer: AssetId<ShaderBuffer>,
     /// Bytes into the buffer, and the bytes.
@@ -169,7 +169,7 @@ fn write_attributes_in_place(
     buffers: Res<RenderAssets<GpuShaderBuffer>>,
     queue: Res<RenderQueue>,
 ) {
-    pending.0.extend(main.writes.iter().map(|(at, bytes)| (main.buffer, *at, bytes.clone(), 0)));
+    // The older writes first: a surface recoloured again overwrites its own bytes.
     pending.0.retain_mut(|(id, at, bytes, waited)| {
         if let Some(gpu) = buffers.get(*id) {
             queue.write_buffer(&gpu.buffer, *at, bytes);
@@ -178,6 +178,13 @@ fn write_attributes_in_place(
         *waited += 1;
         *waited < crate::scene::handoff::MAX_WAIT_FRAMES
     });
+    // This frame's writes straight from the main world's bytes; copied only to wait.
+    for (at, bytes) in &main.writes {
+        match buffers.get(main.buffer) {
+            Some(gpu) => queue.write_buffer(&gpu.buffer, *at, bytes),
+            None => pending.0.push((main.buffer, *at, bytes.clone(), 0)),
+        }
+    }
 }
 
 /// The store with a buffer of one vertex (laid out when the first skin comes), and the
