@@ -527,8 +527,25 @@ fn kernel_skin_crowd_one_core(bencher: Bencher, bodies: usize) {
 /// last (the crowd's memory in the caches that hold it); `cold`: each run after 320 MB of
 /// other memory was written, more than every cache here (as drawing on llvmpipe between
 /// frames leaves them).
-#[divan::bench(args = ["64 warm", "64 cold", "256 warm", "256 cold"], sample_size = 1, sample_count = 60)]
+#[divan::bench(args = ["16 warm", "16 cold", "64 warm", "64 cold", "256 warm", "256 cold"], sample_size = 1, sample_count = 60)]
 fn kernel_skin_crowd_all_cores(bencher: Bencher, case: &str) {
+    each_body_on_all_cores(bencher, case, |asset, palette, out| {
+        let skin = &asset.skin;
+        marionette::rig::lbs::skin(&skin.bind_positions, &skin.weights, palette, out);
+    });
+}
+
+/// The floor under [`kernel_skin_crowd_all_cores`]: each body's bind positions copied into
+/// its output, split the same way. The same bytes read and written, no arithmetic: how long
+/// this machine's memory alone takes to move them.
+#[divan::bench(args = ["16 cold", "64 cold", "256 cold"], sample_size = 1, sample_count = 60)]
+fn crowd_memory_floor_all_cores(bencher: Bencher, case: &str) {
+    each_body_on_all_cores(bencher, case, |asset, _, out| out.copy_from_slice(&asset.skin.bind_positions));
+}
+
+/// Runs `body` on each body of the crowd that `case` names ("64 cold": 64 bodies, caches
+/// emptied before each run) on Bevy's compute task pool, a few bodies a task.
+fn each_body_on_all_cores(bencher: Bencher, case: &str, body: fn(&CharacterAsset, &[Mat4], &mut [Vec3])) {
     let (bodies, cold) = case.split_once(' ').map(|(n, c)| (n.parse::<usize>().unwrap(), c == "cold")).unwrap();
     let pool = bevy::tasks::ComputeTaskPool::get_or_init(bevy::tasks::TaskPool::new);
     let Crowd { assets, palettes, mut outs } = crowd_of_bodies(bodies);
@@ -547,8 +564,7 @@ fn kernel_skin_crowd_all_cores(bencher: Bencher, case: &str) {
             {
                 scope.spawn(async move {
                     for ((asset, palette), out) in assets.iter().zip(palettes).zip(outs) {
-                        let skin = &asset.skin;
-                        marionette::rig::lbs::skin(&skin.bind_positions, &skin.weights, palette, out);
+                        body(asset, palette, out);
                     }
                 });
             }

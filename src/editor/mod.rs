@@ -15,6 +15,7 @@
 //! drag, gizmo, shortcuts), [`ui::InspectorPlugin`], [`present::screenshot::ScreenshotPlugin`].
 
 pub mod bench;
+pub mod cores;
 pub mod edits;
 pub mod interact;
 pub mod order;
@@ -70,9 +71,10 @@ impl Plugin for InteractionPlugin {
     }
 }
 
-/// Bevy's task pools with every core for compute (systems and the parallel skinning):
-/// one thread each for IO and async tasks on top, instead of taking them from the cores
-/// (on 2 cores Bevy's default leaves compute a single thread).
+/// Bevy's task pools with every core for compute (systems and the parallel skinning),
+/// each compute worker on a core of its own ([`cores`]): one thread each for IO and async
+/// tasks on top, instead of taking them from the cores (on 2 cores Bevy's default leaves
+/// compute a single thread).
 pub fn task_pools() -> bevy::app::TaskPoolPlugin {
     let one = |policy: bevy::app::TaskPoolThreadAssignmentPolicy| bevy::app::TaskPoolThreadAssignmentPolicy {
         min_threads: 1,
@@ -80,14 +82,17 @@ pub fn task_pools() -> bevy::app::TaskPoolPlugin {
         ..policy
     };
     let defaults = bevy::app::TaskPoolOptions::default();
-    let cores = bevy::tasks::available_parallelism();
+    let core_count = bevy::tasks::available_parallelism();
     bevy::app::TaskPoolPlugin {
         task_pool_options: bevy::app::TaskPoolOptions {
-            min_total_threads: cores + 2,
-            max_total_threads: cores + 2,
+            min_total_threads: core_count + 2,
+            max_total_threads: core_count + 2,
             io: one(defaults.io),
             async_compute: one(defaults.async_compute),
-            compute: defaults.compute,
+            compute: bevy::app::TaskPoolThreadAssignmentPolicy {
+                on_thread_spawn: cores::pin_each_worker_to_a_core(),
+                ..defaults.compute
+            },
         },
     }
 }

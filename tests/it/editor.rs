@@ -474,3 +474,26 @@ fn a_frame_sequence_writes_one_picture_per_frame_at_its_time() {
     let at = differing(&picture("frame_0007.png"), &picture("single.png"));
     assert!(at < 10, "frame 7 differs from the picture at 0.7 s in {at} pixels");
 }
+
+/// The compute workers' start callback pins the k-th thread to the k-th core the process
+/// may run on, wrapping round, and leaves the thread that made it unpinned.
+#[cfg(target_os = "linux")]
+#[test]
+fn compute_workers_are_pinned_one_to_a_core_in_turn() {
+    use marionette::editor::cores::{allowed_cores, pin_each_worker_to_a_core};
+    let cores = allowed_cores();
+    assert!(!cores.is_empty() && cores.is_sorted(), "{cores:?}");
+    let Some(pin) = pin_each_worker_to_a_core() else {
+        assert_eq!(cores.len(), 1, "only a single core goes unpinned");
+        return;
+    };
+    for k in 0..cores.len() + 1 {
+        let pin = pin.clone();
+        let own = std::thread::spawn(move || {
+            pin();
+            allowed_cores()
+        });
+        assert_eq!(own.join().unwrap(), vec![cores[k % cores.len()]], "thread {k}");
+    }
+    assert_eq!(allowed_cores(), cores, "the caller keeps every core");
+}
