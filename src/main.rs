@@ -62,10 +62,12 @@ fn run(cli: Cli) -> Result<()> {
         }
         Some(Command::Bind(args)) => marionette::cli::bind::run(&args)?,
         Some(Command::Smpl(args)) => marionette::cli::smpl::run(&args)?,
-        Some(Command::Bench { characters, frames, data, puppets, json, gpu }) => {
+        Some(Command::Bench { characters, frames, data, puppets, json, gpu, no_draw }) => {
             use marionette::editor::bench;
             let crowd = bench::crowd_of(data, puppets).map_err(anyhow::Error::msg)?;
-            let report = bench::run(characters as usize, frames as usize, &crowd, gpu).map_err(anyhow::Error::msg)?;
+            let (characters, frames) = (characters as usize, frames as usize);
+            let setup = bench::Setup { characters, frames, crowd, gpu_skinning: gpu, drawn: !no_draw };
+            let report = bench::run(&setup).map_err(anyhow::Error::msg)?;
             if json {
                 println!("{}", serde_json::to_string(&report)?);
             } else {

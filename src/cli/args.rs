@@ -97,6 +97,11 @@ pub enum Command {
         /// Skin the crowd with the GPU skinning compute shader instead of on the CPU.
         #[arg(long)]
         gpu: bool,
+        /// Leave the picture undrawn while measuring (the camera off; extraction and upload
+        /// go on): the frame's CPU work as on a machine whose GPU draws, without llvmpipe
+        /// rasterising on the same cores between frames.
+        #[arg(long)]
+        no_draw: bool,
     },
     /// Rebuild the project's own characters into a folder (normally `assets`).
     GenAssets {

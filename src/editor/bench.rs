@@ -42,6 +42,9 @@ pub struct BenchReport {
     pub sampling_ms_p50: f64,
     pub fk_ms_p50: f64,
     pub skin_ms_p50: f64,
+    /// The skin phase against its ideal: the crowd's vertices at the kernel's speed
+    /// (`kernel_mvps`) on every core, `skin_ms_p50 ÷ (vertices ÷ (kernel × cores))`.
+    pub skin_over_ideal: f64,
     pub extract_ms_p50: f64,
     pub upload_ms_p50: f64,
     /// The rest of the render world (drawing; on llvmpipe that is CPU work too).
@@ -83,18 +86,35 @@ pub struct Measured {
     pub pipelined_rendering: bool,
     /// The level of the skinning kernels this CPU ran (`Avx512Vl`, `Avx2` or `Portable`).
     pub kernel_level: String,
+    /// Whether the picture was drawn between the measured frames (`--no-draw`: not, as on
+    /// a machine whose GPU draws it; on llvmpipe the drawing is CPU work that empties the
+    /// caches between frames).
+    pub drawn: bool,
 }
 
 impl Measured {
-    fn now(pipelined_rendering: bool) -> Self {
+    fn now(pipelined_rendering: bool, drawn: bool) -> Self {
         Self {
             cores: std::thread::available_parallelism().map_or(1, |n| n.get()),
             profile: env!("MARIONETTE_BUILD_PROFILE").to_string(),
             debug_assertions: cfg!(debug_assertions),
             pipelined_rendering,
             kernel_level: format!("{:?}", crate::rig::simd::Simd::best()),
+            drawn,
         }
     }
+}
+
+/// What `bench` runs.
+#[derive(Debug, Clone)]
+pub struct Setup {
+    pub characters: usize,
+    pub frames: usize,
+    pub crowd: CrowdOf,
+    /// Skinned by the GPU skinning compute shader (else on the CPU).
+    pub gpu_skinning: bool,
+    /// The picture drawn between the measured frames.
+    pub drawn: bool,
 }
 
 /// What the crowd is made of.
@@ -137,7 +157,8 @@ struct RenderClock([Option<Instant>; 2]);
 /// Runs the crowd bench: `characters` SMPL bodies (clips and β varied, all playing) or
 /// puppets swaying, as `crowd` says; skinned on the CPU, or by the GPU skinning compute
 /// shader with `gpu`.
-pub fn run(characters: usize, frames: usize, crowd: &CrowdOf, gpu: bool) -> Result<BenchReport, String> {
+pub fn run(setup: &Setup) -> Result<BenchReport, String> {
+    let Setup { characters, frames, ref crowd, gpu_skinning: gpu, drawn } = *setup;
     let smpl_dir = match crowd {
         CrowdOf::Smpl(dir) => Some(dir.clone()),
         CrowdOf::Puppets => None,
@@ -157,6 +178,9 @@ pub fn run(characters: usize, frames: usize, crowd: &CrowdOf, gpu: bool) -> Resu
     *app.world_mut().resource_mut::<PendingScene>() = PendingScene { doc: Some(doc), frame: true };
     warm_up(&mut app)?;
     let asset = first_character_asset(&mut app).ok_or("the crowd has no character")?;
+    if !drawn {
+        stop_drawing(&mut app);
+    }
     let mut samples = Vec::with_capacity(frames);
     let mut bytes = 0;
     for _ in 0..frames {
@@ -175,7 +199,7 @@ pub fn run(characters: usize, frames: usize, crowd: &CrowdOf, gpu: bool) -> Resu
         .chain([("frame".to_string(), whole)])
         .collect();
     Ok(BenchReport {
-        measured: Measured::now(pipelined_rendering),
+        measured: Measured::now(pipelined_rendering, drawn),
         phases_ms,
         characters,
         kind: kind.to_string(),
@@ -187,6 +211,7 @@ pub fn run(characters: usize, frames: usize, crowd: &CrowdOf, gpu: bool) -> Resu
         sampling_ms_p50: phase(1),
         fk_ms_p50: phase(2),
         skin_ms_p50: phase(3),
+        skin_over_ideal: phase(3) / ideal_skin_ms(characters * asset.vertex_count(), kernels.lbs),
         extract_ms_p50: phase(4),
         upload_ms_p50: phase(5),
         render_world_ms_p50: phase(6),
@@ -198,6 +223,22 @@ pub fn run(characters: usize, frames: usize, crowd: &CrowdOf, gpu: bool) -> Resu
     })
 }
 
+/// The crowd's `vertices` skinned at `kernel_mvps` on every core the process may use, in
+/// milliseconds.
+fn ideal_skin_ms(vertices: usize, kernel_mvps: f64) -> f64 {
+    let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
+    vertices as f64 / (kernel_mvps * 1e6 * cores as f64) * 1e3
+}
+
+/// Turns the cameras off once the renderer is ready: extraction and the upload go on, the
+/// picture is no longer drawn.
+fn stop_drawing(app: &mut App) {
+    let world = app.world_mut();
+    for mut camera in world.query::<&mut Camera>().iter_mut(world) {
+        camera.is_active = false;
+    }
+}
+
 /// The report as a table.
 pub fn table(r: &BenchReport) -> String {
     let m = &r.measured;
@@ -207,15 +248,17 @@ pub fn table(r: &BenchReport) -> String {
         format!("{} profile", m.profile)
     };
     let how = format!(
-        "measured on {} cores, {profile}, pipelined rendering {}, kernels at level {}\n",
+        "measured on {} cores, {profile}, pipelined rendering {}, kernels at level {}, picture {}\n",
         m.cores,
         if m.pipelined_rendering { "on" } else { "off" },
-        m.kernel_level
+        m.kernel_level,
+        if m.drawn { "drawn" } else { "not drawn (--no-draw)" }
     );
     how + &format!(
         "{} × {} ({} vertices each), {} frames, skinned {}\n\
          frame (CPU: main world + extraction + upload)  p50 {:.2} ms  p95 {:.2} ms\n\
          \x20 sampling {:.2} ms | FK {:.2} ms | skin {:.2} ms | extract {:.2} ms | upload {:.2} ms   (medians)\n\
+         \x20 skin ÷ ideal (the vertices at the kernel's speed on every core) {:.2}\n\
          \x20 render world besides the upload (drawing; CPU on llvmpipe) {:.2} ms\n\
          mesh data handed on per frame: {} bytes\n\
          kernel: {:.1} M vertices/s per core (the plain loop it replaced: {:.1}, ×{:.2})\n\
@@ -232,6 +275,7 @@ pub fn table(r: &BenchReport) -> String {
         r.skin_ms_p50,
         r.extract_ms_p50,
         r.upload_ms_p50,
+        r.skin_over_ideal,
         r.render_world_ms_p50,
         r.upload_bytes_per_frame,
         r.kernel_mvps,

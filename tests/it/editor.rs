@@ -214,6 +214,7 @@ fn bench_reports_a_crowds_frame_times_as_json() {
         "baseline_kernel_mvps",
         "dual_quaternion_kernel_mvps",
         "kernel_with_flat_normals_mvps",
+        "skin_over_ideal",
     ] {
         let value = report[key].as_f64().unwrap_or_else(|| panic!("{key} is a number: {report}"));
         assert!(value > 0.0, "{key} = {value}");
@@ -224,6 +225,24 @@ fn bench_reports_a_crowds_frame_times_as_json() {
     let per_frame = 3 * puppet.vertex_count() * marionette::scene::upload::SKIN_VERTEX_BYTES;
     assert_eq!(report["upload_bytes_per_frame"], per_frame);
     assert_eq!(report["gpu_skinning"], false);
+    assert_eq!(report["measured"]["drawn"], true);
+}
+
+/// `bench --no-draw` turns the camera off once the renderer is ready: the report says the
+/// picture was not drawn, and the crowd is still skinned and handed on every frame.
+#[test]
+fn bench_without_drawing_still_skins_and_hands_on_the_crowd() {
+    let output = Command::new(env!("CARGO_BIN_EXE_marionette"))
+        .args(["bench", "--characters", "2", "--frames", "4", "--json", "--no-draw"])
+        .env_remove("MARIONETTE_DATA")
+        .output()
+        .unwrap();
+    assert!(output.status.success(), "{}", String::from_utf8_lossy(&output.stderr));
+    let report: serde_json::Value = serde_json::from_str(String::from_utf8_lossy(&output.stdout).trim()).unwrap();
+    assert_eq!(report["measured"]["drawn"], false);
+    let puppet = marionette::formats::puppet::embedded_puppet();
+    let per_frame = 2 * puppet.vertex_count() * marionette::scene::upload::SKIN_VERTEX_BYTES;
+    assert_eq!(report["upload_bytes_per_frame"], per_frame);
 }
 
 /// `bench --data` takes the data folder or the SMPL folder itself, refuses a folder with no
