@@ -188,6 +188,8 @@ pub fn run(setup: &Setup) -> Result<BenchReport, String> {
         bytes += app.world().resource::<HandedOn>().0;
     }
     let kernels = kernel_speeds(&asset);
+    let measured = Measured::now(pipelined_rendering, drawn);
+    let cores = measured.cores;
     let phase = |k: usize| median(samples.iter().map(|s| s[k]).collect());
     let frame: Vec<f64> = samples.iter().map(|s| s[1] + s[2] + s[3] + s[4] + s[5]).collect();
     let names = ["sampling", "fk", "skin", "extract", "upload", "render_world"];
@@ -199,7 +201,7 @@ pub fn run(setup: &Setup) -> Result<BenchReport, String> {
         .chain([("frame".to_string(), whole)])
         .collect();
     Ok(BenchReport {
-        measured: Measured::now(pipelined_rendering, drawn),
+        measured,
         phases_ms,
         characters,
         kind: kind.to_string(),
@@ -211,7 +213,7 @@ pub fn run(setup: &Setup) -> Result<BenchReport, String> {
         sampling_ms_p50: phase(1),
         fk_ms_p50: phase(2),
         skin_ms_p50: phase(3),
-        skin_over_ideal: phase(3) / ideal_skin_ms(characters * asset.vertex_count(), kernels.lbs),
+        skin_over_ideal: phase(3) / ideal_skin_ms(characters * asset.vertex_count(), kernels.lbs, cores),
         extract_ms_p50: phase(4),
         upload_ms_p50: phase(5),
         render_world_ms_p50: phase(6),
@@ -223,10 +225,8 @@ pub fn run(setup: &Setup) -> Result<BenchReport, String> {
     })
 }
 
-/// The crowd's `vertices` skinned at `kernel_mvps` on every core the process may use, in
-/// milliseconds.
-fn ideal_skin_ms(vertices: usize, kernel_mvps: f64) -> f64 {
-    let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
+/// The crowd's `vertices` skinned at `kernel_mvps` on each of `cores`, in milliseconds.
+fn ideal_skin_ms(vertices: usize, kernel_mvps: f64, cores: usize) -> f64 {
     vertices as f64 / (kernel_mvps * 1e6 * cores as f64) * 1e3
 }
 

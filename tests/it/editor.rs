@@ -193,18 +193,28 @@ fn model1_and_model2_render_side_by_side() {
     assert_eq!(image::open(&out).unwrap().to_rgb8().dimensions(), (160, 120));
 }
 
-/// `marionette bench --json` runs a small crowd through the app and the render world
-/// (puppets: no data folder) and reports every figure the issue asks for.
-#[test]
-fn bench_reports_a_crowds_frame_times_as_json() {
+/// `marionette bench --json` with `args` on puppets (no data folder): its report.
+fn puppet_bench_report(args: &[&str]) -> serde_json::Value {
     let output = Command::new(env!("CARGO_BIN_EXE_marionette"))
-        .args(["bench", "--characters", "3", "--frames", "5", "--json"])
+        .args(["bench", "--json"])
+        .args(args)
         .env_remove("MARIONETTE_DATA")
         .output()
         .unwrap();
     assert!(output.status.success(), "{}", String::from_utf8_lossy(&output.stderr));
-    let stdout = String::from_utf8_lossy(&output.stdout);
-    let report: serde_json::Value = serde_json::from_str(stdout.trim()).expect("one JSON object");
+    serde_json::from_str(String::from_utf8_lossy(&output.stdout).trim()).expect("one JSON object")
+}
+
+/// The packed vertices of `n` puppets, as the upload hands them on.
+fn puppet_vertex_bytes(n: usize) -> usize {
+    n * marionette::formats::puppet::embedded_puppet().vertex_count() * marionette::scene::upload::SKIN_VERTEX_BYTES
+}
+
+/// `marionette bench --json` runs a small crowd through the app and the render world
+/// (puppets: no data folder) and reports every figure the issue asks for.
+#[test]
+fn bench_reports_a_crowds_frame_times_as_json() {
+    let report = puppet_bench_report(&["--characters", "3", "--frames", "5"]);
     assert_eq!(report["characters"], 3);
     assert_eq!(report["kind"], "puppet");
     for key in [
@@ -221,9 +231,7 @@ fn bench_reports_a_crowds_frame_times_as_json() {
     }
     assert!(report["frame_ms_p95"].as_f64() >= report["frame_ms_p50"].as_f64());
     // Three swaying puppets re-skin every frame: their packed vertices go to the GPU.
-    let puppet = marionette::formats::puppet::embedded_puppet();
-    let per_frame = 3 * puppet.vertex_count() * marionette::scene::upload::SKIN_VERTEX_BYTES;
-    assert_eq!(report["upload_bytes_per_frame"], per_frame);
+    assert_eq!(report["upload_bytes_per_frame"], puppet_vertex_bytes(3));
     assert_eq!(report["gpu_skinning"], false);
     assert_eq!(report["measured"]["drawn"], true);
 }
@@ -232,17 +240,9 @@ fn bench_reports_a_crowds_frame_times_as_json() {
 /// picture was not drawn, and the crowd is still skinned and handed on every frame.
 #[test]
 fn bench_without_drawing_still_skins_and_hands_on_the_crowd() {
-    let output = Command::new(env!("CARGO_BIN_EXE_marionette"))
-        .args(["bench", "--characters", "2", "--frames", "4", "--json", "--no-draw"])
-        .env_remove("MARIONETTE_DATA")
-        .output()
-        .unwrap();
-    assert!(output.status.success(), "{}", String::from_utf8_lossy(&output.stderr));
-    let report: serde_json::Value = serde_json::from_str(String::from_utf8_lossy(&output.stdout).trim()).unwrap();
+    let report = puppet_bench_report(&["--characters", "2", "--frames", "4", "--no-draw"]);
     assert_eq!(report["measured"]["drawn"], false);
-    let puppet = marionette::formats::puppet::embedded_puppet();
-    let per_frame = 2 * puppet.vertex_count() * marionette::scene::upload::SKIN_VERTEX_BYTES;
-    assert_eq!(report["upload_bytes_per_frame"], per_frame);
+    assert_eq!(report["upload_bytes_per_frame"], puppet_vertex_bytes(2));
 }
 
 /// `bench --data` takes the data folder or the SMPL folder itself, refuses a folder with no
@@ -285,13 +285,7 @@ fn bench_finds_the_smpl_bodies_it_is_given_or_says_why_not() {
 /// the GPU each frame (one matrix per joint per puppet).
 #[test]
 fn bench_with_gpu_skinning_hands_on_only_palettes() {
-    let output = Command::new(env!("CARGO_BIN_EXE_marionette"))
-        .args(["bench", "--characters", "3", "--frames", "5", "--json", "--gpu"])
-        .env_remove("MARIONETTE_DATA")
-        .output()
-        .unwrap();
-    assert!(output.status.success(), "{}", String::from_utf8_lossy(&output.stderr));
-    let report: serde_json::Value = serde_json::from_str(String::from_utf8_lossy(&output.stdout).trim()).unwrap();
+    let report = puppet_bench_report(&["--characters", "3", "--frames", "5", "--gpu"]);
     assert_eq!(report["gpu_skinning"], true);
     let puppet = marionette::formats::puppet::embedded_puppet();
     assert_eq!(report["upload_bytes_per_frame"], 3 * puppet.skeleton.len() * 64);
