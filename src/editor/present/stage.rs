@@ -1,7 +1,7 @@
 //! The stage: a floor with a subtle grid, a sun that casts shadows, an ambient fill, up to
 //! three lamps, the background; all as the scene's `StageDoc` says.
 
-use bevy::light::DirectionalLightShadowMap;
+use bevy::light::{CascadeShadowConfig, CascadeShadowConfigBuilder, DirectionalLightShadowMap};
 use bevy::prelude::*;
 
 /// Scene-wide view settings: the scene file's own type (floor, shadows, axes, floor
@@ -88,6 +88,32 @@ pub fn fit_stage_to_scene(
         for mut floor in &mut floors {
             floor.scale = Vec3::new(side, 1.0, side);
         }
+    }
+}
+
+/// The sun's shadow cascades for `extent`: Bevy's defaults (the first cascade to 10 m,
+/// shadows to 150 m from the camera) are made for a stage of people, the least extent
+/// (10 m a side of the origin); a larger stage scales them with it, so that a model in
+/// other units keeps the shadows a person has. With the defaults the Khronos fox (155
+/// units long, 79 tall) was shadowed only where it came within 150 units of the camera
+/// that framed it: a patch by its front legs.
+pub fn sun_shadow_cascades(extent: &StageExtent) -> CascadeShadowConfig {
+    let scale = (extent.half / StageExtent::default().half).max(1.0);
+    let people = CascadeShadowConfigBuilder::default();
+    CascadeShadowConfigBuilder {
+        minimum_distance: people.minimum_distance * scale,
+        first_cascade_far_bound: people.first_cascade_far_bound * scale,
+        maximum_distance: people.maximum_distance * scale,
+        ..people
+    }
+    .build()
+}
+
+/// Fits the sun's shadow cascades to the stage whenever it grows or shrinks (reads
+/// `StageExtent`; writes the sun's `CascadeShadowConfig`).
+pub fn fit_shadows_to_stage(extent: Res<StageExtent>, mut suns: Query<&mut CascadeShadowConfig, With<Sun>>) {
+    if extent.is_changed() {
+        suns.iter_mut().for_each(|mut cascades| *cascades = sun_shadow_cascades(&extent));
     }
 }
 
