@@ -91,14 +91,18 @@ pub fn fit_stage_to_scene(
     }
 }
 
-/// The sun's shadow cascades for `extent`: Bevy's defaults (the first cascade to 10 m,
-/// shadows to 150 m from the camera) are made for a stage of people, the least extent
-/// (10 m a side of the origin); a larger stage scales them with it, so that a model in
-/// other units keeps the shadows a person has. With the defaults the Khronos fox (155
-/// units long, 79 tall) was shadowed only where it came within 150 units of the camera
-/// that framed it: a patch by its front legs.
-pub fn sun_shadow_cascades(extent: &StageExtent) -> CascadeShadowConfig {
-    let scale = (extent.half / StageExtent::default().half).max(1.0);
+/// How far from what it looks at a camera may be for Bevy's default shadow cascades (the
+/// first to 10 m, shadows to 150 m): people seen whole.
+pub const PEOPLE_CAMERA_DISTANCE: f32 = 10.0;
+
+/// The sun's shadow cascades for a camera `camera_distance` from what it looks at: Bevy's
+/// defaults up to [`PEOPLE_CAMERA_DISTANCE`], and beyond it all their bounds scaled with the
+/// distance, so that what the camera frames keeps the shadows a person has. With the
+/// defaults the Khronos fox (155 units long, framed from farther than that) was shadowed only where
+/// it came within 150 units of the camera: a patch by its front legs. (The floor's size
+/// plays no part: a large floor under people keeps their sharp shadows.)
+pub fn sun_shadow_cascades(camera_distance: f32) -> CascadeShadowConfig {
+    let scale = (camera_distance / PEOPLE_CAMERA_DISTANCE).max(1.0);
     let people = CascadeShadowConfigBuilder::default();
     CascadeShadowConfigBuilder {
         minimum_distance: people.minimum_distance * scale,
@@ -109,11 +113,17 @@ pub fn sun_shadow_cascades(extent: &StageExtent) -> CascadeShadowConfig {
     .build()
 }
 
-/// Fits the sun's shadow cascades to the stage whenever it grows or shrinks (reads
-/// `StageExtent`; writes the sun's `CascadeShadowConfig`).
-pub fn fit_shadows_to_stage(extent: Res<StageExtent>, mut suns: Query<&mut CascadeShadowConfig, With<Sun>>) {
-    if extent.is_changed() {
-        suns.iter_mut().for_each(|mut cascades| *cascades = sun_shadow_cascades(&extent));
+/// Fits the sun's shadow cascades to the orbit camera whenever it moves (reads the
+/// `OrbitCamera`; writes the sun's `CascadeShadowConfig`).
+pub fn fit_shadows_to_camera(
+    cameras: Query<
+        &crate::editor::interact::camera::OrbitCamera,
+        Changed<crate::editor::interact::camera::OrbitCamera>,
+    >,
+    mut suns: Query<&mut CascadeShadowConfig, With<Sun>>,
+) {
+    if let Some(distance) = cameras.iter().map(|orbit| orbit.distance).reduce(f32::max) {
+        suns.iter_mut().for_each(|mut cascades| *cascades = sun_shadow_cascades(distance));
     }
 }
 

@@ -12,7 +12,7 @@ use crate::editor::interact::ik_drag;
 use crate::editor::present::draw;
 use crate::editor::present::skin_material::{self, SkinAttributeStore, SkinMaterial, SkinMaterialAsset, SkinTextures};
 use crate::editor::present::stage::{
-    StageExtent, StageSettings, apply_stage_settings, draw_grid_and_axes, fit_shadows_to_stage, fit_stage_to_scene,
+    StageExtent, StageSettings, apply_stage_settings, draw_grid_and_axes, fit_shadows_to_camera, fit_stage_to_scene,
     spawn_stage,
 };
 use crate::editor::scene_doc::document::{Library, NextCharacterId, PendingScene, SceneCharacter, spawn_from_doc};
@@ -97,7 +97,7 @@ impl Plugin for ViewPlugin {
                     apply_orbit_camera,
                     draw::draw_skeletons,
                     fit_stage_to_scene,
-                    fit_shadows_to_stage,
+                    fit_shadows_to_camera,
                     draw_grid_and_axes,
                 )
                     .chain()
