@@ -98,9 +98,9 @@ pub const PEOPLE_CAMERA_DISTANCE: f32 = 10.0;
 /// The sun's shadow cascades for a camera `camera_distance` from what it looks at: Bevy's
 /// defaults up to [`PEOPLE_CAMERA_DISTANCE`], and beyond it all their bounds scaled with the
 /// distance, so that what the camera frames keeps the shadows a person has. With the
-/// defaults the Khronos fox (155 units long, framed from farther than that) was shadowed only where
-/// it came within 150 units of the camera: a patch by its front legs. (The floor's size
-/// plays no part: a large floor under people keeps their sharp shadows.)
+/// defaults the Khronos fox (155 units long, framed from farther than that) was shadowed
+/// only where it came within 150 units of the camera: a patch by its front legs. (The
+/// floor's size plays no part: a large floor under people keeps their sharp shadows.)
 pub fn sun_shadow_cascades(camera_distance: f32) -> CascadeShadowConfig {
     let scale = (camera_distance / PEOPLE_CAMERA_DISTANCE).max(1.0);
     let people = CascadeShadowConfigBuilder::default();
