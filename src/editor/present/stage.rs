@@ -4,6 +4,8 @@
 use bevy::light::{CascadeShadowConfig, CascadeShadowConfigBuilder, DirectionalLightShadowMap};
 use bevy::prelude::*;
 
+use crate::editor::interact::camera::OrbitCamera;
+
 /// Scene-wide view settings: the scene file's own type (floor, shadows, axes, floor
 /// height), held as a resource.
 #[derive(Resource, Clone, Debug, Default, PartialEq, Deref, DerefMut)]
@@ -116,10 +118,7 @@ pub fn sun_shadow_cascades(camera_distance: f32) -> CascadeShadowConfig {
 /// Fits the sun's shadow cascades to the orbit camera whenever it moves (reads the
 /// `OrbitCamera`; writes the sun's `CascadeShadowConfig`).
 pub fn fit_shadows_to_camera(
-    cameras: Query<
-        &crate::editor::interact::camera::OrbitCamera,
-        Changed<crate::editor::interact::camera::OrbitCamera>,
-    >,
+    cameras: Query<&OrbitCamera, Changed<OrbitCamera>>,
     mut suns: Query<&mut CascadeShadowConfig, With<Sun>>,
 ) {
     if let Some(distance) = cameras.iter().map(|orbit| orbit.distance).reduce(f32::max) {
@@ -265,7 +264,7 @@ const BACKDROP_DEPTH: f32 = 800.0;
 pub fn show_gradient_backdrop(
     mut commands: Commands,
     settings: Res<StageSettings>,
-    cameras: Query<(Entity, Ref<crate::editor::interact::camera::OrbitCamera>)>,
+    cameras: Query<(Entity, Ref<OrbitCamera>)>,
     mut backdrops: Query<(Entity, &mut Transform, &mut Visibility, &Mesh3d), With<Backdrop>>,
     mut meshes: ResMut<Assets<Mesh>>,
     mut materials: ResMut<Assets<StandardMaterial>>,
