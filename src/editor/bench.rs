@@ -46,6 +46,13 @@ pub struct BenchReport {
     /// (`kernel_mvps`) on every core, `skin_ms_p50 ÷ (vertices ÷ (kernel × cores))` (a
     /// figure of CPU skinning: with `gpu_skinning` the phase only bounds and hands over).
     pub skin_over_ideal: f64,
+    /// The floor the crowd's memory puts under the skin phase on this machine, in
+    /// milliseconds: each character's bind positions copied into an output of its own, split
+    /// over the cores as the phase splits the crowd (the bytes the kernel reads and writes
+    /// but its shared weights, and no arithmetic); see [`memory_floor_ms`].
+    pub memory_floor_ms: f64,
+    /// `skin_ms_p50 ÷ memory_floor_ms`.
+    pub skin_over_memory_floor: f64,
     pub extract_ms_p50: f64,
     pub upload_ms_p50: f64,
     /// The rest of the render world (drawing; on llvmpipe that is CPU work too).
@@ -189,6 +196,7 @@ pub fn run(setup: &Setup) -> Result<BenchReport, String> {
         bytes += app.world().resource::<HandedOn>().0;
     }
     let kernels = kernel_speeds(&asset);
+    let memory_floor_ms = memory_floor_ms(&mut app);
     let measured = Measured::now(pipelined_rendering, drawn);
     let cores = measured.cores;
     let phase = |k: usize| median(samples.iter().map(|s| s[k]).collect());
@@ -215,6 +223,8 @@ pub fn run(setup: &Setup) -> Result<BenchReport, String> {
         fk_ms_p50: phase(2),
         skin_ms_p50: phase(3),
         skin_over_ideal: phase(3) / ideal_skin_ms(characters * asset.vertex_count(), kernels.lbs, cores),
+        memory_floor_ms,
+        skin_over_memory_floor: phase(3) / memory_floor_ms,
         extract_ms_p50: phase(4),
         upload_ms_p50: phase(5),
         render_world_ms_p50: phase(6),
@@ -229,6 +239,40 @@ pub fn run(setup: &Setup) -> Result<BenchReport, String> {
 /// The crowd's `vertices` skinned at `kernel_mvps` on each of `cores`, in milliseconds.
 fn ideal_skin_ms(vertices: usize, kernel_mvps: f64, cores: usize) -> f64 {
     vertices as f64 / (kernel_mvps * 1e6 * cores as f64) * 1e3
+}
+
+/// Copies of the crowd's memory timed in [`memory_floor_ms`], the first not kept.
+const FLOOR_RUNS: usize = 21;
+
+/// Each character's bind positions copied into an output of its own on Bevy's compute task
+/// pool, in batches of a few characters as the skin phase takes them (eight a thread): the
+/// median of [`FLOOR_RUNS`] in milliseconds. The bytes the kernel streams for the crowd at
+/// this machine's memory speed: the skin phase can come near it but not below it, however
+/// fast its arithmetic.
+fn memory_floor_ms(app: &mut App) -> f64 {
+    let world = app.world_mut();
+    let binds: Vec<std::sync::Arc<CharacterAsset>> =
+        world.query::<&Character>().iter(world).map(|c| c.asset.clone()).collect();
+    let mut outs: Vec<Vec<Vec3>> = binds.iter().map(|a| vec![Vec3::ZERO; a.skin.bind_positions.len()]).collect();
+    let pool = bevy::tasks::ComputeTaskPool::get();
+    let per_batch = binds.len().div_ceil(pool.thread_num().max(1) * 8).max(1);
+    let mut times: Vec<f64> = (0..FLOOR_RUNS)
+        .map(|_| {
+            let t = Instant::now();
+            pool.scope(|scope| {
+                for (assets, outs) in binds.chunks(per_batch).zip(outs.chunks_mut(per_batch)) {
+                    scope.spawn(async move {
+                        for (asset, out) in assets.iter().zip(outs) {
+                            out.copy_from_slice(&asset.skin.bind_positions);
+                        }
+                    });
+                }
+            });
+            t.elapsed().as_secs_f64() * 1e3
+        })
+        .collect();
+    times.remove(0);
+    median(times)
 }
 
 /// Turns the cameras off once the renderer is ready: extraction and the upload go on, the
@@ -259,7 +303,8 @@ pub fn table(r: &BenchReport) -> String {
         "{} × {} ({} vertices each), {} frames, skinned {}\n\
          frame (CPU: main world + extraction + upload)  p50 {:.2} ms  p95 {:.2} ms\n\
          \x20 sampling {:.2} ms | FK {:.2} ms | skin {:.2} ms | extract {:.2} ms | upload {:.2} ms   (medians)\n\
-         \x20 skin ÷ ideal (the vertices at the kernel's speed on every core) {:.2}\n\
+         \x20 skin ÷ ideal (the vertices at the kernel's speed on every core) {:.2}; \
+         ÷ memory floor (its bytes copied on every core, {:.2} ms) {:.2}\n\
          \x20 render world besides the upload (drawing; CPU on llvmpipe) {:.2} ms\n\
          mesh data handed on per frame: {} bytes\n\
          kernel: {:.1} M vertices/s per core (the plain loop it replaced: {:.1}, ×{:.2})\n\
@@ -277,6 +322,8 @@ pub fn table(r: &BenchReport) -> String {
         r.extract_ms_p50,
         r.upload_ms_p50,
         r.skin_over_ideal,
+        r.memory_floor_ms,
+        r.skin_over_memory_floor,
         r.render_world_ms_p50,
         r.upload_bytes_per_frame,
         r.kernel_mvps,

@@ -225,6 +225,8 @@ fn bench_reports_a_crowds_frame_times_as_json() {
         "dual_quaternion_kernel_mvps",
         "kernel_with_flat_normals_mvps",
         "skin_over_ideal",
+        "memory_floor_ms",
+        "skin_over_memory_floor",
     ] {
         let value = report[key].as_f64().unwrap_or_else(|| panic!("{key} is a number: {report}"));
         assert!(value > 0.0, "{key} = {value}");
