@@ -43,7 +43,8 @@ pub struct BenchReport {
     pub fk_ms_p50: f64,
     pub skin_ms_p50: f64,
     /// The skin phase against its ideal: the crowd's vertices at the kernel's speed
-    /// (`kernel_mvps`) on every core, `skin_ms_p50 ÷ (vertices ÷ (kernel × cores))` (a
+    /// (`kernel_mvps`) on every core, `skin_ms_p50 ÷ (vertices ÷ (kernel × cores))`, on as
+    /// many cores as the phase has characters (or chunks of one) to share among them (a
     /// figure of CPU skinning: with `gpu_skinning` the phase only bounds and hands over).
     pub skin_over_ideal: f64,
     /// The floor the crowd's memory puts under the skin phase on this machine, in
@@ -222,7 +223,7 @@ pub fn run(setup: &Setup) -> Result<BenchReport, String> {
         sampling_ms_p50: phase(1),
         fk_ms_p50: phase(2),
         skin_ms_p50: phase(3),
-        skin_over_ideal: phase(3) / ideal_skin_ms(characters * asset.vertex_count(), kernels.lbs, cores),
+        skin_over_ideal: phase(3) / ideal_skin_ms(characters, asset.vertex_count(), kernels.lbs, cores),
         memory_floor_ms,
         skin_over_memory_floor: phase(3) / memory_floor_ms,
         extract_ms_p50: phase(4),
@@ -236,9 +237,13 @@ pub fn run(setup: &Setup) -> Result<BenchReport, String> {
     })
 }
 
-/// The crowd's `vertices` skinned at `kernel_mvps` on each of `cores`, in milliseconds.
-fn ideal_skin_ms(vertices: usize, kernel_mvps: f64, cores: usize) -> f64 {
-    vertices as f64 / (kernel_mvps * 1e6 * cores as f64) * 1e3
+/// The vertices of `characters` of `vertices_each` skinned at `kernel_mvps` on each of
+/// `cores`, in milliseconds; on fewer cores where the phase has fewer tasks than cores (one
+/// a character, one a chunk of a character larger than a chunk).
+pub fn ideal_skin_ms(characters: usize, vertices_each: usize, kernel_mvps: f64, cores: usize) -> f64 {
+    let tasks = characters * vertices_each.div_ceil(crate::scene::systems::SKIN_CHUNK_VERTICES);
+    let cores = cores.min(tasks).max(1);
+    (characters * vertices_each) as f64 / (kernel_mvps * 1e6 * cores as f64) * 1e3
 }
 
 /// Copies of the crowd's memory timed in [`memory_floor_ms`], the first not kept.

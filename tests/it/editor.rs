@@ -539,3 +539,17 @@ fn compute_workers_are_pinned_one_to_a_core_in_turn() {
     }
     assert_eq!(allowed_cores(), cores, "the caller keeps every core");
 }
+
+/// The skin phase's ideal: the crowd's vertices at the kernel's speed on every core, on as
+/// many cores as the phase has tasks (one a character, one a chunk of a larger one).
+#[test]
+fn the_skin_phases_ideal_uses_only_the_cores_it_has_tasks_for() {
+    use marionette::editor::bench::ideal_skin_ms;
+    let chunk = marionette::scene::systems::SKIN_CHUNK_VERTICES;
+    // 64 SMPL bodies at 500 M vertices/s on two cores: 440,960 ÷ 1e9 s.
+    assert!((ideal_skin_ms(64, 6890, 500.0, 2) - 0.44096).abs() < 1e-9);
+    // One body is one task: one core, however many there are.
+    assert!((ideal_skin_ms(1, 6890, 500.0, 2) - 0.01378).abs() < 1e-9);
+    // One body of two chunks is two tasks (in ms: vertices ÷ 1e9 per second × 1e3).
+    assert!((ideal_skin_ms(1, 2 * chunk, 500.0, 8) - (2 * chunk) as f64 / 1e6).abs() < 1e-9);
+}
