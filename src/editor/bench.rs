@@ -52,7 +52,7 @@ pub struct BenchReport {
     /// over the cores as the phase splits the crowd (the bytes the kernel reads and writes
     /// but its shared weights, and no arithmetic); see [`memory_floor_ms`].
     pub memory_floor_ms: f64,
-    /// `skin_ms_p50 ÷ memory_floor_ms`.
+    /// `skin_ms_p50 ÷ memory_floor_ms` (CPU skinning, as `skin_over_ideal`).
     pub skin_over_memory_floor: f64,
     pub extract_ms_p50: f64,
     pub upload_ms_p50: f64,
@@ -250,7 +250,7 @@ pub fn ideal_skin_ms(characters: usize, vertices_each: usize, kernel_mvps: f64, 
 const FLOOR_RUNS: usize = 21;
 
 /// Each character's bind positions copied into an output of its own on Bevy's compute task
-/// pool, in batches of a few characters as the skin phase takes them (eight a thread): the
+/// pool, in batches of a few characters as the skin phase takes them: the
 /// median of [`FLOOR_RUNS`] in milliseconds. The bytes the kernel streams for the crowd at
 /// this machine's memory speed: the skin phase can come near it but not below it, however
 /// fast its arithmetic.
@@ -260,7 +260,8 @@ fn memory_floor_ms(app: &mut App) -> f64 {
         world.query::<&Character>().iter(world).map(|c| c.asset.clone()).collect();
     let mut outs: Vec<Vec<Vec3>> = binds.iter().map(|a| vec![Vec3::ZERO; a.skin.bind_positions.len()]).collect();
     let pool = bevy::tasks::ComputeTaskPool::get();
-    let per_batch = binds.len().div_ceil(pool.thread_num().max(1) * 8).max(1);
+    let batches = pool.thread_num().max(1) * crate::scene::systems::SKIN_BATCHES_PER_THREAD;
+    let per_batch = binds.len().div_ceil(batches).max(1);
     let mut times: Vec<f64> = (0..FLOOR_RUNS)
         .map(|_| {
             let t = Instant::now();

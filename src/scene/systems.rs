@@ -110,6 +110,11 @@ pub fn compute_joint_to_world(
     }
 }
 
+/// Batches of characters a thread the skin phase splits the crowd into: a few characters a
+/// batch, so that a thread held up elsewhere leaves its share to the others (Bevy's default
+/// of one batch a thread left the phase a third longer).
+pub const SKIN_BATCHES_PER_THREAD: usize = 8;
+
 /// Skins characters marked dirty, in model space and in parallel on Bevy's compute task
 /// pool: palette `current · bind` from the matrix stack's output (`JointScratch`) and the
 /// asset's shared inverse binds, the LBS or DQ kernel of the bind vertices and their
@@ -135,9 +140,7 @@ pub fn skin_changed_characters(
     )>,
     mut skin_bounds: Query<&mut Aabb, With<SkinMesh>>,
 ) {
-    // Batches of a few characters, so that a thread held up elsewhere leaves its share to
-    // the others (Bevy's default of one batch a thread left the phase a third longer).
-    let batches = bevy::ecs::batching::BatchingStrategy::new().batches_per_thread(8);
+    let batches = bevy::ecs::batching::BatchingStrategy::new().batches_per_thread(SKIN_BATCHES_PER_THREAD);
     characters.par_iter_mut().batching_strategy(batches).for_each(
         |(character, view, method, on_gpu, heat, dirty, mut scratch, mut upload, mut attributes, mut job, joints)| {
             if *dirty == PoseDirty::default() {
