@@ -309,8 +309,8 @@ pub fn table(r: &BenchReport) -> String {
         "{} × {} ({} vertices each), {} frames, skinned {}\n\
          frame (CPU: main world + extraction + upload)  p50 {:.2} ms  p95 {:.2} ms\n\
          \x20 sampling {:.2} ms | FK {:.2} ms | skin {:.2} ms | extract {:.2} ms | upload {:.2} ms   (medians)\n\
-         \x20 skin ÷ ideal (the vertices at the kernel's speed on every core) {:.2}; \
-         ÷ memory floor (its bytes copied on every core, {:.2} ms) {:.2}\n\
+         \x20 skin ÷ ideal (the vertices at the kernel's speed on every core it can use) {:.2}; \
+         ÷ memory floor (its bytes copied on every core, {:.3} ms) {:.2}\n\
          \x20 render world besides the upload (drawing; CPU on llvmpipe) {:.2} ms\n\
          mesh data handed on per frame: {} bytes\n\
          kernel: {:.1} M vertices/s per core (the plain loop it replaced: {:.1}, ×{:.2})\n\
