@@ -47,6 +47,15 @@ pub struct BenchReport {
     /// many cores as the phase has characters (or chunks of one) to share among them (a
     /// figure of CPU skinning: with `gpu_skinning` the phase only bounds and hands over).
     pub skin_over_ideal: f64,
+    /// The skin phase against its ideal frame by frame: each frame's skin phase over the
+    /// ideal of the kernel's speeds timed on each core right after that frame (this machine's
+    /// cores each change speed every few milliseconds, independently: one core at two thirds
+    /// of the other's is common), the median of the frames' ratios. See
+    /// [`kernel_on_each_core`].
+    pub skin_over_paired_ideal: f64,
+    /// The kernel's speed on each core the process may use, timed after every frame (the
+    /// median per core), in M vertices per second.
+    pub core_kernel_mvps: Vec<f64>,
     /// The floor the crowd's memory puts under the skin phase on this machine, in
     /// milliseconds: each character's bind positions copied into an output of its own, split
     /// over the cores as the phase splits the crowd (the bytes the kernel reads and writes
@@ -191,10 +200,13 @@ pub fn run(setup: &Setup) -> Result<BenchReport, String> {
         stop_drawing(&mut app);
     }
     let mut samples = Vec::with_capacity(frames);
+    let mut core_speeds = Vec::with_capacity(frames);
     let mut bytes = 0;
+    let mut on_each_core = kernel_on_each_core(&asset);
     for _ in 0..frames {
         samples.push(timed_frame(&mut app));
         bytes += app.world().resource::<HandedOn>().0;
+        core_speeds.push(on_each_core());
     }
     let kernels = kernel_speeds(&asset);
     let memory_floor_ms = memory_floor_ms(&mut app);
@@ -204,6 +216,14 @@ pub fn run(setup: &Setup) -> Result<BenchReport, String> {
     let frame: Vec<f64> = samples.iter().map(|s| s[1] + s[2] + s[3] + s[4] + s[5]).collect();
     let names = ["sampling", "fk", "skin", "extract", "upload", "render_world"];
     let whole = Percentiles::of(frame);
+    let vertices_each = asset.vertex_count();
+    let paired = samples
+        .iter()
+        .zip(&core_speeds)
+        .map(|(s, speeds)| s[3] / ideal_skin_ms_on_cores(characters, vertices_each, speeds));
+    let core_kernel_mvps = (0..core_speeds.first().map_or(0, Vec::len))
+        .map(|c| median(core_speeds.iter().map(|s| s[c]).collect()))
+        .collect();
     let phases_ms = names
         .iter()
         .enumerate()
@@ -216,14 +236,16 @@ pub fn run(setup: &Setup) -> Result<BenchReport, String> {
         characters,
         kind: kind.to_string(),
         gpu_skinning,
-        vertices_per_character: asset.vertex_count(),
+        vertices_per_character: vertices_each,
         frames,
         frame_ms_p50: whole.p50,
         frame_ms_p95: whole.p95,
         sampling_ms_p50: phase(1),
         fk_ms_p50: phase(2),
         skin_ms_p50: phase(3),
-        skin_over_ideal: phase(3) / ideal_skin_ms(characters, asset.vertex_count(), kernels.lbs, cores),
+        skin_over_ideal: phase(3) / ideal_skin_ms(characters, vertices_each, kernels.lbs, cores),
+        skin_over_paired_ideal: median(paired.collect()),
+        core_kernel_mvps,
         memory_floor_ms,
         skin_over_memory_floor: phase(3) / memory_floor_ms,
         extract_ms_p50: phase(4),
@@ -241,9 +263,17 @@ pub fn run(setup: &Setup) -> Result<BenchReport, String> {
 /// `cores`, in milliseconds; on fewer cores where the phase has fewer tasks than cores (one
 /// a character, one a chunk of a character larger than a chunk).
 pub fn ideal_skin_ms(characters: usize, vertices_each: usize, kernel_mvps: f64, cores: usize) -> f64 {
+    ideal_skin_ms_on_cores(characters, vertices_each, &vec![kernel_mvps; cores.max(1)])
+}
+
+/// [`ideal_skin_ms`] on cores of different speeds (M vertices per second, one a core): the
+/// vertices at the sum of the speeds of the fastest cores, as many as the phase has tasks.
+pub fn ideal_skin_ms_on_cores(characters: usize, vertices_each: usize, core_mvps: &[f64]) -> f64 {
     let tasks = characters * vertices_each.div_ceil(crate::scene::systems::SKIN_CHUNK_VERTICES);
-    let cores = cores.min(tasks).max(1);
-    (characters * vertices_each) as f64 / (kernel_mvps * 1e6 * cores as f64) * 1e3
+    let mut fastest = core_mvps.to_vec();
+    fastest.sort_by(|a, b| b.total_cmp(a));
+    let mvps: f64 = fastest.iter().take(tasks.max(1)).sum();
+    (characters * vertices_each) as f64 / (mvps * 1e6) * 1e3
 }
 
 /// Copies of the crowd's memory timed in [`memory_floor_ms`], the first not kept.
@@ -311,6 +341,7 @@ pub fn table(r: &BenchReport) -> String {
          \x20 sampling {:.2} ms | FK {:.2} ms | skin {:.2} ms | extract {:.2} ms | upload {:.2} ms   (medians)\n\
          \x20 skin ÷ ideal (the vertices at the kernel's speed on every core it can use) {:.2}; \
          ÷ memory floor (its bytes copied on every core, {:.3} ms) {:.2}\n\
+         \x20 skin ÷ ideal frame by frame (the kernel timed on each core right after each frame, medians {}) {:.2}\n\
          \x20 render world besides the upload (drawing; CPU on llvmpipe) {:.2} ms\n\
          mesh data handed on per frame: {} bytes\n\
          kernel: {:.1} M vertices/s per core (the plain loop it replaced: {:.1}, ×{:.2})\n\
@@ -330,6 +361,8 @@ pub fn table(r: &BenchReport) -> String {
         r.skin_over_ideal,
         r.memory_floor_ms,
         r.skin_over_memory_floor,
+        r.core_kernel_mvps.iter().map(|m| format!("{m:.0}")).collect::<Vec<_>>().join(" | "),
+        r.skin_over_paired_ideal,
         r.render_world_ms_p50,
         r.upload_bytes_per_frame,
         r.kernel_mvps,
@@ -480,9 +513,7 @@ struct KernelSpeeds {
 const BURST: usize = 8;
 
 fn kernel_speeds(asset: &CharacterAsset) -> KernelSpeeds {
-    let n = asset.skeleton.len();
-    let pose: Vec<JointRotation> = (0..n).map(|i| JointRotation::euler_xyz(0.1 * i as f32, 0.05, -0.02)).collect();
-    let palette = crate::rig::fk::posed_palette(&asset.skeleton, &asset.bind_world_to_joint, &pose, Mat4::IDENTITY);
+    let palette = posed_palette(asset);
     let mut dual_quaternions = Vec::new();
     crate::rig::dqs::dual_quaternion_palette(&palette, &mut dual_quaternions);
     let skin = &asset.skin;
@@ -517,6 +548,49 @@ fn kernel_speeds(asset: &CharacterAsset) -> KernelSpeeds {
         dual_quaternion: mvps(&seconds[2]),
         lbs_and_flat_normals: mvps(&seconds[3]),
     }
+}
+
+/// Timed calls of the kernel on each core after every frame (after one call not timed).
+const CORE_BURST: usize = 4;
+
+/// A timer of the LBS kernel on one posed character on each core the process may use, in
+/// turn (this thread pinned to it, then given every core back): the median of
+/// [`CORE_BURST`] calls a core, in M vertices per second. Called right after each frame, so
+/// each frame's skin phase is set against the speed the cores had then: on this 2-core
+/// machine each core drops to about 60 % of its speed and back every few milliseconds, on
+/// its own, so the speed timed once after the frames may be a state the frames did not run in.
+/// It skins a copy of the character's bind positions and weights, so that it does not warm
+/// the caches for the next frame's crowd (whose bodies share one model's weights).
+fn kernel_on_each_core(asset: &CharacterAsset) -> impl FnMut() -> Vec<f64> + use<> {
+    let cores = crate::editor::cores::allowed_cores();
+    let cores = if cores.is_empty() { vec![0] } else { cores };
+    let palette = posed_palette(asset);
+    let (bind, weights) = (asset.skin.bind_positions.clone(), asset.skin.weights.unshared());
+    let mut out = vec![Vec3::ZERO; bind.len()];
+    move || {
+        let kernel = |out: &mut [Vec3]| crate::rig::lbs::skin(&bind, &weights, &palette, out);
+        cores
+            .iter()
+            .map(|&core| {
+                crate::editor::cores::on_core(core, &cores, || {
+                    kernel(&mut out);
+                    let times = (0..CORE_BURST).map(|_| {
+                        let t = Instant::now();
+                        kernel(&mut out);
+                        t.elapsed().as_secs_f64()
+                    });
+                    bind.len() as f64 / median(times.collect()) / 1e6
+                })
+            })
+            .collect()
+    }
+}
+
+/// The character posed away from its bind pose: its palette.
+fn posed_palette(asset: &CharacterAsset) -> Vec<Mat4> {
+    let pose: Vec<JointRotation> =
+        (0..asset.skeleton.len()).map(|i| JointRotation::euler_xyz(0.1 * i as f32, 0.05, -0.02)).collect();
+    crate::rig::fk::posed_palette(&asset.skeleton, &asset.bind_world_to_joint, &pose, Mat4::IDENTITY)
 }
 
 fn median(v: Vec<f64>) -> f64 {

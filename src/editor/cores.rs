@@ -43,16 +43,30 @@ pub fn allowed_cores() -> Vec<usize> {
     Vec::new()
 }
 
+/// Runs `f` on the calling thread pinned to `core`, then gives the thread back every core
+/// in `cores` (the process's, from [`allowed_cores`]).
+pub fn on_core<R>(core: usize, cores: &[usize], f: impl FnOnce() -> R) -> R {
+    pin_this_thread_to(&[core]);
+    let result = f();
+    pin_this_thread_to(cores);
+    result
+}
+
 /// Pins the calling thread to `core` (a hint: where the system refuses, it runs anywhere).
-#[cfg(target_os = "linux")]
 fn pin_this_thread(core: usize) {
-    // SAFETY: as in `allowed_cores`; the set holds one core below `CPU_SETSIZE`.
+    pin_this_thread_to(&[core]);
+}
+
+/// Lets the calling thread run on `cores` only (a hint, as [`pin_this_thread`]).
+#[cfg(target_os = "linux")]
+fn pin_this_thread_to(cores: &[usize]) {
+    // SAFETY: as in `allowed_cores`; the set holds cores below `CPU_SETSIZE` only.
     unsafe {
         let mut set: libc::cpu_set_t = std::mem::zeroed();
-        libc::CPU_SET(core, &mut set);
+        cores.iter().filter(|&&c| c < libc::CPU_SETSIZE as usize).for_each(|&c| libc::CPU_SET(c, &mut set));
         libc::sched_setaffinity(0, std::mem::size_of::<libc::cpu_set_t>(), &set);
     }
 }
 
 #[cfg(not(target_os = "linux"))]
-fn pin_this_thread(_core: usize) {}
+fn pin_this_thread_to(_cores: &[usize]) {}

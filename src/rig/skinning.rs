@@ -97,6 +97,12 @@ impl SkinWeights {
         Self { offsets: offsets.into(), influences: influences.into(), groups }
     }
 
+    /// The same rows in memory of their own (a clone shares them): for timing a kernel
+    /// without warming the caches for the characters that share these.
+    pub fn unshared(&self) -> Self {
+        Self::of_rows(self.offsets.to_vec(), self.influences.to_vec())
+    }
+
     /// Every vertex bound rigidly to one joint.
     pub fn rigid(joint_of_vertex: &[u16]) -> Self {
         let offsets: Vec<u32> = (0..=joint_of_vertex.len() as u32).collect();
