@@ -49,8 +49,8 @@ pub struct BenchReport {
     pub skin_over_ideal: f64,
     /// The skin phase against its ideal frame by frame: each frame's skin phase over the
     /// ideal of the kernel's speeds timed on each core right after that frame (this machine's
-    /// cores each change speed every few milliseconds, independently: one core at two thirds
-    /// of the other's is common), the median of the frames' ratios. See
+    /// cores each change speed within tens of milliseconds, independently: one core at two
+    /// thirds of the other's is common), the median of the frames' ratios. See
     /// [`kernel_on_each_core`].
     pub skin_over_paired_ideal: f64,
     /// The kernel's speed on each core the process may use, timed after every frame (the
@@ -113,7 +113,7 @@ pub struct Measured {
 impl Measured {
     fn now(pipelined_rendering: bool, drawn: bool) -> Self {
         Self {
-            cores: std::thread::available_parallelism().map_or(1, |n| n.get()),
+            cores: core_count(),
             profile: env!("MARIONETTE_BUILD_PROFILE").to_string(),
             debug_assertions: cfg!(debug_assertions),
             pipelined_rendering,
@@ -121,6 +121,11 @@ impl Measured {
             drawn,
         }
     }
+}
+
+/// The cores the process may use.
+fn core_count() -> usize {
+    std::thread::available_parallelism().map_or(1, |n| n.get())
 }
 
 /// What `bench` runs.
@@ -557,13 +562,15 @@ const CORE_BURST: usize = 4;
 /// turn (this thread pinned to it, then given every core back): the median of
 /// [`CORE_BURST`] calls a core, in M vertices per second. Called right after each frame, so
 /// each frame's skin phase is set against the speed the cores had then: on this 2-core
-/// machine each core drops to about 60 % of its speed and back every few milliseconds, on
-/// its own, so the speed timed once after the frames may be a state the frames did not run in.
+/// machine each core drops to about 60 % of its speed and back within tens of milliseconds,
+/// on its own, so the speed timed once after the frames may be a state the frames did not
+/// run in.
 /// It skins a copy of the character's bind positions and weights, so that it does not warm
 /// the caches for the next frame's crowd (whose bodies share one model's weights).
 fn kernel_on_each_core(asset: &CharacterAsset) -> impl FnMut() -> Vec<f64> + use<> {
+    // Where the cores are not known (not Linux), as many timings as cores, on any of them.
     let cores = crate::editor::cores::allowed_cores();
-    let cores = if cores.is_empty() { vec![0] } else { cores };
+    let cores = if cores.is_empty() { vec![0; core_count()] } else { cores };
     let palette = posed_palette(asset);
     let (bind, weights) = (asset.skin.bind_positions.clone(), asset.skin.weights.unshared());
     let mut out = vec![Vec3::ZERO; bind.len()];
