@@ -538,12 +538,7 @@ fn kernel_speeds(asset: &CharacterAsset) -> KernelSpeeds {
     let started = Instant::now();
     while started.elapsed() < Duration::from_millis(600) {
         for (kernel, times) in kernels.iter_mut().zip(&mut seconds) {
-            kernel(&mut out);
-            for _ in 1..BURST {
-                let t = Instant::now();
-                kernel(&mut out);
-                times.push(t.elapsed().as_secs_f64());
-            }
+            times.extend(burst(BURST - 1, || kernel(&mut out)));
         }
     }
     let mvps = |times: &Vec<f64>| skin.bind_positions.len() as f64 / median(times.clone()) / 1e6;
@@ -580,17 +575,24 @@ fn kernel_on_each_core(asset: &CharacterAsset) -> impl FnMut() -> Vec<f64> + use
             .iter()
             .map(|&core| {
                 crate::editor::cores::on_core(core, &cores, || {
-                    kernel(&mut out);
-                    let times = (0..CORE_BURST).map(|_| {
-                        let t = Instant::now();
-                        kernel(&mut out);
-                        t.elapsed().as_secs_f64()
-                    });
-                    bind.len() as f64 / median(times.collect()) / 1e6
+                    bind.len() as f64 / median(burst(CORE_BURST, || kernel(&mut out))) / 1e6
                 })
             })
             .collect()
     }
+}
+
+/// `call` once, not timed (it finds its memory where other work left it), then `timed`
+/// times, each timed: their seconds.
+fn burst(timed: usize, mut call: impl FnMut()) -> Vec<f64> {
+    call();
+    (0..timed)
+        .map(|_| {
+            let t = Instant::now();
+            call();
+            t.elapsed().as_secs_f64()
+        })
+        .collect()
 }
 
 /// The character posed away from its bind pose: its palette.

@@ -19,7 +19,7 @@ pub fn pin_each_worker_to_a_core() -> Option<Arc<dyn Fn() + Send + Sync + 'stati
     let next = AtomicUsize::new(0);
     Some(Arc::new(move || {
         let k = next.fetch_add(1, Ordering::Relaxed);
-        pin_this_thread(cores[k % cores.len()]);
+        pin_this_thread_to(&[cores[k % cores.len()]]);
     }))
 }
 
@@ -52,12 +52,8 @@ pub fn on_core<R>(core: usize, cores: &[usize], f: impl FnOnce() -> R) -> R {
     result
 }
 
-/// Pins the calling thread to `core` (a hint: where the system refuses, it runs anywhere).
-fn pin_this_thread(core: usize) {
-    pin_this_thread_to(&[core]);
-}
-
-/// Lets the calling thread run on `cores` only (a hint, as [`pin_this_thread`]).
+/// Lets the calling thread run on `cores` only (a hint: where the system refuses, it runs
+/// anywhere).
 #[cfg(target_os = "linux")]
 fn pin_this_thread_to(cores: &[usize]) {
     // SAFETY: as in `allowed_cores`; the set holds cores below `CPU_SETSIZE` only.
