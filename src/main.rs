@@ -34,6 +34,9 @@ fn run(cli: Cli) -> Result<()> {
         Some(Command::Export(args)) => marionette::cli::export::run(&args)?,
         Some(Command::Render { paths, out, shot, poses, ik, skinning, match_height, clip, frames }) => {
             let started = std::time::Instant::now();
+            if let Some(spec) = clip.own_clip() {
+                marionette::document::posing::check_clip_spec(&paths, &spec).map_err(anyhow::Error::msg)?;
+            }
             let edits = marionette::editor::StartupEdits {
                 poses,
                 ik,

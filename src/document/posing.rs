@@ -115,6 +115,34 @@ pub fn find_clip<'a>(clips: &'a [NodeClip], spec: &str) -> Option<&'a NodeClip> 
     })
 }
 
+/// `--clip SPEC` against the files it is given with: fails on a file that has clips but none
+/// that `spec` names, or when no file has a clip it names, listing each file's clips (the
+/// numbers `info` gives them).
+pub fn check_clip_spec(paths: &[std::path::PathBuf], spec: &str) -> Result<(), String> {
+    let mut matched = false;
+    let mut listed = Vec::new();
+    for path in paths.iter().filter(|p| crate::formats::has_parts(p)) {
+        let parts = crate::formats::load_parts(path).map_err(|e| e.to_string())?;
+        let clips: Vec<&NodeClip> = parts.iter().flat_map(|p| &p.clips).collect();
+        let names = || {
+            let mut names: Vec<String> = clips.iter().map(|c| format!("{} `{}`", c.index, c.name)).collect();
+            names.dedup();
+            if names.is_empty() { "none".to_string() } else { names.join(", ") }
+        };
+        if parts.iter().any(|p| find_clip(&p.clips, spec).is_some()) {
+            matched = true;
+        } else if !clips.is_empty() {
+            return Err(format!("{}: no clip `{spec}` (its clips: {})", path.display(), names()));
+        } else {
+            listed.push(format!("{}: none", path.display()));
+        }
+    }
+    if !matched {
+        return Err(format!("no file has a clip `{spec}` ({})", listed.join("; ")));
+    }
+    Ok(())
+}
+
 /// Every character of a glTF file, shaped by the morph weights the file sets (or its clip
 /// keys), each posed by its clip `clip` at `time` seconds (by its file's node transforms without one) and
 /// then by `poses` where it has the joints:
@@ -189,12 +217,16 @@ pub fn describe(asset: &CharacterAsset) -> String {
         crate::rig::character::SkinKind::Rigid => "meshes carried by their nodes (a prop: nothing skinned)",
     };
     out += &format!("skin: {kind}\n");
-    out += &describe_humanoid(s);
+    out += &describe_humanoid(asset);
     out += &format!("vertices: {}\n", asset.vertex_count());
     out += &format!("triangles: {}\n", asset.triangle_count());
     if !asset.morphs.is_empty() {
         let names: Vec<&str> = asset.morphs.iter().map(|m| m.name.as_str()).collect();
         out += &format!("morphs: {}\n", names.join(", "));
+    }
+    if !asset.expressions.is_empty() {
+        let names: Vec<&str> = asset.expressions.iter().map(|e| e.name.as_str()).collect();
+        out += &format!("expressions: {}\n", names.join(", "));
     }
     let avg = if w.vertex_count() > 0 { w.total_influences() as f32 / w.vertex_count() as f32 } else { 0.0 };
     out += &format!("influences per vertex: max {}, mean {avg:.2}\n", w.max_influences());
@@ -209,19 +241,39 @@ pub fn describe(asset: &CharacterAsset) -> String {
     out
 }
 
-/// The humanoid map, a line of `bone joint` pairs (or why there is none).
-pub fn describe_humanoid(skeleton: &Skeleton) -> String {
+/// The humanoid map: how many bones and how they were found, then a line a bone
+/// (`Bone = joint (how)`) and a line for each doubt; or why there is none.
+pub fn describe_humanoid(asset: &CharacterAsset) -> String {
+    let skeleton = &asset.skeleton;
     if skeleton.len() < 5 {
         return String::new();
     }
-    match crate::rig::humanoid::detect(skeleton) {
-        Some(map) => {
-            let pairs: Vec<String> =
-                map.iter().map(|(bone, &j)| format!("{bone:?} {}", skeleton.joint(j).name)).collect();
-            format!("humanoid: {}\n", pairs.join(", "))
-        }
-        None => "humanoid: not found (no two legs and two arms)\n".to_string(),
+    let Some(found) = crate::rig::humanoid::of_asset(asset) else {
+        return "humanoid: not found (no two legs and two arms)\n".to_string();
+    };
+    use crate::rig::humanoid::Found;
+    let count = |how: Found| found.found.values().filter(|&&f| f == how).count();
+    let mut out = format!(
+        "humanoid: {} of {} bones ({} by name, {} by structure, {} named by the file)\n",
+        found.map.len(),
+        crate::rig::humanoid::HumanBone::ALL.len(),
+        count(Found::Name),
+        count(Found::Structure),
+        count(Found::File),
+    );
+    for (bone, &j) in &found.map {
+        let how = match found.found.get(bone) {
+            Some(Found::Name) => "name",
+            Some(Found::Structure) => "structure",
+            Some(Found::File) => "file",
+            None => "assigned",
+        };
+        out += &format!("  {bone:?} = {} ({how})\n", skeleton.joint(j).name);
     }
+    for doubt in &found.doubts {
+        out += &format!("humanoid doubt: {doubt}\n");
+    }
+    out
 }
 
 /// A parsed `JOINT=x,y,z`: move the joint to a world-space target by IK.

@@ -32,7 +32,7 @@ pub struct Retargeting {
 /// assigned by hand over it (an empty or unknown key takes the bone off).
 pub fn humanoid_map(asset: &CharacterAsset, assigned: &std::collections::BTreeMap<HumanBone, String>) -> HumanoidMap {
     let skeleton = &asset.skeleton;
-    let mut map = crate::rig::humanoid::detect(skeleton).unwrap_or_default();
+    let mut map = crate::rig::humanoid::of_asset(asset).map(|d| d.map).unwrap_or_default();
     for (bone, key) in assigned {
         match crate::formats::scene::joint_of_pose_key(skeleton, key) {
             Some(j) => map.insert(*bone, j),
@@ -56,22 +56,53 @@ pub fn floor_of(asset: &CharacterAsset) -> f32 {
     at.iter().map(|p| p.y).fold(f32::INFINITY, f32::min)
 }
 
-/// The floor a motion stands on: the character's own, lowered where the motion takes its
-/// feet lower than they stand (a clip that hangs from a fixed root).
-pub fn motion_floor(asset: &CharacterAsset, map: &HumanoidMap, frames: &[Frame]) -> f32 {
+/// The floor a motion stands on, in the character's model space: the lowest its skin
+/// reaches over the frames (a skeleton's bone boxes, for a BVH: its rest is only its offsets
+/// and its place is the motion's), and for a character with a mesh no higher than its own
+/// floor standing (a clip that leaves the ground throughout still stands on it).
+pub fn motion_floor(asset: &CharacterAsset, frames: &[Frame]) -> f32 {
     let skeleton = &asset.skeleton;
-    let feet: Vec<usize> = [HumanBone::LeftFoot, HumanBone::RightFoot, HumanBone::LeftToes, HumanBone::RightToes]
+    let lowest = frames
         .iter()
-        .filter_map(|b| map.get(b).copied())
-        .collect();
-    let lowest_foot = |root, pose: &[JointRotation]| {
-        let (_, at) = crate::rig::retarget::world_frames(skeleton, root, pose);
-        feet.iter().map(|&j| at[j].y).fold(f32::INFINITY, f32::min)
+        .map(|f| {
+            let origin = glam::Mat4::from_translation(f.root - skeleton.joint(0).rest_offset);
+            let skin = super::posing::posed_positions(asset, &f.pose, origin);
+            skin.iter().map(|p| p.y).fold(f32::INFINITY, f32::min)
+        })
+        .fold(f32::INFINITY, f32::min);
+    match asset.skin_kind {
+        crate::rig::character::SkinKind::Mesh if lowest.is_finite() => floor_of(asset).min(lowest),
+        _ if lowest.is_finite() => lowest,
+        _ => floor_of(asset),
+    }
+}
+
+/// The points a character stands on: the lowest skin vertices (at most 4,096 a foot) that
+/// each foot joint of its map, or a joint below it (toes), moves most, as their joints
+/// move them.
+pub fn soles(asset: &CharacterAsset, map: &HumanoidMap) -> Vec<crate::rig::retarget::Sole> {
+    const MOST: usize = 4096;
+    let (skin, skeleton) = (&asset.skin, &asset.skeleton);
+    let dominant = |v: usize| {
+        let row = skin.weights.of_vertex(v);
+        row.iter().max_by(|a, b| a.weight.total_cmp(&b.weight)).map(|i| usize::from(i.joint))
     };
-    let floor = floor_of(asset);
-    let standing = lowest_foot(skeleton.joint(0).rest_offset, &skeleton.initial_pose());
-    let lowest = frames.iter().map(|f| lowest_foot(f.root, &f.pose)).fold(f32::INFINITY, f32::min);
-    if lowest.is_finite() { floor.min(lowest - (standing - floor)) } else { floor }
+    let mut out = Vec::new();
+    for &foot in [HumanBone::LeftFoot, HumanBone::RightFoot].iter().filter_map(|b| map.get(b)) {
+        let mut own: Vec<usize> = (0..skin.weights.vertex_count())
+            .filter(|&v| dominant(v).is_some_and(|j| j == foot || skeleton.is_below(j, foot)))
+            .collect();
+        own.sort_by(|&a, &b| skin.bind_positions[a].y.total_cmp(&skin.bind_positions[b].y));
+        out.extend(own.into_iter().take(MOST).map(|v| {
+            let p = skin.bind_positions[v];
+            let parts = skin.weights.of_vertex(v).iter().map(|i| {
+                let j = usize::from(i.joint);
+                (j, i.weight, asset.bind_world_to_joint[j].transform_point3(p))
+            });
+            parts.collect()
+        }));
+    }
+    out
 }
 
 /// A character's own motion as frames at [`FPS`] over the clip's length: its keyframed
@@ -233,10 +264,21 @@ pub fn retarget(
         .ok_or_else(|| here(format!("expected {} to have a motion of its own, found none", source.name)))?;
     let (s_map, t_map) = (humanoid_map(&source_asset, &source.humanoid), humanoid_map(target_asset, &target.humanoid));
     let (s_skel, t_skel) = (&source_asset.skeleton, &target_asset.skeleton);
-    let (s_floor, t_floor) = (motion_floor(&source_asset, &s_map, &source_frames), floor_of(target_asset));
+    let s_floor = motion_floor(&source_asset, &source_frames);
+    // A character playing its own clip stands on the clip's floor: the clip onto itself is
+    // the clip.
+    let same_rig = source_asset.skeleton == target_asset.skeleton && s_map == t_map;
+    let t_floor = if same_rig { s_floor } else { floor_of(target_asset) };
+    let (s_soles, t_soles) = (soles(&source_asset, &s_map), soles(target_asset, &t_map));
     let retargeter = Retargeter::new(
-        Humanoid { skeleton: s_skel, map: &s_map, floor: s_floor },
-        Humanoid { skeleton: t_skel, map: &t_map, floor: t_floor },
+        Humanoid {
+            skeleton: s_skel,
+            map: &s_map,
+            floor: s_floor,
+            rest_floor: floor_of(&source_asset),
+            soles: &s_soles,
+        },
+        Humanoid { skeleton: t_skel, map: &t_map, floor: t_floor, rest_floor: floor_of(target_asset), soles: &t_soles },
         settings.rest,
     )
     .ok_or_else(|| {
@@ -313,7 +355,7 @@ pub fn pose_onto(
             named.push(j);
         }
     }
-    let side = |(skeleton, map)| Humanoid { skeleton, map, floor: 0.0 };
+    let side = |(skeleton, map)| Humanoid { skeleton, map, floor: 0.0, rest_floor: 0.0, soles: &[] };
     let rest = crate::rig::retarget::RestAlignment::Directions;
     match Retargeter::new(side((s, s_map)), side(target), rest) {
         Some(retargeter) => retargeter.pose_over(&full, current, &named),

@@ -44,7 +44,7 @@ impl CharacterSource {
             }
             Some("json") => Ok(Self::Homer { json: path.to_path_buf() }),
             Some("bvh") => Ok(Self::Bvh { path: path.to_path_buf() }),
-            Some("glb" | "gltf" | "fbx") => Ok(Self::Parts { path: path.to_path_buf() }),
+            Some("glb" | "gltf" | "vrm" | "fbx") => Ok(Self::Parts { path: path.to_path_buf() }),
             Some("skin") => {
                 let skel = path.with_extension("skel");
                 if !skel.is_file() {
@@ -73,7 +73,7 @@ impl CharacterSource {
             )),
             _ => Err(FormatError::other(
                 path,
-                "expected a character file (.skel, .obj, .attach), found an unknown extension",
+                "expected a character file (.skel, .obj, .attach, .bvh, .json, .glb, .gltf, .vrm, .fbx), found an unknown extension",
             )),
         }
     }
@@ -132,8 +132,8 @@ pub fn load_character(path: &Path) -> Result<CharacterAsset, FormatError> {
         }
         CharacterSource::Homer { json } => super::homer::load_homer(&json),
         CharacterSource::Bvh { path } => {
-            let skeleton = super::bvh::parse_bvh(open(&path)?, &path)?.skeleton;
-            Ok(CharacterAsset::with_bone_boxes(name, skeleton, Vec::new()))
+            let bvh = super::bvh::parse_bvh(open(&path)?, &path)?;
+            Ok(CharacterAsset::with_bone_boxes(name, bvh.skeleton, bvh.warnings))
         }
         CharacterSource::Parts { path } => first_part(&path),
         CharacterSource::Prop { obj } => load_prop(&obj),

@@ -87,8 +87,9 @@ fn mat4(m: &ufbx::Matrix) -> Mat4 {
 /// How a mesh's vertices follow the joints, and the transform that takes them from the
 /// mesh's geometry into the asset's bind space.
 enum Placed {
-    /// By its skin clusters; the transform is the mesh's at rest.
-    Skinned(Mat4),
+    /// By its skin clusters; the transform is the mesh's at rest, the joint the one its
+    /// unweighted vertices follow.
+    Skinned(Mat4, usize),
     /// Rigidly on a joint, into its bind frame.
     Rigid(usize, Mat4),
 }
@@ -96,7 +97,7 @@ enum Placed {
 impl Placed {
     fn to(&self) -> Mat4 {
         match *self {
-            Placed::Skinned(m) | Placed::Rigid(_, m) => m,
+            Placed::Skinned(m, _) | Placed::Rigid(_, m) => m,
         }
     }
 }
@@ -116,6 +117,19 @@ impl Fbx<'_> {
     /// The node's parent, none for the children of the scene's root.
     fn parent(&self, node: &ufbx::Node) -> Option<u32> {
         node.parent.as_ref().filter(|p| !p.is_root).map(|p| p.element.typed_id)
+    }
+
+    /// The joint a mesh node's unweighted vertices follow: the node's own, or its nearest
+    /// ancestor's in the skeleton (the root's where none is).
+    fn holder(&self, node: u32, joint_of_node: &[Option<usize>]) -> usize {
+        let mut at = Some(node);
+        while let Some(n) = at {
+            if let Some(j) = joint_of_node[n as usize] {
+                return j;
+            }
+            at = self.parent(self.node(n));
+        }
+        0
     }
 
     fn part(&self) -> Result<Part, FormatError> {
@@ -144,7 +158,7 @@ impl Fbx<'_> {
             }
         }
         let stem = self.path.file_stem().and_then(|s| s.to_str()).unwrap_or("fbx").to_string();
-        let (mut raw, raw_of_node) = self.raw_joints(&relevant, &stem);
+        let (mut raw, raw_of_node) = self.raw_joints(&relevant, &stem)?;
         // Each cluster's joint and bind matrix; a bone two clusters bind differently gets
         // a fixed child joint for the second.
         let mut bound: Vec<Option<Mat4>> = vec![None; raw.len()];
@@ -159,6 +173,13 @@ impl Fbx<'_> {
                 let mut bind = mat4(&cluster.geometry_to_bone) * mat4(&self.node(m).geometry_to_world).inverse();
                 // Affine by construction: its last row exactly so.
                 (bind.x_axis.w, bind.y_axis.w, bind.z_axis.w, bind.w_axis.w) = (0.0, 0.0, 0.0, 1.0);
+                if !bind.is_finite() || bind.determinant().abs() < 1e-12 {
+                    return Err(self.error(format!(
+                        "skin cluster `{}`: expected a finite, invertible bind matrix, found determinant {}",
+                        cluster.element.name,
+                        bind.determinant()
+                    )));
+                }
                 let slot = match bound[r] {
                     None => {
                         bound[r] = Some(bind);
@@ -193,13 +214,17 @@ impl Fbx<'_> {
             // joint's bind frame.
             let to_model = match joint_of_node[m as usize].filter(|_| mesh.skin_deformers.is_empty()) {
                 Some(j) => Placed::Rigid(j, bind[j].inverse()),
-                None => Placed::Skinned(mat4(&node.geometry_to_world)),
+                None => Placed::Skinned(mat4(&node.geometry_to_world), self.holder(m, &joint_of_node)),
             };
             self.mesh(node, mesh, &to_model, &cluster_joint, &new_index, &mut geometry)?;
+            if geometry.non_finite || !to_model.to().is_finite() {
+                return Err(self.error(format!("mesh `{}`: expected finite vertex positions", node.element.name)));
+            }
         }
         let Geometry {
             mut skin,
             texcoords,
+            unweighted,
             rows,
             morphs,
             morph_weights,
@@ -216,7 +241,13 @@ impl Fbx<'_> {
         }
         let (weights, normalised) =
             SkinWeights::from_rows(rows, skeleton.len()).map_err(|e| self.error(format!("the skin weights: {e}")))?;
-        let warnings = super::weight_warnings::normalised_warnings(self.path, &normalised);
+        let mut warnings = super::weight_warnings::normalised_warnings(self.path, &normalised);
+        for (mesh, count) in unweighted {
+            warnings.push(format!(
+                "{}: mesh `{mesh}`: {count} vertices have no skin weight; they follow the mesh's node",
+                self.path.display()
+            ));
+        }
         skin.weights = weights;
         let clips = self.clips(&joint_of_node, skeleton.len(), &morph_channels)?;
         let mut asset = CharacterAsset::with_inverse_binds(stem, skeleton, skin, bind, warnings)
@@ -232,7 +263,7 @@ impl Fbx<'_> {
 
     /// The relevant nodes as raw joints, depth first (a common root named `name` when
     /// there are several root nodes), and each node's raw joint.
-    fn raw_joints(&self, relevant: &[bool], name: &str) -> (Vec<RawJoint>, Vec<Option<usize>>) {
+    fn raw_joints(&self, relevant: &[bool], name: &str) -> Result<(Vec<RawJoint>, Vec<Option<usize>>), FormatError> {
         let mut raw = Vec::new();
         let mut raw_of_node = vec![None; relevant.len()];
         let roots: Vec<u32> = (0..relevant.len() as u32)
@@ -248,9 +279,19 @@ impl Fbx<'_> {
             let node = self.node(t);
             let local = &node.local_transform;
             let name = if node.element.name.is_empty() { format!("node {t}") } else { node.element.name.to_string() };
-            let mut joint = RawJoint::new(name, parent, vec3(local.translation));
-            joint.initial_rotation = JointRotation::Quat(quat(local.rotation).normalize());
-            let scale = vec3(local.scale);
+            let (translation, rotation, scale) = (vec3(local.translation), quat(local.rotation), vec3(local.scale));
+            if !translation.is_finite() || !scale.is_finite() || scale.min_element().abs() < 1e-12 {
+                return Err(self.error(format!(
+                    "node `{name}`: expected a finite translation and a finite, non-zero scale, found {translation} and {scale}"
+                )));
+            }
+            if !rotation.is_finite() || rotation.length_squared() < 1e-12 {
+                return Err(
+                    self.error(format!("node `{name}`: expected a rotation that can be normalised, found {rotation}"))
+                );
+            }
+            let mut joint = RawJoint::new(name, parent, translation);
+            joint.initial_rotation = JointRotation::Quat(rotation.normalize());
             if (scale - Vec3::ONE).abs().max_element() > 1e-6 {
                 joint.rest_scale = scale;
             }
@@ -260,7 +301,7 @@ impl Fbx<'_> {
             let children = node.children.iter().map(|c| c.element.typed_id).filter(|&c| relevant[c as usize]);
             todo.extend(children.collect::<Vec<_>>().into_iter().rev().map(|c| (c, Some(me))));
         }
-        (raw, raw_of_node)
+        Ok((raw, raw_of_node))
     }
 
     /// Appends a mesh: its corners' vertices (split by texture coordinate), triangles by
@@ -285,6 +326,7 @@ impl Fbx<'_> {
             let uv = if has_uv { mesh.vertex_uv.indices[index] } else { 0 };
             *vertex_of.entry((point, uv)).or_insert_with(|| {
                 let p = vec3(mesh.vertices[point as usize]);
+                out.non_finite |= !p.is_finite();
                 let v = out.skin.bind_positions.len() as u32;
                 out.skin.bind_positions.push(placed.to().transform_point3(p));
                 // FBX counts v from the image's bottom row; ours from its top.
@@ -322,7 +364,7 @@ impl Fbx<'_> {
         let mut rows: Vec<Vec<(usize, f32)>> = vec![Vec::new(); count];
         match (placed, mesh.skin_deformers.first()) {
             (&Placed::Rigid(joint, _), _) => rows.iter_mut().for_each(|r| r.push((joint, 1.0))),
-            (Placed::Skinned(_), Some(skin)) => {
+            (&Placed::Skinned(_, holder), Some(skin)) => {
                 out.skinned = true;
                 for (point, corners) in corners_of_point.iter().enumerate() {
                     let Some(sv) = skin.vertices.get(point) else { continue };
@@ -338,8 +380,13 @@ impl Fbx<'_> {
                         }
                     }
                 }
+                let unweighted = rows.iter().filter(|r| r.is_empty()).count();
+                if unweighted > 0 {
+                    rows.iter_mut().filter(|r| r.is_empty()).for_each(|r| r.push((holder, 1.0)));
+                    out.unweighted.push((node.element.name.to_string(), unweighted));
+                }
             }
-            (Placed::Skinned(_), None) => {
+            (Placed::Skinned(..), None) => {
                 return Err(self.error(format!("mesh `{}`: expected a skin or a node", node.element.name)));
             }
         }
@@ -381,7 +428,7 @@ impl Fbx<'_> {
         morph_channels: &[(u32, usize)],
     ) -> Result<Vec<NodeClip>, FormatError> {
         let mut clips = Vec::new();
-        for (index, stack) in self.scene.anim_stacks.iter().enumerate() {
+        for stack in self.scene.anim_stacks.iter() {
             let opts = ufbx::BakeOpts { trim_start_time: true, ..Default::default() };
             let baked = ufbx::bake_anim(self.scene, &stack.anim, opts)
                 .map_err(|e| self.error(format!("animation stack `{}`: {}", stack.element.name, e.description)))?;
@@ -390,21 +437,30 @@ impl Fbx<'_> {
             let time = |t: f64| t as f32;
             for node in baked.nodes.iter() {
                 let Some(j) = joint_of_node.get(node.typed_id as usize).copied().flatten() else { continue };
-                if !node.constant_translation {
+                // A curve of one key is constant, yet it sets the node's value: a track
+                // wherever its value is not the node's own.
+                let local = &self.node(node.typed_id).local_transform;
+                let moves_from = |keys: &[ufbx::BakedVec3], own: ufbx::Vec3| {
+                    keys.iter().any(|k| vec3(k.value).distance(vec3(own)) > 1e-6 * vec3(own).length().max(1.0))
+                };
+                let turns_from = |keys: &[ufbx::BakedQuat], own: ufbx::Quat| {
+                    keys.iter().any(|k| quat(k.value).dot(quat(own)).abs() < 1.0 - 1e-7)
+                };
+                if !node.constant_translation || moves_from(&node.translation_keys, local.translation) {
                     let keys = &node.translation_keys;
                     tracks[j].translation = Some(linear_track(
                         keys.iter().map(|k| time(k.time)).collect(),
                         keys.iter().map(|k| vec3(k.value)).collect(),
                     ));
                 }
-                if !node.constant_rotation {
+                if !node.constant_rotation || turns_from(&node.rotation_keys, local.rotation) {
                     let keys = &node.rotation_keys;
                     tracks[j].rotation = Some(linear_track(
                         keys.iter().map(|k| time(k.time)).collect(),
                         keys.iter().map(|k| quat(k.value)).collect(),
                     ));
                 }
-                if !node.constant_scale {
+                if !node.constant_scale || moves_from(&node.scale_keys, local.scale) {
                     let keys = &node.scale_keys;
                     tracks[j].scale = Some(linear_track(
                         keys.iter().map(|k| time(k.time)).collect(),
@@ -448,14 +504,16 @@ impl Fbx<'_> {
                     stack.element.name
                 )));
             }
+            // Numbered among the clips kept (as a glTF file's animations are), from 0.
+            let number = clips.len();
             let name = if stack.element.name.is_empty() {
-                format!("animation {index}")
+                format!("animation {number}")
             } else {
                 stack.element.name.to_string()
             };
             let moves = tracks.iter().any(|t| t != &JointTracks::default()) || weights.iter().any(Option::is_some);
             if moves {
-                clips.push(NodeClip { name, index, tracks, weights, root_parent: Mat4::IDENTITY });
+                clips.push(NodeClip { name, index: number, tracks, weights, root_parent: Mat4::IDENTITY });
             }
         }
         Ok(clips)
@@ -479,6 +537,10 @@ struct Geometry {
     skinned: bool,
     /// Whether a mesh has texture coordinates.
     textured: bool,
+    /// Whether a vertex position was not finite.
+    non_finite: bool,
+    /// Per mesh with vertices no cluster weighs: its name and how many.
+    unweighted: Vec<(String, usize)>,
 }
 
 impl Geometry {

@@ -26,7 +26,7 @@ use crate::rig::{CharacterAsset, JointRotation, MorphTarget, RawJoint, Skeleton,
 pub fn is_gltf(path: &Path) -> bool {
     path.extension()
         .and_then(|e| e.to_str())
-        .is_some_and(|e| e.eq_ignore_ascii_case("glb") || e.eq_ignore_ascii_case("gltf"))
+        .is_some_and(|e| ["glb", "gltf", "vrm"].iter().any(|g| e.eq_ignore_ascii_case(g)))
 }
 
 /// Loads every part (character or prop) of a glTF file.
@@ -43,7 +43,13 @@ pub fn parse_gltf(bytes: &[u8], path: &Path) -> Result<Vec<Part>, FormatError> {
         return Err(FormatError::other(path, format!("at $.extensionsRequired: needs `{ext}`, which is not read")));
     }
     let buffers = buffers(&gltf, bin, path)?;
-    let file = File::new(&gltf, &buffers, path);
+    let mut file = File::new(&gltf, &buffers, path);
+    if gltf.extensions_used().any(|e| e == "VRMC_vrm" || e == "VRM") {
+        let (json, _) = super::gltf_check::split_glb(bytes).map_err(|e| FormatError::other(path, e))?;
+        let json: serde_json::Value =
+            serde_json::from_slice(json).map_err(|e| FormatError::other(path, format!("at $: {e}")))?;
+        file.vrm = super::vrm::read(&json).map_err(|e| FormatError::other(path, e))?;
+    }
     let parts = file.parts();
     if parts.is_empty() {
         return Err(file.error("at $.nodes: expected a node with a mesh, found none".into()));
@@ -83,6 +89,8 @@ struct File<'a> {
     relevant: Vec<bool>,
     /// The images decoded so far.
     images: std::cell::RefCell<super::gltf_materials::Images>,
+    /// A VRM avatar's humanoid bones and expressions.
+    vrm: Option<super::vrm::Vrm>,
 }
 
 /// The nodes of one part: its roots, and its mesh nodes in file order.
@@ -132,7 +140,7 @@ impl<'a> File<'a> {
                 at = parent[node];
             }
         }
-        Self { gltf, buffers, path, parent, animated, shown, seed, relevant, images: Default::default() }
+        Self { gltf, buffers, path, parent, animated, shown, seed, relevant, images: Default::default(), vrm: None }
     }
 
     /// The nodes with a mesh in the scene shown, in file order.
@@ -313,7 +321,42 @@ impl<'a> File<'a> {
         asset.morphs = morphs;
         asset.materials = looks.materials;
         asset.surfaces = looks.surfaces;
+        if let Some(vrm) = &self.vrm {
+            self.add_vrm(vrm, &joint_of_node, &morph_of, &mut asset);
+        }
         Ok(Part { asset, clips, morph_weights })
+    }
+
+    /// A VRM avatar's humanoid bones (those in the part) and its expressions (the morph
+    /// targets of the part's meshes they set).
+    fn add_vrm(
+        &self,
+        vrm: &super::vrm::Vrm,
+        joint_of_node: &[Option<usize>],
+        morph_of: &[(usize, usize, usize)],
+        asset: &mut CharacterAsset,
+    ) {
+        use super::vrm::BindTarget;
+        for &(bone, node) in &vrm.bones {
+            if let Some(j) = joint_of_node.get(node).copied().flatten() {
+                asset.humanoid.insert(bone, j);
+            }
+        }
+        for expression in &vrm.expressions {
+            let mut weights = Vec::new();
+            for bind in &expression.binds {
+                for &(node, first, count) in morph_of {
+                    let named = match bind.on {
+                        BindTarget::Node(n) => n == node,
+                        BindTarget::Mesh(m) => self.node(node).mesh().is_some_and(|mesh| mesh.index() == m),
+                    };
+                    if named && bind.index < count {
+                        weights.push((first + bind.index, bind.weight));
+                    }
+                }
+            }
+            asset.expressions.push(crate::rig::character::Expression { name: expression.name.clone(), weights });
+        }
     }
 
     /// The node the part's skeleton starts at and the transform of the static nodes above

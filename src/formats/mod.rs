@@ -26,6 +26,7 @@ pub mod scene;
 pub mod smpl;
 pub mod stage;
 pub mod uri;
+pub mod vrm;
 pub mod weight_warnings;
 
 pub use character::{CharacterSource, has_parts, load_character, load_parts};

@@ -82,6 +82,30 @@ pub struct CharacterAsset {
     /// The runs of the mesh drawn with one material each (empty: one run, drawn with the
     /// first material if there is one, else the character's tint).
     pub surfaces: Vec<Surface>,
+    /// The humanoid bones the file names (a VRM avatar's); empty where it names none.
+    pub humanoid: super::humanoid::HumanoidMap,
+    /// Named sets of morph weights (a VRM avatar's expressions).
+    pub expressions: Vec<Expression>,
+}
+
+/// A named set of morph weights: each listed morph target at its weight, the rest at 0.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Expression {
+    pub name: String,
+    pub weights: Vec<(usize, f32)>,
+}
+
+impl Expression {
+    /// The weights of `morphs` morph targets the expression sets.
+    pub fn morph_weights(&self, morphs: usize) -> Vec<f32> {
+        let mut out = vec![0.0; morphs];
+        for &(m, w) in &self.weights {
+            if let Some(slot) = out.get_mut(m) {
+                *slot = (*slot + w).min(1.0);
+            }
+        }
+        out
+    }
 }
 
 /// A morph target: how far some vertices move (bind space) at full weight.
@@ -111,6 +135,8 @@ impl CharacterAsset {
             morphs: Vec::new(),
             materials: Vec::new(),
             surfaces: Vec::new(),
+            humanoid: Default::default(),
+            expressions: Vec::new(),
         })
     }
 
@@ -151,6 +177,8 @@ impl CharacterAsset {
             morphs: Vec::new(),
             materials: Vec::new(),
             surfaces: Vec::new(),
+            humanoid: Default::default(),
+            expressions: Vec::new(),
         }
     }
 

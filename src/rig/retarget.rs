@@ -10,8 +10,11 @@
 //!   [`RestAlignment::OwnRest`] the rotations are carried from rest to rest (the source's
 //!   rest frame gives the target its own rest pose). Rigs facing another way in their
 //!   model space (a multiple of 90° about +y) are turned to face the source's way.
-//! - **Translation.** The hips move as the source's, scaled by the ratio of leg lengths
-//!   (thigh + shin), their height over each one's floor likewise.
+//! - **Translation.** The hips move across as the source's, scaled by the ratio of leg
+//!   lengths (thigh + shin); in height the target's lowest foot joint stands as far over its
+//!   floor as it does standing, raised as the source's rises over its own standing
+//!   clearance times that ratio (so a target of other proportions stands on its floor
+//!   where the source stands on its own).
 //! - **Feet.** Where the source plants a foot (low and still), the target's foot keeps the
 //!   place it had when the contact began, moving only as the source's foot moves (scaled);
 //!   no ankle sinks below its standing height where the source's stands on the floor, and
@@ -37,13 +40,33 @@ pub enum RestAlignment {
     OwnRest,
 }
 
-/// A humanoid to retarget from or onto: its skeleton, map, and the height of its floor in
-/// model space (its lowest point standing in its initial pose).
+/// A humanoid to retarget from or onto: its skeleton, map, the height of the floor its
+/// motion stands on in model space, and of its lowest point standing in its initial pose
+/// (for a target, the same); and its soles: points of its skin under its feet, by which
+/// it stands (empty: its foot joints).
 #[derive(Clone, Copy)]
 pub struct Humanoid<'a> {
     pub skeleton: &'a Skeleton,
     pub map: &'a HumanoidMap,
     pub floor: f32,
+    pub rest_floor: f32,
+    pub soles: &'a [Sole],
+}
+
+/// A skin point as its joints move it: each joint, its weight, and the point in that
+/// joint's frame.
+pub type Sole = Vec<(usize, f32, Vec3)>;
+
+impl Humanoid<'_> {
+    /// The height of its lowest sole point (or foot joint) with its joints turned and
+    /// placed as `rotations` and `at` say; infinite without feet.
+    fn lowest_foot(&self, rotations: &[Quat], at: &[Vec3]) -> f32 {
+        if self.soles.is_empty() {
+            return FEET.iter().filter_map(|b| self.map.get(b)).map(|&j| at[j].y).fold(f32::INFINITY, f32::min);
+        }
+        let height = |sole: &Sole| sole.iter().map(|&(j, w, p)| w * (at[j] + rotations[j] * p).y).sum::<f32>();
+        self.soles.iter().map(height).fold(f32::INFINITY, f32::min)
+    }
 }
 
 /// One frame of motion: the root joint's position in model space and every joint's
@@ -81,6 +104,7 @@ pub struct Retargeter<'a> {
     target: Humanoid<'a>,
     rest: RestAlignment,
     source_rest: Vec<Quat>,
+    target_rest: Vec<Quat>,
     source_rest_at: Vec<Vec3>,
     target_rest_at: Vec<Vec3>,
     bones: Vec<Option<Bone>>,
@@ -93,9 +117,17 @@ pub struct Retargeter<'a> {
     target_leg: f32,
 }
 
+/// The bones a humanoid stands on.
+const FEET: [HumanBone; 4] = [HumanBone::LeftFoot, HumanBone::RightFoot, HumanBone::LeftToes, HumanBone::RightToes];
+
 /// The bones each standard bone points at, the first mapped on both sides taken.
 fn aims(bone: HumanBone) -> &'static [HumanBone] {
+    static BONES: [HumanBone; HumanBone::ALL.len()] = HumanBone::ALL;
     use HumanBone::*;
+    if let Some(k) = BONES.iter().position(|&b| b == bone).filter(|_| bone.is_finger()) {
+        // A phalanx points at the next one out.
+        return if (k - 21) % 3 < 2 { std::slice::from_ref(&BONES[k + 1]) } else { &[] };
+    }
     match bone {
         Hips => &[Spine, Chest],
         Spine => &[Chest],
@@ -113,7 +145,7 @@ fn aims(bone: HumanBone) -> &'static [HumanBone] {
         RightUpperLeg => &[RightLowerLeg],
         RightLowerLeg => &[RightFoot],
         RightFoot => &[RightToes],
-        Head | LeftHand | RightHand | LeftToes | RightToes => &[],
+        _ => &[],
     }
 }
 
@@ -214,6 +246,7 @@ impl<'a> Retargeter<'a> {
             rest,
             namesakes,
             source_rest,
+            target_rest,
             source_rest_at,
             target_rest_at,
             bones,
@@ -236,21 +269,21 @@ impl<'a> Retargeter<'a> {
     /// The source's frame carried onto the target (no feet planted), and the joints whose
     /// rotations the target's limits clamped.
     pub fn frame(&self, source: &Frame) -> (Frame, Vec<usize>) {
-        let (pose, clamped, s_at) = self.carried(source, self.target.skeleton.initial_pose(), |_| true);
-        let root = self.placed_root(&s_at, &pose);
+        let (pose, clamped, (s_rot, s_at)) = self.carried(source, self.target.skeleton.initial_pose(), |_| true);
+        let root = self.placed_root((&s_rot, &s_at), &pose);
         (Frame { root, pose }, clamped)
     }
 
     /// The source's pose carried onto `base` (a pose of the target): the mapped joints
     /// whose source joints `drives` says, and (driving every joint) the unmapped joints
     /// with namesakes; the rest keep `base`. With the joints it clamped and the source's
-    /// joint positions.
+    /// joints' world rotations and positions.
     fn carried(
         &self,
         source: &Frame,
         mut pose: Vec<JointRotation>,
         drives: impl Fn(usize) -> bool,
-    ) -> (Vec<JointRotation>, Vec<usize>, Vec<Vec3>) {
+    ) -> (Vec<JointRotation>, Vec<usize>, (Vec<Quat>, Vec<Vec3>)) {
         let (s, t) = (self.source.skeleton, self.target.skeleton);
         let (s_rot, s_at) = world_frames(s, source.root, &source.pose);
         let mut world = vec![Quat::IDENTITY; t.len()];
@@ -285,7 +318,7 @@ impl<'a> Retargeter<'a> {
             }
             world[j] = (parent * pose[j].to_quat()).normalize();
         }
-        (pose, clamped, s_at)
+        (pose, clamped, (s_rot, s_at))
     }
 
     /// The target's joints driven by the source joints `driving`, carried from
@@ -303,16 +336,30 @@ impl<'a> Retargeter<'a> {
     }
 
     /// The target root that puts its hips where the source's are, scaled by the leg ratio:
-    /// across from their rests, and their height over the floor.
-    fn placed_root(&self, s_at: &[Vec3], pose: &[JointRotation]) -> Vec3 {
+    /// across from their rests; in height, its lowest foot joint as far over its floor as
+    /// it stands, raised as the source's is over its own standing clearance times the
+    /// ratio (the hips' height over the floor, from their standing heights, for a rig
+    /// without feet on either side).
+    fn placed_root(&self, (s_rot, s_at): (&[Quat], &[Vec3]), pose: &[JointRotation]) -> Vec3 {
         let t = self.target.skeleton;
         let (sh, th) = (self.source.map[&HumanBone::Hips], self.target.map[&HumanBone::Hips]);
         let root_offset = t.joint(0).rest_offset;
-        let (_, at) = world_frames(t, root_offset, pose);
+        let (rotations, at) = world_frames(t, root_offset, pose);
         let moved = (s_at[sh] - self.source_rest_at[sh]) * self.ratio;
-        let mut wanted = self.target_rest_at[th] + moved;
-        wanted.y = self.target.floor + (s_at[sh].y - self.source.floor) * self.ratio;
-        root_offset + (wanted - at[th])
+        let mut shift = self.target_rest_at[th] + moved - at[th];
+        let (s_low, t_low) = (self.source.lowest_foot(s_rot, s_at), self.target.lowest_foot(&rotations, &at));
+        let s_clear = self.source.lowest_foot(&self.source_rest, &self.source_rest_at) - self.source.rest_floor;
+        let t_clear = self.target.lowest_foot(&self.target_rest, &self.target_rest_at) - self.target.rest_floor;
+        shift.y = if s_low.is_finite() && t_low.is_finite() {
+            self.target.floor + t_clear + (s_low - self.source.floor - s_clear) * self.ratio - t_low
+        } else {
+            let (s_standing, t_standing) = (
+                self.source_rest_at[sh].y - self.source.rest_floor,
+                self.target_rest_at[th].y - self.target.rest_floor,
+            );
+            self.target.floor + t_standing + (s_at[sh].y - self.source.floor - s_standing) * self.ratio - at[th].y
+        };
+        root_offset + shift
     }
 
     /// Every frame carried onto the target (`fps` frames a second), with the source's
@@ -348,10 +395,12 @@ impl<'a> Retargeter<'a> {
     ) -> (Vec<bool>, Vec<bool>) {
         let (s, t) = (self.source.skeleton, self.target.skeleton);
         let s_foot: Vec<Vec3> = source.iter().map(|f| world_frames(s, f.root, &f.pose).1[sf]).collect();
-        let mut planted = planted_frames(&s_foot, fps, self.source.floor, self.source_rest_at[sf].y, self.source_leg);
-        planted.iter_mut().for_each(|p| *p &= plant);
+        // The ankles' standing heights over their floors.
         let (s_ankle, t_ankle) =
-            (self.source_rest_at[sf].y - self.source.floor, self.target_rest_at[tf].y - self.target.floor);
+            (self.source_rest_at[sf].y - self.source.rest_floor, self.target_rest_at[tf].y - self.target.rest_floor);
+        let (floor, leg) = (self.source.floor, self.source_leg);
+        let mut planted = planted_frames(&s_foot, fps, floor, floor + s_ankle, leg);
+        planted.iter_mut().for_each(|p| *p &= plant);
         // The lowest the target's ankle may go, for the source's ankle at `y`: standing
         // height where the source's stands (or higher), lower in proportion where the
         // source's is lower (a foot rolled onto its toes).
@@ -471,8 +520,8 @@ pub fn retarget_pose(
     rest: RestAlignment,
 ) -> Option<Vec<JointRotation>> {
     let retargeter = Retargeter::new(
-        Humanoid { skeleton: source.0, map: source.1, floor: 0.0 },
-        Humanoid { skeleton: target.0, map: target.1, floor: 0.0 },
+        Humanoid { skeleton: source.0, map: source.1, floor: 0.0, rest_floor: 0.0, soles: &[] },
+        Humanoid { skeleton: target.0, map: target.1, floor: 0.0, rest_floor: 0.0, soles: &[] },
         rest,
     )?;
     let frame = Frame { root: source.0.joint(0).rest_offset, pose: source_pose.to_vec() };

@@ -118,3 +118,110 @@ fn bad_fbx_files_say_what_and_name_the_file() {
         }
     }
 }
+
+/// `bytes` with every occurrence of `pattern` followed by `at` bytes overwritten by `with`.
+fn patched(bytes: &[u8], pattern: &[u8], at: usize, with: &[u8]) -> (Vec<u8>, usize) {
+    let mut out = bytes.to_vec();
+    let mut count = 0;
+    let mut from = 0;
+    while let Some(k) = out[from..].windows(pattern.len()).position(|w| w == pattern) {
+        let start = from + k + pattern.len() + at;
+        if start + with.len() > out.len() {
+            break;
+        }
+        out[start..start + with.len()].copy_from_slice(with);
+        count += 1;
+        from = start + with.len();
+    }
+    (out, count)
+}
+
+/// Hostile FBX regressions, made from a Blender fixture: a node translation that is not a
+/// number, and a cluster whose bind matrix is all zeros (singular), are refused with a
+/// message naming the file and what was wrong, never a panic or a skin of NaNs.
+#[test]
+fn hostile_fbx_transforms_and_binds_are_refused_at_the_boundary() {
+    let dir = crate::common::scratch("fbx-hostile");
+    let whole =
+        std::fs::read(std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/blender_arm.fbx")).unwrap();
+    // `P: "Lcl Translation", "Lcl Translation", "", "A", D x, D y, D z`: x made NaN.
+    let property = b"Lcl TranslationS\x0f\x00\x00\x00Lcl TranslationS\x00\x00\x00\x00S\x01\x00\x00\x00AD";
+    let (nan, count) = patched(&whole, property, 0, &f64::NAN.to_le_bytes());
+    assert!(count >= 2, "the fixture's translations were found");
+    // Every 4×4 matrix a cluster's bind is made of (the cluster's `Transform` and
+    // `TransformLink`, the bind pose's `Matrix`: `d[16]`, count, encoding 0, byte length,
+    // then the doubles) all zero.
+    let matrix = b"\x10\x00\x00\x00\x00\x00\x00\x00\x80\x00\x00\x00";
+    let mut singular = whole.clone();
+    for name in [&b"Transformd"[..], b"TransformLinkd", b"Matrixd"] {
+        let (out, count) = patched(&singular, &[name, matrix].concat(), 0, &[0; 128]);
+        assert!(count >= 1, "the fixture's {} were found", String::from_utf8_lossy(name));
+        singular = out;
+    }
+    for (file, bytes, says) in [("nan.fbx", nan, "translation"), ("singular.fbx", singular, "bind")] {
+        let path = dir.join(file);
+        std::fs::write(&path, bytes).unwrap();
+        match marionette::formats::load_parts(&path) {
+            Err(e) => {
+                let e = e.to_string();
+                assert!(e.contains(file) && e.contains(says), "{e}");
+            }
+            Ok(parts) => panic!("{file} loaded ({} parts)", parts.len()),
+        }
+    }
+}
+
+/// A Blender FBX whose hair mesh has two vertices no bone weighs loads (with a warning
+/// naming the mesh) and those vertices follow the mesh's node: at rest where Blender put
+/// them, and left there while the arm turns (the node is the armature, which stays).
+#[test]
+fn vertices_without_weights_follow_their_mesh_node() {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/unweighted.fbx");
+    let parts = marionette::formats::load_parts(&path).unwrap();
+    let asset = &parts[0].asset;
+    assert!(
+        asset.warnings.iter().any(|w| w.contains("`Hair`") && w.contains("2 vertices have no skin weight")),
+        "{:?}",
+        asset.warnings
+    );
+    // Blender's z up is y up here: the strand's free end at (0.2..0.3, 1.5, 0).
+    let free: Vec<usize> = asset
+        .skin
+        .bind_positions
+        .iter()
+        .enumerate()
+        .filter(|(_, p)| (p.y - 1.5).abs() < 1e-5 && p.z.abs() < 1e-5 && (0.19..0.31).contains(&p.x))
+        .map(|(v, _)| v)
+        .collect();
+    assert_eq!(free.len(), 2, "the two unweighted vertices, once each");
+    // The arm bent at `lower`: the strand's weighted end goes with it, the free end stays.
+    let lower = asset.skeleton.find("lower").unwrap();
+    let mut pose = asset.skeleton.initial_pose();
+    pose[lower] = marionette::rig::JointRotation::Quat(glam::Quat::from_rotation_x(0.7) * pose[lower].to_quat());
+    let rest =
+        marionette::document::posing::posed_positions(asset, &asset.skeleton.initial_pose(), glam::Mat4::IDENTITY);
+    let posed = marionette::document::posing::posed_positions(asset, &pose, glam::Mat4::IDENTITY);
+    let moved = (0..rest.len()).filter(|&v| posed[v].distance(rest[v]) > 1e-3).count();
+    assert!(moved > 0, "bending moves the weighted vertices");
+    for v in free {
+        assert!(rest[v].distance(asset.skin.bind_positions[v]) < 1e-5, "at rest where the file puts it");
+        assert!(posed[v].distance(rest[v]) < 1e-5, "left where the mesh's node puts it");
+    }
+}
+
+/// A curve whose keys are all one value (Blender writes a constant curve so; ufbx calls it
+/// constant) still sets its joint: `lower` stays turned 30° about x through the clip, its
+/// box's far end over half a bone (sin 30°, and the box's width) off the arm's plane, where
+/// the node's own rotation would leave it at 0.1.
+#[test]
+fn constant_fbx_curves_set_their_joint() {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/one_key.fbx");
+    let parts = marionette::formats::load_parts(&path).unwrap();
+    let (rest, _) = posed_gltf(&parts, None, 0.0, &[], SkinningMethod::Linear).unwrap();
+    let height = rest.iter().map(|p| p.y).fold(f32::MIN, f32::max);
+    for t in [0.0, 0.5, 0.9] {
+        let (posed, _) = posed_gltf(&parts, Some("0"), t, &[], SkinningMethod::Linear).unwrap();
+        let off_plane = posed.iter().map(|p| p.z.abs()).fold(0.0, f32::max) / (height / 2.0);
+        assert!((0.5..0.7).contains(&off_plane), "t = {t}: {off_plane}");
+    }
+}

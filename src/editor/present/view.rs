@@ -280,7 +280,7 @@ fn put_motion_on_humanoids(
 ) {
     let mut fitted = 0;
     for c in &mut doc.characters {
-        if library.load(&c.source).is_ok_and(|a| crate::rig::humanoid::detect(&a.skeleton).is_some()) {
+        if library.load(&c.source).is_ok_and(|a| crate::rig::humanoid::of_asset(&a).is_some()) {
             c.anim = Some(anim.clone());
             fitted += 1;
         }

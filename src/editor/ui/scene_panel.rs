@@ -308,10 +308,24 @@ fn match_heights(panels: &Panels, entity: Entity, height: f32) -> Vec<Edit> {
         .collect()
 }
 
-/// A slider per morph target; the new weights when one moved.
+/// A button per expression (a VRM avatar's: sets the morph weights it names) and a slider
+/// per morph target; the new weights when one changed them.
 fn morph_sliders(ui: &mut egui::Ui, morphs: &crate::scene::morphs::Morphs) -> Option<Vec<f32>> {
     let mut weights = morphs.weights.clone();
     egui::CollapsingHeader::new("Morphs").default_open(true).show(ui, |ui| {
+        if !morphs.base.expressions.is_empty() {
+            ui.horizontal_wrapped(|ui| {
+                ui.label("Expression");
+                if ui.button("neutral").clicked() {
+                    weights.iter_mut().for_each(|w| *w = 0.0);
+                }
+                for expression in &morphs.base.expressions {
+                    if ui.button(&expression.name).clicked() {
+                        weights = expression.morph_weights(weights.len());
+                    }
+                }
+            });
+        }
         for (target, w) in morphs.base.morphs.iter().zip(weights.iter_mut()) {
             ui.add(egui::Slider::new(w, 0.0..=1.0).text(&target.name).clamping(egui::SliderClamping::Edits));
         }
