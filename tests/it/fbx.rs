@@ -225,3 +225,25 @@ fn constant_fbx_curves_set_their_joint() {
         assert!((0.5..0.7).contains(&off_plane), "t = {t}: {off_plane}");
     }
 }
+
+/// One clip numbering for every format: an FBX file's clips are numbered from 0 as a glTF
+/// file's animations are, `--clip 0` finds the first in either, and a `--clip` that names
+/// no clip of a file fails, listing the file's clips.
+#[test]
+fn clips_are_numbered_alike_and_a_missing_clip_fails_naming_the_clips() {
+    let data = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data");
+    let (fbx, glb) = (data.join("one_key.fbx"), data.join("blender_pair.glb"));
+    for path in [&fbx, &glb] {
+        let parts = marionette::formats::load_parts(path).unwrap();
+        assert_eq!(parts[0].clips[0].index, 0, "{path:?}");
+        marionette::document::posing::check_clip_spec(std::slice::from_ref(path), "0").unwrap();
+    }
+    let e = marionette::document::posing::check_clip_spec(&[fbx.clone(), glb.clone()], "7").unwrap_err();
+    assert!(e.contains("one_key.fbx: no clip `7` (its clips: 0 `Scene`)"), "{e}");
+    // A file of several whose clips it names one of, and one whose it names none of.
+    let e = marionette::document::posing::check_clip_spec(&[fbx, glb], "Scene").unwrap_err();
+    assert!(
+        e.contains("blender_pair.glb: no clip `Scene` (its clips: 0 `walker_rig_action`, 1 `waver_rig_action`)"),
+        "{e}"
+    );
+}
