@@ -310,3 +310,44 @@ fn position_channels_below_the_root_move_the_figure() {
     assert!((start.y - 100.0).abs() < 0.01 && (end.y - 100.0).abs() < 0.01, "hips at {start} and {end}");
     assert!(bvh.warnings.is_empty(), "{:?}", bvh.warnings);
 }
+
+/// Finger motion carries over where both rigs have fingers: a Mixamo-named hand's fingers
+/// curled (every phalanx of every finger turned 40° about the hand's across axis) put on
+/// the VRM avatar through the two maps, each target phalanx pointing where the source's
+/// points (within 2°).
+#[test]
+fn finger_motion_carries_between_rigs_of_other_names() {
+    use marionette::rig::JointRotation;
+    use marionette::rig::retarget::{RestAlignment, retarget_pose};
+    let source = marionette::formats::load_character(&fixture("mixamo.glb")).unwrap();
+    let target = marionette::formats::load_character(&vrm_avatar(1)).unwrap();
+    let (s_map, t_map) = (humanoid_map(&source, &Default::default()), humanoid_map(&target, &Default::default()));
+    let mut pose = source.skeleton.initial_pose();
+    for finger in 0..5 {
+        for phalanx in 0..3 {
+            let j = s_map[&HumanBone::finger(true, finger, phalanx)];
+            let curl = glam::Quat::from_rotation_z(-0.7);
+            pose[j] = JointRotation::Quat(pose[j].to_quat() * curl);
+        }
+    }
+    let carried =
+        retarget_pose((&source.skeleton, &s_map), &pose, (&target.skeleton, &t_map), RestAlignment::Directions)
+            .unwrap();
+    let (_, sa) = world_frames(&source.skeleton, source.skeleton.joint(0).rest_offset, &pose);
+    let (_, ta) = world_frames(&target.skeleton, target.skeleton.joint(0).rest_offset, &carried);
+    let mut worst = 0.0f32;
+    for finger in 0..5 {
+        for phalanx in 0..2 {
+            let (a, b) = (HumanBone::finger(true, finger, phalanx), HumanBone::finger(true, finger, phalanx + 1));
+            let s_dir = sa[s_map[&b]] - sa[s_map[&a]];
+            let t_dir = ta[t_map[&b]] - ta[t_map[&a]];
+            worst = worst.max(s_dir.angle_between(t_dir).to_degrees());
+        }
+    }
+    // The curl moved the fingers: compare with the rest.
+    let (_, rest) =
+        world_frames(&source.skeleton, source.skeleton.joint(0).rest_offset, &source.skeleton.initial_pose());
+    let moved = sa[s_map[&HumanBone::LeftIndexDistal]].distance(rest[s_map[&HumanBone::LeftIndexDistal]]);
+    assert!(moved > 0.01, "the curl moved the index's tip {moved} m");
+    assert!(worst < 2.0, "a phalanx {worst}° off the source's");
+}
