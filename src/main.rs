@@ -21,8 +21,18 @@ fn main() -> ExitCode {
 fn run(cli: Cli) -> Result<()> {
     match cli.command {
         None => marionette::editor::run(Vec::new(), Default::default()),
-        Some(Command::Edit { paths, clip }) => {
+        Some(Command::Edit { paths, clip, poses, ik, recover }) => {
+            let paths = if recover {
+                use marionette::editor::ui::unsaved::{newest_recovery, recovery_dir};
+                let newest = newest_recovery()
+                    .ok_or_else(|| anyhow::anyhow!("{}: no recovery file", recovery_dir().display()))?;
+                vec![newest]
+            } else {
+                paths
+            };
             let edits = marionette::editor::StartupEdits {
+                poses,
+                ik,
                 anim: clip.anim_doc(true),
                 time: clip.time,
                 clip: clip.own_clip(),

@@ -23,6 +23,17 @@ pub enum Command {
         paths: Vec<PathBuf>,
         #[command(flatten)]
         clip: ClipArgs,
+        /// `JOINT=rx,ry,rz` applied to every character that has the joint (the scene opens
+        /// with unsaved changes). Repeatable.
+        #[arg(long = "pose", value_name = "JOINT=rx,ry,rz")]
+        poses: Vec<PoseSpec>,
+        /// `JOINT=x,y,z` world-space IK target for every character that has the joint.
+        #[arg(long = "ik", value_name = "JOINT=x,y,z")]
+        ik: Vec<IkSpec>,
+        /// Open the newest recovery file (what autosave or a crash left in
+        /// `$XDG_STATE_HOME/marionette/recovery`).
+        #[arg(long, conflicts_with = "paths")]
+        recover: bool,
     },
     /// Print what a character file loads as: joints, vertices, triangles, weight checks.
     Info { path: PathBuf },

@@ -113,6 +113,7 @@ pub fn windowless_plugins() -> bevy::app::PluginGroupBuilder {
 
 /// Opens the editor window on `paths` (or on the default scene) and runs until closed.
 pub fn run(paths: Vec<PathBuf>, edits: StartupEdits) {
+    ui::unsaved::install_panic_hook(ui::unsaved::Autosave::from_env().file);
     App::new()
         .add_plugins(DefaultPlugins.set(task_pools()).set(WindowPlugin {
             primary_window: Some(Window {
@@ -120,6 +121,8 @@ pub fn run(paths: Vec<PathBuf>, edits: StartupEdits) {
                 resolution: WindowResolution::new(1280, 800),
                 ..default()
             }),
+            // A close request asks first where there are unsaved changes (`UnsavedWorkPlugin`).
+            close_when_requested: false,
             ..default()
         }))
         .add_plugins(bevy_egui::EguiPlugin::default())
@@ -138,6 +141,7 @@ pub fn run(paths: Vec<PathBuf>, edits: StartupEdits) {
             InteractionPlugin,
             ui::InspectorPlugin,
             ui::recent::RecentFilesPlugin,
+            ui::unsaved::UnsavedWorkPlugin,
             present::screenshot::ScreenshotPlugin,
         ))
         // The inspector's edits (bevy_egui's pass) land before the chain that animates,

@@ -82,3 +82,21 @@ pub struct JointDrag {
     /// The last solve's note (reached or not, limited), shown in the panel.
     pub note: String,
 }
+
+/// Whether the scene differs from its file: the history state it was saved or opened at,
+/// whether the startup options changed it, and a save made this frame (its state is
+/// recorded once the frame's edits are applied).
+#[derive(Resource, Clone, Debug, Default)]
+pub struct SavedState {
+    pub at: u64,
+    pub changed_at_start: bool,
+    pub saved_now: bool,
+}
+
+impl SavedState {
+    /// Whether the scene in the history state `state` (a gesture under way or not) has
+    /// changes its file does not.
+    pub fn unsaved(&self, state: u64, gesture_open: bool) -> bool {
+        self.changed_at_start || gesture_open || state != self.at
+    }
+}

@@ -33,6 +33,7 @@ mod rig_families;
 mod robust;
 mod shot;
 mod smpl;
+mod unsaved;
 mod untrusted;
 mod wild;
 mod writers;

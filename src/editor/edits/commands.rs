@@ -34,6 +34,7 @@ impl Plugin for CommandsPlugin {
         crate::editor::order::add_editor_order(app);
         app.init_resource::<EditQueue>()
             .init_resource::<History>()
+            .init_resource::<crate::editor::state::SavedState>()
             .init_resource::<GestureHold>()
             .init_resource::<CharacterIndex>()
             .init_resource::<NextCharacterId>()
@@ -46,6 +47,7 @@ impl Plugin for CommandsPlugin {
 /// and is judged (what changed) in the next, once that frame's chain has run: a clip's
 /// pose is only written by playback. Exclusive: edits may spawn and despawn.
 pub fn apply_edits(world: &mut World) {
+    record_save(world);
     if world.resource::<History>().gesture_ended {
         close_gesture(world);
     }
@@ -67,10 +69,20 @@ pub fn apply_edits(world: &mut World) {
         close_gesture(world);
     }
     if let Some(request) = request
-        && let Some(step) = world.resource_mut::<History>().pop(request)
+        && let Some((id, step)) = world.resource_mut::<History>().pop(request)
     {
         let back = replay(world, step);
-        world.resource_mut::<History>().push_opposite(request, back);
+        world.resource_mut::<History>().push_opposite(request, (id, back));
+    }
+}
+
+/// A save made since the last frame marks the history's state as the file's.
+fn record_save(world: &mut World) {
+    let state = world.resource::<History>().state();
+    if let Some(mut saved) = world.get_resource_mut::<crate::editor::state::SavedState>()
+        && saved.saved_now
+    {
+        *saved = crate::editor::state::SavedState { at: state, changed_at_start: false, saved_now: false };
     }
 }
 

@@ -9,8 +9,10 @@ use crate::editor::edits::edit::Edit;
 /// The undo and redo steps, and what undoes the gesture under way.
 #[derive(Resource, Default, Debug)]
 pub struct History {
-    undo: Vec<Vec<Edit>>,
-    redo: Vec<Vec<Edit>>,
+    undo: Vec<Step>,
+    redo: Vec<Step>,
+    /// The id the next committed step gets.
+    next_id: u64,
     /// What undoes the gesture under way, in the order its edits were applied.
     gesture: Vec<Edit>,
     /// Where the gesture's last add or remove was recorded: edits before it are not merged
@@ -21,6 +23,9 @@ pub struct History {
     /// Requests from keys or buttons, served by `apply_edits`.
     pub request: Option<HistoryRequest>,
 }
+
+/// An undo or redo step: the state it returns from (its id), and the edits that undo it.
+pub type Step = (u64, Vec<Edit>);
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum HistoryRequest {
@@ -51,6 +56,12 @@ impl History {
 
     pub fn gesture_open(&self) -> bool {
         !self.gesture.is_empty()
+    }
+
+    /// Which state the scene is in: the id of the step undo would reverse (0 where the
+    /// history began). Undoing back to a state gives its id again.
+    pub fn state(&self) -> u64 {
+        self.undo.last().map_or(0, |(id, _)| *id)
     }
 
     /// Adds what undoes one applied edit to the gesture under way. Within a gesture only
@@ -94,11 +105,12 @@ impl History {
     /// Records a finished gesture as an undo step; a new step clears the redo steps.
     pub fn commit(&mut self, step: Vec<Edit>) {
         self.redo.clear();
-        push_bounded(&mut self.undo, step);
+        self.next_id += 1;
+        push_bounded(&mut self.undo, (self.next_id, step));
     }
 
     /// The step to replay for `request`.
-    pub fn pop(&mut self, request: HistoryRequest) -> Option<Vec<Edit>> {
+    pub fn pop(&mut self, request: HistoryRequest) -> Option<Step> {
         match request {
             HistoryRequest::Undo => self.undo.pop(),
             HistoryRequest::Redo => self.redo.pop(),
@@ -106,7 +118,7 @@ impl History {
     }
 
     /// Records what undoes a replayed step on the other stack.
-    pub fn push_opposite(&mut self, request: HistoryRequest, step: Vec<Edit>) {
+    pub fn push_opposite(&mut self, request: HistoryRequest, step: Step) {
         match request {
             HistoryRequest::Undo => push_bounded(&mut self.redo, step),
             HistoryRequest::Redo => push_bounded(&mut self.undo, step),
@@ -114,7 +126,7 @@ impl History {
     }
 }
 
-fn push_bounded(stack: &mut Vec<Vec<Edit>>, step: Vec<Edit>) {
+fn push_bounded(stack: &mut Vec<Step>, step: Step) {
     stack.push(step);
     if stack.len() > HISTORY_DEPTH {
         stack.remove(0);

@@ -38,6 +38,7 @@ pub fn scene_shortcuts(
     state: Option<Res<InspectorState>>,
     mut pending: ResMut<PendingScene>,
     mut messages: ResMut<Messages>,
+    mut saved: ResMut<crate::editor::state::SavedState>,
 ) {
     if !viewport_has_keys(&wants) {
         return;
@@ -52,7 +53,7 @@ pub fn scene_shortcuts(
         }
         if let Some(state) = &state {
             if keys.just_pressed(KeyCode::KeyS) {
-                save_scene_to(&state.scene_path, &scene.capture(), &mut messages);
+                save_scene_to(&state.scene_path, &scene.capture(), &mut messages, &mut saved);
             }
             if keys.just_pressed(KeyCode::KeyO) {
                 open_scene_from(&state.scene_path, &mut pending, &mut messages);

@@ -39,6 +39,8 @@ impl Plugin for ScenePlugin {
             .init_resource::<Selection>()
             .init_resource::<UnloadedCharacters>()
             .init_resource::<PendingScene>()
+            .init_resource::<crate::editor::scene_doc::document::ChangedAtStartup>()
+            .init_resource::<crate::editor::state::SavedState>()
             .init_resource::<ik_drag::Pins>()
             .init_resource::<Library>()
             .init_resource::<FramingAspect>()
@@ -106,7 +108,9 @@ impl Plugin for ViewPlugin {
     }
 }
 
-/// Turns the startup paths into the first scene (writes `PendingScene`, `Messages`).
+/// Turns the startup paths into the first scene (writes `PendingScene`, `Messages`, and
+/// whether the startup options changed it).
+#[allow(clippy::too_many_arguments)]
 fn queue_startup_scene(
     paths: Res<StartupPaths>,
     edits: Res<StartupEdits>,
@@ -115,6 +119,7 @@ fn queue_startup_scene(
     mut pending: ResMut<PendingScene>,
     mut arrange: ResMut<crate::editor::scene_doc::arrange::ArrangeWhenSkinned>,
     mut framing: ResMut<FramingView>,
+    mut changed: ResMut<crate::editor::scene_doc::document::ChangedAtStartup>,
 ) {
     let mut notes = Vec::new();
     let doc = startup_doc(&paths.0, &mut library, &mut notes);
@@ -124,7 +129,9 @@ fn queue_startup_scene(
     };
     notes.into_iter().for_each(|m| messages.push(m));
     if let Some(mut doc) = doc {
+        let before = doc.clone();
         apply_startup_edits(&mut doc, &edits, &mut library, &mut messages);
+        changed.0 = doc != before;
         if let Some(view) = startup_view(&mut doc, &edits) {
             framing.0 = view;
         }
@@ -394,6 +401,8 @@ pub struct SceneReset<'w> {
     pose_library: ResMut<'w, crate::editor::edits::pose_library::PoseLibrary>,
     shot: ResMut<'w, crate::editor::present::stage::ShotSettings>,
     bookmarks: ResMut<'w, crate::editor::interact::camera::Bookmarks>,
+    saved: ResMut<'w, crate::editor::state::SavedState>,
+    changed_at_startup: ResMut<'w, crate::editor::scene_doc::document::ChangedAtStartup>,
 }
 
 impl SceneReset<'_> {
@@ -402,6 +411,8 @@ impl SceneReset<'_> {
         self.unloaded.0.clear();
         self.pins.0.clear();
         *self.history = history::History::default();
+        let changed_at_start = std::mem::take(&mut self.changed_at_startup.0);
+        *self.saved = crate::editor::state::SavedState { changed_at_start, ..Default::default() };
     }
 }
 

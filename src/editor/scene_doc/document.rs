@@ -89,6 +89,11 @@ pub struct PendingScene {
     pub frame: bool,
 }
 
+/// The startup options changed the first scene from its file (`--pose`, `--clip`, …):
+/// taken when it is opened, so it opens with unsaved changes.
+#[derive(Resource, Default)]
+pub struct ChangedAtStartup(pub bool);
+
 /// Ids for new characters.
 #[derive(Resource, Default)]
 pub struct NextCharacterId(pub u64);
@@ -313,11 +318,24 @@ fn clip_joint(clip: &crate::rig::anim::Clip, anim: &crate::formats::scene::AnimD
     clip.joint_names.iter().position(|n| n == wanted)
 }
 
-/// Saves the scene to `path`, saying so (or why not) in the messages.
-pub fn save_scene_to(path: &str, doc: &SceneDoc, messages: &mut crate::editor::state::Messages) {
+/// Saves the scene to `path`, saying so (or why not) in the messages; a save marks the
+/// scene saved. Whether it was saved.
+pub fn save_scene_to(
+    path: &str,
+    doc: &SceneDoc,
+    messages: &mut crate::editor::state::Messages,
+    saved: &mut crate::editor::state::SavedState,
+) -> bool {
     match write_scene(Path::new(path), doc) {
-        Ok(()) => messages.push(format!("saved the scene to {path}")),
-        Err(e) => messages.push(format!("the scene was not saved: {e}")),
+        Ok(()) => {
+            messages.push(format!("saved the scene to {path}"));
+            saved.saved_now = true;
+            true
+        }
+        Err(e) => {
+            messages.push(format!("the scene was not saved: {e} (the changes are kept)"));
+            false
+        }
     }
 }
 

@@ -82,7 +82,12 @@ pub fn show(ctx: &egui::Context, state: &mut InspectorState, panels: &mut Panels
         }
         DialogPurpose::SaveScene => {
             state.scene_path = text.clone();
-            crate::editor::scene_doc::document::save_scene_to(&text, &panels.scene.capture(), &mut panels.messages);
+            crate::editor::scene_doc::document::save_scene_to(
+                &text,
+                &panels.scene.capture(),
+                &mut panels.messages,
+                &mut panels.saved,
+            );
         }
         DialogPurpose::AddFile => super::open::open_path(&text, state, panels),
         DialogPurpose::ExportGltf => export_gltf(&path, panels),

@@ -14,6 +14,7 @@ pub mod recent;
 pub mod scene_panel;
 pub mod smpl_panel;
 pub mod stage_panel;
+pub mod unsaved;
 
 use bevy::diagnostic::{DiagnosticsStore, FrameTimeDiagnosticsPlugin};
 use bevy::ecs::system::SystemParam;
@@ -90,6 +91,8 @@ pub struct Panels<'w, 's> {
     pub selection: ResMut<'w, Selection>,
     pub history: ResMut<'w, History>,
     pub messages: ResMut<'w, Messages>,
+    /// Whether the scene differs from its file.
+    pub saved: ResMut<'w, crate::editor::state::SavedState>,
     pub library: ResMut<'w, Library>,
     pub ids: ResMut<'w, NextCharacterId>,
     pub pending: ResMut<'w, PendingScene>,

@@ -46,7 +46,7 @@ fn scene_file_row(ui: &mut egui::Ui, state: &mut InspectorState, panels: &mut Pa
     ui.horizontal(|ui| {
         ui.add(egui::TextEdit::singleline(&mut state.scene_path).desired_width(170.0));
         if ui.button("Save").on_hover_text("Ctrl+S").clicked() {
-            save_scene_to(&state.scene_path, &panels.scene.capture(), &mut panels.messages);
+            save_scene_to(&state.scene_path, &panels.scene.capture(), &mut panels.messages, &mut panels.saved);
         }
         if ui.button("Open").on_hover_text("Ctrl+O").clicked() {
             open_scene_from(&state.scene_path, &mut panels.pending, &mut panels.messages);

@@ -1,0 +1,226 @@
+//! Never losing a user's work, on the live ECS (no window): an edit leaves the scene
+//! unsaved, undoing back to the saved state clears it, a save clears it and a failed one
+//! keeps it; a close request with unsaved changes asks and does not exit, without them it
+//! exits; opening another scene asks likewise, the scene in memory kept; the question's
+//! answers; autosave writes a recovery file that reads back as
+//! the scene in memory.
+
+use std::time::Duration;
+
+use bevy::prelude::*;
+use bevy::window::WindowCloseRequested;
+use marionette::editor::edits::commands::Edit;
+use marionette::editor::edits::history::{History, HistoryRequest};
+use marionette::editor::scene_doc::document::{PendingScene, SceneReader, save_scene_to};
+use marionette::editor::state::SavedState;
+use marionette::editor::ui::unsaved::{
+    Autosave, CloseAnswer, Leaving, UnsavedQuestion, UnsavedWorkPlugin, closes_after,
+};
+use marionette::formats::scene::{CharacterDoc, CharacterId, SceneDoc, SourceDoc};
+use marionette::rig::JointRotation;
+
+use crate::common::scratch;
+use crate::edits::{Captured, edit, entity, joint, request, scene_app};
+
+/// The scene app with the unsaved-work plugin (its autosave off unless a test sets it) and
+/// a puppet (id 1) opened.
+fn app() -> App {
+    let mut app = scene_app();
+    app.add_message::<WindowCloseRequested>().add_plugins(UnsavedWorkPlugin);
+    app.insert_resource(Autosave::new(None, scratch("unsaved-off").join("never.ron")));
+    let puppet =
+        CharacterDoc { id: Some(CharacterId(1)), ..CharacterDoc::new(SourceDoc::Embedded("puppet".into()), "p") };
+    *app.world_mut().resource_mut::<PendingScene>() =
+        PendingScene { doc: Some(SceneDoc { characters: vec![puppet], ..SceneDoc::default() }), frame: false };
+    app.update();
+    app.update();
+    app
+}
+
+fn unsaved(app: &App) -> bool {
+    let history = app.world().resource::<History>();
+    app.world().resource::<SavedState>().unsaved(history.state(), history.gesture_open())
+}
+
+fn bend_elbow(app: &mut App, angle: f32) {
+    let elbow = joint(app, 1, "l_elbow");
+    let rotation = JointRotation::Euler(glam::Vec3::new(0.0, angle, 0.0), marionette::rig::EulerOrder::Xyz);
+    edit(app, Edit::Pose { character: CharacterId(1), joints: vec![(elbow, rotation)] });
+    app.update();
+}
+
+/// Saves the scene in memory to `path` as the editor's Save does; whether it was saved.
+fn save(app: &mut App, path: &std::path::Path) -> bool {
+    let path = path.display().to_string();
+    let ok = app
+        .world_mut()
+        .run_system_once(
+            move |scene: SceneReader,
+                  mut messages: ResMut<marionette::editor::Messages>,
+                  mut saved: ResMut<SavedState>| {
+                save_scene_to(&path, &scene.capture(), &mut messages, &mut saved)
+            },
+        )
+        .unwrap();
+    app.update();
+    ok
+}
+
+use bevy::ecs::system::RunSystemOnce;
+
+#[test]
+fn an_edit_leaves_the_scene_unsaved_until_undone_or_saved() {
+    let mut app = app();
+    assert!(!unsaved(&app), "a scene just opened is its file");
+    bend_elbow(&mut app, 0.5);
+    assert!(unsaved(&app), "an edit");
+    request(&mut app, HistoryRequest::Undo);
+    app.update();
+    assert!(!unsaved(&app), "undone back to the saved state");
+    request(&mut app, HistoryRequest::Redo);
+    app.update();
+    assert!(unsaved(&app), "redone");
+    let dir = scratch("unsaved-save");
+    assert!(save(&mut app, &dir.join("scene.ron")));
+    assert!(!unsaved(&app), "saved");
+    bend_elbow(&mut app, 0.9);
+    assert!(unsaved(&app));
+    // A save that fails (a folder where the file should be) keeps the changes and says why.
+    std::fs::create_dir_all(dir.join("taken.ron")).unwrap();
+    assert!(!save(&mut app, &dir.join("taken.ron")));
+    assert!(unsaved(&app), "a failed save keeps the changes");
+    let messages = &app.world().resource::<marionette::editor::Messages>().0;
+    assert!(messages.last().unwrap().contains("not saved"), "{messages:?}");
+    // Undo to the state saved last: saved again.
+    request(&mut app, HistoryRequest::Undo);
+    app.update();
+    assert!(!unsaved(&app));
+}
+
+fn exits(app: &App) -> usize {
+    app.world().resource::<bevy::ecs::message::Messages<AppExit>>().len()
+}
+
+#[test]
+fn closing_with_unsaved_changes_asks_and_does_not_exit() {
+    let mut app = app();
+    let window = entity(&app, 1);
+    bend_elbow(&mut app, 0.5);
+    app.world_mut().write_message(WindowCloseRequested { window });
+    app.update();
+    assert!(matches!(app.world().resource::<UnsavedQuestion>().about, Some(Leaving::Close)), "the question opens");
+    assert_eq!(exits(&app), 0, "the app stays");
+    // Without changes a close request ends the app.
+    request(&mut app, HistoryRequest::Undo);
+    app.update();
+    app.world_mut().resource_mut::<UnsavedQuestion>().about = None;
+    app.world_mut().write_message(WindowCloseRequested { window });
+    app.update();
+    assert!(app.world().resource::<UnsavedQuestion>().about.is_none());
+    assert!(exits(&app) > 0, "closed");
+    // The answers: Don't save closes, Cancel stays, Save closes only when the save worked.
+    assert!(closes_after(CloseAnswer::DontSave, || unreachable!("no save")));
+    assert!(!closes_after(CloseAnswer::Cancel, || unreachable!("no save")));
+    assert!(closes_after(CloseAnswer::Save, || true));
+    assert!(!closes_after(CloseAnswer::Save, || false));
+}
+
+#[test]
+fn autosave_writes_a_recovery_file_that_reads_back_as_the_scene_in_memory() {
+    let mut app = app();
+    let file = scratch("unsaved-autosave").join("recovery").join("scene.ron");
+    app.insert_resource(Autosave::new(Some(Duration::from_millis(200)), file.clone()));
+    bend_elbow(&mut app, 0.7);
+    std::thread::sleep(Duration::from_millis(250));
+    app.update();
+    // Written on another thread: wait for it.
+    let mut waited = 0;
+    while !file.is_file() && waited < 100 {
+        std::thread::sleep(Duration::from_millis(50));
+        waited += 1;
+    }
+    let back = marionette::document::scenes::read_scene(&file).expect("a recovery file");
+    let memory = app.world().resource::<Captured>().0.clone();
+    assert_eq!(back, memory, "the recovery file is the scene in memory");
+    let text = std::fs::read_to_string(&file).unwrap();
+    assert!(text.starts_with("// Marionette's recovery of "), "{}", &text[..60.min(text.len())]);
+}
+
+#[test]
+fn opening_another_scene_with_unsaved_changes_holds_it_back_and_asks() {
+    let mut app = app();
+    bend_elbow(&mut app, 0.5);
+    let before = app.world().resource::<Captured>().0.clone();
+    let other =
+        CharacterDoc { id: Some(CharacterId(7)), ..CharacterDoc::new(SourceDoc::Embedded("puppet".into()), "q") };
+    *app.world_mut().resource_mut::<PendingScene>() =
+        PendingScene { doc: Some(SceneDoc { characters: vec![other], ..SceneDoc::default() }), frame: false };
+    app.update();
+    app.update();
+    assert!(matches!(app.world().resource::<UnsavedQuestion>().about, Some(Leaving::Open(_))), "the question opens");
+    assert_eq!(app.world().resource::<Captured>().0, before, "the scene in memory stays");
+    assert!(unsaved(&app));
+}
+
+/// End to end, under a private Xvfb: `edit scene.ron --pose …` with autosave every 3 s,
+/// killed with SIGKILL once it has autosaved, leaves a recovery file that holds the pose and
+/// renders; `edit --recover` finds it (its newest).
+#[test]
+fn a_killed_editor_leaves_a_recovery_file_that_holds_its_pose_and_renders() {
+    use std::process::{Command, Stdio};
+    let dir = scratch("unsaved-killed");
+    let state = dir.join("state");
+    let scene = dir.join("scene.ron");
+    let puppet = CharacterDoc::new(SourceDoc::Embedded("puppet".into()), "p");
+    marionette::document::scenes::write_scene(&scene, &SceneDoc { characters: vec![puppet], ..SceneDoc::default() })
+        .unwrap();
+    let display = format!(":{}", 90 + std::process::id() % 500);
+    let mut xvfb = Command::new("Xvfb")
+        .args([display.as_str(), "-screen", "0", "1280x800x24", "-nolisten", "tcp"])
+        .stdout(Stdio::null())
+        .stderr(Stdio::null())
+        .spawn()
+        .expect("Xvfb (scripts/install-deps.sh installs it)");
+    std::thread::sleep(Duration::from_secs(1));
+    let mut editor = Command::new(env!("CARGO_BIN_EXE_marionette"))
+        .args(["edit", scene.to_str().unwrap(), "--pose", "l_elbow=0,1.2,0"])
+        .env("DISPLAY", &display)
+        .env("MARIONETTE_AUTOSAVE_SECONDS", "3")
+        .env("XDG_STATE_HOME", &state)
+        .stdout(Stdio::null())
+        .stderr(Stdio::null())
+        .spawn()
+        .unwrap();
+    let recovery = state.join("marionette/recovery");
+    let mut found = None;
+    for _ in 0..180 {
+        std::thread::sleep(Duration::from_millis(500));
+        found = std::fs::read_dir(&recovery).ok().and_then(|mut d| d.next()).and_then(Result::ok).map(|e| e.path());
+        if found.is_some() || editor.try_wait().unwrap().is_some() {
+            break;
+        }
+    }
+    editor.kill().ok();
+    editor.wait().ok();
+    xvfb.kill().ok();
+    xvfb.wait().ok();
+    let file = found.expect("the editor autosaved within 90 s");
+    // Written whole: give a rename under way its moment, then read.
+    std::thread::sleep(Duration::from_millis(200));
+    let doc = marionette::document::scenes::read_scene(&file).unwrap();
+    let pose = &doc.characters[0].pose;
+    let elbow = pose.get("l_elbow").expect("the pose --pose set");
+    let q = elbow.to_quat();
+    let want = JointRotation::Euler(glam::Vec3::new(0.0, 1.2, 0.0), marionette::rig::EulerOrder::Xyz).to_quat();
+    assert!((q - want).length().min((q + want).length()) < 1e-5, "{elbow:?}");
+    // The file renders.
+    let out = dir.join("recovered.png");
+    let render = Command::new(env!("CARGO_BIN_EXE_marionette"))
+        .args(["render", file.to_str().unwrap(), "--out", out.to_str().unwrap(), "--width", "64", "--height", "48"])
+        .output()
+        .unwrap();
+    assert!(render.status.success(), "{}", String::from_utf8_lossy(&render.stderr));
+    // `edit --recover` would open the newest: this one.
+    let left = marionette::editor::ui::unsaved::left_recovery_files(&recovery);
+    assert_eq!(left.first(), Some(&file), "the killed session's file is offered");
+}
