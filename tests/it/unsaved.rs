@@ -174,17 +174,10 @@ fn a_killed_editor_leaves_a_recovery_file_that_holds_its_pose_and_renders() {
     let puppet = CharacterDoc::new(SourceDoc::Embedded("puppet".into()), "p");
     marionette::document::scenes::write_scene(&scene, &SceneDoc { characters: vec![puppet], ..SceneDoc::default() })
         .unwrap();
-    let display = format!(":{}", 90 + std::process::id() % 500);
-    let mut xvfb = Command::new("Xvfb")
-        .args([display.as_str(), "-screen", "0", "1280x800x24", "-nolisten", "tcp"])
-        .stdout(Stdio::null())
-        .stderr(Stdio::null())
-        .spawn()
-        .expect("Xvfb (scripts/install-deps.sh installs it)");
-    std::thread::sleep(Duration::from_secs(1));
+    let display = Display::start(90 + std::process::id() % 500);
     let mut editor = Command::new(env!("CARGO_BIN_EXE_marionette"))
         .args(["edit", scene.to_str().unwrap(), "--pose", "l_elbow=0,1.2,0"])
-        .env("DISPLAY", &display)
+        .env("DISPLAY", &display.name)
         .env("MARIONETTE_AUTOSAVE_SECONDS", "3")
         .env("XDG_STATE_HOME", &state)
         .stdout(Stdio::null())
@@ -202,8 +195,7 @@ fn a_killed_editor_leaves_a_recovery_file_that_holds_its_pose_and_renders() {
     }
     editor.kill().ok();
     editor.wait().ok();
-    xvfb.kill().ok();
-    xvfb.wait().ok();
+    drop(display);
     let file = found.expect("the editor autosaved within 90 s");
     // Written whole: give a rename under way its moment, then read.
     std::thread::sleep(Duration::from_millis(200));
@@ -223,4 +215,97 @@ fn a_killed_editor_leaves_a_recovery_file_that_holds_its_pose_and_renders() {
     // `edit --recover` would open the newest: this one.
     let left = marionette::editor::ui::unsaved::left_recovery_files(&recovery);
     assert_eq!(left.first(), Some(&file), "the killed session's file is offered");
+}
+
+/// A private Xvfb display for the life of the value.
+struct Display {
+    name: String,
+    server: std::process::Child,
+}
+
+impl Display {
+    fn start(number: u32) -> Self {
+        let name = format!(":{number}");
+        let server = std::process::Command::new("Xvfb")
+            .args([name.as_str(), "-screen", "0", "1280x800x24", "-nolisten", "tcp"])
+            .stdout(std::process::Stdio::null())
+            .stderr(std::process::Stdio::null())
+            .spawn()
+            .expect("Xvfb (scripts/install-deps.sh installs it)");
+        std::thread::sleep(Duration::from_secs(1));
+        Self { name, server }
+    }
+}
+
+impl Drop for Display {
+    fn drop(&mut self) {
+        self.server.kill().ok();
+        self.server.wait().ok();
+    }
+}
+
+/// The editor under random input (a fixed seed): clicks, drags, wheel turns and shortcut
+/// keys over the whole window for `MARIONETTE_MONKEY_SECONDS` (60 by default), with
+/// autosave every 2 s. It must still be running at the end (no panic, no exit), answer
+/// to more input, and what it autosaved must read back as a valid scene (no NaN).
+#[test]
+fn the_editor_survives_random_input() {
+    use std::process::{Command, Stdio};
+    let seconds: u64 = std::env::var("MARIONETTE_MONKEY_SECONDS").ok().and_then(|s| s.parse().ok()).unwrap_or(60);
+    let dir = scratch("monkey");
+    let display = Display::start(600 + std::process::id() % 300);
+    let mut editor = Command::new(env!("CARGO_BIN_EXE_marionette"))
+        .env("DISPLAY", &display.name)
+        .env("MARIONETTE_AUTOSAVE_SECONDS", "2")
+        .env("XDG_STATE_HOME", dir.join("state"))
+        .current_dir(&dir)
+        .stdout(Stdio::null())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let xdotool = |args: &[String]| {
+        Command::new("xdotool").args(args).env("DISPLAY", &display.name).stderr(Stdio::null()).status().ok();
+    };
+    // The window first (llvmpipe takes a while).
+    std::thread::sleep(Duration::from_secs(8));
+    let mut seed: u64 = 0x5EED_1234;
+    let mut next = |n: u64| {
+        seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+        (seed >> 33) % n
+    };
+    let keys = ["s", "f", "k", "Escape", "ctrl+z", "ctrl+shift+z", "Delete", "space", "Tab", "r", "g", "1", "Left"];
+    let started = std::time::Instant::now();
+    let mut actions = 0;
+    while started.elapsed() < Duration::from_secs(seconds) && editor.try_wait().unwrap().is_none() {
+        let (x, y) = (next(1280).to_string(), next(800).to_string());
+        let action: Vec<String> = match next(6) {
+            0 | 1 => vec!["mousemove".into(), x, y, "click".into(), "1".into()],
+            2 => {
+                let (x2, y2) = (next(1280).to_string(), next(800).to_string());
+                let drag = ["mousemove", &x, &y, "mousedown", "1", "mousemove", &x2, &y2, "mouseup", "1"];
+                drag.iter().map(|s| s.to_string()).collect()
+            }
+            3 => vec!["mousemove".into(), x, y, "click".into(), if next(2) == 0 { "4" } else { "5" }.into()],
+            _ => vec!["key".into(), keys[next(keys.len() as u64) as usize].into()],
+        };
+        xdotool(&action);
+        actions += 1;
+        std::thread::sleep(Duration::from_millis(100 + next(300)));
+    }
+    let alive = editor.try_wait().unwrap().is_none();
+    editor.kill().ok();
+    let output = editor.wait_with_output().unwrap();
+    let log = String::from_utf8_lossy(&output.stderr);
+    assert!(
+        alive,
+        "the editor ended under random input after {actions} actions:\n{}",
+        &log[log.len().saturating_sub(3000)..]
+    );
+    assert!(!log.contains("panicked"), "{}", &log[log.len().saturating_sub(3000)..]);
+    // Whatever it autosaved is a valid scene.
+    let recovery = dir.join("state/marionette/recovery");
+    for file in std::fs::read_dir(&recovery).into_iter().flatten().filter_map(Result::ok) {
+        marionette::document::scenes::read_scene(&file.path()).expect("the autosaved scene reads back");
+    }
+    eprintln!("monkey: {actions} actions over {seconds} s");
 }

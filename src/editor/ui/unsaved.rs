@@ -32,7 +32,13 @@ impl Plugin for UnsavedWorkPlugin {
             .init_resource::<crate::editor::state::SavedState>()
             .insert_resource(Autosave::from_env())
             .add_systems(Update, (ask_before_closing, show_unsaved_in_title, autosave_unsaved_scene))
-            .add_systems(PostUpdate, ask_before_opening.before(crate::editor::order::EditorSystems::OpenScene))
+            // After the panels' pass (where Open is clicked), before the scene is replaced.
+            .add_systems(
+                PostUpdate,
+                ask_before_opening
+                    .after(bevy_egui::EguiPostUpdateSet::EndPass)
+                    .before(crate::editor::order::EditorSystems::OpenScene),
+            )
             .init_resource::<LeftRecovery>()
             .add_systems(Startup, find_left_recovery)
             .add_systems(EguiPrimaryContextPass, (close_question_ui, recovery_offer_ui));
@@ -131,6 +137,7 @@ fn recovery_offer_ui(
     mut left: ResMut<LeftRecovery>,
     mut pending: ResMut<PendingScene>,
     mut messages: ResMut<Messages>,
+    mut changed: ResMut<crate::editor::scene_doc::document::ChangedAtStartup>,
 ) -> Result {
     let Some(newest) = left.0.first().cloned() else { return Ok(()) };
     let ctx = contexts.ctx_mut()?;
@@ -152,7 +159,11 @@ fn recovery_offer_ui(
     });
     match answer {
         Some("Recover") => match crate::document::scenes::read_scene(&newest) {
-            Ok(doc) => *pending = PendingScene { frame: doc.camera.is_none(), doc: Some(doc) },
+            Ok(doc) => {
+                // Recovered work is saved nowhere yet.
+                *pending = PendingScene { frame: doc.camera.is_none(), doc: Some(doc) };
+                changed.0 = true;
+            }
             Err(e) => messages.push(format!("could not recover: {e}")),
         },
         Some("Discard") => left.0.iter().for_each(|f| {
