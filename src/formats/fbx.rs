@@ -41,12 +41,20 @@ pub fn parse_fbx(bytes: &[u8], path: &Path) -> Result<Vec<Part>, FormatError> {
         geometry_transform_handling: ufbx::GeometryTransformHandling::ModifyGeometry,
         inherit_mode_handling: ufbx::InheritModeHandling::Compensate,
         load_external_files: false,
+        // A hostile file may ask for any amount of memory: at most 32 MB and 64 bytes a byte
+        // of the file for each of ufbx's two allocators.
+        temp_allocator: memory_limit(bytes.len()),
+        result_allocator: memory_limit(bytes.len()),
         ..Default::default()
     };
     let scene = ufbx::load_memory(bytes, opts)
         .map_err(|e| FormatError::other(path, format!("expected an FBX file, {}", e.description)))?;
     let file = Fbx { scene: &scene, path };
     Ok(vec![file.part()?])
+}
+
+fn memory_limit(file_bytes: usize) -> ufbx::AllocatorOpts {
+    ufbx::AllocatorOpts { memory_limit: (32 << 20) + 64 * file_bytes, ..Default::default() }
 }
 
 struct Fbx<'a> {

@@ -536,8 +536,17 @@ fn animations(root: &Root) -> Result<(), String> {
 
 fn textures(root: &Root) -> Result<(), String> {
     for (i, image) in root.images.iter().enumerate() {
-        if let Some(view) = image.buffer_view {
-            index(view.value(), root.buffer_views.len(), &format!("$.images[{i}].bufferView"), "buffer view")?;
+        match (image.buffer_view, &image.uri) {
+            (Some(view), _) => {
+                index(view.value(), root.buffer_views.len(), &format!("$.images[{i}].bufferView"), "buffer view")?;
+                if image.mime_type.is_none() {
+                    return Err(format!(
+                        "at $.images[{i}].mimeType: expected the MIME type an image in a buffer view needs"
+                    ));
+                }
+            }
+            (None, None) => return Err(format!("at $.images[{i}]: expected a uri or a bufferView, found neither")),
+            (None, Some(_)) => {}
         }
     }
     for (t, texture) in root.textures.iter().enumerate() {

@@ -44,6 +44,7 @@ pub(crate) enum Reader {
     Cse169Anim,
     Bvh,
     Glb,
+    Fbx,
     Obj,
     Off,
     SmplHierarchy,
@@ -78,6 +79,15 @@ fn read(reader: Reader, bytes: &[u8]) -> Result<(), FormatError> {
                 }
             }
         }),
+        Reader::Fbx => marionette::formats::fbx::parse_fbx(bytes, path).map(|parts| {
+            for c in &parts {
+                for clip in &c.clips {
+                    for t in [-1.0, 0.0, 0.3, 1e9, f32::NAN] {
+                        clip.sample(&c.asset.skeleton, t);
+                    }
+                }
+            }
+        }),
         Reader::Obj => obj::parse_obj(input, path).map(drop),
         Reader::Off => off::parse_off(input, path).map(drop),
         Reader::SmplHierarchy => smpl::parse_hierarchy(input, path).map(drop),
@@ -101,8 +111,13 @@ fn names_a_place(e: &FormatError) -> bool {
     match e {
         FormatError::Syntax { line, .. } => *line >= 1,
         FormatError::Other { message, .. } => {
+            // An FBX file's place is its element (a node, mesh, cluster or stack, named), or
+            // where ufbx stopped reading it (its own description).
+            let fbx = ["node `", "mesh `", "skin cluster `", "animation stack `", "the node tree", "the skin weights"];
             ["at $", "at byte ", "characters[", "camera.", "stage.", "poses[", "shot.", "bookmarks["]
                 .iter()
+                .chain(&fbx)
+                .chain(&["expected an FBX file, ", "expected a node with a mesh"])
                 .any(|p| message.starts_with(p))
         }
         FormatError::Rig { .. } | FormatError::Io { .. } => false,
@@ -213,6 +228,11 @@ fn file_seeds() -> Vec<Seed> {
         Seed {
             reader: Reader::Glb,
             bytes: std::fs::read(Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/blender_pair.glb")).unwrap(),
+            whole: true,
+        },
+        Seed {
+            reader: Reader::Fbx,
+            bytes: std::fs::read(Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/one_key.fbx")).unwrap(),
             whole: true,
         },
         attach(assets.join("puppet.skel"), assets.join("puppet.attach")),
@@ -443,6 +463,7 @@ fn regressions_are_rejected_with_a_place() {
             "json" => Reader::HomerRig,
             "ron" => Reader::Scene,
             "glb" | "gltf" => Reader::Glb,
+            "fbx" => Reader::Fbx,
             "txt" if name.contains("skin") => Reader::SmplSkin,
             "txt" if name.contains("clip") => Reader::SmplClip,
             "txt" if name.contains("hierarchy") => Reader::SmplHierarchy,
