@@ -289,17 +289,10 @@ fn motion_clip(
             }
         }
         for (j, joint) in dofs.iter().enumerate() {
-            let rotations: Vec<(usize, f32)> = joint
-                .iter()
-                .filter_map(|&(dof, column)| match dof {
-                    Dof::Rotation(axis) => Some((axis, row[column].to_radians())),
-                    Dof::Position(_) => None,
-                })
-                .collect();
-            if rotations.is_empty() {
+            if !joint.iter().any(|(dof, _)| matches!(dof, Dof::Rotation(_))) {
                 continue;
             }
-            let angles = rotation_of(&rotations).to_euler(EulerOrder::Xyz);
+            let angles = JointRotation::Quat(rotation_in(joint, row)).to_euler(EulerOrder::Xyz);
             for axis in 0..3 {
                 let c = Clip::joint_channel(j, axis);
                 let previous = channels[c].last().map(|k| k.value);
@@ -325,16 +318,13 @@ fn positioned(offset: Vec3, dofs: &[(Dof, usize)], row: &[f32]) -> Vec3 {
     at
 }
 
-/// A joint's rotation in one frame.
+/// A joint's rotation in one frame: its rotation channels listed outermost first,
+/// `R = R(a₀) · R(a₁) · …`.
 fn rotation_in(dofs: &[(Dof, usize)], row: &[f32]) -> Quat {
-    let rotations: Vec<(usize, f32)> = dofs
-        .iter()
-        .filter_map(|&(dof, column)| match dof {
-            Dof::Rotation(axis) => Some((axis, row[column].to_radians())),
-            Dof::Position(_) => None,
-        })
-        .collect();
-    rotation_of(&rotations).to_quat()
+    dofs.iter().fold(Quat::IDENTITY, |q, &(dof, column)| match dof {
+        Dof::Rotation(axis) => q * Quat::from_axis_angle(Vec3::AXES[axis], row[column].to_radians()),
+        Dof::Position(_) => q,
+    })
 }
 
 /// Position channels below the root, as BVH defines them (a joint's position channels are
@@ -414,11 +404,4 @@ fn ancestors(joints: &[Read], mut j: usize) -> Vec<usize> {
         j = p;
     }
     out
-}
-
-/// The rotation of channels listed outermost first: `R = R(a₀) · R(a₁) · …`.
-fn rotation_of(rotations: &[(usize, f32)]) -> JointRotation {
-    let q =
-        rotations.iter().fold(Quat::IDENTITY, |q, &(axis, angle)| q * Quat::from_axis_angle(Vec3::AXES[axis], angle));
-    JointRotation::Quat(q)
 }

@@ -71,16 +71,16 @@ struct Figures {
     worst_excused: f32,
 }
 
-struct Side {
-    asset: std::sync::Arc<CharacterAsset>,
-    map: HumanoidMap,
-    floor: f32,
-    leg: f32,
+pub(crate) struct Side {
+    pub(crate) asset: std::sync::Arc<CharacterAsset>,
+    pub(crate) map: HumanoidMap,
+    pub(crate) floor: f32,
+    pub(crate) leg: f32,
     /// The hips' height over the lowest point standing in the initial pose.
-    standing: f32,
+    pub(crate) standing: f32,
 }
 
-fn side(library: &mut AssetLibrary, doc: &CharacterDoc, floor: f32) -> Side {
+pub(crate) fn side(library: &mut AssetLibrary, doc: &CharacterDoc, floor: f32) -> Side {
     let asset = library.shaped(doc).unwrap();
     let map = humanoid_map(&asset, &doc.humanoid);
     let skeleton = &asset.skeleton;

@@ -20,11 +20,11 @@ use marionette::document::AssetLibrary;
 use marionette::document::posing::posed_positions;
 use marionette::document::retarget::{file_motion_doc, humanoid_map, retarget};
 use marionette::formats::scene::{CharacterDoc, MotionSourceDoc, RetargetDoc, SourceDoc};
-use marionette::rig::CharacterAsset;
-use marionette::rig::humanoid::{Found, HumanBone, HumanoidMap};
+use marionette::rig::humanoid::{Found, HumanBone};
 use marionette::rig::retarget::{Frame, Retargeted, world_frames};
 
 use crate::common::scratch;
+use crate::retarget::{Side, side};
 
 fn fixture(file: &str) -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/data/rigs").join(file)
@@ -125,28 +125,6 @@ fn vrm_avatars_load_with_the_files_humanoid_bones_and_expressions() {
         assert!(info.contains("expressions: "), "{info}");
         assert!(info.contains(&format!("humanoid: {} of 51 bones", found.map.len())), "{info}");
     }
-}
-
-/// One side of a retargeting: its asset, map, floor, leg length (thigh + shin) and the
-/// height of its hips over its lowest point standing in its initial pose.
-struct Side {
-    asset: std::sync::Arc<CharacterAsset>,
-    map: HumanoidMap,
-    floor: f32,
-    leg: f32,
-    standing: f32,
-}
-
-fn side(library: &mut AssetLibrary, doc: &CharacterDoc, floor: f32) -> Side {
-    let asset = library.shaped(doc).unwrap();
-    let map = humanoid_map(&asset, &doc.humanoid);
-    let s = &asset.skeleton;
-    let (_, at) = world_frames(s, s.joint(0).rest_offset, &s.initial_pose());
-    use HumanBone::*;
-    let leg = |u, l, f| at[map[&u]].distance(at[map[&l]]) + at[map[&l]].distance(at[map[&f]]);
-    let leg = (leg(LeftUpperLeg, LeftLowerLeg, LeftFoot) + leg(RightUpperLeg, RightLowerLeg, RightFoot)) / 2.0;
-    let standing = at[map[&Hips]].y - marionette::document::retarget::floor_of(&asset);
-    Side { asset, map, floor, leg, standing }
 }
 
 /// The lowest point of a side's skin in a frame.
