@@ -248,8 +248,12 @@ pub fn write_glb(characters: &[GltfCharacter], mesh: GltfMesh) -> Result<Vec<u8>
             doc[key] = json!(list);
         }
     }
-    if looks.transformed {
-        doc["extensionsUsed"] = json!(["KHR_texture_transform"]);
+    let used: Vec<&str> = [("KHR_texture_transform", looks.transformed), ("KHR_materials_unlit", looks.unlit)]
+        .into_iter()
+        .filter_map(|(name, used)| used.then_some(name))
+        .collect();
+    if !used.is_empty() {
+        doc["extensionsUsed"] = json!(used);
     }
     if let Some(a) = b.non_finite {
         return Err(format!("at $.accessors[{a}]: the glTF would hold a number that is not finite"));

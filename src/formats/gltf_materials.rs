@@ -155,6 +155,7 @@ fn material(
             gltf::material::AlphaMode::Blend => AlphaMode::Blend,
         },
         double_sided: m.double_sided(),
+        unlit: m.unlit(),
     })
 }
 

@@ -23,6 +23,8 @@ pub struct Materials {
     sampler_of: HashMap<Sampler, usize>,
     /// Whether a texture is transformed (the extension is then used).
     pub transformed: bool,
+    /// Whether a material is unlit (`KHR_materials_unlit` is then used).
+    pub unlit: bool,
 }
 
 impl Materials {
@@ -73,6 +75,10 @@ impl Materials {
         }
         if m.double_sided {
             out["doubleSided"] = json!(true);
+        }
+        if m.unlit {
+            out["extensions"] = json!({ "KHR_materials_unlit": {} });
+            self.unlit = true;
         }
         self.materials.push(out);
         self.materials.len() - 1

@@ -24,6 +24,9 @@ pub struct Material {
     pub emissive_texture: Option<TextureRef>,
     pub alpha: AlphaMode,
     pub double_sided: bool,
+    /// Shown in its own colour, unlit (glTF's `KHR_materials_unlit`; a VRM avatar's unlit
+    /// MToon fallback).
+    pub unlit: bool,
 }
 
 impl Default for Material {
@@ -42,6 +45,7 @@ impl Default for Material {
             emissive_texture: None,
             alpha: AlphaMode::Opaque,
             double_sided: false,
+            unlit: false,
         }
     }
 }

@@ -329,3 +329,39 @@ fn finger_motion_carries_between_rigs_of_other_names() {
     assert!(moved > 0.01, "the curl moved the index's tip {moved} m");
     assert!(worst < 2.0, "a phalanx {worst}° off the source's");
 }
+
+/// A material marked unlit (`KHR_materials_unlit`, as VRM exporters mark an unlit MToon
+/// material's glTF fallback) reads as unlit, and goes out as unlit again.
+#[test]
+fn unlit_materials_read_and_write_as_unlit() {
+    let glb = std::fs::read(fixture("vroid.glb")).unwrap();
+    let bytes = crate::common::glb_with_json(&glb, |json| {
+        if json["materials"].as_array().is_none_or(|m| m.is_empty()) {
+            json["materials"] = serde_json::json!([{ "name": "toon" }]);
+            for mesh in json["meshes"].as_array_mut().unwrap() {
+                for p in mesh["primitives"].as_array_mut().unwrap() {
+                    p["material"] = serde_json::json!(0);
+                }
+            }
+        }
+        json["materials"][0]["extensions"] = serde_json::json!({ "KHR_materials_unlit": {} });
+        json["extensionsUsed"] = serde_json::json!(["KHR_materials_unlit"]);
+    });
+    let dir = scratch("unlit");
+    let path = dir.join("unlit.glb");
+    std::fs::write(&path, bytes).unwrap();
+    let asset = marionette::formats::load_character(&path).unwrap();
+    assert!(
+        asset.materials.iter().all(|m| m.unlit),
+        "{:?}",
+        asset.materials.iter().map(|m| m.unlit).collect::<Vec<_>>()
+    );
+    let out = dir.join("out.glb");
+    let run = std::process::Command::new(env!("CARGO_BIN_EXE_marionette"))
+        .args(["export", path.to_str().unwrap(), "--out", out.to_str().unwrap()])
+        .output()
+        .unwrap();
+    assert!(run.status.success(), "{}", String::from_utf8_lossy(&run.stderr));
+    let back = marionette::formats::load_character(&out).unwrap();
+    assert!(!back.materials.is_empty() && back.materials.iter().all(|m| m.unlit));
+}

@@ -293,6 +293,7 @@ pub fn skin_material_of(
             Alpha::Blend => AlphaMode::Blend,
         },
         double_sided: m.double_sided,
+        unlit: m.unlit,
         cull_mode: if m.double_sided { None } else { Some(bevy::render::render_resource::Face::Back) },
         uv_transform: bevy::math::Affine2::from_scale_angle_translation(
             transform.scale,
