@@ -309,3 +309,60 @@ fn the_editor_survives_random_input() {
     }
     eprintln!("monkey: {actions} actions over {seconds} s");
 }
+
+/// A panic in the editor writes the newest state to the recovery file before the process
+/// ends, and says where: `edit --pose` under Xvfb, autosave every 2 s, made to panic after
+/// 12 s (`MARIONETTE_TEST_PANIC_AFTER_SECONDS`).
+#[test]
+fn a_panic_leaves_the_recovery_file_and_says_where() {
+    use std::process::{Command, Stdio};
+    let dir = scratch("unsaved-panic");
+    let scene = dir.join("scene.ron");
+    let puppet = CharacterDoc::new(SourceDoc::Embedded("puppet".into()), "p");
+    marionette::document::scenes::write_scene(&scene, &SceneDoc { characters: vec![puppet], ..SceneDoc::default() })
+        .unwrap();
+    let display = Display::start(60 + std::process::id() % 25);
+    let mut editor = Command::new(env!("CARGO_BIN_EXE_marionette"))
+        .args(["edit", scene.to_str().unwrap(), "--pose", "l_knee=0.8,0,0"])
+        .env("DISPLAY", &display.name)
+        .env("MARIONETTE_AUTOSAVE_SECONDS", "2")
+        .env(marionette::editor::ui::unsaved::PANIC_AFTER, "12")
+        .env("XDG_STATE_HOME", dir.join("state"))
+        .stdout(Stdio::null())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let mut ended = None;
+    for _ in 0..240 {
+        std::thread::sleep(Duration::from_millis(500));
+        if let Some(status) = editor.try_wait().unwrap() {
+            ended = Some(status);
+            break;
+        }
+    }
+    editor.kill().ok();
+    let output = editor.wait_with_output().unwrap();
+    drop(display);
+    let log = String::from_utf8_lossy(&output.stderr);
+    assert!(ended.is_some_and(|s| !s.success()), "the editor crashed:\n{}", &log[log.len().saturating_sub(2000)..]);
+    let said = log.lines().find(|l| l.contains("the scene was saved to")).expect("the crash says where the scene went");
+    let file = dir.join("state/marionette/recovery").read_dir().unwrap().next().unwrap().unwrap().path();
+    assert!(said.contains(&file.display().to_string()), "{said}");
+    let doc = marionette::document::scenes::read_scene(&file).unwrap();
+    assert!(doc.characters[0].pose.contains_key("l_knee"), "the pose --pose set");
+}
+
+/// The window's title names the scene's file and carries a star while it is unsaved.
+#[test]
+fn the_title_carries_a_star_while_unsaved() {
+    let mut app = app();
+    let window = app.world_mut().spawn((Window::default(), bevy::window::PrimaryWindow)).id();
+    app.update();
+    let title = |app: &App| app.world().get::<Window>(window).unwrap().title.clone();
+    assert!(!title(&app).contains('*'), "{}", title(&app));
+    bend_elbow(&mut app, 0.4);
+    assert!(title(&app).contains(" *"), "{}", title(&app));
+    request(&mut app, HistoryRequest::Undo);
+    app.update();
+    assert!(!title(&app).contains('*'), "{}", title(&app));
+}

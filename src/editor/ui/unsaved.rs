@@ -32,6 +32,7 @@ impl Plugin for UnsavedWorkPlugin {
             .init_resource::<crate::editor::state::SavedState>()
             .insert_resource(Autosave::from_env())
             .add_systems(Update, (ask_before_closing, show_unsaved_in_title, autosave_unsaved_scene))
+            .add_systems(Update, panic_when_asked.run_if(|| std::env::var_os(PANIC_AFTER).is_some()))
             // After the panels' pass (where Open is clicked), before the scene is replaced.
             .add_systems(
                 PostUpdate,
@@ -86,6 +87,17 @@ impl Autosave {
             None => Some(AUTOSAVE_EVERY),
         };
         Self::new(every, recovery_dir().join(format!("scene-{}.ron", std::process::id())))
+    }
+}
+
+/// For tests of the panic hook: the editor panics this many seconds after it starts.
+pub const PANIC_AFTER: &str = "MARIONETTE_TEST_PANIC_AFTER_SECONDS";
+
+/// Panics [`PANIC_AFTER`] seconds after the app started (a test's crash).
+fn panic_when_asked(time: Res<Time<Real>>) {
+    let after = std::env::var(PANIC_AFTER).ok().and_then(|s| s.parse::<f32>().ok()).unwrap_or(f32::INFINITY);
+    if time.elapsed_secs() > after {
+        panic!("{PANIC_AFTER} asked for a crash after {after} s");
     }
 }
 
