@@ -33,6 +33,7 @@ fn run(cli: Cli) -> Result<()> {
             let edits = marionette::editor::StartupEdits {
                 poses,
                 ik,
+                recovered: recover,
                 anim: clip.anim_doc(true),
                 time: clip.time,
                 clip: clip.own_clip(),
@@ -58,6 +59,7 @@ fn run(cli: Cli) -> Result<()> {
                 view: shot.view,
                 ortho: shot.ortho,
                 transparent: shot.transparent,
+                recovered: false,
             };
             let (sequence, pictures) = (frames.sequence(), frames.pictures());
             let (notes, picture) =

@@ -34,6 +34,8 @@ pub struct StartupEdits {
     pub ortho: bool,
     /// `--transparent`: no background and no floor (a PNG with alpha).
     pub transparent: bool,
+    /// `--recover`: the scene is a recovery file, saved nowhere yet.
+    pub recovered: bool,
 }
 
 /// Messages for the user (load errors, warnings, where files went), newest last.

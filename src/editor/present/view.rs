@@ -131,7 +131,7 @@ fn queue_startup_scene(
     if let Some(mut doc) = doc {
         let before = doc.clone();
         apply_startup_edits(&mut doc, &edits, &mut library, &mut messages);
-        changed.0 = doc != before;
+        changed.0 = doc != before || edits.recovered;
         if let Some(view) = startup_view(&mut doc, &edits) {
             framing.0 = view;
         }
