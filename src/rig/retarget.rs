@@ -126,7 +126,7 @@ fn aims(bone: HumanBone) -> &'static [HumanBone] {
     use HumanBone::*;
     if let Some(k) = BONES.iter().position(|&b| b == bone).filter(|_| bone.is_finger()) {
         // A phalanx points at the next one out.
-        return if (k - 21) % 3 < 2 { std::slice::from_ref(&BONES[k + 1]) } else { &[] };
+        return if (k - HumanBone::BODY_COUNT) % 3 < 2 { std::slice::from_ref(&BONES[k + 1]) } else { &[] };
     }
     match bone {
         Hips => &[Spine, Chest],

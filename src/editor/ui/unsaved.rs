@@ -32,7 +32,10 @@ impl Plugin for UnsavedWorkPlugin {
             .init_resource::<crate::editor::state::SavedState>()
             .insert_resource(Autosave::from_env())
             .add_systems(Update, (ask_before_closing, show_unsaved_in_title, autosave_unsaved_scene))
-            .add_systems(Update, panic_when_asked.run_if(|| std::env::var_os(PANIC_AFTER).is_some()))
+            .add_systems(
+                Update,
+                panic_when_asked.after(autosave_unsaved_scene).run_if(|| std::env::var_os(PANIC_AFTER).is_some()),
+            )
             // After the panels' pass (where Open is clicked), before the scene is replaced.
             .add_systems(
                 PostUpdate,
@@ -93,10 +96,12 @@ impl Autosave {
 /// For tests of the panic hook: the editor panics this many seconds after it starts.
 pub const PANIC_AFTER: &str = "MARIONETTE_TEST_PANIC_AFTER_SECONDS";
 
-/// Panics [`PANIC_AFTER`] seconds after the app started (a test's crash).
+/// Panics [`PANIC_AFTER`] seconds after the app started, once autosave has captured the
+/// scene (a test's crash).
 fn panic_when_asked(time: Res<Time<Real>>) {
     let after = std::env::var(PANIC_AFTER).ok().and_then(|s| s.parse::<f32>().ok()).unwrap_or(f32::INFINITY);
-    if time.elapsed_secs() > after {
+    let captured = LAST_STATE.lock().is_ok_and(|s| s.is_some());
+    if time.elapsed_secs() > after && captured {
         panic!("{PANIC_AFTER} asked for a crash after {after} s");
     }
 }

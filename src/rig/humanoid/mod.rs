@@ -130,18 +130,18 @@ impl HumanBone {
         HumanBone::RightLittleDistal,
     ];
 
-    /// The bones of the body, fingers apart.
-    pub const BODY: &'static [HumanBone] = HumanBone::ALL.split_at(21).0;
+    /// How many of [`HumanBone::ALL`] are the body's (the fingers' follow).
+    pub const BODY_COUNT: usize = 21;
 
     /// A finger's phalanx: `left`'s hand, `finger` 0 (thumb) to 4 (little), `phalanx` 0
     /// (proximal) to 2 (distal).
     pub fn finger(left: bool, finger: usize, phalanx: usize) -> HumanBone {
-        HumanBone::ALL[21 + usize::from(!left) * 15 + finger * 3 + phalanx]
+        HumanBone::ALL[Self::BODY_COUNT + usize::from(!left) * 15 + finger * 3 + phalanx]
     }
 
     /// Whether the bone is a finger's.
     pub fn is_finger(self) -> bool {
-        HumanBone::ALL.iter().position(|&b| b == self).is_some_and(|k| k >= 21)
+        HumanBone::ALL.iter().position(|&b| b == self).is_some_and(|k| k >= Self::BODY_COUNT)
     }
 }
 
