@@ -247,3 +247,35 @@ fn clips_are_numbered_alike_and_a_missing_clip_fails_naming_the_clips() {
         "{e}"
     );
 }
+
+/// An FBX whose connections make a cycle of nodes (A under B under A, which the format's
+/// connections allow to be written), or a node under itself, is refused naming the file,
+/// never a hang or a stack overflow.
+#[test]
+fn fbx_node_cycles_are_refused() {
+    let dir = crate::common::scratch("fbx-cycles");
+    let file = |connections: &str| {
+        format!(
+            "; FBX 7.4.0 project file\nFBXHeaderExtension:  {{\n\tFBXHeaderVersion: 1003\n\tFBXVersion: 7400\n}}\n\
+             Objects:  {{\n\tGeometry: 100, \"Geometry::tri\", \"Mesh\" {{\n\t\tVertices: *9 {{\n\t\t\ta: 0,0,0,1,0,0,0,1,0\n\t\t}}\n\
+             \t\tPolygonVertexIndex: *3 {{\n\t\t\ta: 0,1,-3\n\t\t}}\n\t}}\n\tModel: 200, \"Model::A\", \"Mesh\" {{\n\t}}\n\
+             \tModel: 300, \"Model::B\", \"Null\" {{\n\t}}\n}}\nConnections:  {{\n{connections}}}\n"
+        )
+    };
+    let cases = [
+        ("cycle.fbx", "\tC: \"OO\",100,200\n\tC: \"OO\",200,300\n\tC: \"OO\",300,200\n\tC: \"OO\",300,0\n"),
+        ("self.fbx", "\tC: \"OO\",100,200\n\tC: \"OO\",200,200\n\tC: \"OO\",300,0\n"),
+    ];
+    // The same file without the cycle loads: the cases fail for their cycles alone.
+    let plain = dir.join("plain.fbx");
+    std::fs::write(&plain, file("\tC: \"OO\",100,200\n\tC: \"OO\",200,300\n\tC: \"OO\",300,0\n")).unwrap();
+    marionette::formats::load_parts(&plain).expect("the file without a cycle");
+    for (name, connections) in cases {
+        let path = dir.join(name);
+        std::fs::write(&path, file(connections)).unwrap();
+        match marionette::formats::load_parts(&path) {
+            Err(e) => assert!(e.to_string().contains(name), "{e}"),
+            Ok(parts) => assert!(!parts.is_empty(), "{name}: loaded with its cycle broken"),
+        }
+    }
+}
