@@ -5,8 +5,6 @@
 use marionette::rig::Skeleton;
 use marionette::rig::humanoid::{HumanBone, HumanoidMap, detect};
 
-use crate::common::optional_data_dir;
-
 fn named(skeleton: &Skeleton, map: &HumanoidMap) -> Vec<(HumanBone, String)> {
     map.iter().map(|(b, &j)| (*b, skeleton.joint(j).name.clone())).collect()
 }
@@ -48,8 +46,9 @@ fn the_puppet_maps_by_its_structure_and_names() {
 }
 
 #[test]
+#[cfg_attr(not(marionette_data), ignore)]
 fn the_smpl_body_maps_collars_to_shoulders_and_its_feet_to_toes() {
-    let Some(data) = optional_data_dir() else { return };
+    let data = crate::common::data_dir();
     let asset = marionette::formats::load_character(&data.join("smpl")).unwrap();
     expect(
         &asset.skeleton,
@@ -75,8 +74,9 @@ fn the_smpl_body_maps_collars_to_shoulders_and_its_feet_to_toes() {
 }
 
 #[test]
+#[cfg_attr(not(marionette_data), ignore)]
 fn the_6837_models_map_by_structure_alone() {
-    let Some(data) = optional_data_dir() else { return };
+    let data = crate::common::data_dir();
     for k in 1..=4 {
         let skeleton =
             marionette::formats::character::load_skeleton(&data.join(format!("mit6837/Model{k}.skel"))).unwrap();
@@ -105,8 +105,9 @@ fn the_6837_models_map_by_structure_alone() {
 }
 
 #[test]
+#[cfg_attr(not(marionette_data), ignore)]
 fn the_khronos_figures_map_every_limb_with_left_as_named() {
-    let Some(data) = optional_data_dir() else { return };
+    let data = crate::common::data_dir();
     for file in ["khronos/CesiumMan.glb", "khronos/RiggedFigure.glb"] {
         let skeleton = marionette::formats::character::load_skeleton(&data.join(file)).unwrap();
         let map = detect(&skeleton).expect(file);
@@ -128,6 +129,7 @@ fn the_khronos_figures_map_every_limb_with_left_as_named() {
 /// world rotation); carried from the puppet onto the SMPL body, every mapped bone turns
 /// in the world exactly as the puppet's did from its initial pose.
 #[test]
+#[cfg_attr(not(marionette_data), ignore)]
 fn a_retargeted_pose_turns_each_bone_as_its_source_turned() {
     use glam::Quat;
     use marionette::rig::JointRotation;
@@ -153,7 +155,7 @@ fn a_retargeted_pose_turns_each_bone_as_its_source_turned() {
             assert!(want[j].angle_between(got[j]) < 1e-5, "{rest:?}: {}", puppet.joint(j).name);
         }
     }
-    let Some(data) = optional_data_dir() else { return };
+    let data = crate::common::data_dir();
     let body = marionette::formats::load_character(&data.join("smpl")).unwrap().skeleton;
     let body_map = detect(&body).unwrap();
     let carried = retarget_pose((&puppet, &map), &pose, (&body, &body_map), RestAlignment::OwnRest).unwrap();
@@ -169,8 +171,9 @@ fn a_retargeted_pose_turns_each_bone_as_its_source_turned() {
 /// Homer's rig (the chest its root, the abdomen hung below it): every limb from the joint
 /// at the shoulder or hip, the chest never an arm bone.
 #[test]
+#[cfg_attr(not(marionette_data), ignore)]
 fn homer_maps_his_arms_from_the_shoulders() {
-    let Some(data) = optional_data_dir() else { return };
+    let data = crate::common::data_dir();
     let homer = marionette::formats::load_character(&data.join("homer/homer.json")).unwrap();
     expect(
         &homer.skeleton,
@@ -194,9 +197,10 @@ fn homer_maps_his_arms_from_the_shoulders() {
 /// glTF, whose file pose is the stride) maps as the puppet does: sides are told across its
 /// hips, not along x.
 #[test]
+#[cfg_attr(not(marionette_data), ignore)]
 fn a_character_in_mid_stride_maps_as_at_rest() {
     use marionette::formats::scene::{AnimDoc, CharacterDoc, MotionSourceDoc, RetargetDoc, SceneDoc, SourceDoc};
-    let Some(data) = optional_data_dir() else { return };
+    let data = crate::common::data_dir();
     let from = MotionSourceDoc::File { path: data.join("smpl"), clip: Some("7516".into()) };
     let anim = AnimDoc { retarget: Some(RetargetDoc::of(from)), time: 1.0, playing: false, ..AnimDoc::default() };
     let walker = CharacterDoc { anim: Some(anim), ..CharacterDoc::new(SourceDoc::Embedded("puppet".into()), "walker") };

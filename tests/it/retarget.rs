@@ -15,8 +15,6 @@ use marionette::rig::humanoid::{HumanBone, HumanoidMap};
 use marionette::rig::retarget::{Frame, Retargeted};
 use marionette::rig::{CharacterAsset, JointRotation, Skeleton};
 
-use crate::common::optional_data_dir;
-
 /// Each joint's world position: the root at `root`, then parent · T(offset) · R, walked
 /// here by hand.
 fn positions(skeleton: &Skeleton, root: Vec3, pose: &[JointRotation]) -> Vec<Vec3> {
@@ -189,8 +187,9 @@ fn doc_of(library: &mut AssetLibrary, path: &Path) -> CharacterDoc {
 /// Every source with a clip of its own onto every target, the figures printed and held to
 /// the bounds.
 #[test]
+#[cfg_attr(not(marionette_data), ignore)]
 fn clips_carry_across_humanoids_of_every_origin() {
-    let Some(data) = optional_data_dir() else { return };
+    let data = crate::common::data_dir();
     let mut library = AssetLibrary::default();
     let sources: Vec<(PathBuf, Option<&str>)> = vec![
         (data.join("smpl"), Some("7516")),
@@ -259,8 +258,9 @@ fn same_rotation(a: glam::Quat, b: glam::Quat, tolerance: f32) -> bool {
 /// root within 1e-5, for the SMPL body (its clip stood upright, hanging from a fixed root
 /// below the body's floor) and CesiumMan (whose walk dips 0.026 below its rest's floor).
 #[test]
+#[cfg_attr(not(marionette_data), ignore)]
 fn a_clip_retargeted_onto_its_own_character_is_itself() {
-    let Some(data) = optional_data_dir() else { return };
+    let data = crate::common::data_dir();
     let mut library = AssetLibrary::default();
     for (path, clip) in [(data.join("smpl"), Some("7516")), (data.join("khronos/CesiumMan.glb"), None)] {
         let source = file_motion_doc(&mut library, &path, clip).unwrap();
@@ -497,10 +497,11 @@ fn a_t_pose_clip_drives_an_a_pose_character() {
 /// their humanoid maps: each posed arm bone points as the puppet's (2°); mirrored, the
 /// body's right arm points as the puppet's left, reflected in x.
 #[test]
+#[cfg_attr(not(marionette_data), ignore)]
 fn a_pose_carries_to_a_rig_with_other_names_as_it_was_or_mirrored() {
     use marionette::document::retarget::pose_onto;
     use marionette::editor::edits::pose_library::pose_by_name;
-    let Some(data) = optional_data_dir() else { return };
+    let data = crate::common::data_dir();
     let puppet = marionette::formats::puppet::embedded_puppet();
     let body = marionette::formats::load_character(&data.join("smpl")).unwrap();
     let (p_map, b_map) = (humanoid_map(&puppet, &Default::default()), humanoid_map(&body, &Default::default()));

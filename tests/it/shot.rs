@@ -9,7 +9,7 @@ use std::process::Command;
 
 use marionette::formats::scene::{BackgroundDoc, CameraDoc, CharacterDoc, SceneDoc, SourceDoc, StageDoc, SunDoc};
 
-use crate::common::{optional_data_dir, scratch};
+use crate::common::scratch;
 
 /// Renders `scene` with `flags` into `out` (64×96 unless the flags say).
 fn render(scene: &Path, flags: &[&str], out: &Path) -> image::RgbaImage {
@@ -110,8 +110,9 @@ fn a_gradient_background_fills_behind_the_characters() {
 }
 
 #[test]
+#[cfg_attr(not(marionette_data), ignore)]
 fn an_orthographic_front_view_draws_model1_at_one_size_whatever_the_distance() {
-    let Some(data) = optional_data_dir() else { return };
+    let data = crate::common::data_dir();
     let dir = scratch("shot-ortho");
     let model = CharacterDoc::new(SourceDoc::File(data.join("mit6837/Model1.skel")), "m");
     let stage = StageDoc { floor: false, background: BackgroundDoc::Transparent, ..StageDoc::default() };
