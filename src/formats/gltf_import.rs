@@ -48,7 +48,11 @@ pub fn parse_gltf(bytes: &[u8], path: &Path) -> Result<Vec<Part>, FormatError> {
         let (json, _) = super::gltf_check::split_glb(bytes).map_err(|e| FormatError::other(path, e))?;
         let json: serde_json::Value =
             serde_json::from_slice(json).map_err(|e| FormatError::other(path, format!("at $: {e}")))?;
-        file.vrm = super::vrm::read(&json).map_err(|e| FormatError::other(path, e))?;
+        let vrm = super::vrm::read(&json).map_err(|e| FormatError::other(path, e))?;
+        if let Some(vrm) = &vrm {
+            vrm.check(gltf.nodes().len(), gltf.meshes().len()).map_err(|e| FormatError::other(path, e))?;
+        }
+        file.vrm = vrm;
     }
     let parts = file.parts();
     if parts.is_empty() {

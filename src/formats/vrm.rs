@@ -53,7 +53,12 @@ pub fn read(json: &Value) -> Result<Option<Vrm>, String> {
 /// VRM 1.0: `humanoid.humanBones.{bone}.node`, `expressions.{preset,custom}.{name}.morphTargetBinds`.
 fn read_1(vrm: &Value) -> Result<Vrm, String> {
     let mut out = Vrm::default();
-    let bones = vrm.pointer("/humanoid/humanBones").and_then(Value::as_object);
+    let bones = match vrm.pointer("/humanoid/humanBones") {
+        None => None,
+        Some(v) => {
+            Some(v.as_object().ok_or("at $.extensions.VRMC_vrm.humanoid.humanBones: expected an object of bones")?)
+        }
+    };
     let metacarpal = bones.is_some_and(|b| b.keys().any(|k| k.ends_with("ThumbMetacarpal")));
     let upper_chest = bones.is_some_and(|b| b.contains_key("upperChest"));
     for (name, bone) in bones.into_iter().flatten() {
@@ -114,6 +119,35 @@ fn read_0(vrm: &Value) -> Result<Vrm, String> {
     Ok(out)
 }
 
+impl Vrm {
+    /// Whether every node and mesh it names is in a file of `nodes` nodes and `meshes`
+    /// meshes; the first that is not, named.
+    pub fn check(&self, nodes: usize, meshes: usize) -> Result<(), String> {
+        for &(bone, node) in &self.bones {
+            if node >= nodes {
+                return Err(format!(
+                    "at $.extensions (VRM humanoid bone {bone:?}): expected a node index below {nodes}, found {node}"
+                ));
+            }
+        }
+        for e in &self.expressions {
+            for bind in &e.binds {
+                let (what, index, count) = match bind.on {
+                    BindTarget::Node(n) => ("node", n, nodes),
+                    BindTarget::Mesh(m) => ("mesh", m, meshes),
+                };
+                if index >= count {
+                    return Err(format!(
+                        "at $.extensions (VRM expression `{}`): expected a {what} index below {count}, found {index}",
+                        e.name
+                    ));
+                }
+            }
+        }
+        Ok(())
+    }
+}
+
 /// The standard bone a VRM bone name is: VRM 1.0 names the thumb's joints metacarpal,
 /// proximal, distal (`metacarpal` says so); 0.x proximal, intermediate, distal. `upperChest`
 /// is the chest (where the arms meet) and `chest` then no bone of ours.
@@ -165,7 +199,7 @@ fn human_bone(name: &str, metacarpal: bool, upper_chest: bool) -> Option<HumanBo
 fn index(v: Option<&Value>, at: &str) -> Result<usize, String> {
     v.and_then(Value::as_u64)
         .and_then(|n| usize::try_from(n).ok())
-        .ok_or_else(|| format!("{at}: expected an index (a whole number from 0)"))
+        .ok_or_else(|| format!("at {at}: expected an index (a whole number from 0)"))
 }
 
 fn weight(v: Option<&Value>, most: f64, at: &str) -> Result<f32, String> {
@@ -175,13 +209,13 @@ fn weight(v: Option<&Value>, most: f64, at: &str) -> Result<f32, String> {
             .as_f64()
             .filter(|w| w.is_finite() && (0.0..=most).contains(w))
             .map(|w| w as f32)
-            .ok_or_else(|| format!("{at}: expected a weight from 0 to {most}")),
+            .ok_or_else(|| format!("at {at}: expected a weight from 0 to {most}")),
     }
 }
 
 fn list<'v>(v: Option<&'v Value>, at: &str) -> Result<&'v [Value], String> {
     match v {
         None => Ok(&[]),
-        Some(v) => v.as_array().map(Vec::as_slice).ok_or_else(|| format!("{at}: expected an array")),
+        Some(v) => v.as_array().map(Vec::as_slice).ok_or_else(|| format!("at {at}: expected an array")),
     }
 }

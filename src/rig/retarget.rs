@@ -115,6 +115,9 @@ pub struct Retargeter<'a> {
     ratio: f32,
     source_leg: f32,
     target_leg: f32,
+    /// How far each one's lowest foot point stands over its floor in its initial pose
+    /// (source, target).
+    clearances: (f32, f32),
 }
 
 /// The bones a humanoid stands on.
@@ -240,6 +243,10 @@ impl<'a> Retargeter<'a> {
         }
         let namesakes =
             (0..t.len()).map(|j| if bones[j].is_some() { None } else { s.find(&t.joint(j).name) }).collect();
+        let clearances = (
+            source.lowest_foot(&source_rest, &source_rest_at) - source.rest_floor,
+            target.lowest_foot(&target_rest, &target_rest_at) - target.rest_floor,
+        );
         Some(Self {
             source,
             target,
@@ -253,6 +260,7 @@ impl<'a> Retargeter<'a> {
             ratio: target_leg / source_leg.max(1e-9),
             source_leg,
             target_leg,
+            clearances,
         })
     }
 
@@ -348,8 +356,7 @@ impl<'a> Retargeter<'a> {
         let moved = (s_at[sh] - self.source_rest_at[sh]) * self.ratio;
         let mut shift = self.target_rest_at[th] + moved - at[th];
         let (s_low, t_low) = (self.source.lowest_foot(s_rot, s_at), self.target.lowest_foot(&rotations, &at));
-        let s_clear = self.source.lowest_foot(&self.source_rest, &self.source_rest_at) - self.source.rest_floor;
-        let t_clear = self.target.lowest_foot(&self.target_rest, &self.target_rest_at) - self.target.rest_floor;
+        let (s_clear, t_clear) = self.clearances;
         shift.y = if s_low.is_finite() && t_low.is_finite() {
             self.target.floor + t_clear + (s_low - self.source.floor - s_clear) * self.ratio - t_low
         } else {

@@ -170,20 +170,10 @@ fn a_killed_editor_leaves_a_recovery_file_that_holds_its_pose_and_renders() {
     use std::process::{Command, Stdio};
     let dir = scratch("unsaved-killed");
     let state = dir.join("state");
-    let scene = dir.join("scene.ron");
-    let puppet = CharacterDoc::new(SourceDoc::Embedded("puppet".into()), "p");
-    marionette::document::scenes::write_scene(&scene, &SceneDoc { characters: vec![puppet], ..SceneDoc::default() })
-        .unwrap();
+    let scene = puppet_scene(&dir);
     let display = Display::start(90 + std::process::id() % 500);
-    let mut editor = Command::new(env!("CARGO_BIN_EXE_marionette"))
-        .args(["edit", scene.to_str().unwrap(), "--pose", "l_elbow=0,1.2,0"])
-        .env("DISPLAY", &display.name)
-        .env("MARIONETTE_AUTOSAVE_SECONDS", "3")
-        .env("XDG_STATE_HOME", &state)
-        .stdout(Stdio::null())
-        .stderr(Stdio::null())
-        .spawn()
-        .unwrap();
+    let args = ["edit", scene.to_str().unwrap(), "--pose", "l_elbow=0,1.2,0"];
+    let mut editor = display.editor(&args, "3", &state).stderr(Stdio::null()).spawn().unwrap();
     let recovery = state.join("marionette/recovery");
     let mut found = None;
     for _ in 0..180 {
@@ -237,6 +227,31 @@ impl Display {
     }
 }
 
+impl Display {
+    /// The editor with `args` on this display, autosaving every `autosave` seconds into
+    /// `state`'s recovery folder, its errors piped.
+    fn editor(&self, args: &[&str], autosave: &str, state: &std::path::Path) -> std::process::Command {
+        let mut command = std::process::Command::new(env!("CARGO_BIN_EXE_marionette"));
+        command
+            .args(args)
+            .env("DISPLAY", &self.name)
+            .env("MARIONETTE_AUTOSAVE_SECONDS", autosave)
+            .env("XDG_STATE_HOME", state)
+            .stdout(std::process::Stdio::null())
+            .stderr(std::process::Stdio::piped());
+        command
+    }
+}
+
+/// A scene of one puppet written to `dir/scene.ron`.
+fn puppet_scene(dir: &std::path::Path) -> std::path::PathBuf {
+    let scene = dir.join("scene.ron");
+    let puppet = CharacterDoc::new(SourceDoc::Embedded("puppet".into()), "p");
+    marionette::document::scenes::write_scene(&scene, &SceneDoc { characters: vec![puppet], ..SceneDoc::default() })
+        .unwrap();
+    scene
+}
+
 impl Drop for Display {
     fn drop(&mut self) {
         self.server.kill().ok();
@@ -254,15 +269,7 @@ fn the_editor_survives_random_input() {
     let seconds: u64 = std::env::var("MARIONETTE_MONKEY_SECONDS").ok().and_then(|s| s.parse().ok()).unwrap_or(60);
     let dir = scratch("monkey");
     let display = Display::start(600 + std::process::id() % 300);
-    let mut editor = Command::new(env!("CARGO_BIN_EXE_marionette"))
-        .env("DISPLAY", &display.name)
-        .env("MARIONETTE_AUTOSAVE_SECONDS", "2")
-        .env("XDG_STATE_HOME", dir.join("state"))
-        .current_dir(&dir)
-        .stdout(Stdio::null())
-        .stderr(Stdio::piped())
-        .spawn()
-        .unwrap();
+    let mut editor = display.editor(&[], "2", &dir.join("state")).current_dir(&dir).spawn().unwrap();
     let xdotool = |args: &[String]| {
         Command::new("xdotool").args(args).env("DISPLAY", &display.name).stderr(Stdio::null()).status().ok();
     };
@@ -315,21 +322,12 @@ fn the_editor_survives_random_input() {
 /// 12 s (`MARIONETTE_TEST_PANIC_AFTER_SECONDS`).
 #[test]
 fn a_panic_leaves_the_recovery_file_and_says_where() {
-    use std::process::{Command, Stdio};
     let dir = scratch("unsaved-panic");
-    let scene = dir.join("scene.ron");
-    let puppet = CharacterDoc::new(SourceDoc::Embedded("puppet".into()), "p");
-    marionette::document::scenes::write_scene(&scene, &SceneDoc { characters: vec![puppet], ..SceneDoc::default() })
-        .unwrap();
+    let scene = puppet_scene(&dir);
     let display = Display::start(60 + std::process::id() % 25);
-    let mut editor = Command::new(env!("CARGO_BIN_EXE_marionette"))
-        .args(["edit", scene.to_str().unwrap(), "--pose", "l_knee=0.8,0,0"])
-        .env("DISPLAY", &display.name)
-        .env("MARIONETTE_AUTOSAVE_SECONDS", "2")
+    let mut editor = display
+        .editor(&["edit", scene.to_str().unwrap(), "--pose", "l_knee=0.8,0,0"], "2", &dir.join("state"))
         .env(marionette::editor::ui::unsaved::PANIC_AFTER, "12")
-        .env("XDG_STATE_HOME", dir.join("state"))
-        .stdout(Stdio::null())
-        .stderr(Stdio::piped())
         .spawn()
         .unwrap();
     let mut ended = None;

@@ -365,3 +365,28 @@ fn unlit_materials_read_and_write_as_unlit() {
     let back = marionette::formats::load_character(&out).unwrap();
     assert!(!back.materials.is_empty() && back.materials.iter().all(|m| m.unlit));
 }
+
+/// Broken VRM extensions are refused with their place: a bone's node past the file's
+/// nodes, an expression's morph index that is no index, a weight past 1, humanoid bones
+/// that are not an object.
+#[test]
+fn broken_vrm_extensions_are_refused_with_their_place() {
+    let avatar = std::fs::read(vrm_avatar(1)).unwrap();
+    let dir = scratch("vrm-broken");
+    let vrm = "/extensions/VRMC_vrm";
+    let cases: [(&str, &str, serde_json::Value, &str); 4] = [
+        ("node", "/humanoid/humanBones/hips/node", serde_json::json!(1_000_000_000_000u64), "node index below"),
+        ("index", "/expressions/preset/happy/morphTargetBinds/0/index", serde_json::json!(-3), "expected an index"),
+        ("weight", "/expressions/preset/happy/morphTargetBinds/0/weight", serde_json::json!(7.5), "weight from 0 to 1"),
+        ("bones", "/humanoid/humanBones", serde_json::json!("hips"), "expected an object"),
+    ];
+    for (name, pointer, value, says) in cases {
+        let bytes = crate::common::glb_with_json(&avatar, |json| {
+            *json.pointer_mut(&format!("{vrm}{pointer}")).unwrap() = value.clone();
+        });
+        let path = dir.join(format!("{name}.vrm"));
+        std::fs::write(&path, bytes).unwrap();
+        let e = marionette::formats::load_character(&path).unwrap_err().to_string();
+        assert!(e.contains(&format!("{name}.vrm")) && e.contains("at $.extensions") && e.contains(says), "{e}");
+    }
+}
