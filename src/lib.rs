@@ -13,8 +13,10 @@
 #![allow(clippy::type_complexity)]
 
 pub mod cli;
-pub mod document;
 pub mod editor;
-pub mod formats;
-pub mod rig;
 pub mod scene;
+
+// The Bevy-free layers are crates of their own; these names keep one path for each.
+pub use marionette_document as document;
+pub use marionette_formats as formats;
+pub use marionette_rig as rig;

@@ -1,5 +1,5 @@
-//! The house's layers, read from the code: `rig/`, `formats/`, `document/` and `cli/` never
-//! use Bevy, and files do not import each other in a loop. Imports are every `crate::…` and
+//! The main crate's files do not import each other in a loop (the Bevy-free layers are
+//! crates of their own, kept in order by Cargo's graph). Imports are every `crate::…` and
 //! `super::…` path in a file (in `use` trees too), resolved to the module file they name; a
 //! parent's `mod child;` and its bare `child::…` paths are the module tree, not imports.
 
@@ -194,35 +194,12 @@ fn cycles(graph: &BTreeMap<PathBuf, BTreeSet<PathBuf>>) -> Vec<BTreeSet<PathBuf>
 fn no_file_imports_another_that_imports_it_back() {
     let src = Path::new(env!("CARGO_MANIFEST_DIR")).join("src");
     let graph = import_graph();
-    assert!(graph.len() > 80, "only {} files read", graph.len());
+    assert!(graph.len() > 50, "only {} files read", graph.len());
     let named = |cycle: &BTreeSet<PathBuf>| -> Vec<String> {
         cycle.iter().map(|f| f.strip_prefix(&src).unwrap().display().to_string()).collect()
     };
     let found: Vec<Vec<String>> = cycles(&graph).iter().map(named).collect();
     assert!(found.is_empty(), "import cycles: {found:?}");
-}
-
-#[test]
-fn the_layers_below_the_ecs_never_use_bevy_and_never_import_the_ecs_or_the_editor() {
-    let src = Path::new(env!("CARGO_MANIFEST_DIR")).join("src");
-    let graph = import_graph();
-    for layer in ["rig", "formats", "document", "cli"] {
-        let mut files = Vec::new();
-        rust_files(&src.join(layer), &mut files);
-        for file in files {
-            let code = code_of(&std::fs::read_to_string(&file).unwrap());
-            assert!(!code.contains("bevy"), "{} uses Bevy", file.display());
-            for target in &graph[&file] {
-                let rel = target.strip_prefix(&src).unwrap();
-                assert!(
-                    !(rel.starts_with("scene") || rel.starts_with("editor")),
-                    "{} imports {}",
-                    file.display(),
-                    rel.display()
-                );
-            }
-        }
-    }
 }
 
 #[test]

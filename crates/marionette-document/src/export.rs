@@ -1,0 +1,239 @@
+//! Exporting a scene: every character of a document as glTF, shaped (SMPL β, morph
+//! weights), posed by its pose and its clip at its time (keyframes, a glTF file's own
+//! animation, SMPL playback), placed and tinted; clips as glTF animations.
+
+use marionette_formats::FormatError;
+use marionette_formats::gltf::{GltfCharacter, GltfMesh, Motion, write_glb};
+use marionette_formats::limits::MAX_SAMPLED_FRAMES;
+use marionette_formats::scene::{CharacterDoc, SceneDoc};
+use marionette_rig::fk::RestOverride;
+use marionette_rig::node_clip::{NodeClip, NodePose, pose_mix};
+
+/// The name a clip from `file` goes out under: the file's stem, else `otherwise`.
+pub fn clip_name(file: &std::path::Path, otherwise: &str) -> String {
+    file.file_stem().map_or_else(|| otherwise.to_owned(), |s| s.to_string_lossy().into_owned())
+}
+
+/// A keyframed clip as glTF splines ([`spline_clip`](marionette_rig::keyframe_splines::spline_clip)):
+/// key for key, times from its start, its joints without keys left at `rest`; refused
+/// where a track would need more than
+/// [`MAX_SAMPLED_FRAMES`](marionette_formats::limits::MAX_SAMPLED_FRAMES) keys.
+pub fn keyframes_as_splines(
+    clip: &marionette_rig::anim::Clip,
+    skeleton: &marionette_rig::Skeleton,
+    rest: &[marionette_rig::JointRotation],
+    name: &str,
+) -> Result<NodeClip, String> {
+    marionette_rig::keyframe_splines::spline_clip(clip, skeleton, rest, name, MAX_SAMPLED_FRAMES)
+        .map_err(|e| format!("{e} (MAX_SAMPLED_FRAMES)"))
+}
+
+/// A character's pose, motion and keyed rest for export.
+struct Posed {
+    /// Where it stands (its document's placement, or where its holder carries it).
+    placement: marionette_formats::scene::PlacementDoc,
+    pose: Vec<marionette_rig::JointRotation>,
+    root: glam::Vec3,
+    /// Rest offsets and scales a clip keys (the root's offset is `root`).
+    rest: Option<(Vec<glam::Vec3>, Vec<glam::Vec3>)>,
+    motion: Option<Motion>,
+    /// The name of `motion`'s animation.
+    motion_name: String,
+    /// The source's own clips, written key for key (with `animated`).
+    clips: std::sync::Arc<[marionette_rig::node_clip::NodeClip]>,
+}
+
+/// Every character of a scene document as glTF: its shape, its pose, its clip (keyframes,
+/// its source's own animation, SMPL playback) at its time, its placement and tint; with
+/// `animated`, the clips as glTF animations.
+pub fn scene_glb(doc: &SceneDoc, mesh: GltfMesh, animated: bool) -> Result<Vec<u8>, FormatError> {
+    let loaded = load_posed(doc, animated)?;
+    let characters: Vec<GltfCharacter> = loaded
+        .iter()
+        .map(|(c, asset, posed)| GltfCharacter {
+            name: &c.name,
+            asset,
+            pose: &posed.pose,
+            root: posed.root,
+            rest: posed.rest_override(),
+            placement: posed.placement,
+            tint: c.view.tint,
+            motion: posed.motion.clone(),
+            motion_name: posed.motion_name.clone(),
+            clips: &posed.clips,
+            morph_weights: &c.morphs,
+        })
+        .collect();
+    write_glb(&characters, mesh).map_err(|e| FormatError::other(std::path::Path::new("the exported scene"), e))
+}
+
+/// Every character of a scene document posed (as [`scene_glb`] poses it) and placed in the
+/// world, as one mesh: the characters' vertices in document order, their triangles
+/// renumbered to match.
+pub fn scene_mesh(doc: &SceneDoc) -> Result<(Vec<glam::Vec3>, Vec<[u32; 3]>), FormatError> {
+    let mut positions = Vec::new();
+    let mut triangles = Vec::new();
+    for (c, asset, posed) in load_posed(doc, false)? {
+        let first = positions.len() as u32;
+        let world = posed.placement.to_mat4() * posed.root_shift(&asset);
+        positions.extend(crate::posing::posed_positions_with_rest(
+            &asset,
+            &posed.pose,
+            posed.rest_override(),
+            world,
+            c.skinning,
+        ));
+        triangles.extend(asset.skin.triangles.iter().map(|t| t.map(|v| v + first)));
+    }
+    Ok((positions, triangles))
+}
+
+/// Every character of `doc` with its shaped asset and its pose; attached characters placed
+/// where their holding joints carry them.
+fn load_posed(
+    doc: &SceneDoc,
+    animated: bool,
+) -> Result<Vec<(&CharacterDoc, std::sync::Arc<marionette_rig::CharacterAsset>, Posed)>, FormatError> {
+    let mut library = super::AssetLibrary::default();
+    let mut loaded = Vec::new();
+    for c in &doc.characters {
+        let asset = library.shaped(c)?;
+        let posed = posed(&mut library, doc, c, &asset, animated)?;
+        loaded.push((c, asset, posed));
+    }
+    for i in 0..loaded.len() {
+        let Some(attached) = &loaded[i].0.attached else { continue };
+        let holder = loaded.iter().find(|(h, ..)| h.id == Some(attached.to));
+        if let Some(joint_world) = holder.and_then(|(_, asset, posed)| posed.joint_world(asset, &attached.joint)) {
+            loaded[i].2.placement = attached.placement(joint_world);
+        }
+    }
+    Ok(loaded)
+}
+
+/// A character's pose from its document and clips at their times, and (with `animated`)
+/// its clip sampled over its length.
+fn posed(
+    library: &mut super::AssetLibrary,
+    scene: &SceneDoc,
+    c: &marionette_formats::scene::CharacterDoc,
+    asset: &marionette_rig::CharacterAsset,
+    animated: bool,
+) -> Result<Posed, FormatError> {
+    let skeleton = &asset.skeleton;
+    let (pose, notes) = super::scenes::pose_from_doc(asset, c);
+    notes.iter().for_each(|n| eprintln!("warning: {n}"));
+    let mut posed = Posed {
+        placement: c.placement,
+        pose,
+        root: skeleton.joint(0).rest_offset,
+        rest: None,
+        motion: None,
+        motion_name: String::new(),
+        clips: std::sync::Arc::new([]),
+    };
+    if let Some(anim) = &c.anim {
+        let clip = super::retarget::anim_clip(library, scene, c, asset, anim)?;
+        let clip = clip.retargeted(skeleton, &anim.names);
+        if animated {
+            let clip_file = if anim.file.as_os_str().is_empty() { std::path::Path::new(&c.name) } else { &anim.file };
+            let splines = keyframes_as_splines(&clip, skeleton, &posed.pose, &clip_name(clip_file, &c.name))
+                .map_err(|e| FormatError::other(clip_file, e))?;
+            posed.clips = std::sync::Arc::new([splines]);
+        }
+        (posed.root, posed.pose) = clip.pose_at(skeleton, anim.time, &posed.pose);
+    }
+    if let Some(part) = library.part_of_source(&c.source) {
+        if let Some(playback) = &c.playback {
+            play_node_clip(&mut posed, skeleton, &part.clips, playback)
+                .map_err(|e| FormatError::other(c.source.path().unwrap_or(std::path::Path::new(&c.name)), e))?;
+        }
+        if animated {
+            // Keyframes on a part whose clips key its root under folded nodes go out in
+            // their frame, which the export writes above the root.
+            let frame = part.clips.first().map_or(glam::Mat4::IDENTITY, |k| k.root_parent);
+            let keyframes = posed.clips.iter().map(|k| marionette_rig::keyframe_splines::reframed(k.clone(), frame));
+            posed.clips = part.clips.iter().cloned().chain(keyframes).collect();
+        }
+    }
+    if animated && let Some((name, motion)) = smpl_motion(library, c, asset)? {
+        (posed.motion_name, posed.motion) = (name, Some(motion));
+    }
+    Ok(posed)
+}
+
+impl Posed {
+    /// The rest offsets and scales its clip keys, for the matrix stack.
+    fn rest_override(&self) -> RestOverride<'_> {
+        self.rest.as_ref().map_or_else(Default::default, |(o, s)| RestOverride { offsets: Some(o), scales: Some(s) })
+    }
+
+    /// Model space as the root's translation moves it from its rest offset.
+    fn root_shift(&self, asset: &marionette_rig::CharacterAsset) -> glam::Mat4 {
+        glam::Mat4::from_translation(self.root - asset.skeleton.joint(0).rest_offset)
+    }
+
+    /// The world transform of the joint `key` names (a pose key), posed.
+    fn joint_world(&self, asset: &marionette_rig::CharacterAsset, key: &str) -> Option<glam::Mat4> {
+        let skeleton = &asset.skeleton;
+        let joint = marionette_formats::scene::joint_of_pose_key(skeleton, key)?;
+        let mut matrices = vec![glam::Mat4::IDENTITY; skeleton.len()];
+        let origin = self.placement.to_mat4() * self.root_shift(asset);
+        marionette_rig::fk::forward_kinematics_with_rest(
+            skeleton,
+            &self.pose,
+            self.rest_override(),
+            origin,
+            &mut matrices,
+        );
+        Some(matrices[joint])
+    }
+}
+
+/// A glTF clip's pose at the playback's time on `posed` (its keyed joints, root and rest).
+fn play_node_clip(
+    posed: &mut Posed,
+    skeleton: &marionette_rig::Skeleton,
+    clips: &[marionette_rig::node_clip::NodeClip],
+    playback: &marionette_formats::scene::PlaybackDoc,
+) -> Result<(), String> {
+    let find = |name: &Option<String>| clips.iter().find(|k| Some(&k.name) == name.as_ref());
+    let Some(clip) = find(&playback.clip) else { return Ok(()) };
+    let blend = find(&playback.blend_clip).map(|k| (k, playback.blend));
+    let now = pose_mix(skeleton, clip, blend, playback.time, &mut posed.pose);
+    posed.root = now.offsets[0];
+    if clip.moves_rest() || blend.is_some_and(|(k, _)| k.moves_rest()) {
+        posed.rest = Some(rest_of(skeleton, &now));
+    }
+    Ok(())
+}
+
+/// A sampled pose's offsets (the root's left at the skeleton's, as `root` carries it) and
+/// scales.
+fn rest_of(skeleton: &marionette_rig::Skeleton, sample: &NodePose) -> (Vec<glam::Vec3>, Vec<glam::Vec3>) {
+    let mut offsets = sample.offsets.clone();
+    offsets[0] = skeleton.joint(0).rest_offset;
+    (offsets, sample.scales.clone())
+}
+
+/// An SMPL body's playing clip, every frame (at its 30 frames per second), with the body's
+/// own root and the clip's rotations, and the clip's name.
+fn smpl_motion(
+    library: &mut super::AssetLibrary,
+    c: &marionette_formats::scene::CharacterDoc,
+    asset: &marionette_rig::CharacterAsset,
+) -> Result<Option<(String, Motion)>, FormatError> {
+    let (Some(smpl), marionette_formats::scene::SourceDoc::File(dir)) = (&c.smpl, &c.source) else { return Ok(None) };
+    let Some(name) = &smpl.clip else { return Ok(None) };
+    let set = library.smpl(dir)?;
+    let Some((_, clip)) = set.clips.iter().find(|(n, _)| n == name) else { return Ok(None) };
+    let mut motion = Motion::default();
+    let root = asset.skeleton.joint(0).rest_offset;
+    for f in 0..clip.frame_count() {
+        motion.times.push(f as f32 / marionette_rig::smpl::CLIP_FPS);
+        motion.poses.push(clip.frame(f).iter().map(|&q| marionette_rig::JointRotation::Quat(q)).collect());
+        motion.roots.push(root);
+    }
+    let stem = name.strip_suffix(".txt").unwrap_or(name);
+    Ok(Some((stem.to_string(), motion)))
+}

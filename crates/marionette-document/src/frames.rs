@@ -1,0 +1,102 @@
+//! Frame sequences for `render --from A --to B --fps N --out dir/frame_%04d.png`: the
+//! times of the frames, where each picture goes, and the turntable's turn at each.
+
+use std::path::{Path, PathBuf};
+
+use marionette_formats::limits::MAX_SAMPLED_FRAMES;
+
+/// Frames from `from` to `to` seconds (both included where `to` falls on a frame) at `fps`
+/// frames per second; with `turntable`, the camera goes once round the scene every that
+/// many seconds.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct FrameSequence {
+    pub from: f32,
+    pub to: f32,
+    pub fps: f32,
+    pub turntable: Option<f32>,
+}
+
+impl FrameSequence {
+    /// Each frame's time: `from + k / fps` up to `to` (a hair of rounding allowed, so that
+    /// 0 to 1 at 10 fps is 11 frames). Refused when the times are not finite and in order,
+    /// or there would be more than [`MAX_SAMPLED_FRAMES`].
+    pub fn times(&self) -> Result<Vec<f32>, String> {
+        let (from, to, fps) = (f64::from(self.from), f64::from(self.to), f64::from(self.fps));
+        if !(from.is_finite() && to.is_finite() && from <= to) {
+            return Err(format!("expected --from at or before --to, found {from} and {to}"));
+        }
+        if !(fps.is_finite() && fps > 0.0) {
+            return Err(format!("expected --fps above 0, found {fps}"));
+        }
+        if let Some(seconds) = self.turntable.filter(|s| !(s.is_finite() && *s > 0.0)) {
+            return Err(format!("expected --turntable above 0 seconds, found {seconds}"));
+        }
+        let last = ((to - from) * fps + 1e-6).floor();
+        if last + 1.0 > MAX_SAMPLED_FRAMES as f64 {
+            return Err(format!(
+                "{} frames from {from} s to {to} s at {fps} per second: more than the {MAX_SAMPLED_FRAMES} a \
+                 render writes (MAX_SAMPLED_FRAMES)",
+                last + 1.0
+            ));
+        }
+        Ok((0..=last as usize).map(|k| (from + k as f64 / fps) as f32).collect())
+    }
+
+    /// The camera's turn (radians about the vertical) at time `t`: one whole turn per
+    /// turntable period from the first frame; none without a turntable.
+    pub fn turn_at(&self, t: f32) -> f32 {
+        self.turntable.map_or(0.0, |seconds| std::f32::consts::TAU * (t - self.from) / seconds)
+    }
+}
+
+/// The path of frame `n` from `pattern`: its one `%d` or `%0Nd` (N digits, zero-padded)
+/// replaced by `n`. Refused without exactly one.
+pub fn frame_path(pattern: &Path, n: usize) -> Result<PathBuf, String> {
+    let text = pattern.to_string_lossy();
+    let expected = || format!("expected one %d or %04d in --out for the frame number, found {text}");
+    let (start, rest) = text.split_once('%').ok_or_else(expected)?;
+    let digits_end = rest.find('d').ok_or_else(expected)?;
+    let width = &rest[..digits_end];
+    let tail = &rest[digits_end + 1..];
+    let valid_width = width.is_empty() || (width.starts_with('0') && width.len() <= 3 && width.parse::<u8>().is_ok());
+    if !valid_width || tail.contains('%') {
+        return Err(expected());
+    }
+    let width: usize = width.parse().unwrap_or(0);
+    Ok(PathBuf::from(format!("{start}{n:0width$}{tail}")))
+}
+
+/// The picture's size and samples asked for on the command line (each none: the scene's).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct PictureRequest {
+    pub width: Option<u32>,
+    pub height: Option<u32>,
+    pub samples: Option<u32>,
+}
+
+impl PictureRequest {
+    /// The picture: what was asked for, the rest as the scene's `shot` says; refused beyond
+    /// the GPU's texture size.
+    pub fn resolved(
+        self,
+        shot: &marionette_formats::scene::ShotDoc,
+    ) -> Result<marionette_formats::scene::ShotDoc, String> {
+        let picture = marionette_formats::scene::ShotDoc {
+            width: self.width.unwrap_or(shot.width),
+            height: self.height.unwrap_or(shot.height),
+            samples: self.samples.unwrap_or(shot.samples),
+        };
+        picture.validate().map(|()| picture)
+    }
+}
+
+/// The pictures a render writes.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Pictures {
+    /// One picture of the scene as it opens.
+    Still,
+    /// One per frame, into the files `out` numbers (`frame_%04d.png`).
+    Sequence(FrameSequence),
+    /// A contact sheet: every pose of the scene's library on its characters, in a grid.
+    PoseSheet,
+}

@@ -1,0 +1,73 @@
+//! A rendered picture finished for saving: supersampled pixels averaged down, and the
+//! background put behind what was drawn (a gradient, or nothing: alpha kept).
+
+use image::{DynamicImage, Rgba, RgbaImage};
+
+use marionette_formats::scene::BackgroundDoc;
+
+/// sRGB (0..=1) to linear light.
+fn to_linear(c: f32) -> f32 {
+    if c <= 0.04045 { c / 12.92 } else { ((c + 0.055) / 1.055).powf(2.4) }
+}
+
+/// Linear light to sRGB (0..=1).
+fn to_srgb(c: f32) -> f32 {
+    if c <= 0.0031308 { c * 12.92 } else { 1.055 * c.powf(1.0 / 2.4) - 0.055 }
+}
+
+fn byte(c: f32) -> u8 {
+    (c.clamp(0.0, 1.0) * 255.0).round() as u8
+}
+
+/// Each `samples`×`samples` block of `rendered` averaged into one pixel: colours in linear
+/// light, weighted by their alpha (a pixel half covered by a character and half by nothing
+/// keeps the character's colour at half alpha).
+pub fn downsampled(rendered: &RgbaImage, samples: u32) -> RgbaImage {
+    if samples <= 1 {
+        return rendered.clone();
+    }
+    let (w, h) = (rendered.width() / samples, rendered.height() / samples);
+    let n = (samples * samples) as f32;
+    RgbaImage::from_fn(w, h, |x, y| {
+        let mut sum = [0.0f32; 4];
+        for dy in 0..samples {
+            for dx in 0..samples {
+                let p = rendered.get_pixel(x * samples + dx, y * samples + dy).0;
+                let alpha = p[3] as f32 / 255.0;
+                for k in 0..3 {
+                    sum[k] += to_linear(p[k] as f32 / 255.0) * alpha;
+                }
+                sum[3] += alpha;
+            }
+        }
+        let alpha = sum[3] / n;
+        let color = |k: usize| if sum[3] > 0.0 { byte(to_srgb(sum[k] / sum[3])) } else { 0 };
+        Rgba([color(0), color(1), color(2), byte(alpha)])
+    })
+}
+
+/// `drawn` over the background: a gradient fills behind it (composited in linear light);
+/// a transparent background keeps the alpha (an RGBA picture); any other is already in
+/// the picture (an RGB one).
+pub fn over_background(drawn: RgbaImage, background: &BackgroundDoc) -> DynamicImage {
+    match background {
+        BackgroundDoc::Transparent => DynamicImage::ImageRgba8(drawn),
+        BackgroundDoc::Gradient { .. } => {
+            let height = drawn.height().max(2) - 1;
+            let mut out = drawn;
+            for (_, y, p) in out.enumerate_pixels_mut() {
+                let (behind, _) = background.at(y as f32 / height as f32);
+                let alpha = p.0[3] as f32 / 255.0;
+                for (c, back) in p.0.iter_mut().zip(behind) {
+                    let front = to_linear(*c as f32 / 255.0);
+                    *c = byte(to_srgb(front * alpha + to_linear(back) * (1.0 - alpha)));
+                }
+                p.0[3] = 255;
+            }
+            DynamicImage::ImageRgb8(DynamicImage::ImageRgba8(out).to_rgb8())
+        }
+        BackgroundDoc::Sky | BackgroundDoc::Color(_) => {
+            DynamicImage::ImageRgb8(DynamicImage::ImageRgba8(drawn).to_rgb8())
+        }
+    }
+}

@@ -1,0 +1,387 @@
+//! Posing and exporting without the ECS: `JOINT=rx,ry,rz` specs, posed skins, and the
+//! `info` summary. Used by the CLI and by tests; no Bevy.
+
+use glam::{Mat4, Vec3};
+
+use marionette_rig::dqs::SkinningMethod;
+use marionette_rig::fk::{RestOverride, posed_palette_with_rest};
+use marionette_rig::lbs::skin;
+use marionette_rig::node_clip::{NodeClip, NodePose};
+use marionette_rig::{CharacterAsset, JointRotation, Skeleton};
+
+/// What is wrong with a `JOINT=rx,ry,rz` spec.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum PoseSpecError {
+    #[error("`{spec}`: expected JOINT=rx,ry,rz (radians)")]
+    Syntax { spec: String },
+    #[error("`{spec}`: no joint named or numbered `{joint}` (joints: {known})")]
+    UnknownJoint { spec: String, joint: String, known: String },
+}
+
+/// A parsed `JOINT=rx,ry,rz` (angles in radians, x applied first).
+#[derive(Debug, Clone, PartialEq)]
+pub struct PoseSpec {
+    pub joint: String,
+    pub angles: Vec3,
+}
+
+impl std::str::FromStr for PoseSpec {
+    type Err = PoseSpecError;
+
+    fn from_str(spec: &str) -> Result<Self, Self::Err> {
+        let err = || PoseSpecError::Syntax { spec: spec.to_string() };
+        let (joint, angles) = spec.split_once('=').ok_or_else(err)?;
+        let a: Vec<f32> =
+            angles.split(',').map(|t| t.trim().parse::<f32>()).collect::<Result<_, _>>().map_err(|_| err())?;
+        if joint.is_empty() || a.len() != 3 || a.iter().any(|v| !v.is_finite()) {
+            return Err(err());
+        }
+        Ok(Self { joint: joint.to_string(), angles: Vec3::new(a[0], a[1], a[2]) })
+    }
+}
+
+/// Applies specs on top of `pose`, each clamped to its joint's limits.
+pub fn apply_pose_specs(
+    skeleton: &Skeleton,
+    pose: &mut [JointRotation],
+    specs: &[PoseSpec],
+) -> Result<(), PoseSpecError> {
+    for spec in specs {
+        let j = skeleton.resolve(&spec.joint).ok_or_else(|| PoseSpecError::UnknownJoint {
+            spec: format!("{}={},{},{}", spec.joint, spec.angles.x, spec.angles.y, spec.angles.z),
+            joint: spec.joint.clone(),
+            known: joint_list(skeleton),
+        })?;
+        let order = match pose[j] {
+            JointRotation::Euler(_, order) => order,
+            JointRotation::Quat(_) => Default::default(),
+        };
+        pose[j] = JointRotation::Euler(spec.angles, order).clamped(&skeleton.joint(j).limits);
+    }
+    Ok(())
+}
+
+fn joint_list(skeleton: &Skeleton) -> String {
+    let names: Vec<&str> = skeleton.joints().iter().map(|j| j.name.as_str()).collect();
+    if names.len() > 12 {
+        format!("{}, ... ({} in all)", names[..12].join(", "), names.len())
+    } else {
+        names.join(", ")
+    }
+}
+
+/// The skin's vertices at `pose`, in source order, with the character placed by `placement`.
+pub fn posed_positions(asset: &CharacterAsset, pose: &[JointRotation], placement: Mat4) -> Vec<Vec3> {
+    posed_positions_by(asset, pose, placement, SkinningMethod::Linear)
+}
+
+/// As [`posed_positions`], by linear blend or dual quaternion skinning.
+pub fn posed_positions_by(
+    asset: &CharacterAsset,
+    pose: &[JointRotation],
+    placement: Mat4,
+    method: SkinningMethod,
+) -> Vec<Vec3> {
+    posed_positions_with_rest(asset, pose, RestOverride::default(), placement, method)
+}
+
+/// As [`posed_positions_by`], with the rest offsets and scales a clip keys.
+pub fn posed_positions_with_rest(
+    asset: &CharacterAsset,
+    pose: &[JointRotation],
+    rest: RestOverride,
+    placement: Mat4,
+    method: SkinningMethod,
+) -> Vec<Vec3> {
+    let palette = posed_palette_with_rest(&asset.skeleton, &asset.bind_world_to_joint, pose, rest, placement);
+    let mut out = vec![Vec3::ZERO; asset.vertex_count()];
+    match method {
+        SkinningMethod::Linear => skin(&asset.skin.bind_positions, &asset.skin.weights, &palette, &mut out),
+        SkinningMethod::DualQuaternion => {
+            let mut dq = Vec::new();
+            marionette_rig::dqs::dual_quaternion_palette(&palette, &mut dq);
+            marionette_rig::dqs::skin_dq(&asset.skin.bind_positions, &asset.skin.weights, &dq, &mut out);
+        }
+    }
+    out
+}
+
+/// The animation `spec` names among a character's clips: by name, or by its index among
+/// the file's animations.
+pub fn find_clip<'a>(clips: &'a [NodeClip], spec: &str) -> Option<&'a NodeClip> {
+    clips.iter().find(|c| c.name == spec).or_else(|| {
+        let index: usize = spec.parse().ok()?;
+        clips.iter().find(|c| c.index == index)
+    })
+}
+
+/// `--clip SPEC` against the files it is given with: fails on a file that has clips but none
+/// that `spec` names, or when no file has a clip it names, listing each file's clips (the
+/// numbers `info` gives them).
+pub fn check_clip_spec(paths: &[std::path::PathBuf], spec: &str) -> Result<(), String> {
+    let mut matched = false;
+    let mut listed = Vec::new();
+    for path in paths.iter().filter(|p| marionette_formats::has_parts(p)) {
+        let parts = marionette_formats::load_parts(path).map_err(|e| e.to_string())?;
+        let clips: Vec<&NodeClip> = parts.iter().flat_map(|p| &p.clips).collect();
+        let names = || {
+            let mut names: Vec<String> = clips.iter().map(|c| format!("{} `{}`", c.index, c.name)).collect();
+            names.dedup();
+            if names.is_empty() { "none".to_string() } else { names.join(", ") }
+        };
+        if parts.iter().any(|p| find_clip(&p.clips, spec).is_some()) {
+            matched = true;
+        } else if !clips.is_empty() {
+            return Err(format!("{}: no clip `{spec}` (its clips: {})", path.display(), names()));
+        } else {
+            listed.push(format!("{}: none", path.display()));
+        }
+    }
+    if !matched {
+        return Err(format!("no file has a clip `{spec}` ({})", listed.join("; ")));
+    }
+    Ok(())
+}
+
+/// Every character of a glTF file, shaped by the morph weights the file sets (or its clip
+/// keys), each posed by its clip `clip` at `time` seconds (by its file's node transforms without one) and
+/// then by `poses` where it has the joints:
+/// the vertices and triangles of all of them, in file order. Fails when no character has
+/// the clip.
+pub fn posed_gltf(
+    characters: &[marionette_formats::part::Part],
+    clip: Option<&str>,
+    time: f32,
+    poses: &[PoseSpec],
+    method: SkinningMethod,
+) -> Result<(Vec<Vec3>, Vec<[u32; 3]>), String> {
+    if let Some(spec) = clip
+        && !characters.iter().any(|c| find_clip(&c.clips, spec).is_some())
+    {
+        let names: Vec<String> =
+            characters.iter().flat_map(|c| &c.clips).map(|c| format!("{} `{}`", c.index, c.name)).collect();
+        return Err(format!(
+            "no animation `{spec}` in the file (it has: {})",
+            if names.is_empty() { "none".to_string() } else { names.join(", ") }
+        ));
+    }
+    let (mut positions, mut triangles) = (Vec::new(), Vec::new());
+    for c in characters {
+        let skeleton = &c.asset.skeleton;
+        let playing = clip.and_then(|spec| find_clip(&c.clips, spec));
+        let node_pose = playing.map_or_else(|| NodePose::of(skeleton), |clip| clip.sample(skeleton, time));
+        // The morph weights the file sets are part of its pose; a clip may key them.
+        let weights =
+            playing.map_or_else(|| c.morph_weights.clone(), |clip| clip.sample_weights(&c.morph_weights, time));
+        let mut pose = node_pose.pose();
+        let mine: Vec<PoseSpec> = poses.iter().filter(|p| skeleton.resolve(&p.joint).is_some()).cloned().collect();
+        apply_pose_specs(skeleton, &mut pose, &mine).map_err(|e| e.to_string())?;
+        let rest = RestOverride { offsets: Some(&node_pose.offsets), scales: Some(&node_pose.scales) };
+        let first = positions.len() as u32;
+        let mut shaped = std::borrow::Cow::Borrowed(&c.asset);
+        if weights.iter().any(|&w| w != 0.0) {
+            shaped.to_mut().skin.bind_positions = c.asset.morphed_positions(&weights);
+        }
+        positions.extend(posed_positions_with_rest(&shaped, &pose, rest, Mat4::IDENTITY, method));
+        triangles.extend(c.asset.skin.triangles.iter().map(|t| t.map(|i| i + first)));
+    }
+    Ok((positions, triangles))
+}
+
+/// A human-readable summary of what was loaded.
+pub fn describe(asset: &CharacterAsset) -> String {
+    let s = &asset.skeleton;
+    let w = &asset.skin.weights;
+    let (lo, hi) = asset.bounds();
+    let mut out = String::new();
+    out += &format!("character: {}\n", asset.name);
+    out += &format!("joints: {}\n", s.len());
+    for (i, j) in s.joints().iter().enumerate() {
+        let parent = j.parent.map_or("-".to_string(), |p| p.to_string());
+        let limits = if j.limits.is_unlimited() {
+            String::new()
+        } else {
+            format!(
+                "  limits x[{:.3},{:.3}] y[{:.3},{:.3}] z[{:.3},{:.3}]",
+                j.limits.min.x, j.limits.max.x, j.limits.min.y, j.limits.max.y, j.limits.min.z, j.limits.max.z
+            )
+        };
+        out += &format!(
+            "  {i:3} {:<24} parent {parent:>3}  offset ({:.4}, {:.4}, {:.4}){limits}\n",
+            j.name, j.rest_offset.x, j.rest_offset.y, j.rest_offset.z
+        );
+    }
+    let kind = match asset.skin_kind {
+        marionette_rig::character::SkinKind::Mesh => "mesh",
+        marionette_rig::character::SkinKind::BoneBoxes => "bone boxes (no mesh in the source)",
+        marionette_rig::character::SkinKind::Rigid => "meshes carried by their nodes (a prop: nothing skinned)",
+    };
+    out += &format!("skin: {kind}\n");
+    out += &describe_humanoid(asset);
+    out += &format!("vertices: {}\n", asset.vertex_count());
+    out += &format!("triangles: {}\n", asset.triangle_count());
+    if !asset.morphs.is_empty() {
+        let names: Vec<&str> = asset.morphs.iter().map(|m| m.name.as_str()).collect();
+        out += &format!("morphs: {}\n", names.join(", "));
+    }
+    if !asset.expressions.is_empty() {
+        let names: Vec<&str> = asset.expressions.iter().map(|e| e.name.as_str()).collect();
+        out += &format!("expressions: {}\n", names.join(", "));
+    }
+    let avg = if w.vertex_count() > 0 { w.total_influences() as f32 / w.vertex_count() as f32 } else { 0.0 };
+    out += &format!("influences per vertex: max {}, mean {avg:.2}\n", w.max_influences());
+    out += &format!("bounds: ({:.3}, {:.3}, {:.3}) .. ({:.3}, {:.3}, {:.3})\n", lo.x, lo.y, lo.z, hi.x, hi.y, hi.z);
+    if asset.warnings.is_empty() {
+        out += "weight warnings: none\n";
+    } else {
+        for warning in &asset.warnings {
+            out += &format!("warning: {warning}\n");
+        }
+    }
+    out
+}
+
+/// The humanoid map: how many bones and how they were found, then a line a bone
+/// (`Bone = joint (how)`) and a line for each doubt; or why there is none.
+pub fn describe_humanoid(asset: &CharacterAsset) -> String {
+    let skeleton = &asset.skeleton;
+    if skeleton.len() < 5 {
+        return String::new();
+    }
+    let Some(found) = marionette_rig::humanoid::of_asset(asset) else {
+        return "humanoid: not found (no two legs and two arms)\n".to_string();
+    };
+    use marionette_rig::humanoid::Found;
+    let count = |how: Found| found.found.values().filter(|&&f| f == how).count();
+    let mut out = format!(
+        "humanoid: {} of {} bones ({} by name, {} by structure, {} named by the file)\n",
+        found.map.len(),
+        marionette_rig::humanoid::HumanBone::ALL.len(),
+        count(Found::Name),
+        count(Found::Structure),
+        count(Found::File),
+    );
+    for (bone, &j) in &found.map {
+        let how = match found.found.get(bone) {
+            Some(Found::Name) => "name",
+            Some(Found::Structure) => "structure",
+            Some(Found::File) => "file",
+            None => "assigned",
+        };
+        out += &format!("  {bone:?} = {} ({how})\n", skeleton.joint(j).name);
+    }
+    for doubt in &found.doubts {
+        out += &format!("humanoid doubt: {doubt}\n");
+    }
+    out
+}
+
+/// A parsed `JOINT=x,y,z`: move the joint to a world-space target by IK.
+#[derive(Debug, Clone, PartialEq)]
+pub struct IkSpec {
+    pub joint: String,
+    pub target: Vec3,
+}
+
+impl std::str::FromStr for IkSpec {
+    type Err = PoseSpecError;
+
+    fn from_str(spec: &str) -> Result<Self, Self::Err> {
+        let pose: PoseSpec = spec
+            .parse()
+            .map_err(|_| PoseSpecError::Syntax { spec: format!("{spec} (expected JOINT=x,y,z, world space)") })?;
+        Ok(Self { joint: pose.joint, target: pose.angles })
+    }
+}
+
+pub use marionette_rig::ik::{IK_ROUNDS, IK_TOLERANCE};
+
+/// Solves the IK specs in turn on top of `pose` (after `--pose`), for a character placed
+/// by `placement`.
+pub fn apply_ik_specs(
+    skeleton: &Skeleton,
+    pose: &mut [JointRotation],
+    placement: Mat4,
+    specs: &[IkSpec],
+) -> Result<Vec<marionette_rig::ik::IkReport>, PoseSpecError> {
+    let goals = specs
+        .iter()
+        .map(|s| {
+            let end = skeleton.resolve(&s.joint).ok_or_else(|| PoseSpecError::UnknownJoint {
+                spec: s.joint.clone(),
+                joint: s.joint.clone(),
+                known: joint_list(skeleton),
+            })?;
+            Ok(marionette_rig::ik::IkGoal { end, target: s.target })
+        })
+        .collect::<Result<Vec<_>, PoseSpecError>>()?;
+    Ok(marionette_rig::ik::solve_ik(skeleton, pose, placement, &goals, IK_TOLERANCE, IK_ROUNDS))
+}
+
+/// One line about an IK solve.
+pub fn describe_ik(skeleton: &Skeleton, r: &marionette_rig::ik::IkReport) -> String {
+    format!(
+        "ik {}: {} after {} rounds ({} FABRIK iterations), distance {:.5}{}",
+        skeleton.joint(r.end).name,
+        if r.reached { "reached" } else { "not reached" },
+        r.rounds,
+        r.iterations,
+        r.distance,
+        if r.limited { ", stopped by joint limits" } else { "" }
+    )
+}
+
+/// One line on a glTF clip: its index and name, length, channels, keys and interpolations.
+pub fn describe_clip(clip: &NodeClip) -> String {
+    use marionette_rig::node_clip::Interpolation;
+    let mut channels = 0;
+    let mut keys = 0;
+    let mut kinds = Vec::new();
+    let mut count = |times: usize, interpolation: Interpolation| {
+        channels += 1;
+        keys += times;
+        if !kinds.contains(&interpolation) {
+            kinds.push(interpolation);
+        }
+    };
+    for t in &clip.tracks {
+        t.translation.iter().for_each(|k| count(k.times.len(), k.interpolation));
+        t.rotation.iter().for_each(|k| count(k.times.len(), k.interpolation));
+        t.scale.iter().for_each(|k| count(k.times.len(), k.interpolation));
+    }
+    let weights = clip.weights.iter().flatten().count();
+    clip.weights.iter().flatten().for_each(|k| count(k.times.len(), k.interpolation));
+    let kinds: Vec<&str> = kinds
+        .iter()
+        .map(|k| match k {
+            Interpolation::Step => "STEP",
+            Interpolation::Linear => "LINEAR",
+            Interpolation::CubicSpline => "CUBICSPLINE",
+        })
+        .collect();
+    let morphs = if weights > 0 { format!(" ({weights} morph weights)") } else { String::new() };
+    format!(
+        "animation {} `{}`: {:.3} s, {channels} channels{morphs}, {keys} keys, {}",
+        clip.index,
+        clip.name,
+        clip.duration(),
+        kinds.join(" + ")
+    )
+}
+
+/// One line on a material: its name, factors, textures, alpha and sidedness.
+pub fn describe_material(m: &marionette_rig::material::Material) -> String {
+    let [r, g, b, a] = m.base_color;
+    let textures: Vec<&str> = m.textures().map(|(what, _)| what).collect();
+    let textures = if textures.is_empty() { String::new() } else { format!(", textures: {}", textures.join(", ")) };
+    let alpha = match m.alpha {
+        marionette_rig::material::AlphaMode::Opaque => "opaque".to_string(),
+        marionette_rig::material::AlphaMode::Mask(cutoff) => format!("alpha mask at {cutoff}"),
+        marionette_rig::material::AlphaMode::Blend => "alpha blended".to_string(),
+    };
+    let sides = if m.double_sided { ", double-sided" } else { "" };
+    format!(
+        "material `{}`: base colour ({r:.3}, {g:.3}, {b:.3}, {a:.3}), metallic {:.2}, roughness {:.2}{textures}, {alpha}{sides}",
+        m.name, m.metallic, m.roughness
+    )
+}
