@@ -88,12 +88,12 @@ pub fn scene_mesh(doc: &SceneDoc) -> Result<(Vec<glam::Vec3>, Vec<[u32; 3]>), Fo
     Ok((positions, triangles))
 }
 
+/// A scene's character with its shaped asset and its pose.
+type PosedCharacter<'a> = (&'a CharacterDoc, std::sync::Arc<marionette_rig::CharacterAsset>, Posed);
+
 /// Every character of `doc` with its shaped asset and its pose; attached characters placed
 /// where their holding joints carry them.
-fn load_posed(
-    doc: &SceneDoc,
-    animated: bool,
-) -> Result<Vec<(&CharacterDoc, std::sync::Arc<marionette_rig::CharacterAsset>, Posed)>, FormatError> {
+fn load_posed(doc: &SceneDoc, animated: bool) -> Result<Vec<PosedCharacter<'_>>, FormatError> {
     let mut library = super::AssetLibrary::default();
     let mut loaded = Vec::new();
     for c in &doc.characters {

@@ -100,3 +100,33 @@ pub enum Pictures {
     /// A contact sheet: every pose of the scene's library on its characters, in a grid.
     PoseSheet,
 }
+
+#[cfg(test)]
+mod tests {
+    use std::path::Path;
+
+    use super::{FrameSequence, frame_path};
+
+    /// Frame sequences: 0 to 1 s at 10 fps is 11 frames at k/10 s; a turntable turns once per
+    /// period; the file pattern takes one `%d` or `%0Nd`; nonsense is refused with a message.
+    #[test]
+    fn frame_sequences_number_their_frames_and_files() {
+        let sequence = FrameSequence { from: 0.0, to: 1.0, fps: 10.0, turntable: Some(2.0) };
+        let times = sequence.times().unwrap();
+        assert_eq!(times.len(), 11);
+        assert!((times[7] - 0.7).abs() < 1e-6 && times[10] == 1.0);
+        assert!((sequence.turn_at(0.5) - std::f32::consts::FRAC_PI_2).abs() < 1e-6, "a quarter turn in half a period");
+        let thirds = FrameSequence { from: 0.0, to: 1.0, fps: 3.0, turntable: None };
+        assert_eq!(thirds.times().unwrap().len(), 4, "1 s at 3 fps: 0, 1/3, 2/3, 1");
+        assert_eq!(frame_path(Path::new("out/frame_%04d.png"), 7).unwrap(), Path::new("out/frame_0007.png"));
+        assert_eq!(frame_path(Path::new("f%d.png"), 12).unwrap(), Path::new("f12.png"));
+        for bad in ["frame.png", "f_%x.png", "f_%04d_%d.png", "f_%4d.png"] {
+            let e = frame_path(Path::new(bad), 0).unwrap_err();
+            assert!(e.contains("expected one %d or %04d"), "{bad}: {e}");
+        }
+        let backwards = FrameSequence { from: 2.0, to: 1.0, fps: 10.0, turntable: None };
+        assert!(backwards.times().unwrap_err().contains("--from at or before --to"));
+        let endless = FrameSequence { from: 0.0, to: 1e30, fps: 10.0, turntable: None };
+        assert!(endless.times().unwrap_err().contains("MAX_SAMPLED_FRAMES"));
+    }
+}

@@ -96,3 +96,6 @@ fn sync_dir(dir: &std::path::Path) -> std::io::Result<()> {
     let _ = dir;
     Ok(())
 }
+
+#[cfg(test)]
+mod tests;

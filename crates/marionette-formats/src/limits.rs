@@ -1,6 +1,6 @@
 //! What Marionette reads and makes at most. Each limit is checked before anything is
 //! allocated for it, and a file past one is refused with an error that names the limit.
-//! The README's "Limits" section lists them.
+//! docs/limits.md lists them.
 
 /// The largest file any reader opens (a larger one is refused before it is read).
 pub const MAX_FILE_BYTES: u64 = 512 << 20;

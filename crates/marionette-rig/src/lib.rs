@@ -73,3 +73,6 @@ pub enum RigError {
     #[error("the mesh has {mesh} vertices but {normals} normals")]
     NormalCountMismatch { mesh: usize, normals: usize },
 }
+
+#[cfg(test)]
+mod tests;

@@ -151,8 +151,11 @@ fn aims(bone: HumanBone) -> &'static [HumanBone] {
     }
 }
 
+/// Every joint's world rotation and position.
+pub type WorldFrames = (Vec<Quat>, Vec<Vec3>);
+
 /// Each joint's world rotation and position for `pose` with the root at `root`.
-pub fn world_frames(skeleton: &Skeleton, root: Vec3, pose: &[JointRotation]) -> (Vec<Quat>, Vec<Vec3>) {
+pub fn world_frames(skeleton: &Skeleton, root: Vec3, pose: &[JointRotation]) -> WorldFrames {
     let mut rotations = vec![Quat::IDENTITY; skeleton.len()];
     for j in 0..skeleton.len() {
         let parent = skeleton.parent(j).map_or(Quat::IDENTITY, |p| rotations[p]);
@@ -289,7 +292,7 @@ impl<'a> Retargeter<'a> {
         source: &Frame,
         mut pose: Vec<JointRotation>,
         drives: impl Fn(usize) -> bool,
-    ) -> (Vec<JointRotation>, Vec<usize>, (Vec<Quat>, Vec<Vec3>)) {
+    ) -> (Vec<JointRotation>, Vec<usize>, WorldFrames) {
         let (s, t) = (self.source.skeleton, self.target.skeleton);
         let (s_rot, s_at) = world_frames(s, source.root, &source.pose);
         let mut world = vec![Quat::IDENTITY; t.len()];

@@ -5,14 +5,14 @@ use std::collections::BTreeMap;
 use std::io::Cursor;
 use std::path::{Path, PathBuf};
 
+use crate::bvh::parse_bvh;
 use glam::{Mat3, Vec3};
-use marionette::formats::bvh::parse_bvh;
 
 fn fixture() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/steps.bvh")
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../../tests/data/steps.bvh")
 }
 
-fn steps() -> marionette::formats::bvh::BvhFile {
+fn steps() -> crate::bvh::BvhFile {
     let path = fixture();
     parse_bvh(std::io::BufReader::new(std::fs::File::open(&path).unwrap()), &path).unwrap()
 }
@@ -65,7 +65,7 @@ fn rotation_channels_compose_outermost_first() {
 #[test]
 fn another_character_plays_it_by_a_name_map() {
     let bvh = steps();
-    let puppet = marionette::formats::puppet::embedded_puppet();
+    let puppet = crate::puppet::embedded_puppet();
     let skeleton = &puppet.skeleton;
     let names = BTreeMap::from([("l_knee".to_string(), "LeftLeg".to_string())]);
     let clip = bvh.clip.retargeted(skeleton, &names);

@@ -2,12 +2,10 @@
 
 use std::f32::consts::{FRAC_PI_2, PI};
 
+use crate::fk::{bind_world_to_joint, forward_kinematics, skinning_palette};
+use crate::skinning::{flat_shade, joint_colors, skin_positions, weight_colors};
+use crate::{DofLimits, EulerOrder, JointRotation, MatrixStack, RawJoint, RigError, Skeleton, SkinWeights};
 use glam::{Mat3, Mat4, Quat, Vec3};
-use marionette::rig::fk::{bind_world_to_joint, forward_kinematics, skinning_palette};
-use marionette::rig::skinning::{flat_shade, joint_colors, skin_positions, weight_colors};
-use marionette::rig::{DofLimits, EulerOrder, JointRotation, MatrixStack, RawJoint, RigError, Skeleton, SkinWeights};
-
-use crate::common::{assert_mat_close, assert_vec_close};
 
 #[test]
 fn empty_matrix_stack_top_is_identity() {
@@ -251,4 +249,15 @@ fn quaternion_poses_drive_fk_like_euler_poses() {
     }
     let q = Quat::from_rotation_y(0.5);
     assert_eq!(JointRotation::Quat(q).with_rotation_of(Quat::IDENTITY), JointRotation::Quat(Quat::IDENTITY));
+}
+
+fn assert_mat_close(a: Mat4, b: Mat4, tol: f32) {
+    let (a, b) = (a.to_cols_array(), b.to_cols_array());
+    for k in 0..16 {
+        assert!((a[k] - b[k]).abs() <= tol, "matrices differ at {k}: {a:?} vs {b:?}");
+    }
+}
+
+fn assert_vec_close(a: Vec3, b: Vec3, tol: f32) {
+    assert!(a.distance(b) <= tol, "{a} vs {b} (distance {})", a.distance(b));
 }

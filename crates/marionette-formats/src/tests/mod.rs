@@ -1,0 +1,4 @@
+//! The readers' unit tests: valid inputs from memory, malformed ones with their messages.
+
+mod bvh;
+mod readers;
