@@ -14,9 +14,9 @@ use bevy::render::render_resource::{TextureFormat, TextureUsages};
 use bevy::render::{Render, RenderApp, RenderSystems};
 
 use crate::document::crowd::{puppet_crowd, smpl_crowd};
-use crate::editor::interact::camera::OrbitCamera;
 use crate::editor::present::readiness::CaptureGate;
 use crate::editor::scene_doc::document::PendingScene;
+use crate::editor::state::camera::OrbitCamera;
 use crate::rig::{CharacterAsset, JointRotation};
 use crate::scene::smpl::SmplCharacter;
 use crate::scene::upload::HandedOn;

@@ -30,8 +30,9 @@ use bevy::prelude::*;
 use bevy::window::WindowResolution;
 
 use crate::scene::{MarionetteSystems, RigCorePlugin, SkinningPlugin};
-use interact::camera::{OrbitCamera, orbit_camera_input};
+use interact::camera::orbit_camera_input;
 pub use present::view::{ScenePlugin, ViewPlugin, apply_pending_scene};
+use state::camera::OrbitCamera;
 pub use state::{Messages, Selection, StartupEdits, StartupPaths, UnloadedCharacters};
 
 /// Mouse and keyboard in the viewport: orbit camera, picking, shortcuts.
@@ -48,7 +49,7 @@ impl Plugin for InteractionPlugin {
         app.init_resource::<interact::pointer::ViewportHasPointer>()
             .init_resource::<interact::pointer::PointerOwner>()
             .init_resource::<interact::picking::PointerPress>()
-            .init_resource::<interact::picking::HoveredJoint>()
+            .init_resource::<state::HoveredJoint>()
             .add_systems(
                 Update,
                 (interact::pointer::track_egui_pointer, interact::picking::hover_joint)
@@ -133,7 +134,7 @@ pub fn run(paths: Vec<PathBuf>, edits: StartupEdits) {
         .insert_resource(StartupPaths(paths))
         .insert_resource(edits)
         // The viewport between the default panels (1280 − 2 × 250 wide, 800 high).
-        .insert_resource(interact::camera::FramingAspect(780.0 / 800.0))
+        .insert_resource(state::camera::FramingAspect(780.0 / 800.0))
         .add_plugins((
             RigCorePlugin,
             SkinningPlugin,

@@ -1,9 +1,9 @@
 //! The editor's system order, declared once. In `Update` the pointer's owners go first:
 //! who has it (panels or viewport), then the rotation gizmo, the move gizmo, then IK drags, then the
-//! viewport's own input (orbit, picking, shortcuts). In `PostUpdate`, inside the scene's
-//! `Animate` (before SMPL playback): a pending scene replaces the world, then the queued
-//! edits apply, then the characters' views follow their documents (and morphs blend after
-//! them); then the scene's own chain, `Solve → MatrixStack → Skin → Draw`, and in `Draw`
+//! viewport's own input (orbit, picking, shortcuts). In `PostUpdate`, in the first step of
+//! the scene's `Animate` (`AnimateSteps::Document`, before every playback): a pending scene
+//! replaces the world, then the queued edits apply, then the characters' views follow their
+//! documents; then the scene's own chain, `Solve → MatrixStack → Skin → Draw`, and in `Draw`
 //! the characters re-placed once skinned, then the stage, the camera and the drawing. Plugins put their systems in these sets and
 //! import nothing else of each other to be ordered.
 
@@ -45,13 +45,8 @@ impl Plugin for EditorOrderPlugin {
         app.configure_sets(Update, (Pointer, Gizmo, MoveGizmo, Drag, Viewport).chain())
             .configure_sets(
                 PostUpdate,
-                (OpenScene, Edits, SyncViews)
-                    .chain()
-                    .in_set(MarionetteSystems::Animate)
-                    .before(crate::scene::smpl::SmplPlayback),
+                (OpenScene, Edits, SyncViews).chain().in_set(crate::scene::AnimateSteps::Document),
             )
-            // Morph weights blend once the scene and its edits are in.
-            .configure_sets(PostUpdate, SyncViews.before(crate::scene::morphs::blend_morphs))
             .configure_sets(PostUpdate, (Arrange, Present).chain().in_set(MarionetteSystems::Draw));
     }
 }

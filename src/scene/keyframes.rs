@@ -9,7 +9,7 @@ use bevy::prelude::*;
 use crate::formats::scene::AnimDoc;
 use crate::rig::JointRotation;
 use crate::rig::anim::Clip;
-use crate::scene::{Character, JointPose, MarionetteSystems};
+use crate::scene::{Character, JointPose};
 
 /// A keyframed clip on a character and its playback state (the scene file's `AnimDoc`).
 #[derive(Component, Clone)]
@@ -30,21 +30,13 @@ impl RootTranslation {
     }
 }
 
-/// Keyframed playback within `Animate`, after the edits and SMPL playback.
-#[derive(SystemSet, Debug, Clone, Copy, PartialEq, Eq, Hash)]
-pub struct KeyframePlayback;
-
 pub struct KeyframePlugin;
 
 impl Plugin for KeyframePlugin {
     fn build(&self, app: &mut App) {
         app.add_systems(
             PostUpdate,
-            (advance_clips, pose_from_keyframes)
-                .chain()
-                .in_set(MarionetteSystems::Animate)
-                .in_set(KeyframePlayback)
-                .after(crate::scene::smpl::SmplPlayback),
+            (advance_clips, pose_from_keyframes).chain().in_set(super::AnimateSteps::Keyframes),
         );
     }
 }

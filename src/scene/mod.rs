@@ -46,6 +46,19 @@ pub enum MarionetteSystems {
     Draw,
 }
 
+/// The steps of `Animate`, in the order they run (declared here, once): what builds the
+/// scene and applies its edits, then SMPL playback, keyframed clips, the sources' own clips
+/// (glTF, FBX, BVH), and last the morph weights those clips and edits set, so a shape never
+/// lags its pose by a frame.
+#[derive(SystemSet, Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum AnimateSteps {
+    Document,
+    Smpl,
+    Keyframes,
+    NodeClips,
+    Morphs,
+}
+
 /// Every kind of playback in `Animate`: SMPL clips, keyframed clips, a glTF file's own
 /// clips, and morph weights (each its own plugin, in the order their sets give).
 pub struct PlaybackPlugin;
@@ -72,6 +85,18 @@ impl Plugin for RigCorePlugin {
             )
                 .chain()
                 .before(bevy::transform::TransformSystems::Propagate),
+        )
+        .configure_sets(
+            PostUpdate,
+            (
+                AnimateSteps::Document,
+                AnimateSteps::Smpl,
+                AnimateSteps::Keyframes,
+                AnimateSteps::NodeClips,
+                AnimateSteps::Morphs,
+            )
+                .chain()
+                .in_set(MarionetteSystems::Animate),
         )
         .add_systems(PostUpdate, systems::clamp_poses_to_limits.in_set(MarionetteSystems::Solve))
         .add_systems(

@@ -6,7 +6,7 @@ use std::sync::Arc;
 use bevy::prelude::*;
 
 use crate::rig::CharacterAsset;
-use crate::scene::{Character, MarionetteSystems, PoseDirty};
+use crate::scene::{Character, PoseDirty};
 
 /// A character's morph weights (one per target of its asset, the scene file's `morphs`)
 /// and the asset as loaded, which they blend from.
@@ -20,9 +20,7 @@ pub struct MorphPlugin;
 
 impl Plugin for MorphPlugin {
     fn build(&self, app: &mut App) {
-        // After the clips that key weights (`NodeClipPlayback` says so), so a shape never
-        // lags its pose by a frame.
-        app.add_systems(PostUpdate, blend_morphs.in_set(MarionetteSystems::Animate));
+        app.add_systems(PostUpdate, blend_morphs.in_set(super::AnimateSteps::Morphs));
     }
 }
 

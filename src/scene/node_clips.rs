@@ -11,7 +11,7 @@ use crate::formats::scene::PlaybackDoc;
 use crate::rig::JointRotation;
 use crate::rig::node_clip::{NodeClip, NodePose, sample_mix};
 use crate::scene::morphs::Morphs;
-use crate::scene::{Character, JointPose, MarionetteSystems, RestOverrides};
+use crate::scene::{Character, JointPose, RestOverrides};
 
 /// The source's clips and their playback (the scene file's own `PlaybackDoc`).
 #[derive(Component, Clone)]
@@ -52,21 +52,14 @@ impl NodeClipPlayer {
 /// Playback of the sources' own clips, within `Animate`.
 pub struct NodeClipPlugin;
 
-/// The systems that play the sources' own clips (after keyframes; morphs blend after).
-#[derive(SystemSet, Debug, Clone, PartialEq, Eq, Hash)]
-pub struct NodeClipPlayback;
-
 impl Plugin for NodeClipPlugin {
     fn build(&self, app: &mut App) {
         app.add_systems(
             PostUpdate,
             (advance_node_clips, pose_from_node_clips, weights_from_node_clips)
                 .chain()
-                .in_set(NodeClipPlayback)
-                .in_set(MarionetteSystems::Animate)
-                .after(super::keyframes::KeyframePlayback),
-        )
-        .configure_sets(PostUpdate, NodeClipPlayback.before(super::morphs::blend_morphs));
+                .in_set(super::AnimateSteps::NodeClips),
+        );
     }
 }
 

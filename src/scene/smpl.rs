@@ -9,7 +9,7 @@ use bevy::prelude::*;
 use crate::formats::scene::SmplDoc;
 use crate::rig::JointRotation;
 use crate::rig::smpl::{Clip, SmplModel};
-use crate::scene::{Character, JointPose, MarionetteSystems, PoseDirty};
+use crate::scene::{Character, JointPose, PoseDirty};
 
 pub use crate::rig::smpl::CLIP_FPS;
 
@@ -52,11 +52,6 @@ impl SmplCharacter {
     }
 }
 
-/// SMPL playback within `Animate`: advance clips, reshape by β, pose from the clips.
-/// Whatever builds scenes runs before it.
-#[derive(SystemSet, Debug, Clone, Copy, PartialEq, Eq, Hash)]
-pub struct SmplPlayback;
-
 /// SMPL bodies: β reshaping and clip playback.
 pub struct SmplPlugin;
 
@@ -64,10 +59,7 @@ impl Plugin for SmplPlugin {
     fn build(&self, app: &mut App) {
         app.add_systems(
             PostUpdate,
-            (advance_playback, reshape_bodies, pose_from_clips)
-                .chain()
-                .in_set(MarionetteSystems::Animate)
-                .in_set(SmplPlayback),
+            (advance_playback, reshape_bodies, pose_from_clips).chain().in_set(super::AnimateSteps::Smpl),
         );
     }
 }

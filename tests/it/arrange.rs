@@ -116,7 +116,7 @@ fn match_height_makes_heights_equal_and_the_row_does_not_overlap() {
 #[test]
 fn framing_sees_every_corner_and_fills_most_of_the_picture() {
     use bevy::camera::CameraProjection;
-    use marionette::editor::interact::camera::OrbitCamera;
+    use marionette::editor::state::camera::OrbitCamera;
     let boxes = [
         (Vec3::new(-0.5, 0.0, -0.3), Vec3::new(0.5, 1.8, 0.3)),
         (Vec3::new(-8.0, 0.0, -2.0), Vec3::new(8.0, 1.0, 2.0)),

@@ -383,8 +383,8 @@ fn the_stage_grows_with_the_scene() {
 fn the_suns_shadows_reach_across_the_stage() {
     use bevy::light::CascadeShadowConfigBuilder;
     use bevy::math::Vec3;
-    use marionette::editor::interact::camera::OrbitCamera;
     use marionette::editor::present::stage::{StageExtent, sun_shadow_cascades};
+    use marionette::editor::state::camera::OrbitCamera;
     let people = CascadeShadowConfigBuilder::default().build();
     for reach in [0.9, 5.0, 80.0, 4000.0] {
         // A model `reach` long either side of the origin and as tall, framed 16:9.

@@ -4,8 +4,8 @@
 use bevy::prelude::*;
 use marionette::editor::edits::commands::{Edit, EditQueue, GestureHold};
 use marionette::editor::edits::history::{History, HistoryRequest};
-use marionette::editor::interact::ik_drag::Pins;
 use marionette::editor::scene_doc::document::{CharacterIndex, PendingScene, SceneCharacter, SceneReader};
+use marionette::editor::state::Pins;
 use marionette::editor::{Messages, ScenePlugin, Selection};
 use marionette::formats::scene::{
     BindingDoc, CharacterDoc, CharacterId, DisplayDoc, SceneDoc, SourceDoc, StageDoc, ViewDoc,
@@ -479,4 +479,38 @@ fn a_glb_of_two_characters_plays_its_clips_in_the_ecs_as_the_rig_samples_them() 
     let again: Vec<Mat4> =
         c.joints.iter().map(|&j| reopened.world().get::<CurrentJointToWorld>(j).unwrap().0).collect();
     again.iter().zip(&expected).for_each(|(a, b)| crate::common::assert_mat_close(*a, *b, 1e-6));
+}
+
+/// The humanoid map is derived data: worked out when a character comes in and when its
+/// assigned bones change (undo included), and left alone by frames that change neither.
+#[test]
+fn the_humanoid_map_is_kept_and_follows_assigned_bones() {
+    use marionette::editor::scene_doc::document::HumanoidMapOf;
+    use marionette::rig::humanoid::{HumanBone, of_asset};
+    let mut app = scene_app();
+    open_puppets(&mut app, &[Some(1)]);
+    let e = entity(&app, 1);
+    let asset = app.world().get::<Character>(e).unwrap().asset.clone();
+    let found = of_asset(&asset).expect("the puppet is a humanoid").map;
+    let map = |app: &App| app.world().get::<HumanoidMapOf>(e).expect("the map is worked out").0.clone();
+    assert_eq!(map(&app), found);
+    let changed = |app: &mut App| {
+        let mut q = app.world_mut().query::<Ref<HumanoidMapOf>>();
+        q.get(app.world(), e).unwrap().last_changed()
+    };
+    let before = changed(&mut app);
+    app.update();
+    app.update();
+    assert_eq!(changed(&mut app), before, "frames without a change leave the map alone");
+
+    let hand = found[&HumanBone::LeftHand];
+    let elsewhere = (0..asset.skeleton.len()).find(|&j| j != hand).unwrap();
+    let key = marionette::formats::scene::pose_key(&asset.skeleton, elsewhere);
+    let bones = [(HumanBone::LeftHand, key)].into_iter().collect();
+    edit(&mut app, Edit::Humanoid { character: CharacterId(1), bones });
+    app.update();
+    assert_eq!(map(&app)[&HumanBone::LeftHand], elsewhere, "an assigned bone is in the map");
+    request(&mut app, HistoryRequest::Undo);
+    app.update();
+    assert_eq!(map(&app), found, "undone, the map is the found one again");
 }

@@ -222,3 +222,49 @@ fn the_import_reader_sees_use_trees_and_super() {
     assert_eq!(resolve("crate::formats::scene::A", &from, &modules), Some(PathBuf::from("scene.rs")));
     assert_eq!(resolve("super::X", &from, &modules), Some(PathBuf::from("a/mod.rs")));
 }
+
+/// The Bevy-free layers build, and run their unit tests, without any Bevy crate.
+#[test]
+fn the_layer_crates_depend_on_no_bevy_crate() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    for layer in ["marionette-rig", "marionette-formats", "marionette-document"] {
+        let out = std::process::Command::new(env!("CARGO"))
+            .current_dir(root)
+            .args(["tree", "--offline", "--locked", "-e", "normal,dev,build", "--prefix", "none", "-p", layer])
+            .output()
+            .unwrap();
+        assert!(out.status.success(), "cargo tree -p {layer}: {}", String::from_utf8_lossy(&out.stderr));
+        let tree = String::from_utf8_lossy(&out.stdout);
+        assert!(tree.lines().count() > 3, "{layer}: {tree}");
+        let bevy: Vec<&str> = tree.lines().filter(|l| l.starts_with("bevy") || l.starts_with("wgpu")).collect();
+        assert!(bevy.is_empty(), "{layer} depends on {bevy:?}");
+    }
+}
+
+/// The editor's rooms, lowest first: a room imports only rooms before it (`state`, the
+/// shared state, imports none; `order` and `cores` are the editor's own ground).
+const EDITOR_ROOMS: [&[&str]; 7] =
+    [&["state", "order", "cores"], &["scene_doc"], &["edits"], &["present"], &["interact"], &["ui"], &["bench"]];
+
+/// The rank of the room a file of `src/editor` is in (`None` for `mod.rs`, the top).
+fn editor_room(src: &Path, file: &Path) -> Option<usize> {
+    let rel = file.strip_prefix(src.join("editor")).ok()?;
+    let first = rel.iter().next()?.to_string_lossy().trim_end_matches(".rs").to_string();
+    EDITOR_ROOMS.iter().position(|rooms| rooms.contains(&first.as_str()))
+}
+
+#[test]
+fn no_editor_room_imports_a_room_above_it() {
+    let src = Path::new(env!("CARGO_MANIFEST_DIR")).join("src");
+    let graph = import_graph();
+    let mut upward = Vec::new();
+    for (file, targets) in &graph {
+        let Some(room) = editor_room(&src, file) else { continue };
+        for target in targets {
+            if editor_room(&src, target).is_some_and(|to| to > room) {
+                upward.push(format!("{} -> {}", file.display(), target.display()));
+            }
+        }
+    }
+    assert!(upward.is_empty(), "{} upward imports: {upward:#?}", upward.len());
+}

@@ -9,14 +9,14 @@ use bevy::prelude::*;
 
 pub use crate::editor::edits::edit::{Edit, EditQueue, GestureHold};
 use crate::editor::edits::history::History;
-use crate::editor::edits::pose_library::PoseLibrary;
-use crate::editor::interact::camera::Bookmarks;
-use crate::editor::present::stage::{ShotSettings, StageSettings};
 use crate::editor::scene_doc::attach::Attached;
 use crate::editor::scene_doc::document::{
     CharacterIndex, HumanoidBones, Library, NextCharacterId, SceneCharacter, SceneReader, spawn_from_doc,
 };
 use crate::editor::state::Messages;
+use crate::editor::state::PoseLibrary;
+use crate::editor::state::camera::Bookmarks;
+use crate::editor::state::{ShotSettings, StageSettings};
 use crate::formats::scene::{AnimDoc, BindingDoc, CharacterDoc, CharacterId};
 use crate::rig::JointRotation;
 use crate::scene::keyframes::ClipPlayer;

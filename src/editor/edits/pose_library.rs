@@ -3,8 +3,6 @@
 //! character with the same joint names, or through the humanoid maps onto any other, as
 //! it was or mirrored left to right.
 
-use std::collections::BTreeMap;
-
 use bevy::prelude::*;
 
 use crate::formats::scene::{CharacterId, LibraryPoseDoc, pose_key};
@@ -12,10 +10,6 @@ use crate::rig::humanoid::HumanoidMap;
 use crate::rig::{JointRotation, Skeleton};
 
 use crate::editor::edits::edit::Edit;
-
-/// The scene's poses by name (the scene file's `poses`).
-#[derive(Resource, Clone, Debug, Default, PartialEq)]
-pub struct PoseLibrary(pub BTreeMap<String, LibraryPoseDoc>);
 
 /// The rotations of `joints` (every joint when none is given) by joint name.
 pub fn pose_by_name(skeleton: &Skeleton, pose: &[JointRotation], joints: &[usize]) -> Vec<(String, JointRotation)> {

@@ -3,8 +3,6 @@
 //! towards the cursor). Pinned joints (P) hold their place meanwhile. Each frame's solve is
 //! an ordinary pose `Edit`, applied in `Animate`; the whole drag is one undo step.
 
-use std::collections::BTreeMap;
-
 use bevy::prelude::*;
 
 use crate::editor::edits::edit::{Edit, EditQueue};
@@ -12,15 +10,11 @@ use crate::editor::interact::picking::{CLICK_SLOP_PX, JointPicker, PICK_RADIUS_P
 use crate::editor::interact::pointer::{PointerOwner, ViewportHasPointer};
 use crate::editor::present::draw::SkeletonGizmos;
 use crate::editor::scene_doc::document::SceneCharacter;
+use crate::editor::state::Pins;
 use crate::editor::state::{Drag, JointDrag, Selection};
-use crate::formats::scene::CharacterId;
 use crate::rig::ik::{IK_ROUNDS, IK_TOLERANCE};
 use crate::rig::ik::{IkGoal, solve_ik};
 use crate::scene::{Character, CurrentJointToWorld, JointPose, Placement};
-
-/// Pinned joints per character id.
-#[derive(Resource, Default)]
-pub struct Pins(pub BTreeMap<CharacterId, Vec<usize>>);
 
 pub struct IkDragPlugin;
 

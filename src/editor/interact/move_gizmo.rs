@@ -346,7 +346,7 @@ fn follow_move(
     selection: Res<Selection>,
     picker: JointPicker,
     skins: MoveTargets,
-    stage: Res<crate::editor::present::stage::StageSettings>,
+    stage: Res<crate::editor::state::StageSettings>,
     mut edits: ResMut<EditQueue>,
     mut gizmo: ResMut<MoveGizmo>,
 ) {

@@ -4,20 +4,17 @@ use bevy::ecs::system::SystemParam;
 use bevy::prelude::*;
 use bevy::window::PrimaryWindow;
 
-use crate::editor::interact::camera::OrbitCamera;
 use crate::editor::interact::pointer::{PointerOwner, ViewportHasPointer};
 use crate::editor::scene_doc::document::SceneCharacter;
 use crate::editor::state::Selection;
+use crate::editor::state::camera::OrbitCamera;
+use crate::editor::state::{HoveredJoint, JointHit};
 use crate::formats::scene::CharacterId;
 use crate::scene::{Character, CurrentJointToWorld, Placement};
 
 /// Where the left button went down, to tell a click from a drag.
 #[derive(Resource, Default)]
 pub struct PointerPress(pub Option<Vec2>);
-
-/// The joint under the cursor (highlighted, and named in a tooltip, before a click).
-#[derive(Resource, Default, Debug)]
-pub struct HoveredJoint(pub Option<JointHit>);
 
 /// What every pick in the viewport reads: the window's cursor, the orbit camera and the
 /// joints that can be picked.
@@ -151,16 +148,6 @@ pub type PickableCharacters<'w, 's> = Query<
     's,
     (Entity, &'static SceneCharacter, &'static Character, &'static Placement, &'static InheritedVisibility),
 >;
-
-/// A joint found under the cursor.
-#[derive(Debug, Clone, Copy)]
-pub struct JointHit {
-    pub entity: Entity,
-    pub id: CharacterId,
-    pub joint: usize,
-    /// World position.
-    pub position: Vec3,
-}
 
 /// The visible joint nearest to `cursor` on screen, within `radius` pixels; deeper joints
 /// win ties (zero-length bones stack joints on one point).

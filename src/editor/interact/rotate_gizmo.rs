@@ -506,7 +506,7 @@ fn draw_rotate_gizmo(
     poses: Query<&JointPose>,
     gizmo: Res<RotateGizmo>,
     ik: Res<JointDrag>,
-    cameras: Query<&GlobalTransform, With<crate::editor::interact::camera::OrbitCamera>>,
+    cameras: Query<&GlobalTransform, With<crate::editor::state::camera::OrbitCamera>>,
     mut gizmos: Gizmos<SkeletonGizmos>,
 ) {
     if ik.active.is_some() {

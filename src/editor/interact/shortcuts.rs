@@ -1,5 +1,6 @@
 //! Keyboard shortcuts in the viewport: S display mode, A axes, Ctrl+Z / Ctrl+Shift+Z undo
-//! and redo, Ctrl+S / Ctrl+O save and open, F12 screenshot (scene edits go out as `Edit`s);
+//! and redo, F12 screenshot (Ctrl+S / Ctrl+O, which save and open the path in the scene
+//! panel, are the panels') (scene edits go out as `Edit`s);
 //! F frames the selection; the numpad's views (as in Blender): 1 front, 3 right, 7 top, with
 //! Ctrl the opposite side, 9 three-quarter, 5 perspective / orthographic.
 
@@ -7,26 +8,24 @@ use bevy::prelude::*;
 
 use crate::editor::edits::edit::{Edit, EditQueue};
 use crate::editor::edits::history::{History, HistoryRequest};
-use crate::editor::interact::camera::OrbitCamera;
 use crate::editor::present::screenshot::ScreenshotRequest;
-use crate::editor::scene_doc::document::{PendingScene, SceneReader, open_scene_from, save_scene_to};
-use crate::editor::state::{Messages, Selection};
-use crate::editor::ui::InspectorState;
+use crate::editor::scene_doc::document::SceneReader;
+use crate::editor::state::Selection;
+use crate::editor::state::camera::OrbitCamera;
 use crate::formats::scene::{ViewDoc, ViewName};
 use crate::scene::{Character, CurrentJointToWorld, Placement};
 
 /// Whether the keys are the viewport's (egui has no text field focused).
-fn viewport_has_keys(wants: &Option<Res<bevy_egui::input::EguiWantsInput>>) -> bool {
+pub fn viewport_has_keys(wants: &Option<Res<bevy_egui::input::EguiWantsInput>>) -> bool {
     !wants.as_ref().is_some_and(|w| w.wants_any_keyboard_input())
 }
 
-fn ctrl_held(keys: &ButtonInput<KeyCode>) -> bool {
+pub fn ctrl_held(keys: &ButtonInput<KeyCode>) -> bool {
     keys.any_pressed([KeyCode::ControlLeft, KeyCode::ControlRight, KeyCode::SuperLeft, KeyCode::SuperRight])
 }
 
-/// The shortcuts that edit, undo, save or open the scene, or take a screenshot (reads keys
-/// and the scene; writes `EditQueue`, `History`'s request, `PendingScene`, `Messages`).
-#[allow(clippy::too_many_arguments)]
+/// The shortcuts that edit or undo the scene, or take a screenshot (reads keys and the
+/// scene; writes `EditQueue`, `History`'s request, `ScreenshotRequest`).
 pub fn scene_shortcuts(
     keys: Res<ButtonInput<KeyCode>>,
     wants: Option<Res<bevy_egui::input::EguiWantsInput>>,
@@ -35,10 +34,6 @@ pub fn scene_shortcuts(
     mut edits: ResMut<EditQueue>,
     mut history: ResMut<History>,
     mut shot: ResMut<ScreenshotRequest>,
-    state: Option<Res<InspectorState>>,
-    mut pending: ResMut<PendingScene>,
-    mut messages: ResMut<Messages>,
-    mut saved: ResMut<crate::editor::state::SavedState>,
 ) {
     if !viewport_has_keys(&wants) {
         return;
@@ -50,14 +45,6 @@ pub fn scene_shortcuts(
         let shift = keys.any_pressed([KeyCode::ShiftLeft, KeyCode::ShiftRight]);
         if keys.just_pressed(KeyCode::KeyZ) {
             history.request = Some(if shift { HistoryRequest::Redo } else { HistoryRequest::Undo });
-        }
-        if let Some(state) = &state {
-            if keys.just_pressed(KeyCode::KeyS) {
-                save_scene_to(&state.scene_path, &scene.capture(), &mut messages, &mut saved);
-            }
-            if keys.just_pressed(KeyCode::KeyO) {
-                open_scene_from(&state.scene_path, &mut pending, &mut messages);
-            }
         }
         return;
     }

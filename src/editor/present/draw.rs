@@ -34,7 +34,7 @@ pub fn draw_skeletons(
     characters: Query<(&Character, &CharacterView, &Placement, Option<&SceneCharacter>, &InheritedVisibility)>,
     joints: Query<&CurrentJointToWorld>,
     selection: Res<Selection>,
-    hovered: Option<Res<crate::editor::interact::picking::HoveredJoint>>,
+    hovered: Option<Res<crate::editor::state::HoveredJoint>>,
     mut gizmos: Gizmos<SkeletonGizmos>,
 ) {
     if let Some(hit) = hovered.as_ref().and_then(|h| h.0)

@@ -15,11 +15,11 @@ use crate::document::AssetLibrary;
 use crate::document::frames::{FrameSequence, PictureRequest, Pictures, frame_path};
 use crate::document::picture;
 use crate::document::scenes::{read_scene, scene_path};
-use crate::editor::interact::camera::OrbitCamera;
 use crate::editor::present::readiness::CaptureGate;
 use crate::editor::present::stage;
 use crate::editor::present::view::ViewPlugin;
 use crate::editor::scene_doc::document::Library;
+use crate::editor::state::camera::OrbitCamera;
 use crate::editor::state::{Messages, StartupEdits, StartupPaths};
 use crate::formats::scene::{BackgroundDoc, BindingDoc, ShotDoc, SourceDoc};
 use crate::formats::scene::{MotionSourceDoc, RetargetDoc};
@@ -107,7 +107,7 @@ pub fn render(
     app.add_plugins(crate::editor::windowless_plugins())
         .add_plugins(ScheduleRunnerPlugin::run_loop(Duration::from_millis(2)))
         .insert_resource(ClearColor(stage::SKY))
-        .insert_resource(crate::editor::interact::camera::FramingAspect(width as f32 / height as f32))
+        .insert_resource(crate::editor::state::camera::FramingAspect(width as f32 / height as f32))
         .insert_resource(StartupPaths(paths))
         .insert_resource(Library(library))
         .insert_resource(edits)
@@ -210,7 +210,7 @@ fn capture_when_ready(
     mut job: ResMut<RenderJob>,
     gate: Res<CaptureGate>,
     messages: Res<Messages>,
-    stage: Res<stage::StageSettings>,
+    stage: Res<crate::editor::state::StageSettings>,
     mut exit: MessageWriter<AppExit>,
 ) {
     if let Some(done) = job.done.clone() {
@@ -255,7 +255,7 @@ fn save_picture(image: &Image, samples: u32, background: &BackgroundDoc, out: &s
 
 /// A gradient goes behind the picture once captured: the render clears to nothing
 /// (reads `StageSettings`; writes `ClearColor`).
-fn clear_behind_gradient(settings: Res<stage::StageSettings>, mut clear: ResMut<ClearColor>) {
+fn clear_behind_gradient(settings: Res<crate::editor::state::StageSettings>, mut clear: ResMut<ClearColor>) {
     if settings.is_changed() && matches!(settings.background, BackgroundDoc::Gradient { .. }) {
         clear.0 = Color::NONE;
     }
@@ -304,7 +304,7 @@ fn next_frame(
 fn pose_frame(
     mut job: ResMut<RenderJob>,
     mut gate: ResMut<CaptureGate>,
-    library: Res<crate::editor::edits::pose_library::PoseLibrary>,
+    library: Res<crate::editor::state::PoseLibrary>,
     characters: Query<(
         &crate::editor::scene_doc::document::SceneCharacter,
         &crate::scene::Character,

@@ -4,17 +4,8 @@
 use bevy::light::{CascadeShadowConfig, CascadeShadowConfigBuilder, DirectionalLightShadowMap};
 use bevy::prelude::*;
 
-use crate::editor::interact::camera::OrbitCamera;
-
-/// Scene-wide view settings: the scene file's own type (floor, shadows, axes, floor
-/// height), held as a resource.
-#[derive(Resource, Clone, Debug, Default, PartialEq, Deref, DerefMut)]
-pub struct StageSettings(pub crate::formats::scene::StageDoc);
-
-/// The picture `render` takes (size, samples): the scene file's own type, held as a
-/// resource; the viewport's frame guide shows its shape.
-#[derive(Resource, Clone, Copy, Debug, Default, PartialEq, Deref, DerefMut)]
-pub struct ShotSettings(pub crate::formats::scene::ShotDoc);
+use crate::editor::state::StageSettings;
+use crate::editor::state::camera::OrbitCamera;
 
 /// The sky (clear) colour.
 pub const SKY: Color =

@@ -7,15 +7,14 @@ use bevy::prelude::*;
 use crate::document::AssetLibrary;
 use crate::document::scenes::{scene_path, startup_doc};
 use crate::editor::edits::history;
-use crate::editor::interact::camera::{FramingAspect, OrbitCamera, apply_orbit_camera};
-use crate::editor::interact::ik_drag;
 use crate::editor::present::draw;
 use crate::editor::present::skin_material::{self, SkinAttributeStore, SkinMaterial, SkinMaterialAsset, SkinTextures};
 use crate::editor::present::stage::{
-    StageExtent, StageSettings, apply_stage_settings, draw_grid_and_axes, fit_shadows_to_camera, fit_stage_to_scene,
-    spawn_stage,
+    StageExtent, apply_stage_settings, draw_grid_and_axes, fit_shadows_to_camera, fit_stage_to_scene, spawn_stage,
 };
 use crate::editor::scene_doc::document::{Library, NextCharacterId, PendingScene, SceneCharacter, spawn_from_doc};
+use crate::editor::state::StageSettings;
+use crate::editor::state::camera::{FramingAspect, OrbitCamera, apply_orbit_camera};
 use crate::editor::state::{Messages, Selection, StartupEdits, StartupPaths, UnloadedCharacters};
 use crate::formats::scene::{CameraDoc, CharacterId, DisplayDoc};
 use crate::rig::SkinTexture;
@@ -32,22 +31,22 @@ pub struct ScenePlugin;
 impl Plugin for ScenePlugin {
     fn build(&self, app: &mut App) {
         app.init_resource::<StageSettings>()
-            .init_resource::<crate::editor::present::stage::ShotSettings>()
-            .init_resource::<crate::editor::interact::camera::Bookmarks>()
-            .init_resource::<crate::editor::interact::camera::CameraRequest>()
+            .init_resource::<crate::editor::state::ShotSettings>()
+            .init_resource::<crate::editor::state::camera::Bookmarks>()
+            .init_resource::<crate::editor::state::camera::CameraRequest>()
             .init_resource::<Messages>()
             .init_resource::<Selection>()
             .init_resource::<UnloadedCharacters>()
             .init_resource::<PendingScene>()
             .init_resource::<crate::editor::scene_doc::document::ChangedAtStartup>()
             .init_resource::<crate::editor::state::SavedState>()
-            .init_resource::<ik_drag::Pins>()
+            .init_resource::<crate::editor::state::Pins>()
             .init_resource::<Library>()
             .init_resource::<FramingAspect>()
             .init_resource::<FrameWhenSkinned>()
             .init_resource::<FramingView>()
             .init_resource::<crate::editor::scene_doc::arrange::ArrangeWhenSkinned>()
-            .init_resource::<crate::editor::edits::pose_library::PoseLibrary>()
+            .init_resource::<crate::editor::state::PoseLibrary>()
             .add_plugins((crate::scene::PlaybackPlugin, crate::editor::edits::commands::CommandsPlugin))
             .add_systems(
                 PostUpdate,
@@ -55,6 +54,7 @@ impl Plugin for ScenePlugin {
                     apply_pending_scene.in_set(crate::editor::order::EditorSystems::OpenScene),
                     (
                         sync_character_views,
+                        crate::editor::scene_doc::document::update_humanoid_maps,
                         crate::editor::scene_doc::retarget::resolve_retargets
                             .run_if(any_with_component::<crate::scene::keyframes::ClipPlayer>),
                     )
@@ -395,12 +395,12 @@ fn stable_ids(characters: &[crate::formats::scene::CharacterDoc], next: &mut Nex
 #[derive(bevy::ecs::system::SystemParam)]
 pub struct SceneReset<'w> {
     selection: ResMut<'w, Selection>,
-    pins: ResMut<'w, ik_drag::Pins>,
+    pins: ResMut<'w, crate::editor::state::Pins>,
     history: ResMut<'w, history::History>,
     unloaded: ResMut<'w, UnloadedCharacters>,
-    pose_library: ResMut<'w, crate::editor::edits::pose_library::PoseLibrary>,
-    shot: ResMut<'w, crate::editor::present::stage::ShotSettings>,
-    bookmarks: ResMut<'w, crate::editor::interact::camera::Bookmarks>,
+    pose_library: ResMut<'w, crate::editor::state::PoseLibrary>,
+    shot: ResMut<'w, crate::editor::state::ShotSettings>,
+    bookmarks: ResMut<'w, crate::editor::state::camera::Bookmarks>,
     saved: ResMut<'w, crate::editor::state::SavedState>,
     changed_at_startup: ResMut<'w, crate::editor::scene_doc::document::ChangedAtStartup>,
 }

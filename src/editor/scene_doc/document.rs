@@ -14,8 +14,8 @@ use bevy::prelude::*;
 
 use crate::document::AssetLibrary;
 use crate::document::scenes::{pose_from_doc, read_scene, write_scene};
-use crate::editor::interact::camera::OrbitCamera;
-use crate::editor::present::stage::StageSettings;
+use crate::editor::state::StageSettings;
+use crate::editor::state::camera::OrbitCamera;
 use crate::formats::FormatError;
 use crate::formats::scene::{BindingDoc, CharacterDoc, CharacterId, SceneDoc, SourceDoc, ViewDoc, pose_key};
 use crate::rig::CharacterAsset;
@@ -110,6 +110,38 @@ impl NextCharacterId {
 #[derive(Component, Clone, Debug, Default, PartialEq)]
 pub struct HumanoidBones(pub std::collections::BTreeMap<crate::rig::humanoid::HumanBone, String>);
 
+/// A character's humanoid map: found from its skeleton, with the bones of its
+/// [`HumanoidBones`] assigned over it. Derived data, worked out again only when the
+/// character or its assigned bones change ([`update_humanoid_maps`]); the panels read it.
+#[derive(Component, Clone, Debug, Default, PartialEq)]
+pub struct HumanoidMapOf(pub crate::rig::humanoid::HumanoidMap);
+
+/// Works out the humanoid map of characters that are new, changed, or whose assigned bones
+/// changed or were taken off (reads `Character`, `HumanoidBones`; writes `HumanoidMapOf`).
+pub fn update_humanoid_maps(
+    mut commands: Commands,
+    changed: Query<
+        (Entity, &Character, Option<&HumanoidBones>),
+        (With<SceneCharacter>, Or<(Changed<Character>, Changed<HumanoidBones>)>),
+    >,
+    mut unassigned: RemovedComponents<HumanoidBones>,
+    characters: Query<&Character, With<SceneCharacter>>,
+) {
+    let none = std::collections::BTreeMap::new();
+    for (entity, character, bones) in &changed {
+        let map = crate::document::retarget::humanoid_map(&character.asset, bones.map_or(&none, |b| &b.0));
+        commands.entity(entity).insert(HumanoidMapOf(map));
+    }
+    for entity in unassigned.read() {
+        if let Ok(character) = characters.get(entity)
+            && !changed.contains(entity)
+        {
+            let map = crate::document::retarget::humanoid_map(&character.asset, &none);
+            commands.entity(entity).insert(HumanoidMapOf(map));
+        }
+    }
+}
+
 /// What a character's retargeted clip was last worked out for (the setting, the bones
 /// assigned by hand and the source's motion), and what the retargeting did (or why it
 /// failed).
@@ -139,6 +171,7 @@ pub struct SceneCharacterData {
     pub node_clips: Option<&'static crate::scene::node_clips::NodeClipPlayer>,
     pub attached: Option<&'static Attached>,
     pub humanoid: Option<&'static HumanoidBones>,
+    pub humanoid_map: Option<&'static HumanoidMapOf>,
     pub retargeted: Option<&'static RetargetedFrom>,
 }
 
@@ -149,9 +182,9 @@ pub struct SceneReader<'w, 's> {
     pub cameras: Query<'w, 's, &'static OrbitCamera>,
     pub stage: Res<'w, StageSettings>,
     pub unloaded: Res<'w, crate::editor::state::UnloadedCharacters>,
-    pub pose_library: Res<'w, crate::editor::edits::pose_library::PoseLibrary>,
-    pub shot: Res<'w, crate::editor::present::stage::ShotSettings>,
-    pub bookmarks: Res<'w, crate::editor::interact::camera::Bookmarks>,
+    pub pose_library: Res<'w, crate::editor::state::PoseLibrary>,
+    pub shot: Res<'w, crate::editor::state::ShotSettings>,
+    pub bookmarks: Res<'w, crate::editor::state::camera::Bookmarks>,
 }
 
 impl SceneReader<'_, '_> {

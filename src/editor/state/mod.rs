@@ -1,7 +1,11 @@
-//! The editor's shared state, imported by its parts (never through `mod.rs`): what the app
-//! opens with, the messages, the selection, a joint drag under way and the characters that
-//! failed to load.
+//! The editor's shared state, the room every other room uses and that uses none of them:
+//! what the app opens with, the messages, the selection, a joint drag under way, the
+//! characters that failed to load, the scene's stage, shot and pose library, the joint under
+//! the cursor, the pinned joints, and the camera's model (`camera`).
 
+pub mod camera;
+
+use std::collections::BTreeMap;
 use std::path::PathBuf;
 
 use bevy::prelude::*;
@@ -73,7 +77,7 @@ pub struct Drag {
     /// Pinned joints of that character and where they must stay (world).
     pub pins: Vec<(usize, Vec3)>,
     /// Where the button went down (window pixels): the pose changes only once the cursor
-    /// has moved beyond [`CLICK_SLOP_PX`](crate::editor::interact::picking::CLICK_SLOP_PX) from it, so a click is no edit.
+    /// has moved beyond the click slop from it, so a click is no edit.
     pub pressed_at: Vec2,
     pub moved: bool,
 }
@@ -102,3 +106,35 @@ impl SavedState {
         self.changed_at_start || gesture_open || state != self.at
     }
 }
+
+/// Scene-wide view settings: the scene file's own type (floor, shadows, axes, floor
+/// height), held as a resource.
+#[derive(Resource, Clone, Debug, Default, PartialEq, Deref, DerefMut)]
+pub struct StageSettings(pub crate::formats::scene::StageDoc);
+
+/// The picture `render` takes (size, samples): the scene file's own type, held as a
+/// resource; the viewport's frame guide shows its shape.
+#[derive(Resource, Clone, Copy, Debug, Default, PartialEq, Deref, DerefMut)]
+pub struct ShotSettings(pub crate::formats::scene::ShotDoc);
+
+/// The scene's poses by name (the scene file's `poses`).
+#[derive(Resource, Clone, Debug, Default, PartialEq)]
+pub struct PoseLibrary(pub BTreeMap<String, crate::formats::scene::LibraryPoseDoc>);
+
+/// The joint under the cursor (highlighted, and named in a tooltip, before a click).
+#[derive(Resource, Default, Debug)]
+pub struct HoveredJoint(pub Option<JointHit>);
+
+/// A joint found under the cursor.
+#[derive(Debug, Clone, Copy)]
+pub struct JointHit {
+    pub entity: Entity,
+    pub id: CharacterId,
+    pub joint: usize,
+    /// World position.
+    pub position: Vec3,
+}
+
+/// Pinned joints per character id.
+#[derive(Resource, Default)]
+pub struct Pins(pub BTreeMap<CharacterId, Vec<usize>>);

@@ -97,7 +97,7 @@ pub struct Panels<'w, 's> {
     pub ids: ResMut<'w, NextCharacterId>,
     pub pending: ResMut<'w, PendingScene>,
     /// A camera the panels ask for.
-    pub camera_request: ResMut<'w, crate::editor::interact::camera::CameraRequest>,
+    pub camera_request: ResMut<'w, crate::editor::state::camera::CameraRequest>,
     /// "Render frames…" (none in an app without the inspector).
     pub frames: Option<ResMut<'w, crate::editor::present::frames_job::FramesJob>>,
     /// The recent files (none in an app without the inspector: nothing is remembered).
@@ -133,7 +133,7 @@ impl Panels<'_, '_> {
 #[derive(SystemParam)]
 pub struct ViewportOverlays<'w> {
     diagnostics: Res<'w, DiagnosticsStore>,
-    hovered: Res<'w, crate::editor::interact::picking::HoveredJoint>,
+    hovered: Res<'w, crate::editor::state::HoveredJoint>,
     gizmo: Res<'w, crate::editor::interact::rotate_gizmo::RotateGizmo>,
     moving: Res<'w, crate::editor::interact::move_gizmo::MoveGizmo>,
 }
@@ -150,7 +150,7 @@ impl Plugin for InspectorPlugin {
             .add_systems(Startup, save_to_the_opened_scene)
             .add_systems(PostUpdate, fit_camera_viewport)
             .add_systems(EguiPrimaryContextPass, inspector_ui)
-            .add_systems(Update, open_dropped_files);
+            .add_systems(Update, (open_dropped_files, scene_panel::file_shortcuts));
     }
 }
 
@@ -278,11 +278,7 @@ fn frame_guide(ctx: &egui::Context, viewport: egui::Rect, shot: &crate::formats:
 }
 
 /// The joint under the cursor, named beside it: "character · joint (index)".
-fn hovered_joint_tooltip(
-    ctx: &egui::Context,
-    panels: &Panels,
-    hovered: &crate::editor::interact::picking::HoveredJoint,
-) {
+fn hovered_joint_tooltip(ctx: &egui::Context, panels: &Panels, hovered: &crate::editor::state::HoveredJoint) {
     let Some(hit) = hovered.0 else { return };
     let Ok(c) = panels.scene.characters.get(hit.entity) else { return };
     let (sc, character) = (c.scene, c.character);

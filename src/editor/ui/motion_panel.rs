@@ -139,9 +139,8 @@ fn source_label(panels: &Panels, from: &MotionSourceDoc) -> String {
 pub fn humanoid_rows(ui: &mut egui::Ui, panels: &Panels, entity: Entity, id: CharacterId) -> Option<Edit> {
     let c = panels.scene.characters.get(entity).ok()?;
     let assigned = c.humanoid.map(|h| h.0.clone()).unwrap_or_default();
-    let asset = &c.character.asset;
-    let skeleton = &asset.skeleton;
-    let map = crate::document::retarget::humanoid_map(asset, &assigned);
+    let skeleton = &c.character.asset.skeleton;
+    let map = c.humanoid_map.map(|m| m.0.clone()).unwrap_or_default();
     let mut edit = None;
     egui::CollapsingHeader::new(format!("Humanoid map ({} of {} bones)", map.len(), HumanBone::ALL.len()))
         .default_open(false)

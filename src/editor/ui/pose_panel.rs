@@ -18,8 +18,7 @@ pub fn pose_panel(ui: &mut egui::Ui, state: &mut InspectorState, panels: &mut Pa
         return;
     };
     let (character, source) = (c.character.clone(), c.scene.source.clone());
-    let assigned = c.humanoid.map(|h| h.0.clone()).unwrap_or_default();
-    let map = crate::document::retarget::humanoid_map(&character.asset, &assigned);
+    let map = c.humanoid_map.map(|m| m.0.clone()).unwrap_or_default();
     let skeleton = &character.asset.skeleton;
     let pose: Vec<JointRotation> =
         character.joints.iter().map(|&e| panels.scene.poses.get(e).map_or(Default::default(), |p| p.0)).collect();

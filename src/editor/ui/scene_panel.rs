@@ -11,6 +11,7 @@ use super::dialogs::DialogPurpose;
 use super::{InspectorState, Panels};
 use crate::editor::edits::edit::Edit;
 use crate::editor::edits::history::HistoryRequest;
+use crate::editor::interact::shortcuts::{ctrl_held, viewport_has_keys};
 use crate::editor::present::screenshot::ScreenshotRequest;
 use crate::editor::scene_doc::arrange::{beside, rescaled_keeping_feet};
 use crate::editor::scene_doc::document::{open_scene_from, save_scene_to};
@@ -377,5 +378,28 @@ fn messages(ui: &mut egui::Ui, panels: &Panels) {
             egui::Color32::from_rgb(190, 40, 40)
         };
         ui.colored_label(color, m);
+    }
+}
+
+/// Ctrl+S saves the scene to the scene path, Ctrl+O opens the scene there, while the
+/// viewport has the keys (reads keys and the scene; writes the file, `PendingScene`,
+/// `Messages`, `SavedState`).
+pub fn file_shortcuts(
+    keys: Res<ButtonInput<KeyCode>>,
+    wants: Option<Res<bevy_egui::input::EguiWantsInput>>,
+    state: Res<InspectorState>,
+    scene: crate::editor::scene_doc::document::SceneReader,
+    mut pending: ResMut<crate::editor::scene_doc::document::PendingScene>,
+    mut messages: ResMut<crate::editor::state::Messages>,
+    mut saved: ResMut<crate::editor::state::SavedState>,
+) {
+    if !viewport_has_keys(&wants) || !ctrl_held(&keys) {
+        return;
+    }
+    if keys.just_pressed(KeyCode::KeyS) {
+        save_scene_to(&state.scene_path, &scene.capture(), &mut messages, &mut saved);
+    }
+    if keys.just_pressed(KeyCode::KeyO) {
+        open_scene_from(&state.scene_path, &mut pending, &mut messages);
     }
 }
