@@ -7,7 +7,6 @@ use std::sync::Arc;
 use bevy::prelude::*;
 
 use crate::formats::scene::SmplDoc;
-use crate::rig::JointRotation;
 use crate::rig::smpl::{Clip, SmplModel};
 use crate::scene::{Character, JointPose, PoseDirty};
 
@@ -119,12 +118,10 @@ fn pose_from_clips(
         let Some(clip) = body.clip() else { continue };
         let state = &body.state;
         let blend = body.blend_clip().map(|other| (other, state.blend));
-        let rotations = sampler.sample(clip, blend, state.time, state.looping);
-        let upright = crate::rig::smpl::upright_turn(clip, state.upright);
-        for (j, (&e, q)) in character.joints.iter().zip(rotations).enumerate() {
-            let q = if j == 0 { upright * *q } else { *q };
+        let rotations = sampler.playback_pose(clip, blend, state.time, state.looping, state.upright);
+        for (&e, rotation) in character.joints.iter().zip(rotations) {
             if let Ok(mut pose) = poses.get_mut(e) {
-                pose.set_if_neq(JointPose(JointRotation::Quat(q)));
+                pose.set_if_neq(JointPose(rotation));
             }
         }
     }

@@ -190,7 +190,7 @@ fn an_smpl_body_playing_a_clip_goes_out_as_an_animation_of_its_frames() {
     let clip_path = marionette::formats::smpl::clip_paths(&dir)[0].clone();
     let name = clip_path.file_name().unwrap().to_string_lossy().into_owned();
     let body = CharacterDoc {
-        smpl: Some(SmplDoc { clip: Some(name), ..SmplDoc::default() }),
+        smpl: Some(SmplDoc { clip: Some(name), upright: false, ..SmplDoc::default() }),
         ..CharacterDoc::new(SourceDoc::File(dir.clone()), "b")
     };
     let doc = SceneDoc { characters: vec![body], ..SceneDoc::default() };
@@ -646,4 +646,93 @@ fn a_normal_mapped_skin_keeps_its_files_normals() {
     assert!(characters[1].asset.skin.normals.is_empty(), "the waver has no normal map");
     let plain = marionette::formats::gltf_import::load_gltf(&pair).unwrap();
     assert!(plain.iter().all(|c| c.asset.skin.normals.is_empty()), "no normal map, no normals");
+}
+
+/// An SMPL body playing a clip with a second one blended in and stood upright goes out as
+/// the editor plays it: the exported animation at frame f, and the still export paused at
+/// a time between frames, hold the rotations the ECS's player gives every joint there.
+#[test]
+#[cfg_attr(not(marionette_data), ignore = "needs MARIONETTE_DATA (the course data)")]
+fn an_smpl_body_with_a_blend_clip_upright_goes_out_as_the_editor_plays_it() {
+    use marionette::editor::scene_doc::document::PendingScene;
+    use marionette::formats::scene::{CharacterDoc, SceneDoc, SmplDoc, SourceDoc};
+    use marionette::scene::{Character, JointPose};
+    let dir = crate::common::data_dir().join("smpl");
+    let clips = marionette::formats::smpl::clip_paths(&dir);
+    let name = |k: usize| clips[k].file_name().unwrap().to_string_lossy().into_owned();
+    let doc_at = |time: f32| {
+        let smpl = SmplDoc {
+            clip: Some(name(0)),
+            blend_clip: Some(name(1)),
+            blend: 0.4,
+            upright: true,
+            time,
+            playing: false,
+            ..SmplDoc::default()
+        };
+        let body = CharacterDoc { smpl: Some(smpl), ..CharacterDoc::new(SourceDoc::File(dir.clone()), "b") };
+        SceneDoc { characters: vec![body], ..SceneDoc::default() }
+    };
+    // The editor's playback, paused at `time` frames.
+    let played = |time: f32| -> Vec<Quat> {
+        let mut app = crate::edits::scene_app();
+        *app.world_mut().resource_mut::<PendingScene>() = PendingScene { doc: Some(doc_at(time)), frame: false };
+        app.update();
+        app.update();
+        let world = app.world_mut();
+        let character = world.query::<&Character>().single(world).unwrap().clone();
+        character.joints.iter().map(|&e| world.get::<JointPose>(e).unwrap().0.to_quat()).collect()
+    };
+    let same = |a: Quat, b: Quat| a.dot(b).abs() > 1.0 - 1e-5;
+
+    let (json, bin) = chunks(&marionette::document::export::scene_glb(&doc_at(0.0), GltfMesh::Skinned, true).unwrap());
+    let animation = &json["animations"][0];
+    let joint_nodes: Vec<u64> =
+        json["skins"][0]["joints"].as_array().unwrap().iter().map(|j| j.as_u64().unwrap()).collect();
+    let frames = [0usize, 7, 40];
+    let expected: Vec<Vec<Quat>> = frames.iter().map(|&f| played(f as f32)).collect();
+    // The blend and the upright turn change the pose (the check would pass on raw frames).
+    let (model, _) = marionette::formats::smpl::load_smpl_dir(&dir).unwrap();
+    let raw = marionette::formats::smpl::parse_clip(
+        std::io::BufReader::new(std::fs::File::open(&clips[0]).unwrap()),
+        &clips[0],
+        model.skeleton.len(),
+    )
+    .unwrap();
+    assert!(!same(expected[1][0], raw.frame(7)[0]), "the root is stood upright");
+    assert!((1..raw.frame(7).len()).any(|j| !same(expected[1][j], raw.frame(7)[j])), "the second clip is mixed in");
+    let mut checked = 0;
+    for channel in animation["channels"].as_array().unwrap() {
+        if channel["target"]["path"] != "rotation" {
+            continue;
+        }
+        let j = joint_nodes.iter().position(|&n| n == channel["target"]["node"].as_u64().unwrap()).unwrap();
+        let values = read(
+            &json,
+            &bin,
+            animation["samplers"][channel["sampler"].as_u64().unwrap() as usize]["output"].as_u64().unwrap() as usize,
+        );
+        for (k, &f) in frames.iter().enumerate() {
+            let q = Quat::from_slice(&values[4 * f..4 * f + 4]);
+            assert!(same(q, expected[k][j]), "joint {j} frame {f}: exported {q} played {}", expected[k][j]);
+        }
+        checked += 1;
+    }
+    assert_eq!(checked, joint_nodes.len());
+
+    // A still export paused between frames stands as the paused editor does.
+    let between = 12.6;
+    let (json, bin) =
+        chunks(&marionette::document::export::scene_glb(&doc_at(between), GltfMesh::Skinned, false).unwrap());
+    let _ = bin;
+    let expected = played(between);
+    for (j, &node) in joint_nodes.iter().enumerate() {
+        let r = &json["nodes"][node as usize]["rotation"];
+        let q = if r.is_null() {
+            Quat::IDENTITY
+        } else {
+            Quat::from_array(std::array::from_fn(|i| r[i].as_f64().unwrap() as f32))
+        };
+        assert!(same(q, expected[j]), "still joint {j}: exported {q} played {}", expected[j]);
+    }
 }

@@ -156,8 +156,12 @@ fn posed(
             posed.clips = part.clips.iter().cloned().chain(keyframes).collect();
         }
     }
-    if animated && let Some((name, motion)) = smpl_motion(library, c, asset)? {
-        (posed.motion_name, posed.motion) = (name, Some(motion));
+    // An SMPL body stands in its clip's pose at its time, as the editor shows it.
+    if let Some(pose) = super::retarget::smpl_pose_now(library, c, skeleton)? {
+        posed.pose = pose;
+    }
+    if animated && let Some((name, frames)) = super::retarget::smpl_frames(library, c, skeleton)? {
+        (posed.motion_name, posed.motion) = (smpl_clip_name(&name), Some(smpl_motion(&frames)));
     }
     Ok(posed)
 }
@@ -216,24 +220,18 @@ fn rest_of(skeleton: &marionette_rig::Skeleton, sample: &NodePose) -> (Vec<glam:
     (offsets, sample.scales.clone())
 }
 
-/// An SMPL body's playing clip, every frame (at its 30 frames per second), with the body's
-/// own root and the clip's rotations, and the clip's name.
-fn smpl_motion(
-    library: &mut super::AssetLibrary,
-    c: &marionette_formats::scene::CharacterDoc,
-    asset: &marionette_rig::CharacterAsset,
-) -> Result<Option<(String, Motion)>, FormatError> {
-    let (Some(smpl), marionette_formats::scene::SourceDoc::File(dir)) = (&c.smpl, &c.source) else { return Ok(None) };
-    let Some(name) = &smpl.clip else { return Ok(None) };
-    let set = library.smpl(dir)?;
-    let Some((_, clip)) = set.clips.iter().find(|(n, _)| n == name) else { return Ok(None) };
+/// An SMPL body's frames as a motion at its 30 frames per second.
+fn smpl_motion(frames: &[marionette_rig::retarget::Frame]) -> Motion {
     let mut motion = Motion::default();
-    let root = asset.skeleton.joint(0).rest_offset;
-    for f in 0..clip.frame_count() {
+    for (f, frame) in frames.iter().enumerate() {
         motion.times.push(f as f32 / marionette_rig::smpl::CLIP_FPS);
-        motion.poses.push(clip.frame(f).iter().map(|&q| marionette_rig::JointRotation::Quat(q)).collect());
-        motion.roots.push(root);
+        motion.poses.push(frame.pose.clone());
+        motion.roots.push(frame.root);
     }
-    let stem = name.strip_suffix(".txt").unwrap_or(name);
-    Ok(Some((stem.to_string(), motion)))
+    motion
+}
+
+/// An SMPL clip's name without its file's `.txt`.
+fn smpl_clip_name(file: &str) -> String {
+    file.strip_suffix(".txt").unwrap_or(file).to_string()
 }

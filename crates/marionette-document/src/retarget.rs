@@ -146,33 +146,69 @@ pub fn motion_frames(
             return Ok(Some(frames));
         }
     }
-    if let (Some(smpl), SourceDoc::File(dir)) = (&c.smpl, &c.source)
-        && let Some(name) = &smpl.clip
-    {
-        let set = library.smpl(dir)?;
-        let Some((_, clip)) = set.clips.iter().find(|(n, _)| n == name) else { return Ok(None) };
-        let blend = smpl.blend_clip.as_ref().and_then(|b| set.clips.iter().find(|(n, _)| n == b)).map(|(_, k)| k);
-        let upright = marionette_rig::smpl::upright_turn(clip, smpl.upright);
-        let root = skeleton.joint(0).rest_offset;
-        let mut sampler = marionette_rig::smpl::BlendSampler::default();
-        let frames = (0..clip.frame_count())
-            .map(|f| {
-                let rotations = sampler.sample(clip, blend.map(|k| (&**k, smpl.blend)), f as f32, false);
-                // Clamped to the joints' limits, as the editor plays it.
-                let pose = rotations
-                    .iter()
-                    .enumerate()
-                    .map(|(j, q)| {
-                        let q = if j == 0 { upright * *q } else { *q };
-                        JointRotation::Quat(q).clamped(&skeleton.joint(j).limits)
-                    })
-                    .collect();
-                Frame { root, pose }
-            })
-            .collect();
-        return Ok(Some(frames));
-    }
-    Ok(None)
+    Ok(smpl_frames(library, c, skeleton)?.map(|(_, frames)| frames))
+}
+
+/// An SMPL body's playing clip as the editor plays it, every frame from the start (with
+/// its blend clip, stood upright when it asks, clamped to the joints' limits) at its own
+/// root, and the clip's file name; `None` when the body plays no clip of its folder.
+pub fn smpl_frames(
+    library: &mut super::AssetLibrary,
+    c: &CharacterDoc,
+    skeleton: &marionette_rig::Skeleton,
+) -> Result<Option<(String, Vec<Frame>)>, FormatError> {
+    let Some((name, clip, blend)) = smpl_clips(library, c)? else { return Ok(None) };
+    let smpl = c.smpl.as_ref().expect("a body with a clip");
+    let root = skeleton.joint(0).rest_offset;
+    let mut sampler = marionette_rig::smpl::BlendSampler::default();
+    let frames = (0..clip.frame_count())
+        .map(|f| {
+            let pose = smpl_pose(&mut sampler, (&clip, blend.as_deref()), smpl, skeleton, f as f32, false);
+            Frame { root, pose }
+        })
+        .collect();
+    Ok(Some((name, frames)))
+}
+
+/// An SMPL body's pose at its document's time (looping as it says), as the editor shows it
+/// paused there; `None` when the body plays no clip of its folder.
+pub fn smpl_pose_now(
+    library: &mut super::AssetLibrary,
+    c: &CharacterDoc,
+    skeleton: &marionette_rig::Skeleton,
+) -> Result<Option<Vec<JointRotation>>, FormatError> {
+    let Some((_, clip, blend)) = smpl_clips(library, c)? else { return Ok(None) };
+    let smpl = c.smpl.as_ref().expect("a body with a clip");
+    let mut sampler = marionette_rig::smpl::BlendSampler::default();
+    Ok(Some(smpl_pose(&mut sampler, (&clip, blend.as_deref()), smpl, skeleton, smpl.time, smpl.looping)))
+}
+
+/// The playing clip of an SMPL body's document and its blend clip, found in its folder.
+type SmplClips =
+    (String, std::sync::Arc<marionette_rig::smpl::Clip>, Option<std::sync::Arc<marionette_rig::smpl::Clip>>);
+
+fn smpl_clips(library: &mut super::AssetLibrary, c: &CharacterDoc) -> Result<Option<SmplClips>, FormatError> {
+    let (Some(smpl), SourceDoc::File(dir)) = (&c.smpl, &c.source) else { return Ok(None) };
+    let Some(name) = &smpl.clip else { return Ok(None) };
+    let set = library.smpl(dir)?;
+    let find = |wanted: &String| set.clips.iter().find(|(n, _)| n == wanted).map(|(_, k)| k.clone());
+    let Some(clip) = find(name) else { return Ok(None) };
+    Ok(Some((name.clone(), clip, smpl.blend_clip.as_ref().and_then(find))))
+}
+
+/// The playback pose at `time_frames`, clamped to the joints' limits as the editor's
+/// matrix stack clamps it.
+fn smpl_pose(
+    sampler: &mut marionette_rig::smpl::BlendSampler,
+    (clip, blend): (&marionette_rig::smpl::Clip, Option<&marionette_rig::smpl::Clip>),
+    smpl: &marionette_formats::scene::SmplDoc,
+    skeleton: &marionette_rig::Skeleton,
+    time_frames: f32,
+    looping: bool,
+) -> Vec<JointRotation> {
+    let blend = blend.map(|k| (k, smpl.blend));
+    let rotations = sampler.playback_pose(clip, blend, time_frames, looping, smpl.upright);
+    rotations.iter().enumerate().map(|(j, r)| r.clamped(&skeleton.joint(j).limits)).collect()
 }
 
 /// The times of frames at [`FPS`] from the start of `range` to its end (at least one);

@@ -146,6 +146,25 @@ impl BlendSampler {
             _ => &self.first,
         }
     }
+
+    /// The pose SMPL playback gives a body — `clip` at `time_frames` with `blend` mixed in
+    /// ([`Self::sample`]), turned upright at the root when `upright` ([`upright_turn`]): the
+    /// one rule the editor's player, export and retargeting share.
+    pub fn playback_pose(
+        &mut self,
+        clip: &Clip,
+        blend: Option<(&Clip, f32)>,
+        time_frames: f32,
+        looping: bool,
+        upright: bool,
+    ) -> Vec<crate::JointRotation> {
+        let turn = upright_turn(clip, upright);
+        self.sample(clip, blend, time_frames, looping)
+            .iter()
+            .enumerate()
+            .map(|(j, &q)| crate::JointRotation::Quat(if j == 0 { turn * q } else { q }))
+            .collect()
+    }
 }
 
 /// How two rotations are interpolated.
