@@ -129,3 +129,17 @@ fn the_kernel_matches_the_oracle_on_every_data_set() {
         assert_kernel_matches_oracle(&name, &asset.skin.bind_positions, &asset.skin.weights, &posed_palette(&asset));
     }
 }
+
+/// The kernel tests above run every level this CPU runs; a level it lacks is reported here
+/// as ignored (build.rs reads the building CPU), never passed unseen.
+#[test]
+#[cfg_attr(not(cpu_avx512), ignore = "this CPU lacks AVX-512 (F and VL): that kernel level is not tested here")]
+fn the_avx512_kernels_are_among_those_tested() {
+    assert!(Simd::available().any(|s| s == Simd::Avx512Vl), "built on a CPU with AVX-512, run on one without");
+}
+
+#[test]
+#[cfg_attr(not(cpu_avx2), ignore = "this CPU lacks AVX2 and FMA: that kernel level is not tested here")]
+fn the_avx2_kernels_are_among_those_tested() {
+    assert!(Simd::available().any(|s| s == Simd::Avx2), "built on a CPU with AVX2, run on one without");
+}
