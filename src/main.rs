@@ -20,7 +20,7 @@ fn main() -> ExitCode {
 
 fn run(cli: Cli) -> Result<()> {
     match cli.command {
-        None => marionette::editor::run(Vec::new(), Default::default()),
+        None => marionette::editor::run(Vec::new(), Default::default(), Default::default()),
         Some(Command::Edit { paths, clip, poses, ik, recover }) => {
             let paths = if recover {
                 use marionette::editor::ui::unsaved::{newest_recovery, recovery_dir};
@@ -39,15 +39,17 @@ fn run(cli: Cli) -> Result<()> {
                 clip: clip.own_clip(),
                 ..Default::default()
             };
-            marionette::editor::run(paths, edits)
+            // The options as every command applies them: one naming what no character has
+            // fails before the window opens; the files read here are the editor's.
+            let mut library = marionette::document::AssetLibrary::default();
+            marionette::editor::present::view::startup_scene(&paths, &edits, &mut library, &mut Vec::new())
+                .map_err(anyhow::Error::msg)?;
+            marionette::editor::run(paths, edits, library)
         }
         Some(Command::Info { path }) => marionette::cli::info(&path)?,
         Some(Command::Export(args)) => marionette::cli::export::run(&args)?,
         Some(Command::Render { paths, out, shot, poses, ik, skinning, match_height, clip, frames }) => {
             let started = std::time::Instant::now();
-            if let Some(spec) = clip.own_clip() {
-                marionette::document::posing::check_clip_spec(&paths, &spec).map_err(anyhow::Error::msg)?;
-            }
             let edits = marionette::editor::StartupEdits {
                 poses,
                 ik,
@@ -60,6 +62,7 @@ fn run(cli: Cli) -> Result<()> {
                 ortho: shot.ortho,
                 transparent: shot.transparent,
                 recovered: false,
+                still: false,
             };
             let (sequence, pictures) = (frames.sequence(), frames.pictures());
             let (notes, picture) =

@@ -302,9 +302,10 @@ pub struct ExportArgs {
     /// (FABRIK), after --pose. Repeatable.
     #[arg(long = "ik", value_name = "JOINT=x,y,z")]
     pub ik: Vec<IkSpec>,
-    /// Linear blend (`lbs`) or dual quaternion (`dq`) skinning.
-    #[arg(long, value_enum, default_value_t = Skinning::Lbs)]
-    pub skinning: Skinning,
+    /// Linear blend (`lbs`) or dual quaternion (`dq`) skinning for every character (without
+    /// it, a scene's characters keep theirs; others are `lbs`).
+    #[arg(long, value_enum)]
+    pub skinning: Option<Skinning>,
     #[command(flatten)]
     pub clip: ClipArgs,
     /// With `--out X.glb`: the posed mesh without a skin, instead of a skinned mesh

@@ -112,8 +112,9 @@ pub fn windowless_plugins() -> bevy::app::PluginGroupBuilder {
         .disable::<bevy::winit::WinitPlugin>()
 }
 
-/// Opens the editor window on `paths` (or on the default scene) and runs until closed.
-pub fn run(paths: Vec<PathBuf>, edits: StartupEdits) {
+/// Opens the editor window on `paths` (or on the default scene), with the files `library`
+/// already read, and runs until closed.
+pub fn run(paths: Vec<PathBuf>, edits: StartupEdits, library: crate::document::AssetLibrary) {
     ui::unsaved::install_panic_hook(ui::unsaved::Autosave::from_env().file);
     App::new()
         .add_plugins(DefaultPlugins.set(task_pools()).set(WindowPlugin {
@@ -133,6 +134,7 @@ pub fn run(paths: Vec<PathBuf>, edits: StartupEdits) {
         .insert_resource(ClearColor(present::stage::SKY))
         .insert_resource(StartupPaths(paths))
         .insert_resource(edits)
+        .insert_resource(scene_doc::document::Library(library))
         // The viewport between the default panels (1280 − 2 × 250 wide, 800 high).
         .insert_resource(state::camera::FramingAspect(780.0 / 800.0))
         .add_plugins((

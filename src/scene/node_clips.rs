@@ -117,16 +117,10 @@ fn pose_from_node_clips(
 /// clip blended in mixes its weights in by its weight).
 fn weights_from_node_clips(mut players: Query<(&NodeClipPlayer, &mut Morphs), Changed<NodeClipPlayer>>) {
     for (player, mut morphs) in &mut players {
-        let Some(clip) = player.clip().filter(|c| c.keys_weights()) else { continue };
+        let Some(clip) = player.clip() else { continue };
         let state = &player.state;
-        let mut weights = clip.sample_weights(&morphs.weights, state.time);
-        if let Some(other) = player.blend_clip().filter(|c| c.keys_weights() && state.blend > 0.0) {
-            let length = other.duration();
-            let t = if length > 0.0 { state.time.rem_euclid(length) } else { state.time };
-            let theirs = other.sample_weights(&weights, t);
-            weights.iter_mut().zip(theirs).for_each(|(w, o)| *w += (o - *w) * state.blend);
-        }
-        weights.truncate(morphs.weights.len());
+        let blend = player.blend_clip().map(|other| (other, state.blend));
+        let weights = crate::rig::node_clip::weights_mix(&morphs.weights, clip, blend, state.time);
         if morphs.weights != weights {
             morphs.weights = weights;
         }

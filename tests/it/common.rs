@@ -62,3 +62,11 @@ pub fn glb_with_json(glb: &[u8], edit: impl FnOnce(&mut serde_json::Value)) -> V
     out.extend(rest);
     out
 }
+
+/// A file's characters posed by its clip `clip` at `t` seconds (by its node transforms
+/// without one), as `export FILE --clip CLIP --time T --out F.obj` writes them.
+pub fn posed_at(path: &std::path::Path, clip: Option<&str>, t: f32) -> Vec<Vec3> {
+    use marionette::document::options::{PoseOptions, posed_file};
+    let options = PoseOptions { clip: clip.map(str::to_string), time: Some(t), ..PoseOptions::default() };
+    posed_file(path, &options).unwrap_or_else(|e| panic!("{}: {e}", path.display())).0
+}

@@ -66,7 +66,7 @@ fn export_clamps_and_rejects_unknown_joints() {
         .unwrap();
     assert!(!output.status.success());
     let stderr = String::from_utf8_lossy(&output.stderr);
-    assert!(stderr.contains("no joint named or numbered `nosuchjoint`"), "{stderr}");
+    assert!(stderr.contains("--pose: no character has a joint named or numbered `nosuchjoint`"), "{stderr}");
     assert!(!out.exists(), "a failed export writes nothing");
 }
 

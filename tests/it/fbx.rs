@@ -5,8 +5,6 @@
 //! within 1e-4 of the model's size; bad FBX files say so, naming the file.
 
 use glam::Vec3;
-use marionette::document::posing::posed_gltf;
-use marionette::rig::dqs::SkinningMethod;
 
 /// The farthest any point of `a` is from the nearest point of `b`, where that is within
 /// `reach` (infinity when a point has none that near): `b` is hashed into cells of `reach`.
@@ -26,9 +24,10 @@ fn farthest_from(a: &[Vec3], b: &[Vec3], reach: f32) -> f32 {
 /// The largest distance between `NAME.fbx` and `NAME_twin.glb` in `dir` posed alike (at
 /// rest and at five times of their first clip), and the model's size.
 pub fn fbx_against_twin(dir: &std::path::Path, name: &str) -> (f32, f32) {
-    let fbx = marionette::formats::load_parts(&dir.join(format!("{name}.fbx"))).unwrap();
-    let twin = marionette::formats::load_parts(&dir.join(format!("{name}_twin.glb"))).unwrap();
-    let (rest, _) = posed_gltf(&twin, None, 0.0, &[], SkinningMethod::Linear).unwrap();
+    let (fbx_path, twin_path) = (dir.join(format!("{name}.fbx")), dir.join(format!("{name}_twin.glb")));
+    let fbx = marionette::formats::load_parts(&fbx_path).unwrap();
+    let twin = marionette::formats::load_parts(&twin_path).unwrap();
+    let rest = crate::common::posed_at(&twin_path, None, 0.0);
     let (lo, hi) = marionette::rig::skinning::bounds(&rest);
     let size = (hi - lo).length();
     let animated = !twin.iter().all(|p| p.clips.is_empty());
@@ -37,8 +36,8 @@ pub fn fbx_against_twin(dir: &std::path::Path, name: &str) -> (f32, f32) {
     let clip = animated.then_some("0");
     let mut worst = 0.0f32;
     for &t in times {
-        let (a, _) = posed_gltf(&fbx, clip, t, &[], SkinningMethod::Linear).unwrap();
-        let (b, _) = posed_gltf(&twin, clip, t, &[], SkinningMethod::Linear).unwrap();
+        let a = crate::common::posed_at(&fbx_path, clip, t);
+        let b = crate::common::posed_at(&twin_path, clip, t);
         let reach = 1e-3 * size;
         worst = worst.max(farthest_from(&a, &b, reach).max(farthest_from(&b, &a, reach)));
     }
@@ -217,11 +216,10 @@ fn vertices_without_weights_follow_their_mesh_node() {
 #[test]
 fn constant_fbx_curves_set_their_joint() {
     let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/one_key.fbx");
-    let parts = marionette::formats::load_parts(&path).unwrap();
-    let (rest, _) = posed_gltf(&parts, None, 0.0, &[], SkinningMethod::Linear).unwrap();
+    let rest = crate::common::posed_at(&path, None, 0.0);
     let height = rest.iter().map(|p| p.y).fold(f32::MIN, f32::max);
     for t in [0.0, 0.5, 0.9] {
-        let (posed, _) = posed_gltf(&parts, Some("0"), t, &[], SkinningMethod::Linear).unwrap();
+        let posed = crate::common::posed_at(&path, Some("0"), t);
         let off_plane = posed.iter().map(|p| p.z.abs()).fold(0.0, f32::max) / (height / 2.0);
         assert!((0.5..0.7).contains(&off_plane), "t = {t}: {off_plane}");
     }
@@ -234,15 +232,25 @@ fn constant_fbx_curves_set_their_joint() {
 fn clips_are_numbered_alike_and_a_missing_clip_fails_naming_the_clips() {
     let data = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data");
     let (fbx, glb) = (data.join("one_key.fbx"), data.join("blender_pair.glb"));
+    // `--clip SPEC` on the characters of these files, as every command applies it.
+    let clip = |paths: &[&std::path::PathBuf], spec: &str| {
+        use marionette::document::options::{PoseOptions, apply_options};
+        let mut library = marionette::document::AssetLibrary::default();
+        let sources = paths.iter().flat_map(|p| library.sources_of(p)).collect();
+        let mut doc = marionette::document::scenes::doc_side_by_side(&mut library, sources, &mut Vec::new());
+        let options = PoseOptions { clip: Some(spec.to_string()), ..PoseOptions::default() };
+        apply_options(&mut doc, &options, &mut library).map(|_| doc)
+    };
     for path in [&fbx, &glb] {
         let parts = marionette::formats::load_parts(path).unwrap();
         assert_eq!(parts[0].clips[0].index, 0, "{path:?}");
-        marionette::document::posing::check_clip_spec(std::slice::from_ref(path), "0").unwrap();
+        let doc = clip(&[path], "0").unwrap();
+        assert_eq!(doc.characters[0].playback.as_ref().unwrap().clip.as_ref(), Some(&parts[0].clips[0].name));
     }
-    let e = marionette::document::posing::check_clip_spec(&[fbx.clone(), glb.clone()], "7").unwrap_err();
+    let e = clip(&[&fbx, &glb], "7").unwrap_err();
     assert!(e.contains("one_key.fbx: no clip `7` (its clips: 0 `Scene`)"), "{e}");
     // A file of several whose clips it names one of, and one whose it names none of.
-    let e = marionette::document::posing::check_clip_spec(&[fbx, glb], "Scene").unwrap_err();
+    let e = clip(&[&fbx, &glb], "Scene").unwrap_err();
     assert!(
         e.contains("blender_pair.glb: no clip `Scene` (its clips: 0 `walker_rig_action`, 1 `waver_rig_action`)"),
         "{e}"

@@ -4,8 +4,6 @@
 //! model's size.
 
 use glam::{DVec3, Vec3};
-use marionette::document::posing::posed_gltf;
-use marionette::rig::dqs::SkinningMethod;
 
 use super::gltf_spec::SpecFile;
 
@@ -13,7 +11,6 @@ use super::gltf_spec::SpecFile;
 /// (the diagonal of its bounds at rest).
 pub fn worst_against_spec(path: &std::path::Path) -> (f64, f64, usize) {
     let spec = SpecFile::read(path);
-    let ours = marionette::formats::gltf_import::load_gltf(path).unwrap_or_else(|e| panic!("{e}"));
     let rest = spec.posed(None);
     let (lo, hi) = rest.iter().fold((DVec3::MAX, DVec3::MIN), |(lo, hi), p| (lo.min(*p), hi.max(*p)));
     let size = (hi - lo).length();
@@ -29,8 +26,7 @@ pub fn worst_against_spec(path: &std::path::Path) -> (f64, f64, usize) {
     for (animation, clip) in &cases {
         let expected = spec.posed(*animation);
         let time = animation.map_or(0.0, |(_, t)| t as f32);
-        let (posed, _) = posed_gltf(&ours, clip.as_deref(), time, &[], SkinningMethod::Linear)
-            .unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+        let posed = crate::common::posed_at(path, clip.as_deref(), time);
         assert_eq!(posed.len(), expected.len(), "{}", path.display());
         let off =
             posed.iter().zip(&expected).map(|(p, q): (&Vec3, &DVec3)| (p.as_dvec3() - *q).length()).fold(0.0, f64::max);
@@ -109,7 +105,7 @@ fn a_skeleton_under_another_skins_joint_moves_with_it() {
     let blender = blender_frames(&data.join("blender_nested.txt"));
     let mut worst_blender = 0.0f32;
     for t in [0.0f32, 0.3, 0.5, 0.75, 1.0] {
-        let (ours, _) = posed_gltf(&parts, Some("0"), t, &[], SkinningMethod::Linear).unwrap();
+        let ours = crate::common::posed_at(&path, Some("0"), t);
         let theirs: Vec<Vec3> =
             blender.iter().filter(|(_, time, _)| *time == t).flat_map(|(_, _, v)| v.iter().copied()).collect();
         let off = farthest_from(&ours, &theirs).max(farthest_from(&theirs, &ours));
@@ -232,8 +228,8 @@ fn an_exported_glb_reads_back_key_for_key() {
             std::iter::once(None).chain(before.iter().flat_map(|c| &c.clips).map(|k| Some(k.name.clone()))).collect();
         for clip in &clips {
             for t in [0.0, 0.37, 1.1] {
-                let (pa, _) = posed_gltf(&before, clip.as_deref(), t, &[], SkinningMethod::Linear).unwrap();
-                let (pb, _) = posed_gltf(&after, clip.as_deref(), t, &[], SkinningMethod::Linear).unwrap();
+                let pa = crate::common::posed_at(path, clip.as_deref(), t);
+                let pb = crate::common::posed_at(&out, clip.as_deref(), t);
                 let off = pa.iter().zip(&pb).map(|(p, q)| p.distance(*q)).fold(0.0f32, f32::max);
                 assert!(off <= 1e-5, "{name} {clip:?} at {t}: {off}");
             }

@@ -3,6 +3,7 @@
 mod alloc;
 mod anim;
 mod arrange;
+mod commands;
 mod common;
 mod data;
 mod dqs;

@@ -41,13 +41,25 @@ struct Posed {
     motion_name: String,
     /// The source's own clips, written key for key (with `animated`).
     clips: std::sync::Arc<[marionette_rig::node_clip::NodeClip]>,
+    /// Its morph weights now: its document's, or as its clip keys them at its time.
+    weights: Vec<f32>,
 }
 
 /// Every character of a scene document as glTF: its shape, its pose, its clip (keyframes,
 /// its source's own animation, SMPL playback) at its time, its placement and tint; with
 /// `animated`, the clips as glTF animations.
 pub fn scene_glb(doc: &SceneDoc, mesh: GltfMesh, animated: bool) -> Result<Vec<u8>, FormatError> {
-    let loaded = load_posed(doc, animated)?;
+    scene_glb_from(&mut super::AssetLibrary::default(), doc, mesh, animated)
+}
+
+/// [`scene_glb`] with the files `library` has read (and reads).
+pub fn scene_glb_from(
+    library: &mut super::AssetLibrary,
+    doc: &SceneDoc,
+    mesh: GltfMesh,
+    animated: bool,
+) -> Result<Vec<u8>, FormatError> {
+    let loaded = load_posed(library, doc, animated)?;
     let characters: Vec<GltfCharacter> = loaded
         .iter()
         .map(|(c, asset, posed)| GltfCharacter {
@@ -61,7 +73,7 @@ pub fn scene_glb(doc: &SceneDoc, mesh: GltfMesh, animated: bool) -> Result<Vec<u
             motion: posed.motion.clone(),
             motion_name: posed.motion_name.clone(),
             clips: &posed.clips,
-            morph_weights: &c.morphs,
+            morph_weights: &posed.weights,
         })
         .collect();
     write_glb(&characters, mesh).map_err(|e| FormatError::other(std::path::Path::new("the exported scene"), e))
@@ -71,10 +83,22 @@ pub fn scene_glb(doc: &SceneDoc, mesh: GltfMesh, animated: bool) -> Result<Vec<u
 /// world, as one mesh: the characters' vertices in document order, their triangles
 /// renumbered to match.
 pub fn scene_mesh(doc: &SceneDoc) -> Result<(Vec<glam::Vec3>, Vec<[u32; 3]>), FormatError> {
+    scene_mesh_from(&mut super::AssetLibrary::default(), doc)
+}
+
+/// [`scene_mesh`] with the files `library` has read (and reads).
+pub fn scene_mesh_from(
+    library: &mut super::AssetLibrary,
+    doc: &SceneDoc,
+) -> Result<(Vec<glam::Vec3>, Vec<[u32; 3]>), FormatError> {
     let mut positions = Vec::new();
     let mut triangles = Vec::new();
-    for (c, asset, posed) in load_posed(doc, false)? {
+    for (c, asset, posed) in load_posed(library, doc, false)? {
         let first = positions.len() as u32;
+        let mut asset = asset;
+        if posed.weights.iter().any(|&w| w != 0.0) {
+            std::sync::Arc::make_mut(&mut asset).skin.bind_positions = asset.morphed_positions(&posed.weights);
+        }
         let world = posed.placement.to_mat4() * posed.root_shift(&asset);
         positions.extend(crate::posing::posed_positions_with_rest(
             &asset,
@@ -93,12 +117,15 @@ type PosedCharacter<'a> = (&'a CharacterDoc, std::sync::Arc<marionette_rig::Char
 
 /// Every character of `doc` with its shaped asset and its pose; attached characters placed
 /// where their holding joints carry them.
-fn load_posed(doc: &SceneDoc, animated: bool) -> Result<Vec<PosedCharacter<'_>>, FormatError> {
-    let mut library = super::AssetLibrary::default();
+fn load_posed<'a>(
+    library: &mut super::AssetLibrary,
+    doc: &'a SceneDoc,
+    animated: bool,
+) -> Result<Vec<PosedCharacter<'a>>, FormatError> {
     let mut loaded = Vec::new();
     for c in &doc.characters {
         let asset = library.shaped(c)?;
-        let posed = posed(&mut library, doc, c, &asset, animated)?;
+        let posed = posed(library, doc, c, &asset, animated)?;
         loaded.push((c, asset, posed));
     }
     for i in 0..loaded.len() {
@@ -109,6 +136,18 @@ fn load_posed(doc: &SceneDoc, animated: bool) -> Result<Vec<PosedCharacter<'_>>,
         }
     }
     Ok(loaded)
+}
+
+/// A character's still pose now — its document's pose under its clips at their times — and
+/// how far its clip has moved its root from the skeleton's rest offset (model space).
+pub fn still_pose(
+    library: &mut super::AssetLibrary,
+    scene: &SceneDoc,
+    c: &CharacterDoc,
+    asset: &marionette_rig::CharacterAsset,
+) -> Result<(Vec<marionette_rig::JointRotation>, glam::Vec3), FormatError> {
+    let posed = posed(library, scene, c, asset, false)?;
+    Ok((posed.pose, posed.root - asset.skeleton.joint(0).rest_offset))
 }
 
 /// A character's pose from its document and clips at their times, and (with `animated`)
@@ -131,6 +170,8 @@ fn posed(
         motion: None,
         motion_name: String::new(),
         clips: std::sync::Arc::new([]),
+        // One weight per morph target: the document's, zero where it sets none.
+        weights: (0..asset.morphs.len()).map(|k| c.morphs.get(k).copied().unwrap_or(0.0)).collect(),
     };
     if let Some(anim) = &c.anim {
         let clip = super::retarget::anim_clip(library, scene, c, asset, anim)?;
@@ -205,6 +246,7 @@ fn play_node_clip(
     let Some(clip) = find(&playback.clip) else { return Ok(()) };
     let blend = find(&playback.blend_clip).map(|k| (k, playback.blend));
     let now = pose_mix(skeleton, clip, blend, playback.time, &mut posed.pose);
+    posed.weights = marionette_rig::node_clip::weights_mix(&posed.weights, clip, blend, playback.time);
     posed.root = now.offsets[0];
     if clip.moves_rest() || blend.is_some_and(|(k, _)| k.moves_rest()) {
         posed.rest = Some(rest_of(skeleton, &now));

@@ -10,6 +10,7 @@ pub mod export;
 pub mod frames;
 pub mod layout;
 pub mod library;
+pub mod options;
 pub mod picture;
 pub mod posing;
 pub mod retarget;

@@ -6,7 +6,7 @@ use glam::{Mat4, Vec3};
 use marionette_rig::dqs::SkinningMethod;
 use marionette_rig::fk::{RestOverride, posed_palette_with_rest};
 use marionette_rig::lbs::skin;
-use marionette_rig::node_clip::{NodeClip, NodePose};
+use marionette_rig::node_clip::NodeClip;
 use marionette_rig::{CharacterAsset, JointRotation, Skeleton};
 
 /// What is wrong with a `JOINT=rx,ry,rz` spec.
@@ -63,6 +63,12 @@ pub fn apply_pose_specs(
 
 fn joint_list(skeleton: &Skeleton) -> String {
     let names: Vec<&str> = skeleton.joints().iter().map(|j| j.name.as_str()).collect();
+    name_list(&names)
+}
+
+/// Names for a message: all of them, or the first 12 and how many there are.
+pub fn name_list(names: &[impl AsRef<str>]) -> String {
+    let names: Vec<&str> = names.iter().map(AsRef::as_ref).collect();
     if names.len() > 12 {
         format!("{}, ... ({} in all)", names[..12].join(", "), names.len())
     } else {
@@ -93,14 +99,21 @@ pub fn posed_positions_with_rest(
     placement: Mat4,
     method: SkinningMethod,
 ) -> Vec<Vec3> {
-    let palette = posed_palette_with_rest(&asset.skeleton, &asset.bind_world_to_joint, pose, rest, placement);
     let mut out = vec![Vec3::ZERO; asset.vertex_count()];
+    let (skeleton, binds, weights) = (&asset.skeleton, &asset.bind_world_to_joint, &asset.skin.weights);
     match method {
-        SkinningMethod::Linear => skin(&asset.skin.bind_positions, &asset.skin.weights, &palette, &mut out),
+        SkinningMethod::Linear => {
+            let palette = posed_palette_with_rest(skeleton, binds, pose, rest, placement);
+            skin(&asset.skin.bind_positions, weights, &palette, &mut out);
+        }
         SkinningMethod::DualQuaternion => {
+            // A dual quaternion holds no scale: skin in model space, then place, as the
+            // editor does (its placement is the character's transform).
+            let palette = posed_palette_with_rest(skeleton, binds, pose, rest, Mat4::IDENTITY);
             let mut dq = Vec::new();
             marionette_rig::dqs::dual_quaternion_palette(&palette, &mut dq);
-            marionette_rig::dqs::skin_dq(&asset.skin.bind_positions, &asset.skin.weights, &dq, &mut out);
+            marionette_rig::dqs::skin_dq(&asset.skin.bind_positions, weights, &dq, &mut out);
+            out.iter_mut().for_each(|p| *p = placement.transform_point3(*p));
         }
     }
     out
@@ -113,79 +126,6 @@ pub fn find_clip<'a>(clips: &'a [NodeClip], spec: &str) -> Option<&'a NodeClip> 
         let index: usize = spec.parse().ok()?;
         clips.iter().find(|c| c.index == index)
     })
-}
-
-/// `--clip SPEC` against the files it is given with: fails on a file that has clips but none
-/// that `spec` names, or when no file has a clip it names, listing each file's clips (the
-/// numbers `info` gives them).
-pub fn check_clip_spec(paths: &[std::path::PathBuf], spec: &str) -> Result<(), String> {
-    let mut matched = false;
-    let mut listed = Vec::new();
-    for path in paths.iter().filter(|p| marionette_formats::has_parts(p)) {
-        let parts = marionette_formats::load_parts(path).map_err(|e| e.to_string())?;
-        let clips: Vec<&NodeClip> = parts.iter().flat_map(|p| &p.clips).collect();
-        let names = || {
-            let mut names: Vec<String> = clips.iter().map(|c| format!("{} `{}`", c.index, c.name)).collect();
-            names.dedup();
-            if names.is_empty() { "none".to_string() } else { names.join(", ") }
-        };
-        if parts.iter().any(|p| find_clip(&p.clips, spec).is_some()) {
-            matched = true;
-        } else if !clips.is_empty() {
-            return Err(format!("{}: no clip `{spec}` (its clips: {})", path.display(), names()));
-        } else {
-            listed.push(format!("{}: none", path.display()));
-        }
-    }
-    if !matched {
-        return Err(format!("no file has a clip `{spec}` ({})", listed.join("; ")));
-    }
-    Ok(())
-}
-
-/// Every character of a glTF file, shaped by the morph weights the file sets (or its clip
-/// keys), each posed by its clip `clip` at `time` seconds (by its file's node transforms without one) and
-/// then by `poses` where it has the joints:
-/// the vertices and triangles of all of them, in file order. Fails when no character has
-/// the clip.
-pub fn posed_gltf(
-    characters: &[marionette_formats::part::Part],
-    clip: Option<&str>,
-    time: f32,
-    poses: &[PoseSpec],
-    method: SkinningMethod,
-) -> Result<(Vec<Vec3>, Vec<[u32; 3]>), String> {
-    if let Some(spec) = clip
-        && !characters.iter().any(|c| find_clip(&c.clips, spec).is_some())
-    {
-        let names: Vec<String> =
-            characters.iter().flat_map(|c| &c.clips).map(|c| format!("{} `{}`", c.index, c.name)).collect();
-        return Err(format!(
-            "no animation `{spec}` in the file (it has: {})",
-            if names.is_empty() { "none".to_string() } else { names.join(", ") }
-        ));
-    }
-    let (mut positions, mut triangles) = (Vec::new(), Vec::new());
-    for c in characters {
-        let skeleton = &c.asset.skeleton;
-        let playing = clip.and_then(|spec| find_clip(&c.clips, spec));
-        let node_pose = playing.map_or_else(|| NodePose::of(skeleton), |clip| clip.sample(skeleton, time));
-        // The morph weights the file sets are part of its pose; a clip may key them.
-        let weights =
-            playing.map_or_else(|| c.morph_weights.clone(), |clip| clip.sample_weights(&c.morph_weights, time));
-        let mut pose = node_pose.pose();
-        let mine: Vec<PoseSpec> = poses.iter().filter(|p| skeleton.resolve(&p.joint).is_some()).cloned().collect();
-        apply_pose_specs(skeleton, &mut pose, &mine).map_err(|e| e.to_string())?;
-        let rest = RestOverride { offsets: Some(&node_pose.offsets), scales: Some(&node_pose.scales) };
-        let first = positions.len() as u32;
-        let mut shaped = std::borrow::Cow::Borrowed(&c.asset);
-        if weights.iter().any(|&w| w != 0.0) {
-            shaped.to_mut().skin.bind_positions = c.asset.morphed_positions(&weights);
-        }
-        positions.extend(posed_positions_with_rest(&shaped, &pose, rest, Mat4::IDENTITY, method));
-        triangles.extend(c.asset.skin.triangles.iter().map(|t| t.map(|i| i + first)));
-    }
-    Ok((positions, triangles))
 }
 
 /// A human-readable summary of what was loaded.

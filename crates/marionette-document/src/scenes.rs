@@ -64,6 +64,18 @@ pub fn doc_side_by_side(library: &mut AssetLibrary, sources: Vec<SourceDoc>, mes
     SceneDoc { characters, ..SceneDoc::default() }
 }
 
+/// A file's characters as a document, each where its file puts it: a character file's
+/// one, or every character of a glTF or FBX file (their warnings are the library's).
+pub fn file_doc(library: &mut AssetLibrary, path: &Path) -> Result<SceneDoc, FormatError> {
+    let mut doc = SceneDoc::default();
+    for source in library.sources_of(path) {
+        let asset = library.load(&source)?;
+        let c = library.new_character_doc(source, &asset);
+        doc.characters.push(c);
+    }
+    Ok(doc)
+}
+
 /// The embedded default scene (`assets/default_scene.ron`).
 pub fn default_scene_doc() -> SceneDoc {
     marionette_formats::scene::parse_scene(

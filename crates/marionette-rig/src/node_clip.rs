@@ -311,3 +311,21 @@ impl NodeClip {
         self.tracks.iter().any(|t| t.translation.is_some() || t.scale.is_some())
     }
 }
+
+/// The morph weights `clip` keys at `t` seconds over `weights` (kept where it keys none),
+/// with `blend`'s clip mixed in by its weight (on the same clock, wrapped to its own
+/// length): what the editor's player and export give a character's morphs.
+pub fn weights_mix(weights: &[f32], clip: &NodeClip, blend: Option<(&NodeClip, f32)>, t: f32) -> Vec<f32> {
+    if !clip.keys_weights() {
+        return weights.to_vec();
+    }
+    let mut mixed = clip.sample_weights(weights, t);
+    if let Some((other, weight)) = blend.filter(|(k, w)| k.keys_weights() && *w > 0.0) {
+        let length = other.duration();
+        let wrapped = if length > 0.0 { t.rem_euclid(length) } else { t };
+        let theirs = other.sample_weights(&mixed, wrapped);
+        mixed.iter_mut().zip(theirs).for_each(|(w, o)| *w += (o - *w) * weight);
+    }
+    mixed.truncate(weights.len());
+    mixed
+}

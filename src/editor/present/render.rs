@@ -87,7 +87,10 @@ pub fn render(
             edits.time = times.first().copied();
             (times.into_iter().map(FrameAt::Time).zip(paths).collect(), Some(sequence))
         }
-        Pictures::Still => (vec![(FrameAt::AsOpened, out.clone())], None),
+        Pictures::Still => {
+            edits.still = true;
+            (vec![(FrameAt::AsOpened, out.clone())], None)
+        }
         Pictures::PoseSheet => {
             if poses.is_empty() {
                 return Err("the scene keeps no poses to show (keep some with \"Keep pose\" in the editor)".into());
@@ -200,7 +203,13 @@ fn preload(paths: &[PathBuf], edits: &StartupEdits) -> Result<(AssetLibrary, Sho
             loaded.and(clip).err().map(|e| format!("{e}{named_in}"))
         })
         .collect();
-    if errors.is_empty() { Ok((library, shot, poses)) } else { Err(errors.join("\n")) }
+    if !errors.is_empty() {
+        return Err(errors.join("\n"));
+    }
+    // The options as every command applies them: one that names what no character has fails
+    // here, before the GPU starts.
+    crate::editor::present::view::startup_scene(paths, edits, &mut library, &mut Vec::new())?;
+    Ok((library, shot, poses))
 }
 
 /// Once the gate opens, captures the target once, saves it and exits; gives up after

@@ -122,16 +122,18 @@ fn queue_startup_scene(
     mut changed: ResMut<crate::editor::scene_doc::document::ChangedAtStartup>,
 ) {
     let mut notes = Vec::new();
-    let doc = startup_doc(&paths.0, &mut library, &mut notes);
+    let before = startup_doc(&paths.0, &mut library, &mut Vec::new());
+    let doc = startup_scene(&paths.0, &edits, &mut library, &mut notes).unwrap_or_else(|e| {
+        notes.push(e);
+        before.clone()
+    });
     *arrange = crate::editor::scene_doc::arrange::ArrangeWhenSkinned {
         side_by_side: !paths.0.is_empty() && scene_path(&paths.0).is_none(),
         match_height: edits.match_height,
     };
     notes.into_iter().for_each(|m| messages.push(m));
     if let Some(mut doc) = doc {
-        let before = doc.clone();
-        apply_startup_edits(&mut doc, &edits, &mut library, &mut messages);
-        changed.0 = doc != before || edits.recovered;
+        changed.0 = Some(&doc) != before.as_ref() || edits.recovered;
         if let Some(view) = startup_view(&mut doc, &edits) {
             framing.0 = view;
         }
@@ -156,146 +158,32 @@ fn startup_view(doc: &mut crate::formats::scene::SceneDoc, edits: &StartupEdits)
     Some(view)
 }
 
-/// Applies `--pose` and `--ik` to every character of `doc` that has the joints.
-fn apply_startup_edits(
-    doc: &mut crate::formats::scene::SceneDoc,
+/// The scene the app opens with: the startup paths as a document (the default scene when
+/// there are none) with the command line's options applied as every command applies them
+/// ([`crate::document::options`]; character files posed in their files' space, then
+/// placed side by side) and `--transparent`. Returns the notes (IK reports), or
+/// what an option named that no character has.
+pub fn startup_scene(
+    paths: &[std::path::PathBuf],
     edits: &StartupEdits,
     library: &mut AssetLibrary,
-    messages: &mut Messages,
-) {
-    use crate::formats::scene::pose_key;
-    if let Some(method) = edits.skinning {
-        doc.characters.iter_mut().for_each(|c| c.skinning = method);
-    }
-    if let Some(anim) = &edits.anim {
-        put_clip_on_fitting_characters(doc, anim, library, messages);
-    }
-    if let Some(spec) = &edits.clip {
-        play_gltf_clip(doc, spec, library, messages);
-    }
-    if let Some(t) = edits.time {
-        pause_clips_at(doc, t);
+    notes: &mut Vec<String>,
+) -> Result<Option<crate::formats::scene::SceneDoc>, String> {
+    let Some(mut doc) = startup_doc(paths, library, notes) else { return Ok(None) };
+    // Character files are posed where their files put them (so `--ik` targets are in the
+    // file's space, as `export` reads them), then stood where the layout puts them.
+    let layout: Option<Vec<_>> = scene_path(paths)
+        .is_none()
+        .then(|| doc.characters.iter_mut().map(|c| std::mem::take(&mut c.placement)).collect());
+    notes.extend(crate::document::options::apply_options(&mut doc, &edits.pose_options(), library)?);
+    for (c, placed) in doc.characters.iter_mut().zip(layout.iter().flatten()) {
+        c.placement = crate::formats::scene::PlacementDoc::from_mat4(placed.to_mat4() * c.placement.to_mat4());
     }
     if edits.transparent {
         doc.stage.background = crate::formats::scene::BackgroundDoc::Transparent;
         doc.stage.floor = false;
     }
-    if edits.poses.is_empty() && edits.ik.is_empty() {
-        return;
-    }
-    for c in &mut doc.characters {
-        let Ok(asset) = library.load(&c.source) else { continue };
-        let skeleton = &asset.skeleton;
-        let (mut pose, _) = crate::document::scenes::pose_from_doc(&asset, c);
-        let poses: Vec<_> = edits.poses.iter().filter(|p| skeleton.resolve(&p.joint).is_some()).cloned().collect();
-        let ik: Vec<_> = edits.ik.iter().filter(|p| skeleton.resolve(&p.joint).is_some()).cloned().collect();
-        let _ = crate::document::posing::apply_pose_specs(skeleton, &mut pose, &poses);
-        if let Ok(reports) = crate::document::posing::apply_ik_specs(skeleton, &mut pose, c.placement.to_mat4(), &ik) {
-            reports.iter().for_each(|r| {
-                messages.push(format!("{}: {}", c.name, crate::document::posing::describe_ik(skeleton, r)))
-            });
-        }
-        let initial = skeleton.initial_pose();
-        c.pose =
-            (0..skeleton.len()).filter(|&j| pose[j] != initial[j]).map(|j| (pose_key(skeleton, j), pose[j])).collect();
-    }
-}
-
-/// Every clip of the document (keyframes, SMPL) paused at `t` seconds.
-fn pause_clips_at(doc: &mut crate::formats::scene::SceneDoc, t: f32) {
-    for c in &mut doc.characters {
-        if let Some(anim) = &mut c.anim {
-            anim.time = t;
-            anim.playing = false;
-        }
-        if let Some(smpl) = c.smpl.as_mut().filter(|s| s.clip.is_some()) {
-            smpl.time = t * crate::rig::smpl::CLIP_FPS;
-            smpl.playing = false;
-        }
-        if let Some(playback) = c.playback.as_mut().filter(|p| p.clip.is_some()) {
-            playback.time = t;
-            playback.playing = false;
-        }
-    }
-}
-
-/// Plays the glTF animation `spec` (name or index) on every character of the document that
-/// it moves; says when it moves none.
-fn play_gltf_clip(
-    doc: &mut crate::formats::scene::SceneDoc,
-    spec: &str,
-    library: &mut AssetLibrary,
-    messages: &mut Messages,
-) {
-    let mut played = 0;
-    for c in &mut doc.characters {
-        let Some(part) = library.part_of_source(&c.source) else { continue };
-        if let Some(clip) = crate::document::posing::find_clip(&part.clips, spec) {
-            let state =
-                c.playback.take().unwrap_or(crate::formats::scene::PlaybackDoc { playing: true, ..Default::default() });
-            c.playback = Some(crate::formats::scene::PlaybackDoc { clip: Some(clip.name.clone()), ..state });
-            played += 1;
-        }
-    }
-    if played == 0 {
-        messages
-            .push(format!("no character has an animation `{spec}` (--clip takes a glTF animation's name or index)"));
-    }
-}
-
-/// Puts the clip on every character whose skeleton it fits (3 channels for the root, 3 per
-/// joint); says which it fits none of.
-fn put_clip_on_fitting_characters(
-    doc: &mut crate::formats::scene::SceneDoc,
-    anim: &crate::formats::scene::AnimDoc,
-    library: &mut AssetLibrary,
-    messages: &mut Messages,
-) {
-    if anim.retarget.is_some() {
-        return put_motion_on_humanoids(doc, anim, library, messages);
-    }
-    let clip = match library.keyframe_clip(&anim.file) {
-        Ok(clip) => clip,
-        Err(e) => return messages.push(e.to_string()),
-    };
-    let mut fitted = 0;
-    for c in &mut doc.characters {
-        let fits = |a: &crate::rig::CharacterAsset| match clip.joint_names.is_empty() {
-            true => 3 + 3 * a.skeleton.len() == clip.channels.len(),
-            false => a.skeleton.joints().iter().any(|j| clip.joint_names.contains(&j.name)),
-        };
-        if library.load(&c.source).is_ok_and(|a| fits(&a)) {
-            c.anim = Some(anim.clone());
-            fitted += 1;
-        }
-    }
-    if fitted == 0 {
-        messages.push(format!(
-            "{}: its {} channels fit no character (3 for the root, then 3 per joint, or joints by name)",
-            anim.file.display(),
-            clip.channels.len()
-        ));
-    }
-}
-
-/// Puts a retargeted motion on every character with a humanoid map; says when none has one.
-fn put_motion_on_humanoids(
-    doc: &mut crate::formats::scene::SceneDoc,
-    anim: &crate::formats::scene::AnimDoc,
-    library: &mut AssetLibrary,
-    messages: &mut Messages,
-) {
-    let mut fitted = 0;
-    for c in &mut doc.characters {
-        if library.load(&c.source).is_ok_and(|a| crate::rig::humanoid::of_asset(&a).is_some()) {
-            c.anim = Some(anim.clone());
-            fitted += 1;
-        }
-    }
-    if fitted == 0 {
-        messages
-            .push("--retarget: no character has a humanoid map (two legs, two arms) to take the motion".to_string());
-    }
+    Ok(Some(doc))
 }
 
 /// Opens the pending document in place of the current scene: every character is

@@ -40,6 +40,23 @@ pub struct StartupEdits {
     pub transparent: bool,
     /// `--recover`: the scene is a recovery file, saved nowhere yet.
     pub recovered: bool,
+    /// `render` of one picture: clips paused where the scene has them.
+    pub still: bool,
+}
+
+impl StartupEdits {
+    /// The posing options, as every command applies them.
+    pub fn pose_options(&self) -> crate::document::options::PoseOptions {
+        crate::document::options::PoseOptions {
+            poses: self.poses.clone(),
+            ik: self.ik.clone(),
+            skinning: self.skinning,
+            anim: self.anim.clone(),
+            clip: self.clip.clone(),
+            time: self.time,
+            still: self.still,
+        }
+    }
 }
 
 /// Messages for the user (load errors, warnings, where files went), newest last.

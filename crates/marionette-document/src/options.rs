@@ -1,0 +1,260 @@
+//! The command line's posing options — `--skinning`, `--anim`/`--retarget`, `--clip`,
+//! `--time`, `--pose`, `--ik` — applied to a scene document in one place, the same way for
+//! `render`, `edit` and `export` and for every kind of input (a scene, character files, a
+//! glTF or FBX file): each input becomes a scene document first, then these options change
+//! it. An option that names what no character has (a joint, a clip) fails.
+//!
+//! Order: skinning; the clip `--anim` names on the characters it fits (or, with
+//! `--retarget`, the humanoids); `--clip` on the characters whose file has it; every clip
+//! paused at `--time`; then `--pose` and `--ik` on top of each character's pose at that
+//! time. A character posed by `--pose`/`--ik` keeps that still pose: its clips are baked
+//! into it (the root's travel into its placement), so every command shows the same figure.
+
+use glam::{Mat4, Vec3};
+
+use marionette_formats::scene::{AnimDoc, PlaybackDoc, SceneDoc, pose_key};
+use marionette_rig::dqs::SkinningMethod;
+
+use crate::AssetLibrary;
+use crate::posing::{IkSpec, PoseSpec, apply_ik_specs, apply_pose_specs, describe_ik, find_clip};
+
+/// What the command line asks of the characters.
+#[derive(Clone, Debug, Default)]
+pub struct PoseOptions {
+    /// `--pose JOINT=rx,ry,rz`: on every character that has the joint.
+    pub poses: Vec<PoseSpec>,
+    /// `--ik JOINT=x,y,z`: on every character that has the joint, after `--pose`.
+    pub ik: Vec<IkSpec>,
+    /// `--skinning`: every character skinned this way.
+    pub skinning: Option<SkinningMethod>,
+    /// `--anim FILE` (or `--retarget FILE`): a clip on every character it fits.
+    pub anim: Option<AnimDoc>,
+    /// `--clip NAME|INDEX`: a glTF or FBX file's own clip on the characters it moves.
+    pub clip: Option<String>,
+    /// `--time T`: every clip paused at T seconds.
+    pub time: Option<f32>,
+    /// A still picture or mesh: without `--time`, every clip paused where its document has
+    /// it (a picture is never taken of a clip that plays on while the renderer warms up).
+    pub still: bool,
+}
+
+impl PoseOptions {
+    /// Whether the options pose a still figure (which baking clips into it gives).
+    pub fn poses_joints(&self) -> bool {
+        !self.poses.is_empty() || !self.ik.is_empty()
+    }
+}
+
+/// Applies `options` to `doc`. Returns what is worth saying (what each retargeting did,
+/// IK reports), or what named something no character has.
+pub fn apply_options(
+    doc: &mut SceneDoc,
+    options: &PoseOptions,
+    library: &mut AssetLibrary,
+) -> Result<Vec<String>, String> {
+    let mut notes = Vec::new();
+    if let Some(method) = options.skinning {
+        doc.characters.iter_mut().for_each(|c| c.skinning = method);
+    }
+    if let Some(anim) = &options.anim {
+        put_clip_on_fitting_characters(doc, anim, library, &mut notes)?;
+    }
+    if let Some(spec) = &options.clip {
+        play_own_clip(doc, spec, library)?;
+    }
+    match options.time {
+        Some(t) => pause_clips_at(doc, t),
+        None if options.still => pause_clips(doc),
+        None => {}
+    }
+    if options.poses_joints() {
+        notes.extend(pose_characters(doc, options, library)?);
+    }
+    Ok(notes)
+}
+
+/// Puts the clip on every character whose skeleton it fits (3 channels for the root, 3 per
+/// joint, or joints by name); a retargeted motion on every humanoid (worked out here, so a
+/// motion that cannot be carried is refused now, and described). The characters' own clips
+/// stop. Fails when it fits none.
+fn put_clip_on_fitting_characters(
+    doc: &mut SceneDoc,
+    anim: &AnimDoc,
+    library: &mut AssetLibrary,
+    notes: &mut Vec<String>,
+) -> Result<(), String> {
+    if let Some(settings) = &anim.retarget {
+        let scene = doc.clone();
+        let mut fitted = 0;
+        for c in &mut doc.characters {
+            let Ok(asset) = library.shaped(c) else { continue };
+            if marionette_rig::humanoid::of_asset(&asset).is_none() {
+                continue;
+            }
+            let from =
+                crate::retarget::motion_source_doc(library, &scene, &settings.from).map_err(|e| e.to_string())?;
+            let done = crate::retarget::retarget(library, &from, c, &asset, settings).map_err(|e| e.to_string())?;
+            notes.push(crate::retarget::describe(&done, &from.name, &c.name, &asset.skeleton));
+            c.anim = Some(anim.clone());
+            c.playback = None;
+            fitted += 1;
+        }
+        return match fitted {
+            0 => Err("--retarget: no character has a humanoid map (two legs, two arms) to take the motion".into()),
+            _ => Ok(()),
+        };
+    }
+    let clip = library.keyframe_clip(&anim.file).map_err(|e| e.to_string())?;
+    let mut fitted = 0;
+    for c in &mut doc.characters {
+        let fits = |a: &marionette_rig::CharacterAsset| match clip.joint_names.is_empty() {
+            true => 3 + 3 * a.skeleton.len() == clip.channels.len(),
+            false => a.skeleton.joints().iter().any(|j| clip.joint_names.contains(&j.name)),
+        };
+        if library.load(&c.source).is_ok_and(|a| fits(&a)) {
+            c.anim = Some(anim.clone());
+            c.playback = None;
+            fitted += 1;
+        }
+    }
+    match fitted {
+        0 => Err(format!(
+            "{}: its {} channels fit no character (3 for the root, then 3 per joint, or joints by name)",
+            anim.file.display(),
+            clip.channels.len()
+        )),
+        _ => Ok(()),
+    }
+}
+
+/// Plays the file's own clip `spec` (name, or index as `info` numbers them) on every
+/// character it moves. Fails on a file that has clips but none `spec` names, or when no
+/// character's file has it, listing the clips there are.
+fn play_own_clip(doc: &mut SceneDoc, spec: &str, library: &mut AssetLibrary) -> Result<(), String> {
+    // Each file once, in order: its clips as `info` lists them, and whether `spec` found one.
+    let mut files: Vec<(String, Vec<String>, bool)> = Vec::new();
+    for c in &mut doc.characters {
+        let Some(part) = library.part_of_source(&c.source) else { continue };
+        let file = c.source.path().map_or(c.name.clone(), |p| p.display().to_string());
+        if !files.iter().any(|f| f.0 == file) {
+            files.push((file.clone(), Vec::new(), false));
+        }
+        let entry = files.iter_mut().find(|f| f.0 == file).expect("just added");
+        for k in part.clips.iter() {
+            let name = format!("{} `{}`", k.index, k.name);
+            if !entry.1.contains(&name) {
+                entry.1.push(name);
+            }
+        }
+        if let Some(clip) = find_clip(&part.clips, spec) {
+            let state = c.playback.take().unwrap_or(PlaybackDoc { playing: true, ..Default::default() });
+            c.playback = Some(PlaybackDoc { clip: Some(clip.name.clone()), ..state });
+            entry.2 = true;
+        }
+    }
+    if let Some((file, clips, _)) = files.iter().find(|(_, clips, found)| !found && !clips.is_empty()) {
+        return Err(format!("{file}: no clip `{spec}` (its clips: {})", clips.join(", ")));
+    }
+    if !files.iter().any(|f| f.2) {
+        let listed: Vec<String> = files.iter().map(|f| format!("{}: none", f.0)).collect();
+        let files =
+            if listed.is_empty() { "no character comes from a glTF or FBX file".into() } else { listed.join("; ") };
+        return Err(format!("no file has a clip `{spec}` ({files})"));
+    }
+    Ok(())
+}
+
+/// Every clip of the document paused where it is.
+fn pause_clips(doc: &mut SceneDoc) {
+    for c in &mut doc.characters {
+        c.anim.iter_mut().for_each(|a| a.playing = false);
+        c.smpl.iter_mut().for_each(|s| s.playing = false);
+        c.playback.iter_mut().for_each(|p| p.playing = false);
+    }
+}
+
+/// Every clip of the document (keyframes, SMPL, a file's own) paused at `t` seconds.
+pub fn pause_clips_at(doc: &mut SceneDoc, t: f32) {
+    for c in &mut doc.characters {
+        if let Some(anim) = &mut c.anim {
+            anim.time = t;
+            anim.playing = false;
+        }
+        if let Some(smpl) = c.smpl.as_mut().filter(|s| s.clip.is_some()) {
+            smpl.time = t * marionette_rig::smpl::CLIP_FPS;
+            smpl.playing = false;
+        }
+        if let Some(playback) = c.playback.as_mut().filter(|p| p.clip.is_some()) {
+            playback.time = t;
+            playback.playing = false;
+        }
+    }
+}
+
+/// `--pose` then `--ik` on every character that has the joints, on top of its pose now;
+/// its clips baked into that still pose. Fails on a joint no character has.
+fn pose_characters(
+    doc: &mut SceneDoc,
+    options: &PoseOptions,
+    library: &mut AssetLibrary,
+) -> Result<Vec<String>, String> {
+    let scene = doc.clone();
+    let mut notes = Vec::new();
+    let mut used = vec![false; options.poses.len() + options.ik.len()];
+    let mut joints_seen = Vec::new();
+    for c in &mut doc.characters {
+        let Ok(asset) = library.shaped(c) else { continue };
+        let skeleton = &asset.skeleton;
+        joints_seen.push((c.name.clone(), skeleton.joints().iter().map(|j| j.name.clone()).collect::<Vec<_>>()));
+        let has = |joint: &str| skeleton.resolve(joint).is_some();
+        let poses: Vec<PoseSpec> = options.poses.iter().filter(|p| has(&p.joint)).cloned().collect();
+        let ik: Vec<IkSpec> = options.ik.iter().filter(|p| has(&p.joint)).cloned().collect();
+        if poses.is_empty() && ik.is_empty() {
+            continue;
+        }
+        let names = options.poses.iter().map(|p| &p.joint).chain(options.ik.iter().map(|p| &p.joint));
+        names.zip(&mut used).filter(|(j, _)| has(j)).for_each(|(_, u)| *u = true);
+        let (mut pose, root_shift) =
+            crate::export::still_pose(library, &scene, c, &asset).map_err(|e| e.to_string())?;
+        apply_pose_specs(skeleton, &mut pose, &poses).map_err(|e| e.to_string())?;
+        let placement = c.placement.to_mat4() * Mat4::from_translation(root_shift);
+        for report in apply_ik_specs(skeleton, &mut pose, placement, &ik).map_err(|e| e.to_string())? {
+            notes.push(format!("{}: {}", c.name, describe_ik(skeleton, &report)));
+        }
+        let initial = skeleton.initial_pose();
+        c.pose =
+            (0..skeleton.len()).filter(|&j| pose[j] != initial[j]).map(|j| (pose_key(skeleton, j), pose[j])).collect();
+        if root_shift != Vec3::ZERO {
+            c.placement = marionette_formats::scene::PlacementDoc::from_mat4(placement);
+        }
+        bake_clips(c);
+    }
+    let specs = options.poses.iter().map(|p| ("--pose", &p.joint)).chain(options.ik.iter().map(|p| ("--ik", &p.joint)));
+    if let Some((option, joint)) = specs.zip(&used).find(|(_, u)| !**u).map(|(s, _)| s) {
+        let known: Vec<String> =
+            joints_seen.iter().map(|(name, joints)| format!("{name}: {}", crate::posing::name_list(joints))).collect();
+        return Err(format!("{option}: no character has a joint named or numbered `{joint}` ({})", known.join("; ")));
+    }
+    Ok(notes)
+}
+
+/// A character posed by hand holds its still pose: its clips are off.
+fn bake_clips(c: &mut marionette_formats::scene::CharacterDoc) {
+    c.anim = None;
+    if let Some(playback) = &mut c.playback {
+        (playback.clip, playback.blend_clip, playback.playing) = (None, None, false);
+    }
+    if let Some(smpl) = &mut c.smpl {
+        (smpl.clip, smpl.blend_clip, smpl.playing) = (None, None, false);
+    }
+}
+
+/// A file's characters (each where its file puts it) posed by `options` as a still, as
+/// `export FILE --out F.obj` writes them: every vertex and triangle, in file order.
+pub fn posed_file(path: &std::path::Path, options: &PoseOptions) -> Result<(Vec<glam::Vec3>, Vec<[u32; 3]>), String> {
+    let mut library = AssetLibrary::default();
+    let mut doc = crate::scenes::file_doc(&mut library, path).map_err(|e| e.to_string())?;
+    let options = PoseOptions { still: true, ..options.clone() };
+    apply_options(&mut doc, &options, &mut library)?;
+    crate::export::scene_mesh_from(&mut library, &doc).map_err(|e| e.to_string())
+}
