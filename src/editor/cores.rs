@@ -1,8 +1,6 @@
-//! One compute worker a core. Left to the scheduler, Bevy's compute workers on this 2-core
-//! machine woke on the same core in about a third of the frames: the skin phase at 16–32
-//! SMPL bodies then ran on one thread (40–60 of 120 frames; 0.39 ms against 0.25), and at
-//! 64 those frames made the frame's p95 (3.70–3.80 ms against 2.67–2.91 with the workers
-//! pinned). Only the compute workers are pinned: the main thread and the threads it starts
+//! One compute worker a core, so that the skin phase's parallel work never lands two
+//! workers on one core while another idles (left to the scheduler they can wake on the same
+//! core). Only the compute workers are pinned: the main thread and the threads it starts
 //! (the renderer's, the IO and async pools) keep every core.
 
 use std::sync::Arc;

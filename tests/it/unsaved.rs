@@ -229,7 +229,8 @@ impl Display {
 
 impl Display {
     /// The editor with `args` on this display, autosaving every `autosave` seconds into
-    /// `state`'s recovery folder, its errors piped.
+    /// `state`'s recovery folder, its settings (recent files) there too, never the user's;
+    /// its errors piped.
     fn editor(&self, args: &[&str], autosave: &str, state: &std::path::Path) -> std::process::Command {
         let mut command = std::process::Command::new(env!("CARGO_BIN_EXE_marionette"));
         command
@@ -237,6 +238,7 @@ impl Display {
             .env("DISPLAY", &self.name)
             .env("MARIONETTE_AUTOSAVE_SECONDS", autosave)
             .env("XDG_STATE_HOME", state)
+            .env("MARIONETTE_CONFIG_DIR", state.join("config"))
             .stdout(std::process::Stdio::null())
             .stderr(std::process::Stdio::piped());
         command

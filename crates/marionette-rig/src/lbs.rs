@@ -161,8 +161,8 @@ fn assert_lengths(bind_positions: &[Vec3], weights: &SkinWeights, out: &[Vec3], 
 }
 
 /// The portable path: each vertex blends its matrices (`M = Σ wᵢ Pᵢ`) with glam's `Vec4`
-/// and transforms its bind position by `M`. (Eight lanes in plain arrays spill 128-bit
-/// registers: 71 µs a SMPL body against this path's 38.)
+/// and transforms its bind position by `M`, one vertex at a time (lanes in plain arrays
+/// spill 128-bit registers).
 fn skin_portable_chunk(
     bind: &[Vec3],
     weights: &SkinWeights,
