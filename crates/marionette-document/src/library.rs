@@ -19,6 +19,7 @@ pub struct AssetLibrary {
     bound: HashMap<(SourceDoc, BindingDoc), Arc<CharacterAsset>>,
     keyframe_clips: HashMap<PathBuf, Arc<marionette_rig::anim::Clip>>,
     parts: HashMap<PathBuf, Vec<LoadedPart>>,
+    humanoids: HashMap<SourceDoc, Arc<marionette_rig::humanoid::HumanoidMap>>,
 }
 
 /// One part of a glTF or FBX file, loaded: its asset, its clips and its morph weights.
@@ -57,6 +58,24 @@ pub struct SmplSet {
 }
 
 impl AssetLibrary {
+    /// The character of `source` with the humanoid map found from its skeleton (none
+    /// assigned by hand), each worked out once.
+    pub fn rig(
+        &mut self,
+        source: &SourceDoc,
+    ) -> Result<(Arc<CharacterAsset>, Arc<marionette_rig::humanoid::HumanoidMap>), FormatError> {
+        let asset = self.load(source)?;
+        let map = match self.humanoids.get(source) {
+            Some(map) => map.clone(),
+            None => {
+                let map = Arc::new(crate::retarget::humanoid_map(&asset, &Default::default()));
+                self.humanoids.insert(source.clone(), map.clone());
+                map
+            }
+        };
+        Ok((asset, map))
+    }
+
     /// The character of `source`, loaded once.
     pub fn load(&mut self, source: &SourceDoc) -> Result<Arc<CharacterAsset>, FormatError> {
         if let Some(asset) = self.cache.get(source) {

@@ -317,7 +317,7 @@ fn pose_frame(
     characters: Query<(
         &crate::editor::scene_doc::document::SceneCharacter,
         &crate::scene::Character,
-        Option<&crate::editor::scene_doc::document::HumanoidBones>,
+        Option<&crate::editor::scene_doc::document::HumanoidMapOf>,
     )>,
     poses: Query<&crate::scene::JointPose>,
     mut edits: ResMut<crate::editor::edits::edit::EditQueue>,
@@ -330,12 +330,10 @@ fn pose_frame(
     let FrameAt::Pose(name) = &job.frames[job.next].0 else { return };
     let Some(pose) = library.0.get(name) else { return };
     let joints: Vec<_> = pose.joints.iter().map(|(k, r)| (k.clone(), *r)).collect();
-    use crate::document::retarget::humanoid_map;
-    let rig = pose.rig.as_ref().and_then(|rig| assets.load(rig).ok());
-    let rig_map = rig.as_ref().map(|a| humanoid_map(a, &Default::default()));
-    let from = rig.as_ref().zip(rig_map.as_ref()).map(|(a, m)| (&a.skeleton, m));
-    for (sc, character, bones) in &characters {
-        let map = humanoid_map(&character.asset, &bones.map(|b| b.0.clone()).unwrap_or_default());
+    let rig = pose.rig.as_ref().and_then(|rig| assets.rig(rig).ok());
+    let from = rig.as_ref().map(|(a, m)| (&a.skeleton, &**m));
+    for (sc, character, map) in &characters {
+        let map = map.map(|m| m.0.clone()).unwrap_or_default();
         let current: Vec<_> =
             character.joints.iter().map(|&e| poses.get(e).map_or(Default::default(), |p| p.0)).collect();
         let target = (&character.asset.skeleton, &map, &current[..]);

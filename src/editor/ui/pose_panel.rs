@@ -60,11 +60,10 @@ pub fn pose_panel(ui: &mut egui::Ui, state: &mut InspectorState, panels: &mut Pa
             .pose_library
             .0
             .values()
-            .map(|kept| kept.rig.as_ref().and_then(|rig| panels.library.load(rig).ok()))
+            .map(|kept| kept.rig.as_ref().and_then(|rig| panels.library.rig(rig).ok()))
             .collect();
         for ((name, kept), rig) in panels.scene.pose_library.0.iter().zip(&kept_rigs) {
-            let rig_map = rig.as_ref().map(|a| crate::document::retarget::humanoid_map(a, &Default::default()));
-            let from = rig.as_ref().zip(rig_map.as_ref()).map(|(a, m)| (&a.skeleton, m));
+            let from = rig.as_ref().map(|(a, m)| (&a.skeleton, &**m));
             ui.horizontal(|ui| {
                 thumbnail(ui, kept);
                 ui.vertical(|ui| {
