@@ -15,7 +15,7 @@ use std::time::{Duration, Instant};
 use arbitrary::Unstructured;
 use marionette::formats::{FormatError, bvh, cse169, cse169_skin, homer, mit6837, obj, off, scene, smpl};
 
-use crate::common::optional_data_dir;
+use crate::common::data_dir;
 
 /// Cases per run (a few seconds on two cores in the test profile).
 const CASES: usize = 20_000;
@@ -202,20 +202,23 @@ struct Seed {
     whole: bool,
 }
 
-/// Seeds from the project's assets and, when present, the real data.
+/// Reads a seed file, cut to [`SEED_BYTES`].
+fn seed(reader: Reader, p: PathBuf) -> Seed {
+    let (bytes, whole) = std::fs::read(&p).map(seed_prefix).unwrap_or_else(|e| panic!("{}: {e}", p.display()));
+    Seed { reader, bytes, whole }
+}
+
+/// An attach seed: its skeleton's joint count and its own (possibly cut) line count.
+fn attach(skel: PathBuf, attach: PathBuf) -> Seed {
+    let joints = lines(&std::fs::read(&skel).unwrap());
+    let cut = seed(Reader::Obj, attach);
+    Seed { reader: Reader::Attach { joints, vertices: lines(&cut.bytes) }, ..cut }
+}
+
+/// Seeds from the project's own assets and fixtures.
 fn file_seeds() -> Vec<Seed> {
-    let seed = |reader, p: PathBuf| {
-        let (bytes, whole) = std::fs::read(&p).map(seed_prefix).unwrap_or_else(|e| panic!("{}: {e}", p.display()));
-        Seed { reader, bytes, whole }
-    };
-    // An attach seed needs its skeleton's joint count and its own (possibly cut) line count.
-    let attach = |skel: PathBuf, attach: PathBuf| {
-        let joints = lines(&std::fs::read(&skel).unwrap());
-        let cut = seed(Reader::Obj, attach);
-        Seed { reader: Reader::Attach { joints, vertices: lines(&cut.bytes) }, ..cut }
-    };
     let assets = Path::new(env!("CARGO_MANIFEST_DIR")).join("assets");
-    let mut seeds = vec![
+    vec![
         seed(Reader::Skel6837, assets.join("puppet.skel")),
         seed(Reader::Obj, assets.join("puppet.obj")),
         seed(Reader::Scene, assets.join("default_scene.ron")),
@@ -236,8 +239,13 @@ fn file_seeds() -> Vec<Seed> {
             whole: true,
         },
         attach(assets.join("puppet.skel"), assets.join("puppet.attach")),
-    ];
-    let Some(data) = optional_data_dir() else { return seeds };
+    ]
+}
+
+/// Seeds from the course data folder.
+fn course_seeds() -> Vec<Seed> {
+    let data = data_dir();
+    let mut seeds = Vec::new();
     let course = data.join("mit6837");
     for m in 1..=4 {
         let skel = course.join(format!("Model{m}.skel"));
@@ -411,6 +419,19 @@ pub(crate) fn check_case(reader: Reader, input: Vec<u8>) -> Result<bool, String>
 fn mutated_inputs_never_panic_hang_or_balloon_and_rejections_name_a_line() {
     let mut seeds = inline_seeds();
     seeds.extend(file_seeds());
+    fuzz_readers(&seeds);
+}
+
+/// The same from the course data's files.
+#[test]
+#[cfg_attr(not(marionette_data), ignore = "needs MARIONETTE_DATA (the course data)")]
+fn mutated_course_files_never_panic_hang_or_balloon_and_rejections_name_a_line() {
+    fuzz_readers(&course_seeds());
+}
+
+/// [`CASES`] byte mutations of `seeds`: none panics, hangs or balloons, every rejection
+/// names its line.
+fn fuzz_readers(seeds: &[Seed]) {
     // Every whole seed is accepted (the mutations start from valid files).
     for seed in seeds.iter().filter(|s| s.whole) {
         if let Err(e) = read(seed.reader, &seed.bytes) {

@@ -13,25 +13,31 @@ use std::time::Instant;
 use arbitrary::{Result as Drawn, Unstructured};
 use serde_json::Value;
 
-use crate::common::optional_data_dir;
+use crate::common::data_dir;
 use crate::fuzz::{Reader, check_case, random_bytes};
 
 /// Cases per run.
 const CASES: usize = 20_000;
 
-fn seeds() -> Vec<(String, Vec<u8>)> {
+/// The project's own GLB files.
+fn project_seeds() -> Vec<(String, Vec<u8>)> {
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
-    let mut files: Vec<PathBuf> = vec![
+    read_seeds(vec![
         root.join("tests/data/blender_arm.glb"),
         root.join("tests/data/blender_pair.glb"),
         root.join("tests/regressions/commands/gltf-clip-3e38-seconds.glb"),
-    ];
-    if let Some(data) = optional_data_dir() {
-        // BrainStem (3 MB) is left out: a case of it takes as long as a hundred others.
-        for name in ["SimpleSkin", "RiggedSimple", "RiggedFigure", "CesiumMan", "Fox", "Box", "AnimatedMorphCube"] {
-            files.push(data.join(format!("khronos/{name}.glb")));
-        }
-    }
+    ])
+}
+
+/// Khronos samples from the data folder (BrainStem, 3 MB, is left out: a case of it takes
+/// as long as a hundred others).
+fn khronos_seeds() -> Vec<(String, Vec<u8>)> {
+    let data = data_dir();
+    let names = ["SimpleSkin", "RiggedSimple", "RiggedFigure", "CesiumMan", "Fox", "Box", "AnimatedMorphCube"];
+    read_seeds(names.iter().map(|name| data.join(format!("khronos/{name}.glb"))).collect())
+}
+
+fn read_seeds(files: Vec<PathBuf>) -> Vec<(String, Vec<u8>)> {
     files
         .into_iter()
         .map(|p| (p.file_name().unwrap().to_string_lossy().into_owned(), std::fs::read(&p).unwrap()))
@@ -269,8 +275,20 @@ fn mutate(json: &mut Value, bin: &mut Vec<u8>, length_delta: &mut i64, u: &mut U
 
 #[test]
 fn mutated_gltf_structure_never_panics_hangs_or_balloons_and_rejections_are_placed() {
-    let seeds = seeds();
-    for (name, bytes) in &seeds {
+    fuzz_structure(&project_seeds());
+}
+
+/// The same over the Khronos samples of the data folder.
+#[test]
+#[cfg_attr(not(marionette_data), ignore = "needs MARIONETTE_DATA (the course data)")]
+fn mutated_khronos_structure_never_panics_hangs_or_balloons_and_rejections_are_placed() {
+    fuzz_structure(&khronos_seeds());
+}
+
+/// [`CASES`] structural mutations of `seeds` (each a valid file): none panics, hangs or
+/// balloons, every rejection names its place.
+fn fuzz_structure(seeds: &[(String, Vec<u8>)]) {
+    for (name, bytes) in seeds {
         // Every seed reads (Box and AnimatedMorphCube have no skin: a placed rejection).
         assert!(check_case(Reader::Glb, bytes.clone()).is_ok(), "{name}");
     }
