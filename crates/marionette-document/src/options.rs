@@ -85,15 +85,20 @@ fn put_clip_on_fitting_characters(
 ) -> Result<(), String> {
     if let Some(settings) = &anim.retarget {
         let scene = doc.clone();
+        // The source, found once (when a character can take its motion).
+        let mut source = None;
         let mut fitted = 0;
         for c in &mut doc.characters {
             let Ok(asset) = library.shaped(c) else { continue };
             if marionette_rig::humanoid::of_asset(&asset).is_none() {
                 continue;
             }
-            let from =
-                crate::retarget::motion_source_doc(library, &scene, &settings.from).map_err(|e| e.to_string())?;
-            let done = crate::retarget::retarget(library, &from, c, &asset, settings).map_err(|e| e.to_string())?;
+            if source.is_none() {
+                let found = crate::retarget::motion_source_doc(library, &scene, &settings.from);
+                source = Some(found.map_err(|e| e.to_string())?);
+            }
+            let from = source.as_ref().expect("found above");
+            let done = crate::retarget::retarget(library, from, c, &asset, settings).map_err(|e| e.to_string())?;
             notes.push(crate::retarget::describe(&done, &from.name, &c.name, &asset.skeleton));
             c.anim = Some(anim.clone());
             c.playback = None;

@@ -122,11 +122,17 @@ fn queue_startup_scene(
     mut changed: ResMut<crate::editor::scene_doc::document::ChangedAtStartup>,
 ) {
     let mut notes = Vec::new();
-    let before = startup_doc(&paths.0, &mut library, &mut Vec::new());
-    let doc = startup_scene(&paths.0, &edits, &mut library, &mut notes).unwrap_or_else(|e| {
-        notes.push(e);
-        before.clone()
-    });
+    let before = startup_doc(&paths.0, &mut library, &mut notes);
+    let mut doc = before.clone();
+    if let Some(opened) = &mut doc {
+        match apply_startup_options(opened, &paths.0, &edits, &mut library) {
+            Ok(said) => notes.extend(said),
+            Err(e) => {
+                notes.push(e);
+                doc.clone_from(&before);
+            }
+        }
+    }
     *arrange = crate::editor::scene_doc::arrange::ArrangeWhenSkinned {
         side_by_side: !paths.0.is_empty() && scene_path(&paths.0).is_none(),
         match_height: edits.match_height,
@@ -170,12 +176,23 @@ pub fn startup_scene(
     notes: &mut Vec<String>,
 ) -> Result<Option<crate::formats::scene::SceneDoc>, String> {
     let Some(mut doc) = startup_doc(paths, library, notes) else { return Ok(None) };
+    notes.extend(apply_startup_options(&mut doc, paths, edits, library)?);
+    Ok(Some(doc))
+}
+
+/// The command line's options on the opened document (see [`startup_scene`]).
+fn apply_startup_options(
+    doc: &mut crate::formats::scene::SceneDoc,
+    paths: &[std::path::PathBuf],
+    edits: &StartupEdits,
+    library: &mut AssetLibrary,
+) -> Result<Vec<String>, String> {
     // Character files are posed where their files put them (so `--ik` targets are in the
     // file's space, as `export` reads them), then stood where the layout puts them.
     let layout: Option<Vec<_>> = scene_path(paths)
         .is_none()
         .then(|| doc.characters.iter_mut().map(|c| std::mem::take(&mut c.placement)).collect());
-    notes.extend(crate::document::options::apply_options(&mut doc, &edits.pose_options(), library)?);
+    let notes = crate::document::options::apply_options(doc, &edits.pose_options(), library)?;
     for (c, placed) in doc.characters.iter_mut().zip(layout.iter().flatten()) {
         c.placement = crate::formats::scene::PlacementDoc::from_mat4(placed.to_mat4() * c.placement.to_mat4());
     }
@@ -183,7 +200,7 @@ pub fn startup_scene(
         doc.stage.background = crate::formats::scene::BackgroundDoc::Transparent;
         doc.stage.floor = false;
     }
-    Ok(Some(doc))
+    Ok(notes)
 }
 
 /// Opens the pending document in place of the current scene: every character is
