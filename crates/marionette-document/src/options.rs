@@ -208,9 +208,16 @@ fn pose_characters(
     let mut used = vec![false; options.poses.len() + options.ik.len()];
     let mut joints_seen = Vec::new();
     for c in &mut doc.characters {
-        let Ok(asset) = library.shaped(c) else { continue };
+        let asset = match library.shaped(c) {
+            Ok(asset) => asset,
+            Err(e) => {
+                joints_seen.push(format!("{}: not loaded: {e}", c.name));
+                continue;
+            }
+        };
         let skeleton = &asset.skeleton;
-        joints_seen.push((c.name.clone(), skeleton.joints().iter().map(|j| j.name.clone()).collect::<Vec<_>>()));
+        let names: Vec<&str> = skeleton.joints().iter().map(|j| j.name.as_str()).collect();
+        joints_seen.push(format!("{}: {}", c.name, crate::posing::name_list(&names)));
         let has = |joint: &str| skeleton.resolve(joint).is_some();
         let poses: Vec<PoseSpec> = options.poses.iter().filter(|p| has(&p.joint)).cloned().collect();
         let ik: Vec<IkSpec> = options.ik.iter().filter(|p| has(&p.joint)).cloned().collect();
@@ -236,9 +243,8 @@ fn pose_characters(
     }
     let specs = options.poses.iter().map(|p| ("--pose", &p.joint)).chain(options.ik.iter().map(|p| ("--ik", &p.joint)));
     if let Some((option, joint)) = specs.zip(&used).find(|(_, u)| !**u).map(|(s, _)| s) {
-        let known: Vec<String> =
-            joints_seen.iter().map(|(name, joints)| format!("{name}: {}", crate::posing::name_list(joints))).collect();
-        return Err(format!("{option}: no character has a joint named or numbered `{joint}` ({})", known.join("; ")));
+        let known = joints_seen.join("; ");
+        return Err(format!("{option}: no character has a joint named or numbered `{joint}` ({known})"));
     }
     Ok(notes)
 }
