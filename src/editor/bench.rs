@@ -1,7 +1,7 @@
 //! `marionette bench`: a crowd of animated characters, headless, through the real app
 //! schedule and the render world (extraction and upload; the picture is drawn into a small
-//! offscreen target), timed per phase over many frames; and the skinning kernel against the
-//! plain loop it replaced.
+//! offscreen target), timed per phase over many frames, with the skinning kernel's speed on
+//! one of its characters. The kernels against each other and against ozz are `benches/`'s.
 
 use std::path::PathBuf;
 use std::time::{Duration, Instant};
@@ -47,35 +47,14 @@ pub struct BenchReport {
     /// many cores as the phase has characters (or chunks of one) to share among them (a
     /// figure of CPU skinning: with `gpu_skinning` the phase only bounds and hands over).
     pub skin_over_ideal: f64,
-    /// The skin phase against its ideal frame by frame: each frame's skin phase over the
-    /// ideal of the kernel's speeds timed on each core right after that frame (this machine's
-    /// cores each change speed within tens of milliseconds, independently: one core at two
-    /// thirds of the other's is common), the median of the frames' ratios. See
-    /// [`kernel_on_each_core`].
-    pub skin_over_paired_ideal: f64,
-    /// The kernel's speed on each core the process may use, timed after every frame (the
-    /// median per core), in M vertices per second.
-    pub core_kernel_mvps: Vec<f64>,
-    /// The floor the crowd's memory puts under the skin phase on this machine, in
-    /// milliseconds: each character's bind positions copied into an output of its own, split
-    /// over the cores as the phase splits the crowd (the bytes the kernel reads and writes
-    /// but its shared weights, and no arithmetic); see [`memory_floor_ms`].
-    pub memory_floor_ms: f64,
-    /// `skin_ms_p50 ÷ memory_floor_ms` (CPU skinning, as `skin_over_ideal`).
-    pub skin_over_memory_floor: f64,
     pub extract_ms_p50: f64,
     pub upload_ms_p50: f64,
     /// The rest of the render world (drawing; on llvmpipe that is CPU work too).
     pub render_world_ms_p50: f64,
     pub upload_bytes_per_frame: usize,
-    /// The kernel on one character of the crowd, positions only, on one core.
+    /// The LBS kernel on one character of the crowd, positions only, on one core, in M
+    /// vertices per second.
     pub kernel_mvps: f64,
-    /// The plain loop it replaced (kept as the oracle), same character, same run.
-    pub baseline_kernel_mvps: f64,
-    /// Dual quaternion skinning, same character, same run.
-    pub dual_quaternion_kernel_mvps: f64,
-    /// The kernel followed by flat normals into unshared buffers (per vertex of the mesh).
-    pub kernel_with_flat_normals_mvps: f64,
 }
 
 /// The 50th and 95th percentiles of a phase, in milliseconds.
@@ -205,16 +184,12 @@ pub fn run(setup: &Setup) -> Result<BenchReport, String> {
         stop_drawing(&mut app);
     }
     let mut samples = Vec::with_capacity(frames);
-    let mut core_speeds = Vec::with_capacity(frames);
     let mut bytes = 0;
-    let mut on_each_core = kernel_on_each_core(&asset);
     for _ in 0..frames {
         samples.push(timed_frame(&mut app));
         bytes += app.world().resource::<HandedOn>().0;
-        core_speeds.push(on_each_core());
     }
-    let kernels = kernel_speeds(&asset);
-    let memory_floor_ms = memory_floor_ms(&mut app);
+    let kernel_mvps = kernel_speed(&asset);
     let measured = Measured::now(pipelined_rendering, drawn);
     let cores = measured.cores;
     let phase = |k: usize| median(samples.iter().map(|s| s[k]).collect());
@@ -222,13 +197,6 @@ pub fn run(setup: &Setup) -> Result<BenchReport, String> {
     let names = ["sampling", "fk", "skin", "extract", "upload", "render_world"];
     let whole = Percentiles::of(frame);
     let vertices_each = asset.vertex_count();
-    let paired = samples
-        .iter()
-        .zip(&core_speeds)
-        .map(|(s, speeds)| s[3] / ideal_skin_ms_on_cores(characters, vertices_each, speeds));
-    let core_kernel_mvps = (0..core_speeds.first().map_or(0, Vec::len))
-        .map(|c| median(core_speeds.iter().map(|s| s[c]).collect()))
-        .collect();
     let phases_ms = names
         .iter()
         .enumerate()
@@ -248,19 +216,12 @@ pub fn run(setup: &Setup) -> Result<BenchReport, String> {
         sampling_ms_p50: phase(1),
         fk_ms_p50: phase(2),
         skin_ms_p50: phase(3),
-        skin_over_ideal: phase(3) / ideal_skin_ms(characters, vertices_each, kernels.lbs, cores),
-        skin_over_paired_ideal: median(paired.collect()),
-        core_kernel_mvps,
-        memory_floor_ms,
-        skin_over_memory_floor: phase(3) / memory_floor_ms,
+        skin_over_ideal: phase(3) / ideal_skin_ms(characters, vertices_each, kernel_mvps, cores),
         extract_ms_p50: phase(4),
         upload_ms_p50: phase(5),
         render_world_ms_p50: phase(6),
         upload_bytes_per_frame: bytes / frames.max(1),
-        kernel_mvps: kernels.lbs,
-        baseline_kernel_mvps: kernels.oracle,
-        dual_quaternion_kernel_mvps: kernels.dual_quaternion,
-        kernel_with_flat_normals_mvps: kernels.lbs_and_flat_normals,
+        kernel_mvps,
     })
 }
 
@@ -268,52 +229,9 @@ pub fn run(setup: &Setup) -> Result<BenchReport, String> {
 /// `cores`, in milliseconds; on fewer cores where the phase has fewer tasks than cores (one
 /// a character, one a chunk of a character larger than a chunk).
 pub fn ideal_skin_ms(characters: usize, vertices_each: usize, kernel_mvps: f64, cores: usize) -> f64 {
-    ideal_skin_ms_on_cores(characters, vertices_each, &vec![kernel_mvps; cores.max(1)])
-}
-
-/// [`ideal_skin_ms`] on cores of different speeds (M vertices per second, one a core): the
-/// vertices at the sum of the speeds of the fastest cores, as many as the phase has tasks.
-pub fn ideal_skin_ms_on_cores(characters: usize, vertices_each: usize, core_mvps: &[f64]) -> f64 {
     let tasks = characters * vertices_each.div_ceil(crate::scene::systems::SKIN_CHUNK_VERTICES);
-    let mut fastest = core_mvps.to_vec();
-    fastest.sort_by(|a, b| b.total_cmp(a));
-    let mvps: f64 = fastest.iter().take(tasks.max(1)).sum();
-    (characters * vertices_each) as f64 / (mvps * 1e6) * 1e3
-}
-
-/// Copies of the crowd's memory timed in [`memory_floor_ms`], the first not kept.
-const FLOOR_RUNS: usize = 21;
-
-/// Each character's bind positions copied into an output of its own on Bevy's compute task
-/// pool, in batches of a few characters as the skin phase takes them: the
-/// median of [`FLOOR_RUNS`] in milliseconds. The bytes the kernel streams for the crowd at
-/// this machine's memory speed: the skin phase can come near it but not below it, however
-/// fast its arithmetic.
-fn memory_floor_ms(app: &mut App) -> f64 {
-    let world = app.world_mut();
-    let binds: Vec<std::sync::Arc<CharacterAsset>> =
-        world.query::<&Character>().iter(world).map(|c| c.asset.clone()).collect();
-    let mut outs: Vec<Vec<Vec3>> = binds.iter().map(|a| vec![Vec3::ZERO; a.skin.bind_positions.len()]).collect();
-    let pool = bevy::tasks::ComputeTaskPool::get();
-    let batches = pool.thread_num().max(1) * crate::scene::systems::SKIN_BATCHES_PER_THREAD;
-    let per_batch = binds.len().div_ceil(batches).max(1);
-    let mut times: Vec<f64> = (0..FLOOR_RUNS)
-        .map(|_| {
-            let t = Instant::now();
-            pool.scope(|scope| {
-                for (assets, outs) in binds.chunks(per_batch).zip(outs.chunks_mut(per_batch)) {
-                    scope.spawn(async move {
-                        for (asset, out) in assets.iter().zip(outs) {
-                            out.copy_from_slice(&asset.skin.bind_positions);
-                        }
-                    });
-                }
-            });
-            t.elapsed().as_secs_f64() * 1e3
-        })
-        .collect();
-    times.remove(0);
-    median(times)
+    let used = cores.clamp(1, tasks.max(1));
+    (characters * vertices_each) as f64 / (kernel_mvps * used as f64 * 1e6) * 1e3
 }
 
 /// Turns the cameras off once the renderer is ready: extraction and the upload go on, the
@@ -344,13 +262,10 @@ pub fn table(r: &BenchReport) -> String {
         "{} × {} ({} vertices each), {} frames, skinned {}\n\
          frame (CPU: main world + extraction + upload)  p50 {:.2} ms  p95 {:.2} ms\n\
          \x20 sampling {:.2} ms | FK {:.2} ms | skin {:.2} ms | extract {:.2} ms | upload {:.2} ms   (medians)\n\
-         \x20 skin ÷ ideal (the vertices at the kernel's speed on every core it can use) {:.2}; \
-         ÷ memory floor (its bytes copied on every core, {:.3} ms) {:.2}\n\
-         \x20 skin ÷ ideal frame by frame (the kernel timed on each core right after each frame, medians {}) {:.2}\n\
+         \x20 skin ÷ ideal (the vertices at the kernel's speed on every core it can use) {:.2}\n\
          \x20 render world besides the upload (drawing; CPU on llvmpipe) {:.2} ms\n\
          mesh data handed on per frame: {} bytes\n\
-         kernel: {:.1} M vertices/s per core (the plain loop it replaced: {:.1}, ×{:.2})\n\
-         \x20 with flat normals {:.1} M vertices/s | dual quaternions {:.1} M vertices/s (LBS is ×{:.2} as fast)",
+         kernel: {:.1} M vertices/s per core (the kernels against each other and ozz: `cargo bench`)",
         r.characters,
         r.kind,
         r.vertices_per_character,
@@ -364,18 +279,9 @@ pub fn table(r: &BenchReport) -> String {
         r.extract_ms_p50,
         r.upload_ms_p50,
         r.skin_over_ideal,
-        r.memory_floor_ms,
-        r.skin_over_memory_floor,
-        r.core_kernel_mvps.iter().map(|m| format!("{m:.0}")).collect::<Vec<_>>().join(" | "),
-        r.skin_over_paired_ideal,
         r.render_world_ms_p50,
         r.upload_bytes_per_frame,
         r.kernel_mvps,
-        r.baseline_kernel_mvps,
-        r.kernel_mvps / r.baseline_kernel_mvps,
-        r.kernel_with_flat_normals_mvps,
-        r.dual_quaternion_kernel_mvps,
-        r.kernel_mvps / r.dual_quaternion_kernel_mvps,
     )
 }
 
@@ -501,85 +407,24 @@ fn wait_for_the_gpu(app: &App) {
     }
 }
 
-/// The kernels on one posed character, in M vertices per second. They run interleaved in
-/// bursts (a few calls of each in turn, the median call of each kept), so a change of the
-/// machine's speed during the run touches all alike and their ratios hold; the first call
-/// of each burst is not kept: it finds the character's memory where the other kernels left
-/// it (one call of each in turn read the LBS kernel a tenth slower than it runs).
-#[derive(Debug, Clone, Copy)]
-struct KernelSpeeds {
-    lbs: f64,
-    oracle: f64,
-    dual_quaternion: f64,
-    lbs_and_flat_normals: f64,
-}
-
-/// Calls of one kernel in a row in [`kernel_speeds`], the first not timed.
+/// Calls of the kernel in a row in [`kernel_speed`], the first not timed.
 const BURST: usize = 8;
 
-fn kernel_speeds(asset: &CharacterAsset) -> KernelSpeeds {
+/// The LBS kernel on one posed character, in M vertices per second: the median call of
+/// bursts run for 300 ms (the first call of each burst not kept: it finds the memory where
+/// the frame left it).
+fn kernel_speed(asset: &CharacterAsset) -> f64 {
     let palette = posed_palette(asset);
-    let mut dual_quaternions = Vec::new();
-    crate::rig::dqs::dual_quaternion_palette(&palette, &mut dual_quaternions);
     let skin = &asset.skin;
-    let corners = skin.triangles.len() * 3;
-    let (mut flat_positions, mut flat_normals) = (vec![[0.0; 3]; corners], vec![[0.0; 3]; corners]);
     let mut out = vec![Vec3::ZERO; asset.vertex_count()];
-    let mut kernels: [&mut dyn FnMut(&mut [Vec3]); 4] = [
-        &mut |o| crate::rig::lbs::skin(&skin.bind_positions, &skin.weights, &palette, o),
-        &mut |o| crate::rig::skinning::skin_positions(&skin.bind_positions, &skin.weights, &palette, o),
-        &mut |o| crate::rig::dqs::skin_dq(&skin.bind_positions, &skin.weights, &dual_quaternions, o),
-        &mut |o| {
-            crate::rig::lbs::skin(&skin.bind_positions, &skin.weights, &palette, o);
-            crate::rig::skinning::flat_shade(o, &skin.triangles, &mut flat_positions, &mut flat_normals);
-        },
-    ];
-    let mut seconds: [Vec<f64>; 4] = Default::default();
+    let mut seconds = Vec::new();
     let started = Instant::now();
-    while started.elapsed() < Duration::from_millis(600) {
-        for (kernel, times) in kernels.iter_mut().zip(&mut seconds) {
-            times.extend(burst(BURST - 1, || kernel(&mut out)));
-        }
+    while started.elapsed() < Duration::from_millis(300) {
+        seconds.extend(burst(BURST - 1, || {
+            crate::rig::lbs::skin(&skin.bind_positions, &skin.weights, &palette, &mut out)
+        }));
     }
-    let mvps = |times: &Vec<f64>| skin.bind_positions.len() as f64 / median(times.clone()) / 1e6;
-    KernelSpeeds {
-        lbs: mvps(&seconds[0]),
-        oracle: mvps(&seconds[1]),
-        dual_quaternion: mvps(&seconds[2]),
-        lbs_and_flat_normals: mvps(&seconds[3]),
-    }
-}
-
-/// Timed calls of the kernel on each core after every frame (after one call not timed).
-const CORE_BURST: usize = 4;
-
-/// A timer of the LBS kernel on one posed character on each core the process may use, in
-/// turn (this thread pinned to it, then given every core back): the median of
-/// [`CORE_BURST`] calls a core, in M vertices per second. Called right after each frame, so
-/// each frame's skin phase is set against the speed the cores had then: on this 2-core
-/// machine each core drops to about 60 % of its speed and back within tens of milliseconds,
-/// on its own, so the speed timed once after the frames may be a state the frames did not
-/// run in.
-/// It skins a copy of the character's bind positions and weights, so that it does not warm
-/// the caches for the next frame's crowd (whose bodies share one model's weights).
-fn kernel_on_each_core(asset: &CharacterAsset) -> impl FnMut() -> Vec<f64> + use<> {
-    // Where the cores are not known (not Linux), as many timings as cores, on any of them.
-    let cores = crate::editor::cores::allowed_cores();
-    let cores = if cores.is_empty() { vec![0; core_count()] } else { cores };
-    let palette = posed_palette(asset);
-    let (bind, weights) = (asset.skin.bind_positions.clone(), asset.skin.weights.unshared());
-    let mut out = vec![Vec3::ZERO; bind.len()];
-    move || {
-        let kernel = |out: &mut [Vec3]| crate::rig::lbs::skin(&bind, &weights, &palette, out);
-        cores
-            .iter()
-            .map(|&core| {
-                crate::editor::cores::on_core(core, &cores, || {
-                    bind.len() as f64 / median(burst(CORE_BURST, || kernel(&mut out))) / 1e6
-                })
-            })
-            .collect()
-    }
+    skin.bind_positions.len() as f64 / median(seconds) / 1e6
 }
 
 /// `call` once, not timed (it finds its memory where other work left it), then `timed`

@@ -41,15 +41,6 @@ pub fn allowed_cores() -> Vec<usize> {
     Vec::new()
 }
 
-/// Runs `f` on the calling thread pinned to `core`, then gives the thread back every core
-/// in `cores` (the process's, from [`allowed_cores`]).
-pub fn on_core<R>(core: usize, cores: &[usize], f: impl FnOnce() -> R) -> R {
-    pin_this_thread_to(&[core]);
-    let result = f();
-    pin_this_thread_to(cores);
-    result
-}
-
 /// Lets the calling thread run on `cores` only (a hint: where the system refuses, it runs
 /// anywhere).
 #[cfg(target_os = "linux")]
