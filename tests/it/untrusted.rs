@@ -89,11 +89,11 @@ const GLTF_CASES: &[(&str, &str)] = &[
     // Numbers nobody can use.
     (
         "gltf-inverse-bind-nan.glb",
-        "at $.skins[0].inverseBindMatrices: expected an invertible matrix for joint 1, found numbers that are not finite",
+        "at $.skins[0].inverseBindMatrices: expected an invertible matrix for joint 1 (`tip`), found numbers that are not finite",
     ),
     (
         "gltf-inverse-bind-singular.glb",
-        "at $.skins[0].inverseBindMatrices: expected an invertible matrix for joint 1, found a singular matrix",
+        "at $.skins[0].inverseBindMatrices: expected an invertible matrix for joint 1 (`tip`), found a singular matrix",
     ),
     (
         "gltf-position-inf.glb",

@@ -184,7 +184,7 @@ fn load_cse169_skin(name: String, skeleton: Skeleton, path: &Path) -> Result<Cha
             ),
         ));
     }
-    let singular = file.bindings.iter().position(|m| m.determinant().abs() < 1e-12 || !m.is_finite());
+    let singular = file.bindings.iter().position(|m| !crate::checks::is_invertible(m));
     if let Some(j) = singular {
         return Err(FormatError::other(
             path,

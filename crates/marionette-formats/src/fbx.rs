@@ -13,13 +13,13 @@ use std::path::Path;
 
 use glam::{Mat4, Quat, Vec2, Vec3};
 
+use super::checks::is_normalisable;
 use super::error::FormatError;
+use super::node_tree::{Binding, Tree, TreeNode, TreeSkeleton, tree_skeleton};
 use super::part::Part;
 use marionette_rig::material::{Material, Surface, TextureRef};
 use marionette_rig::node_clip::{Interpolation, JointTracks, NodeClip, Track};
-use marionette_rig::{
-    CharacterAsset, JointRotation, MorphTarget, Picture, RawJoint, Skeleton, Skin, SkinTexture, SkinWeights,
-};
+use marionette_rig::{CharacterAsset, MorphTarget, Picture, Skin, SkinTexture, SkinWeights};
 
 /// Whether `path` names an FBX file.
 pub fn is_fbx(path: &Path) -> bool {
@@ -166,53 +166,15 @@ impl Fbx<'_> {
             }
         }
         let stem = self.path.file_stem().and_then(|s| s.to_str()).unwrap_or("fbx").to_string();
-        let (mut raw, raw_of_node) = self.raw_joints(&relevant, &stem)?;
-        // Each cluster's joint and bind matrix; a bone two clusters bind differently gets
-        // a fixed child joint for the second.
-        let mut bound: Vec<Option<Mat4>> = vec![None; raw.len()];
-        let mut cluster_joint: HashMap<u32, usize> = HashMap::new();
-        for &m in &mesh_nodes {
-            let mesh = self.node(m).mesh.as_ref().expect("a mesh node");
-            for cluster in mesh.skin_deformers.first().into_iter().flat_map(|s| s.clusters.iter()) {
-                let Some(bone) = cluster.bone_node.as_ref() else { continue };
-                let r = raw_of_node[bone.element.typed_id as usize].expect("a bone is relevant");
-                // The mesh's vertices go into the model's space (`mesh`), so its binds
-                // start from there.
-                let mut bind = mat4(&cluster.geometry_to_bone) * mat4(&self.node(m).geometry_to_world).inverse();
-                // Affine by construction: its last row exactly so.
-                (bind.x_axis.w, bind.y_axis.w, bind.z_axis.w, bind.w_axis.w) = (0.0, 0.0, 0.0, 1.0);
-                if !bind.is_finite() || bind.determinant().abs() < 1e-12 {
-                    return Err(self.error(format!(
-                        "skin cluster `{}`: expected a finite, invertible bind matrix, found determinant {}",
-                        cluster.element.name,
-                        bind.determinant()
-                    )));
-                }
-                let slot = match bound[r] {
-                    None => {
-                        bound[r] = Some(bind);
-                        r
-                    }
-                    Some(first) if first.abs_diff_eq(bind, 1e-6) => r,
-                    Some(_) => {
-                        let name = format!("{} (cluster {})", raw[r].name, cluster.element.name);
-                        raw.push(RawJoint::new(name, Some(r), Vec3::ZERO));
-                        bound.push(Some(bind));
-                        raw.len() - 1
-                    }
-                };
-                cluster_joint.insert(cluster.element.typed_id, slot);
-            }
-        }
-        let (skeleton, new_index) =
-            Skeleton::build_reordered(raw).map_err(|e| self.error(format!("the node tree: {e}")))?;
-        let mut rest = vec![Mat4::IDENTITY; skeleton.len()];
-        marionette_rig::fk::forward_kinematics(&skeleton, &skeleton.initial_pose(), Mat4::IDENTITY, &mut rest);
-        let mut bind = vec![Mat4::IDENTITY; skeleton.len()];
-        for (r, b) in bound.iter().enumerate() {
-            bind[new_index[r]] = b.unwrap_or_else(|| rest[new_index[r]].inverse());
-        }
-        let joint_of_node: Vec<Option<usize>> = raw_of_node.iter().map(|r| r.map(|r| new_index[r])).collect();
+        let (clusters, bindings) = self.bindings(&mesh_nodes);
+        let roots: Vec<usize> = (0..n).filter(|&t| relevant[t] && self.parent(self.node(t as u32)).is_none()).collect();
+        let tree = Tree { name: &stem, node_count: n, roots: &roots, at: "the node tree" };
+        let children = |t: usize| {
+            self.node(t as u32).children.iter().map(|c| c.element.typed_id as usize).filter(|&c| relevant[c]).collect()
+        };
+        let TreeSkeleton { skeleton, bind, joint_of_node, skin_joints } =
+            tree_skeleton(&tree, |t| Ok(self.tree_node(t as u32)), children, &bindings).map_err(|e| self.error(e))?;
+        let cluster_joint: HashMap<u32, usize> = clusters.into_iter().zip(skin_joints.iter().map(|j| j[0])).collect();
 
         let mut geometry = Geometry::default();
         for &m in &mesh_nodes {
@@ -224,7 +186,7 @@ impl Fbx<'_> {
                 Some(j) => Placed::Rigid(j, bind[j].inverse()),
                 None => Placed::Skinned(mat4(&node.geometry_to_world), self.holder(m, &joint_of_node)),
             };
-            self.mesh(node, mesh, &to_model, &cluster_joint, &new_index, &mut geometry)?;
+            self.mesh(node, mesh, &to_model, &cluster_joint, &mut geometry)?;
             if geometry.non_finite || !to_model.to().is_finite() {
                 return Err(self.error(format!("mesh `{}`: expected finite vertex positions", node.element.name)));
             }
@@ -269,47 +231,38 @@ impl Fbx<'_> {
         Ok(Part { asset, clips, morph_weights })
     }
 
-    /// The relevant nodes as raw joints, depth first (a common root named `name` when
-    /// there are several root nodes), and each node's raw joint.
-    fn raw_joints(&self, relevant: &[bool], name: &str) -> Result<(Vec<RawJoint>, Vec<Option<usize>>), FormatError> {
-        let mut raw = Vec::new();
-        let mut raw_of_node = vec![None; relevant.len()];
-        let roots: Vec<u32> = (0..relevant.len() as u32)
-            .filter(|&t| relevant[t as usize] && self.parent(self.node(t)).is_none())
-            .collect();
-        let mut todo: Vec<(u32, Option<usize>)> = if roots.len() == 1 {
-            vec![(roots[0], None)]
-        } else {
-            raw.push(RawJoint::new(name, None, Vec3::ZERO));
-            roots.iter().rev().map(|&r| (r, Some(0))).collect()
-        };
-        while let Some((t, parent)) = todo.pop() {
-            let node = self.node(t);
-            let local = &node.local_transform;
-            let name = if node.element.name.is_empty() { format!("node {t}") } else { node.element.name.to_string() };
-            let (translation, rotation, scale) = (vec3(local.translation), quat(local.rotation), vec3(local.scale));
-            if !translation.is_finite() || !scale.is_finite() || scale.min_element().abs() < 1e-12 {
-                return Err(self.error(format!(
-                    "node `{name}`: expected a finite translation and a finite, non-zero scale, found {translation} and {scale}"
-                )));
+    /// Each skin cluster of the mesh nodes, as a binding of its bone: the clusters' ids and
+    /// bindings in turn.
+    fn bindings(&self, mesh_nodes: &[u32]) -> (Vec<u32>, Vec<Binding>) {
+        let (mut clusters, mut bindings) = (Vec::new(), Vec::new());
+        for &m in mesh_nodes {
+            let mesh = self.node(m).mesh.as_ref().expect("a mesh node");
+            for cluster in mesh.skin_deformers.first().into_iter().flat_map(|s| s.clusters.iter()) {
+                let Some(bone) = cluster.bone_node.as_ref() else { continue };
+                // The mesh's vertices go into the model's space (`mesh`), so its binds
+                // start from there.
+                let mut bind = mat4(&cluster.geometry_to_bone) * mat4(&self.node(m).geometry_to_world).inverse();
+                // Affine by construction: its last row exactly so.
+                (bind.x_axis.w, bind.y_axis.w, bind.z_axis.w, bind.w_axis.w) = (0.0, 0.0, 0.0, 1.0);
+                clusters.push(cluster.element.typed_id);
+                let name = &cluster.element.name;
+                let (label, at) = (format!("cluster {name}"), format!("the bind matrix of skin cluster `{name}`"));
+                bindings.push(Binding { label, at, joints: vec![(bone.element.typed_id as usize, bind)] });
             }
-            if !rotation.is_finite() || rotation.length_squared() < 1e-12 {
-                return Err(
-                    self.error(format!("node `{name}`: expected a rotation that can be normalised, found {rotation}"))
-                );
-            }
-            let mut joint = RawJoint::new(name, parent, translation);
-            joint.initial_rotation = JointRotation::Quat(rotation.normalize());
-            if (scale - Vec3::ONE).abs().max_element() > 1e-6 {
-                joint.rest_scale = scale;
-            }
-            raw_of_node[t as usize] = Some(raw.len());
-            let me = raw.len();
-            raw.push(joint);
-            let children = node.children.iter().map(|c| c.element.typed_id).filter(|&c| relevant[c as usize]);
-            todo.extend(children.collect::<Vec<_>>().into_iter().rev().map(|c| (c, Some(me))));
         }
-        Ok((raw, raw_of_node))
+        (clusters, bindings)
+    }
+
+    /// A node's name and its local transform.
+    fn tree_node(&self, t: u32) -> TreeNode {
+        let node = self.node(t);
+        let local = &node.local_transform;
+        TreeNode {
+            name: if node.element.name.is_empty() { format!("node {t}") } else { node.element.name.to_string() },
+            translation: vec3(local.translation),
+            rotation: quat(local.rotation),
+            scale: vec3(local.scale),
+        }
     }
 
     /// Appends a mesh: its corners' vertices (split by texture coordinate), triangles by
@@ -321,7 +274,6 @@ impl Fbx<'_> {
         mesh: &ufbx::Mesh,
         placed: &Placed,
         cluster_joint: &HashMap<u32, usize>,
-        new_index: &[usize],
         out: &mut Geometry,
     ) -> Result<(), FormatError> {
         let first = out.skin.bind_positions.len();
@@ -383,7 +335,7 @@ impl Fbx<'_> {
                         let Some(&joint) = cluster_joint.get(&cluster.element.typed_id) else { continue };
                         if w.weight > 0.0 {
                             for &v in corners {
-                                rows[v as usize - first].push((new_index[joint], w.weight as f32));
+                                rows[v as usize - first].push((joint, w.weight as f32));
                             }
                         }
                     }
@@ -490,9 +442,9 @@ impl Fbx<'_> {
             }
             let tracks_ok = tracks.iter().all(|t| {
                 t.translation.as_ref().is_none_or(|k| k.is_complete() && k.values.iter().all(|v| v.is_finite()))
-                    && t.rotation.as_ref().is_none_or(|k| {
-                        k.is_complete() && k.values.iter().all(|q| q.is_finite() && q.length_squared() > 1e-12)
-                    })
+                    && t.rotation
+                        .as_ref()
+                        .is_none_or(|k| k.is_complete() && k.values.iter().all(|q| is_normalisable(*q)))
                     && t.scale.as_ref().is_none_or(|k| k.is_complete() && k.values.iter().all(|v| v.is_finite()))
             });
             let times_ok = tracks

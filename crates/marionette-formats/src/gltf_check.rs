@@ -473,7 +473,7 @@ fn nodes(root: &Root) -> Result<(), String> {
 fn node_numbers(node: &json::Node, at: &str) -> Result<(), String> {
     if let Some(matrix) = &node.matrix {
         finite_numbers(matrix, &format!("{at}.matrix"))?;
-        if glam::Mat4::from_cols_array(matrix).determinant().abs() < 1e-12 {
+        if !crate::checks::is_invertible(&glam::Mat4::from_cols_array(matrix)) {
             return Err(format!("at {at}.matrix: expected an invertible transform, found a singular matrix"));
         }
     }

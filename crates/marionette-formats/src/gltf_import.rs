@@ -18,9 +18,10 @@ use std::path::Path;
 use glam::{Mat4, Quat, Vec3};
 
 use super::error::FormatError;
+use super::node_tree::{Binding, Tree, TreeNode, TreeSkeleton, tree_skeleton};
 use super::part::Part;
 use marionette_rig::node_clip::{Interpolation, JointTracks, NodeClip, Track};
-use marionette_rig::{CharacterAsset, JointRotation, MorphTarget, RawJoint, Skeleton, Skin, SkinWeights};
+use marionette_rig::{CharacterAsset, MorphTarget, Skin, SkinWeights};
 
 /// Whether `path` names a glTF file (`.glb`, `.gltf`).
 pub fn is_gltf(path: &Path) -> bool {
@@ -101,12 +102,6 @@ struct File<'a> {
 struct PartNodes {
     roots: Vec<usize>,
     meshes: Vec<usize>,
-}
-
-/// A skin's joints as raw joints of its part, with their inverse bind matrices.
-struct SkinSlots {
-    skin: usize,
-    joints: Vec<(usize, Mat4)>,
 }
 
 /// How a primitive's vertices follow the joints.
@@ -239,20 +234,18 @@ impl<'a> File<'a> {
         let mut warnings = Vec::new();
         let name = self.part_name(part, n, count);
         let (top, root_parent) = self.folded_top(part);
-        let (mut raw, raw_of_node) = self.raw_joints(part, top, root_parent, &name)?;
-        let skins = self.skin_slots(part, &raw_of_node, &mut raw)?;
-        let (skeleton, new_index) = Skeleton::build_reordered(raw)
-            .map_err(|e| self.error(format!("at $.nodes (the tree of node {}): {e}", part.roots[0])))?;
-        let joint_of_node: Vec<Option<usize>> = raw_of_node.iter().map(|r| r.map(|r| new_index[r])).collect();
-        let mut bind = vec![None; skeleton.len()];
-        for slots in &skins {
-            for &(raw_joint, ibm) in &slots.joints {
-                bind[new_index[raw_joint]].get_or_insert(ibm);
-            }
-        }
-        let mut rest = vec![Mat4::IDENTITY; skeleton.len()];
-        marionette_rig::fk::forward_kinematics(&skeleton, &skeleton.initial_pose(), Mat4::IDENTITY, &mut rest);
-        let bind: Vec<Mat4> = bind.iter().zip(&rest).map(|(b, world)| b.unwrap_or_else(|| world.inverse())).collect();
+        let (skins, bindings) = self.skins_of(part);
+        let roots = top.map_or_else(|| part.roots.clone(), |top| vec![top]);
+        let at = format!("at $.nodes (the tree of node {})", part.roots[0]);
+        let tree = Tree { name: &name, node_count: self.parent.len(), roots: &roots, at: &at };
+        let fold = |index| (Some(index) == top && root_parent != Mat4::IDENTITY).then_some(root_parent);
+        let TreeSkeleton { skeleton, bind, joint_of_node, skin_joints } = tree_skeleton(
+            &tree,
+            |index| self.tree_node(index, fold(index)),
+            |index| self.relevant_children(index),
+            &bindings,
+        )
+        .map_err(|e| self.error(e))?;
 
         let mut skin_data = Skin::default();
         let mut rows = Vec::new();
@@ -265,14 +258,11 @@ impl<'a> File<'a> {
         for &node_index in &part.meshes {
             let node = self.node(node_index);
             let Some(mesh) = node.mesh() else { continue };
-            let slot_joints: Vec<usize>;
             let bound = match node.skin() {
                 Some(skin) => {
                     skinned = true;
-                    let slots =
-                        skins.iter().find(|s| s.skin == skin.index()).expect("every skin of the part has slots");
-                    slot_joints = slots.joints.iter().map(|&(r, _)| new_index[r]).collect();
-                    Bound::Skinned(&slot_joints)
+                    let k = skins.iter().position(|&s| s == skin.index()).expect("every skin of the part is bound");
+                    Bound::Skinned(&skin_joints[k])
                 }
                 None => {
                     let joint = joint_of_node[node_index].expect("a mesh node is a joint");
@@ -385,106 +375,49 @@ impl<'a> File<'a> {
         (Some(top), fold)
     }
 
-    /// The part's joints in depth-first order (a common root first when it has several
-    /// root nodes) and each node's raw joint.
-    fn raw_joints(
-        &self,
-        part: &PartNodes,
-        top: Option<usize>,
-        root_parent: Mat4,
-        name: &str,
-    ) -> Result<(Vec<RawJoint>, Vec<Option<usize>>), FormatError> {
-        let mut raw = Vec::new();
-        let mut raw_of_node = vec![None; self.parent.len()];
-        let mut todo: Vec<(usize, Option<usize>)> = match top {
-            Some(top) => vec![(top, None)],
-            None => {
-                raw.push(RawJoint::new(name, None, Vec3::ZERO));
-                part.roots.iter().rev().map(|&r| (r, Some(0))).collect()
+    /// A node's name and transform in its parent's frame, `fold` (the static nodes above the
+    /// part's top) put before it.
+    fn tree_node(&self, index: usize, fold: Option<Mat4>) -> Result<TreeNode, String> {
+        let node = self.node(index);
+        let (translation, rotation, scale) = match (fold, node.transform()) {
+            (None, gltf::scene::Transform::Decomposed { translation, rotation, scale }) => {
+                (Vec3::from(translation), Quat::from_array(rotation), Vec3::from(scale))
+            }
+            (fold, _) => {
+                let local = fold.unwrap_or(Mat4::IDENTITY) * local_matrix(&node);
+                if !is_trs(local) {
+                    return Err(format!(
+                        "at $.nodes[{index}].matrix: expected a translation, rotation and scale, found a shear"
+                    ));
+                }
+                let (scale, rotation, translation) = local.to_scale_rotation_translation();
+                (translation, rotation, scale)
             }
         };
-        while let Some((index, parent)) = todo.pop() {
-            let node = self.node(index);
-            let folded = (parent.is_none() && root_parent != Mat4::IDENTITY).then(|| root_parent * local_matrix(&node));
-            let (translation, rotation, scale) = match (folded, node.transform()) {
-                (None, gltf::scene::Transform::Decomposed { translation, rotation, scale }) => {
-                    (Vec3::from(translation), Quat::from_array(rotation), Vec3::from(scale))
-                }
-                (folded, _) => {
-                    let local = folded.unwrap_or_else(|| local_matrix(&node));
-                    if !is_trs(local) {
-                        return Err(self.error(format!(
-                            "at $.nodes[{index}].matrix: expected a translation, rotation and scale, found a shear"
-                        )));
-                    }
-                    let (scale, rotation, translation) = local.to_scale_rotation_translation();
-                    (translation, rotation, scale)
-                }
-            };
-            let name = node.name().map_or_else(|| format!("node {index}"), str::to_string);
-            let mut joint = RawJoint::new(name, parent, translation);
-            joint.initial_rotation = JointRotation::Quat(rotation.normalize());
-            if (scale - Vec3::ONE).abs().max_element() > 1e-6 {
-                joint.rest_scale = scale;
-            }
-            raw_of_node[index] = Some(raw.len());
-            let me = raw.len();
-            raw.push(joint);
-            todo.extend(self.relevant_children(index).into_iter().rev().map(|c| (c, Some(me))));
-        }
-        Ok((raw, raw_of_node))
+        let name = node.name().map_or_else(|| format!("node {index}"), str::to_string);
+        Ok(TreeNode { name, translation, rotation, scale })
     }
 
-    /// Each skin of the part's meshes: its joints as raw joints, with their inverse bind
-    /// matrices. A joint that an earlier skin binds differently gets a fixed child joint
-    /// (added to `raw`) that carries this skin's binding.
-    fn skin_slots(
-        &self,
-        part: &PartNodes,
-        raw_of_node: &[Option<usize>],
-        raw: &mut Vec<RawJoint>,
-    ) -> Result<Vec<SkinSlots>, FormatError> {
-        let mut bound: Vec<Option<Mat4>> = vec![None; raw.len()];
-        let mut skins: Vec<SkinSlots> = Vec::new();
+    /// The skins of the part's meshes (once each, in the order they are first used): their
+    /// indices, and their joints' nodes with their inverse bind matrices (identity where the
+    /// file gives none).
+    fn skins_of(&self, part: &PartNodes) -> (Vec<usize>, Vec<Binding>) {
+        let (mut skins, mut bindings) = (Vec::new(), Vec::new());
         for skin in part.meshes.iter().filter_map(|&m| self.node(m).skin()) {
-            if skins.iter().any(|s| s.skin == skin.index()) {
+            if skins.contains(&skin.index()) {
                 continue;
             }
             let mut ibms: Vec<Mat4> = vec![Mat4::IDENTITY; skin.joints().len()];
             if let Some(read) = skin.reader(self.data()).read_inverse_bind_matrices() {
-                for (k, m) in read.enumerate().take(ibms.len()) {
-                    let m = Mat4::from_cols_array_2d(&m);
-                    if !m.is_finite() || m.determinant().abs() < 1e-12 || !m.inverse().is_finite() {
-                        let what = if m.is_finite() { "a singular matrix" } else { "numbers that are not finite" };
-                        return Err(self.error(format!(
-                            "at $.skins[{}].inverseBindMatrices: expected an invertible matrix for joint {k}, found {what}",
-                            skin.index()
-                        )));
-                    }
-                    ibms[k] = m;
-                }
+                ibms.iter_mut().zip(read).for_each(|(ibm, m)| *ibm = Mat4::from_cols_array_2d(&m));
             }
-            let mut joints = Vec::with_capacity(ibms.len());
-            for (node, ibm) in skin.joints().zip(ibms) {
-                let r = raw_of_node[node.index()].expect("a skin's joints are relevant");
-                let slot = match bound[r] {
-                    None => {
-                        bound[r] = Some(ibm);
-                        r
-                    }
-                    Some(first) if same_matrix(first, ibm) => r,
-                    Some(_) => {
-                        let name = format!("{} (skin {})", raw[r].name, skin.index());
-                        raw.push(RawJoint::new(name, Some(r), Vec3::ZERO));
-                        bound.push(Some(ibm));
-                        raw.len() - 1
-                    }
-                };
-                joints.push((slot, ibm));
-            }
-            skins.push(SkinSlots { skin: skin.index(), joints });
+            let joints = skin.joints().map(|j| j.index()).zip(ibms).collect();
+            skins.push(skin.index());
+            let (label, at) =
+                (format!("skin {}", skin.index()), format!("at $.skins[{}].inverseBindMatrices", skin.index()));
+            bindings.push(Binding { label, at, joints });
         }
-        Ok(skins)
+        (skins, bindings)
     }
 
     /// Appends one triangle primitive: its positions, triangles and influence rows.
@@ -667,7 +600,7 @@ impl<'a> File<'a> {
                         let rotation = |k: usize, q: &Quat| {
                             q.is_finite()
                                 && (interpolation == Interpolation::CubicSpline && k % 3 != 1
-                                    || q.length_squared() > 1e-12)
+                                    || crate::checks::is_normalisable(*q))
                         };
                         finite_keys(values.iter().enumerate().map(|(k, q)| rotation(k, q)), &sampler)
                             .map_err(|e| self.error(format!("{e} (a rotation that is not zero)")))?;
@@ -815,12 +748,6 @@ fn is_trs(m: Mat4) -> bool {
     let back = Mat4::from_scale_rotation_translation(s, r, t);
     let size = m.to_cols_array().iter().fold(1.0f32, |a, x| a.max(x.abs()));
     back.abs_diff_eq(m, 1e-5 * size)
-}
-
-/// Whether two inverse bind matrices are the same binding (within 1e-6 of their size).
-fn same_matrix(a: Mat4, b: Mat4) -> bool {
-    let size = a.to_cols_array().iter().fold(1.0f32, |m, x| m.max(x.abs()));
-    a.abs_diff_eq(b, 1e-6 * size)
 }
 
 /// The file's buffers: the GLB's binary chunk (borrowed), or `.bin` files beside a `.gltf`.

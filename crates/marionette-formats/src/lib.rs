@@ -18,6 +18,7 @@ pub mod gltf_out_materials;
 pub mod homer;
 pub mod limits;
 pub mod mit6837;
+pub mod node_tree;
 pub mod obj;
 pub mod off;
 pub mod part;

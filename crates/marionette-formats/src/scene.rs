@@ -7,7 +7,7 @@ use std::path::{Path, PathBuf};
 
 use serde::{Deserialize, Serialize};
 
-use super::checks::{finite, positive};
+use super::checks::{finite, is_invertible, is_normalisable, positive};
 use super::error::FormatError;
 use marionette_rig::{JointRotation, Skeleton};
 
@@ -568,12 +568,12 @@ impl SceneDoc {
             finite(&at("placement.translation"), &c.placement.translation.to_array())?;
             finite(&at("placement.yaw"), &[c.placement.yaw])?;
             finite(&at("placement.tilt"), &c.placement.tilt.to_array())?;
-            if c.placement.tilt.length_squared() < 1e-12 {
+            if !is_normalisable(c.placement.tilt) {
                 return Err(format!("{}: expected a rotation, found a zero quaternion", at("placement.tilt")));
             }
             if let Some(attached) = &c.attached {
                 finite(&at("attached.offset"), &attached.offset.to_cols_array())?;
-                if attached.offset.determinant().abs() < 1e-12 {
+                if !is_invertible(&attached.offset) {
                     return Err(format!("{}: expected an invertible matrix", at("attached.offset")));
                 }
             }
@@ -627,7 +627,7 @@ fn rotations(at: &str, pose: &BTreeMap<String, JointRotation>) -> Result<(), Str
             JointRotation::Euler(angles, _) => finite(&at, &angles.to_array())?,
             JointRotation::Quat(q) => {
                 finite(&at, &q.to_array())?;
-                if q.length_squared() < 1e-12 {
+                if !is_normalisable(*q) {
                     return Err(format!("{at}: expected a rotation, found a zero quaternion"));
                 }
             }

@@ -6,6 +6,7 @@ use std::path::{Path, PathBuf};
 
 use glam::{Quat, Vec3};
 
+use super::checks::is_normalisable;
 use super::error::{FormatError, open, parse_number, read_lines};
 use super::obj::parse_obj;
 use marionette_rig::skinning::NormalisedRow;
@@ -222,7 +223,7 @@ pub fn parse_clip(reader: impl BufRead, path: &Path, joint_count: usize) -> Resu
         for (joint, q) in v[3..].chunks_exact(4).enumerate() {
             let q = Quat::from_xyzw(q[0], q[1], q[2], q[3]);
             // A zero (or overflowing) quaternion normalises to NaN.
-            if !(q.length_squared().is_finite() && q.length_squared() > 1e-12) {
+            if !is_normalisable(q) {
                 return Err(FormatError::syntax(
                     path,
                     *n,
