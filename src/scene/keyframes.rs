@@ -9,6 +9,8 @@ use bevy::prelude::*;
 use crate::formats::scene::AnimDoc;
 use crate::rig::JointRotation;
 use crate::rig::anim::Clip;
+use crate::rig::playback::{Clock, Span};
+use crate::scene::playhead::{Playhead, advance_playheads};
 use crate::scene::{Character, JointPose};
 
 /// A keyframed clip on a character and its playback state (the scene file's `AnimDoc`).
@@ -30,38 +32,30 @@ impl RootTranslation {
     }
 }
 
+/// Its clock runs in seconds over the clip's keyed range.
+impl Playhead for ClipPlayer {
+    fn clock(&self) -> Clock {
+        let s = &self.state;
+        Clock { time: s.time, playing: s.playing, speed: s.speed, looping: s.looping }
+    }
+
+    fn set_clock(&mut self, clock: Clock) {
+        (self.state.time, self.state.playing) = (clock.time, clock.playing);
+    }
+
+    fn span(&self) -> Option<Span> {
+        Some(Span::keyed(self.clip.range.0, self.clip.range.1))
+    }
+}
+
 pub struct KeyframePlugin;
 
 impl Plugin for KeyframePlugin {
     fn build(&self, app: &mut App) {
         app.add_systems(
             PostUpdate,
-            (advance_clips, pose_from_keyframes).chain().in_set(super::AnimateSteps::Keyframes),
+            (advance_playheads::<ClipPlayer>, pose_from_keyframes).chain().in_set(super::AnimateSteps::Keyframes),
         );
-    }
-}
-
-/// Advances playing clips by the frame time over the clip's range, looping or stopping
-/// at its end (reads `Time`; writes `ClipPlayer`).
-fn advance_clips(time: Res<Time>, mut players: Query<&mut ClipPlayer>) {
-    for mut player in &mut players {
-        if !player.state.playing {
-            continue;
-        }
-        let (start, end) = player.clip.range;
-        let length = end - start;
-        let state = &mut player.state;
-        let t = state.time + time.delta_secs() * state.speed;
-        state.time = if length <= 0.0 {
-            start
-        } else if state.looping {
-            start + (t - start).rem_euclid(length)
-        } else if t >= end {
-            state.playing = false;
-            end
-        } else {
-            t
-        };
     }
 }
 

@@ -20,6 +20,7 @@ pub mod handoff;
 pub mod keyframes;
 pub mod morphs;
 pub mod node_clips;
+pub mod playhead;
 pub mod smpl;
 pub mod spawn;
 pub mod systems;

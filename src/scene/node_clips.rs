@@ -10,7 +10,9 @@ use bevy::prelude::*;
 use crate::formats::scene::PlaybackDoc;
 use crate::rig::JointRotation;
 use crate::rig::node_clip::{NodeClip, NodePose, sample_mix};
+use crate::rig::playback::{Clock, Span};
 use crate::scene::morphs::Morphs;
+use crate::scene::playhead::{Playhead, advance_playheads};
 use crate::scene::{Character, JointPose, RestOverrides};
 
 /// The source's clips and their playback (the scene file's own `PlaybackDoc`).
@@ -49,6 +51,22 @@ impl NodeClipPlayer {
     }
 }
 
+/// Its clock runs in seconds over the clip, from 0 to its duration.
+impl Playhead for NodeClipPlayer {
+    fn clock(&self) -> Clock {
+        let s = &self.state;
+        Clock { time: s.time, playing: s.playing, speed: s.speed, looping: s.looping }
+    }
+
+    fn set_clock(&mut self, clock: Clock) {
+        (self.state.time, self.state.playing) = (clock.time, clock.playing);
+    }
+
+    fn span(&self) -> Option<Span> {
+        self.clip().map(|c| Span::keyed(0.0, c.duration()))
+    }
+}
+
 /// Playback of the sources' own clips, within `Animate`.
 pub struct NodeClipPlugin;
 
@@ -56,31 +74,10 @@ impl Plugin for NodeClipPlugin {
     fn build(&self, app: &mut App) {
         app.add_systems(
             PostUpdate,
-            (advance_node_clips, pose_from_node_clips, weights_from_node_clips)
+            (advance_playheads::<NodeClipPlayer>, pose_from_node_clips, weights_from_node_clips)
                 .chain()
                 .in_set(super::AnimateSteps::NodeClips),
         );
-    }
-}
-
-/// Advances playing clips by the frame time, looping or stopping at the clip's end (reads
-/// `Time`; writes `NodeClipPlayer`).
-fn advance_node_clips(time: Res<Time>, mut players: Query<&mut NodeClipPlayer>) {
-    for mut player in &mut players {
-        let Some(length) = player.clip().map(NodeClip::duration) else { continue };
-        if !player.state.playing {
-            continue;
-        }
-        let state = &mut player.state;
-        let t = state.time + time.delta_secs() * state.speed;
-        state.time = if state.looping {
-            if length > 0.0 { t.rem_euclid(length) } else { t }
-        } else if t >= length {
-            state.playing = false;
-            length
-        } else {
-            t
-        };
     }
 }
 

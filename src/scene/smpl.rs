@@ -7,7 +7,9 @@ use std::sync::Arc;
 use bevy::prelude::*;
 
 use crate::formats::scene::SmplDoc;
+use crate::rig::playback::{Clock, Span};
 use crate::rig::smpl::{Clip, SmplModel};
+use crate::scene::playhead::{Playhead, advance_playheads};
 use crate::scene::{Character, JointPose, PoseDirty};
 
 pub use crate::rig::smpl::CLIP_FPS;
@@ -51,6 +53,23 @@ impl SmplCharacter {
     }
 }
 
+/// Its clock runs in frames, at [`CLIP_FPS`] times its speed; it loops through the step
+/// from the last frame back to the first.
+impl Playhead for SmplCharacter {
+    fn clock(&self) -> Clock {
+        let s = &self.state;
+        Clock { time: s.time, playing: s.playing, speed: s.speed * CLIP_FPS, looping: s.looping }
+    }
+
+    fn set_clock(&mut self, clock: Clock) {
+        (self.state.time, self.state.playing) = (clock.time, clock.playing);
+    }
+
+    fn span(&self) -> Option<Span> {
+        Some(self.clip_frames()).filter(|&n| n > 0).map(Span::frames)
+    }
+}
+
 /// SMPL bodies: β reshaping and clip playback.
 pub struct SmplPlugin;
 
@@ -58,27 +77,10 @@ impl Plugin for SmplPlugin {
     fn build(&self, app: &mut App) {
         app.add_systems(
             PostUpdate,
-            (advance_playback, reshape_bodies, pose_from_clips).chain().in_set(super::AnimateSteps::Smpl),
+            (advance_playheads::<SmplCharacter>, reshape_bodies, pose_from_clips)
+                .chain()
+                .in_set(super::AnimateSteps::Smpl),
         );
-    }
-}
-
-/// Advances playing clips by the frame time (reads `Time`; writes `SmplCharacter`).
-fn advance_playback(time: Res<Time>, mut bodies: Query<&mut SmplCharacter>) {
-    for mut body in &mut bodies {
-        let n = body.clip_frames() as f32;
-        if !body.state.playing || n == 0.0 {
-            continue;
-        }
-        let state = &mut body.state;
-        let mut t = state.time + time.delta_secs() * CLIP_FPS * state.speed;
-        if state.looping {
-            t = t.rem_euclid(n);
-        } else if t >= n - 1.0 {
-            t = n - 1.0;
-            state.playing = false;
-        }
-        state.time = t;
     }
 }
 

@@ -23,6 +23,7 @@ pub mod material;
 pub mod matrix_stack;
 pub mod mirror;
 pub mod node_clip;
+pub mod playback;
 pub mod pose;
 pub mod retarget;
 pub mod simd;
