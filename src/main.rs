@@ -65,9 +65,15 @@ fn run(cli: Cli) -> Result<()> {
                 still: false,
             };
             let (sequence, pictures) = (frames.sequence(), frames.pictures());
-            let (notes, picture) =
-                marionette::editor::present::render::render(paths, edits, out.clone(), shot.picture(), pictures)
-                    .map_err(anyhow::Error::msg)?;
+            let (notes, picture) = marionette::editor::present::render::render(
+                paths,
+                edits,
+                out.clone(),
+                shot.picture(),
+                pictures,
+                shot.data,
+            )
+            .map_err(anyhow::Error::msg)?;
             for n in notes {
                 eprintln!("note: {n}");
             }

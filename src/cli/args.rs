@@ -184,6 +184,11 @@ pub struct ShotArgs {
     /// An orthographic lens, framed to the characters.
     #[arg(long)]
     pub ortho: bool,
+    /// Write the picture's data beside it: depth (EXR and PNG), normals, instance and
+    /// body-part masks, the OpenPose drawing and JSON, and a COCO keypoints file with the
+    /// camera (one for a whole frame sequence).
+    #[arg(long)]
+    pub data: bool,
 }
 
 fn parse_view(s: &str) -> Result<crate::formats::scene::ViewName, String> {

@@ -6,6 +6,7 @@ mod arrange;
 mod commands;
 mod common;
 mod data;
+mod data_pictures;
 mod dqs;
 mod ecs;
 mod editor;

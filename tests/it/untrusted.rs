@@ -506,6 +506,7 @@ fn render_of_a_scene_whose_clip_fails_to_load_fails_and_writes_nothing() {
         out.clone(),
         PictureRequest { width: Some(64), height: Some(64), samples: None },
         Pictures::Still,
+        false,
     )
     .unwrap_err();
     assert!(e.contains("bad.anim:1:") && e.contains("(character `p` of"), "{e}");

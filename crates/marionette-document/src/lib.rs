@@ -4,6 +4,7 @@
 //! (OBJ posing, glTF, animations). `export`, `info`, `bind`, `smpl` and `gen-assets` run on
 //! it alone; the editor calls it.
 
+pub mod annotate;
 pub mod crowd;
 pub mod default_scene;
 pub mod export;

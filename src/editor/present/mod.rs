@@ -2,6 +2,7 @@
 //! skin material, the scene's plugins for the window and the renderer (`view`), when a
 //! frame may be captured, screenshots and the headless render.
 
+pub mod data;
 pub mod draw;
 pub mod frames_job;
 pub mod readiness;

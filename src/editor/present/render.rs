@@ -12,9 +12,11 @@ use bevy::render::render_resource::{TextureFormat, TextureUsages};
 use bevy::render::view::screenshot::{Screenshot, ScreenshotCaptured};
 
 use crate::document::AssetLibrary;
+use crate::document::annotate;
 use crate::document::frames::{FrameSequence, PictureRequest, Pictures, frame_path};
 use crate::document::picture;
 use crate::document::scenes::{read_scene, scene_path};
+use crate::editor::present::data::{DataFrame, DataScene};
 use crate::editor::present::readiness::CaptureGate;
 use crate::editor::present::stage;
 use crate::editor::present::view::ViewPlugin;
@@ -54,6 +56,19 @@ struct RenderJob {
     done: Option<Result<(), String>>,
     /// Where the result and the messages are left for the caller.
     outcome: Arc<Mutex<(Option<Result<(), String>>, Vec<String>)>>,
+    /// `--data`: the COCO file's path and its images and annotations so far (the passes
+    /// are written beside each picture as it is saved).
+    data: Option<CocoSoFar>,
+    /// The saved picture's width and height.
+    size: (u32, u32),
+}
+
+/// A render's COCO file as it fills, a picture at a time.
+#[derive(Default)]
+struct CocoSoFar {
+    path: PathBuf,
+    images: Vec<serde_json::Value>,
+    annotations: Vec<serde_json::Value>,
 }
 
 /// What one picture shows.
@@ -77,7 +92,14 @@ pub fn render(
     out: PathBuf,
     picture: PictureRequest,
     pictures: Pictures,
+    data: bool,
 ) -> Result<(Vec<String>, ShotDoc), String> {
+    let data = match (data, pictures) {
+        (false, _) => None,
+        (true, Pictures::PoseSheet) => return Err("--data: a contact sheet of poses carries no data".into()),
+        (true, Pictures::Sequence(_)) => Some(CocoSoFar { path: sequence_path(&out)?, ..default() }),
+        (true, Pictures::Still) => Some(CocoSoFar { path: annotate::write::beside(&out, "json"), ..default() }),
+    };
     let (library, shot, poses) = preload(&paths, &edits)?;
     let cells = std::env::temp_dir().join(format!("marionette-sheet-{}", std::process::id()));
     let (frames, sequence): (Vec<(FrameAt, PathBuf)>, _) = match pictures {
@@ -136,6 +158,8 @@ pub fn render(
         saved: None,
         done: None,
         outcome: outcome.clone(),
+        data,
+        size: (width, height),
     });
     app.add_systems(Startup, move |mut commands: Commands| {
         let orbit = OrbitCamera::default();
@@ -220,6 +244,7 @@ fn capture_when_ready(
     gate: Res<CaptureGate>,
     messages: Res<Messages>,
     stage: Res<crate::editor::state::StageSettings>,
+    scene: DataScene,
     mut exit: MessageWriter<AppExit>,
 ) {
     if let Some(done) = job.done.clone() {
@@ -244,12 +269,46 @@ fn capture_when_ready(
     job.requested = true;
     let out = job.frames[job.next].1.clone();
     let (samples, background) = (job.samples, stage.background);
+    // What the data pictures show is taken now, with the frame the capture draws.
+    let frame = match job.data.is_some().then(|| scene.frame(job.size.0, job.size.1)).transpose() {
+        Ok(frame) => frame,
+        Err(e) => {
+            job.done = Some(Err(e));
+            return;
+        }
+    };
     commands.spawn(Screenshot::image(job.target.clone())).observe(
         move |captured: On<ScreenshotCaptured>, mut job: ResMut<RenderJob>| {
-            job.saved = Some(save_picture(&captured.image, samples, &background, &out));
+            let saved = save_picture(&captured.image, samples, &background, &out);
+            job.saved = Some(match &frame {
+                Some(frame) => saved.and_then(|()| write_data(frame, &out, &mut job)),
+                None => saved,
+            });
             eprintln!("progress: {}/{}", job.next + 1, job.frames.len());
         },
     );
+}
+
+/// Writes the data passes beside the picture `out` and adds it to the COCO file so far.
+fn write_data(frame: &DataFrame, out: &std::path::Path, job: &mut RenderJob) -> Result<(), String> {
+    let passes = frame.passes();
+    annotate::write::passes(out, &frame.camera, &passes, &frame.figures)?;
+    let image_id = job.next as u64 + 1;
+    let Some(coco) = job.data.as_mut() else { return Ok(()) };
+    let file_name = out.file_name().map_or_else(String::new, |n| n.to_string_lossy().into_owned());
+    let first = coco.annotations.len() as u64 + 1;
+    coco.images.push(annotate::coco::image_json(image_id, &file_name, &frame.camera));
+    coco.annotations.extend(annotate::coco::annotations(&frame.camera, &passes, &frame.figures, image_id, first));
+    Ok(())
+}
+
+/// The COCO file of a frame sequence: its pattern with `all` for the frame number
+/// (`f_%04d.png` → `f_all.json`).
+fn sequence_path(pattern: &std::path::Path) -> Result<PathBuf, String> {
+    let text = pattern.to_string_lossy();
+    let (start, rest) = text.split_once('%').ok_or_else(|| format!("expected a %d in {text}"))?;
+    let tail = rest.split_once('d').map_or("", |(_, t)| t);
+    Ok(annotate::write::beside(std::path::Path::new(&format!("{start}all{tail}")), "json"))
 }
 
 /// The captured pixels averaged down from their samples, over the background, as PNG.
@@ -284,7 +343,10 @@ fn next_frame(
 ) {
     let Some(saved) = job.saved.take() else { return };
     if saved.is_err() || job.next + 1 == job.frames.len() {
-        job.done = Some(saved);
+        let coco = job.data.take();
+        job.done = Some(saved.and_then(|()| {
+            coco.map_or(Ok(()), |c| annotate::write::json(&c.path, &annotate::coco::file(c.images, c.annotations)))
+        }));
         return;
     }
     let first_yaw = *job.first_yaw.get_or_insert_with(|| cameras.iter().next().map_or(0.0, |c| c.0.yaw));

@@ -14,6 +14,13 @@ pub const SKY: Color =
 #[derive(Component)]
 pub struct Floor;
 
+/// The floor's corners in the world as `transform` places its mesh.
+pub fn floor_corners(transform: &Transform) -> [Vec3; 4] {
+    let half = FLOOR_SIZE / 2.0;
+    [(-half, -half), (half, -half), (half, half), (-half, half)]
+        .map(|(x, z)| transform.transform_point(Vec3::new(x, 0.0, z)))
+}
+
 /// The side of the floor mesh (metres) before it is scaled to the scene.
 const FLOOR_SIZE: f32 = 40.0;
 

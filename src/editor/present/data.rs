@@ -1,0 +1,126 @@
+//! `render --data`: the frame as the data pictures see it (the document layer's
+//! [`annotate`](crate::document::annotate)): each shown character's skinned vertices,
+//! body parts and keypoints in the world, the floor, and the camera, taken from the ECS at
+//! the moment the picture is captured.
+
+use bevy::ecs::system::SystemParam;
+use bevy::prelude::*;
+
+use crate::document::annotate::{self, Figure, Pinhole, Surface, raster::FLOOR};
+use crate::editor::present::stage::{Floor, floor_corners};
+use crate::editor::scene_doc::document::{HumanoidMapOf, SceneCharacter};
+use crate::editor::state::camera::OrbitCamera;
+use crate::formats::scene::DisplayDoc;
+use crate::scene::smpl::SmplCharacter;
+use crate::scene::{Character, CharacterView, JointScratch, SkinScratch};
+
+/// What a data picture is made from.
+pub struct DataFrame {
+    pub camera: Pinhole,
+    pub figures: Vec<Figure>,
+    /// The floor's corners, where it is shown.
+    pub floor: Option<[Vec3; 4]>,
+}
+
+impl DataFrame {
+    /// The passes: the figures' triangles and the floor's, rasterised.
+    pub fn passes(&self) -> annotate::Passes {
+        let floor = self.floor.unwrap_or([Vec3::ZERO; 4]);
+        let floor_triangles: &[[u32; 3]] = if self.floor.is_some() { &[[0, 2, 1], [0, 3, 2]] } else { &[] };
+        let surfaces: Vec<Surface> = self
+            .figures
+            .iter()
+            .map(Figure::surface)
+            .chain([Surface { instance: FLOOR, positions: &floor, triangles: floor_triangles, parts: &[] }])
+            .collect();
+        annotate::rasterize(&self.camera, &surfaces)
+    }
+}
+
+/// The ECS's view of what a data picture shows.
+#[derive(SystemParam)]
+pub struct DataScene<'w, 's> {
+    characters: Query<
+        'w,
+        's,
+        (
+            &'static SceneCharacter,
+            &'static Character,
+            &'static SkinScratch,
+            &'static JointScratch,
+            &'static GlobalTransform,
+            &'static CharacterView,
+            Option<&'static HumanoidMapOf>,
+            Has<SmplCharacter>,
+        ),
+    >,
+    floors: Query<'w, 's, (&'static Transform, &'static Visibility), With<Floor>>,
+    cameras: Query<'w, 's, &'static OrbitCamera>,
+}
+
+impl DataScene<'_, '_> {
+    /// The frame now, for a picture of `width` × `height`. Characters are numbered in the
+    /// order of their scene ids (from 1), so a sequence keeps each one's number.
+    pub fn frame(&self, width: u32, height: u32) -> Result<DataFrame, String> {
+        let orbit = self.cameras.iter().next().ok_or("the render has no camera")?;
+        let camera = Pinhole::of(orbit, width, height)?;
+        let mut characters: Vec<_> = self.characters.iter().collect();
+        characters.sort_by_key(|c| c.0.id);
+        let figures = characters
+            .into_iter()
+            .enumerate()
+            .filter(|(_, c)| c.5.0.visible && c.5.0.display != DisplayDoc::Skeleton)
+            .map(|(k, (scene, character, skin, joints, place, _, map, smpl))| {
+                figure(k as u16 + 1, &scene.name, character, skin, joints, place.to_matrix(), map.map(|m| &m.0), smpl)
+            })
+            .collect();
+        let floor = self.floors.iter().find(|(_, v)| **v != Visibility::Hidden).map(|(t, _)| floor_corners(t));
+        Ok(DataFrame { camera, figures, floor })
+    }
+}
+
+/// One character as a figure: its skinned vertices (as drawn) and joints in the world, its
+/// vertices' body parts and its keypoints.
+#[allow(clippy::too_many_arguments)]
+fn figure(
+    instance: u16,
+    name: &str,
+    character: &Character,
+    skin: &SkinScratch,
+    joints: &JointScratch,
+    world: Mat4,
+    map: Option<&crate::rig::humanoid::HumanoidMap>,
+    smpl: bool,
+) -> Figure {
+    let asset = &character.asset;
+    let model = if skin.positions.len() == asset.vertex_count() {
+        skin.positions.to_vec()
+    } else {
+        // Skinned on the GPU: the same linear blend here.
+        let palette: Vec<Mat4> =
+            joints.matrices.iter().zip(&asset.bind_world_to_joint).map(|(m, bind)| *m * *bind).collect();
+        let mut out = vec![Vec3::ZERO; asset.vertex_count()];
+        crate::rig::skinning::skin_positions(&asset.skin.bind_positions, &asset.skin.weights, &palette, &mut out);
+        out
+    };
+    let positions: Vec<Vec3> = model.iter().map(|&p| world.transform_point3(p)).collect();
+    let joint_world: Vec<Vec3> = joints.matrices.iter().map(|m| world.transform_point3(m.w_axis.truncate())).collect();
+    let joint_parts = annotate::joint_parts(&asset.skeleton, map);
+    let parts = annotate::vertex_parts(asset, &joint_parts);
+    let (points, bones) = match map {
+        Some(map) if joint_world.len() == asset.skeleton.len() => (
+            annotate::keypoints(&asset.skeleton, map, &joint_world, &joint_parts, &positions, smpl),
+            map.iter().filter_map(|(&bone, &j)| Some((bone, *joint_world.get(j)?))).collect(),
+        ),
+        _ => Default::default(),
+    };
+    Figure {
+        name: name.to_string(),
+        instance,
+        positions,
+        triangles: asset.skin.triangles.clone(),
+        parts,
+        points,
+        bones,
+    }
+}
