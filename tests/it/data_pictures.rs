@@ -284,3 +284,73 @@ fn write_box(path: &Path, centre: DVec3, half: f64) {
     }
     std::fs::write(path, text).unwrap();
 }
+
+/// The OpenPose drawing in ControlNet's reference colours (the table of `controlnet_aux`'s
+/// `draw_bodypose`, written out here): each point a disc in its colour, each limb between
+/// two points at 60 % of its colour, on black.
+#[test]
+fn the_openpose_drawing_has_controlnets_colours_and_limbs() {
+    const COLOURS: [[u8; 3]; 18] = [
+        [255, 0, 0],
+        [255, 85, 0],
+        [255, 170, 0],
+        [255, 255, 0],
+        [170, 255, 0],
+        [85, 255, 0],
+        [0, 255, 0],
+        [0, 255, 85],
+        [0, 255, 170],
+        [0, 255, 255],
+        [0, 170, 255],
+        [0, 85, 255],
+        [0, 0, 255],
+        [85, 0, 255],
+        [170, 0, 255],
+        [255, 0, 255],
+        [255, 0, 170],
+        [255, 0, 85],
+    ];
+    // ControlNet's limbs over its 18 points (from 1): the first arm and leg limbs.
+    const LIMBS: [[usize; 2]; 12] =
+        [[2, 3], [2, 6], [3, 4], [4, 5], [6, 7], [7, 8], [2, 9], [9, 10], [10, 11], [2, 12], [12, 13], [13, 14]];
+    // BODY_25's index of each of ControlNet's 18 points (nose, neck, right arm, left arm,
+    // right leg, left leg, eyes, ears).
+    const FROM_25: [usize; 18] = [0, 1, 2, 3, 4, 5, 6, 7, 9, 10, 11, 12, 13, 14, 15, 16, 17, 18];
+    let dir = scratch("data-openpose");
+    render_data(&dir, &[puppet("a", 0.0, 0.3)], &[]);
+    let drawing = image::open(dir.join("shot.openpose.png")).unwrap().to_rgb8();
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("shot.openpose.json")).unwrap()).unwrap();
+    let body: Vec<f64> = serde_json::from_value(json["people"][0]["pose_keypoints_2d"].clone()).unwrap();
+    let point = |k: usize| {
+        let j = FROM_25[k];
+        (body[3 * j + 2] > 0.0).then(|| (body[3 * j], body[3 * j + 1]))
+    };
+    let pixel = |(x, y): (f64, f64)| drawing.get_pixel(x as u32, y as u32).0;
+    let mut points = 0;
+    for (k, colour) in COLOURS.iter().enumerate() {
+        let Some(p) = point(k) else { continue };
+        points += 1;
+        // A later point's disc (radius 4) may cover this one's centre.
+        let covered = (k + 1..18).filter_map(point).any(|q| (q.0 - p.0).powi(2) + (q.1 - p.1).powi(2) <= 16.0);
+        if !covered {
+            assert_eq!(pixel(p), *colour, "point {k} at {p:?}");
+        }
+    }
+    let mut limbs = 0;
+    for (k, [a, b]) in LIMBS.iter().enumerate() {
+        let (Some(a), Some(b)) = (point(a - 1), point(b - 1)) else { continue };
+        let length = ((a.0 - b.0).powi(2) + (a.1 - b.1).powi(2)).sqrt();
+        if length < 10.0 {
+            continue;
+        }
+        // Midway, away from both points' discs (later limbs may cross: the first drawn at
+        // the middle of a limb is not always its own, so count those that are).
+        let middle = ((a.0 + b.0) / 2.0, (a.1 + b.1) / 2.0);
+        let dim = COLOURS[k].map(|c| (f64::from(c) * 0.6) as u8);
+        limbs += usize::from(pixel(middle) == dim);
+    }
+    assert_eq!(points, 13, "the puppet's neck and 12 limb points (no face)");
+    assert!(limbs >= 10, "{limbs} limbs in their colour at 60 %");
+    assert_eq!(drawing.get_pixel(0, 0).0, [0, 0, 0], "on black");
+}

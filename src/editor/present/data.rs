@@ -35,6 +35,30 @@ impl DataFrame {
             .collect();
         annotate::rasterize(&self.camera, &surfaces)
     }
+
+    /// Writes the passes beside `picture`; returns its COCO image (`image_id`) and
+    /// annotations (ids from `first_id`).
+    pub fn write_beside(
+        &self,
+        picture: &std::path::Path,
+        image_id: u64,
+        first_id: u64,
+    ) -> Result<(serde_json::Value, Vec<serde_json::Value>), String> {
+        let passes = self.passes();
+        annotate::write::passes(picture, &self.camera, &passes, &self.figures)?;
+        let file_name = picture.file_name().map_or_else(String::new, |n| n.to_string_lossy().into_owned());
+        let image = annotate::coco::image_json(image_id, &file_name, &self.camera);
+        Ok((image, annotate::coco::annotations(&self.camera, &passes, &self.figures, image_id, first_id)))
+    }
+
+    /// Writes the passes and a COCO file of this one picture beside `picture`.
+    pub fn write_all_beside(&self, picture: &std::path::Path) -> Result<(), String> {
+        let (image, annotations) = self.write_beside(picture, 1, 1)?;
+        annotate::write::json(
+            &annotate::write::beside(picture, "json"),
+            &annotate::coco::file(vec![image], annotations),
+        )
+    }
 }
 
 /// The ECS's view of what a data picture shows.

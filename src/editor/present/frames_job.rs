@@ -22,12 +22,21 @@ pub struct FramesRequest {
     pub turntable: Option<f32>,
     /// Where the frames go: a path with one `%04d`.
     pub pattern: String,
+    /// Write each frame's data pictures and one COCO file (`render --data`).
+    pub with_data: bool,
 }
 
 impl Default for FramesRequest {
     fn default() -> Self {
         let cwd = std::env::current_dir().map(|d| d.display().to_string()).unwrap_or_default();
-        Self { from: 0.0, to: 2.0, fps: 24.0, turntable: None, pattern: format!("{cwd}/frames/frame_%04d.png") }
+        Self {
+            from: 0.0,
+            to: 2.0,
+            fps: 24.0,
+            turntable: None,
+            pattern: format!("{cwd}/frames/frame_%04d.png"),
+            with_data: false,
+        }
     }
 }
 
@@ -68,6 +77,9 @@ impl FramesJob {
         command.args(["--fps", &r.fps.to_string(), "--out", &r.pattern]);
         if let Some(seconds) = r.turntable {
             command.args(["--turntable", &seconds.to_string()]);
+        }
+        if r.with_data {
+            command.arg("--data");
         }
         let mut child = command
             .stdout(Stdio::null())

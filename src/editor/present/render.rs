@@ -291,14 +291,11 @@ fn capture_when_ready(
 
 /// Writes the data passes beside the picture `out` and adds it to the COCO file so far.
 fn write_data(frame: &DataFrame, out: &std::path::Path, job: &mut RenderJob) -> Result<(), String> {
-    let passes = frame.passes();
-    annotate::write::passes(out, &frame.camera, &passes, &frame.figures)?;
     let image_id = job.next as u64 + 1;
     let Some(coco) = job.data.as_mut() else { return Ok(()) };
-    let file_name = out.file_name().map_or_else(String::new, |n| n.to_string_lossy().into_owned());
-    let first = coco.annotations.len() as u64 + 1;
-    coco.images.push(annotate::coco::image_json(image_id, &file_name, &frame.camera));
-    coco.annotations.extend(annotate::coco::annotations(&frame.camera, &passes, &frame.figures, image_id, first));
+    let (image, annotations) = frame.write_beside(out, image_id, coco.annotations.len() as u64 + 1)?;
+    coco.images.push(image);
+    coco.annotations.extend(annotations);
     Ok(())
 }
 

@@ -6,6 +6,9 @@ use std::path::{Path, PathBuf};
 use bevy::prelude::*;
 use bevy::render::view::screenshot::{Screenshot, ScreenshotCaptured};
 
+use bevy::window::PrimaryWindow;
+
+use crate::editor::present::data::DataScene;
 use crate::editor::present::readiness::CaptureGate;
 use crate::editor::state::Messages;
 
@@ -15,6 +18,8 @@ pub struct ScreenshotRequest {
     /// The folder field of the panel.
     pub dir_text: String,
     pub with_panels: bool,
+    /// Write the data pictures beside it (the panels are then left out).
+    pub with_data: bool,
     /// Frames left before the capture (the panels are hidden meanwhile).
     countdown: Option<u8>,
 }
@@ -23,19 +28,25 @@ impl Default for ScreenshotRequest {
     fn default() -> Self {
         let dir =
             std::env::current_dir().map(|d| d.join("screenshots")).unwrap_or_else(|_| PathBuf::from("screenshots"));
-        Self { dir_text: dir.display().to_string(), with_panels: false, countdown: None }
+        Self { dir_text: dir.display().to_string(), with_panels: false, with_data: false, countdown: None }
     }
 }
 
 impl ScreenshotRequest {
     pub fn request(&mut self) {
         // Two frames without panels, so the captured frame has none.
-        self.countdown = Some(if self.with_panels { 0 } else { 2 });
+        self.countdown = Some(if self.panels_shown() { 0 } else { 2 });
+    }
+
+    /// Whether the panels are in the picture: asked for, and no data pictures (whose
+    /// camera is the whole window's).
+    fn panels_shown(&self) -> bool {
+        self.with_panels && !self.with_data
     }
 
     /// Whether the panels are hidden this frame (for a screenshot without them).
     pub fn hide_ui(&self) -> bool {
-        self.countdown.is_some() && !self.with_panels
+        self.countdown.is_some() && !self.panels_shown()
     }
 }
 
@@ -71,6 +82,8 @@ fn take_requested_screenshot(
     mut request: ResMut<ScreenshotRequest>,
     mut messages: ResMut<Messages>,
     gate: Option<Res<CaptureGate>>,
+    scene: DataScene,
+    windows: Query<&Window, With<PrimaryWindow>>,
 ) {
     let Some(n) = request.countdown else { return };
     if n > 0 {
@@ -96,10 +109,29 @@ fn take_requested_screenshot(
     }
     let now = std::time::SystemTime::now().duration_since(std::time::UNIX_EPOCH).map_or(0, |d| d.as_secs());
     let path = dir.join(format!("marionette_{}.png", timestamp(now)));
+    // The data pictures' frame is taken now, with the frame the capture draws.
+    let size = windows.iter().next().map(|w| (w.physical_width(), w.physical_height()));
+    let frame = match (request.with_data, size) {
+        (true, Some((w, h))) => match scene.frame(w, h) {
+            Ok(frame) => Some(frame),
+            Err(e) => {
+                messages.push(format!("no data pictures: {e}"));
+                None
+            }
+        },
+        _ => None,
+    };
     commands.spawn(Screenshot::primary_window()).observe(
-        move |captured: On<ScreenshotCaptured>, mut messages: ResMut<Messages>| match save_png(&captured.image, &path) {
-            Ok(()) => messages.push(format!("saved screenshot {}", path.display())),
-            Err(e) => messages.push(format!("no screenshot: {e}")),
+        move |captured: On<ScreenshotCaptured>, mut messages: ResMut<Messages>| {
+            let saved = save_png(&captured.image, &path)
+                .and_then(|()| frame.as_ref().map_or(Ok(()), |frame| frame.write_all_beside(&path)));
+            match saved {
+                Ok(()) if frame.is_some() => {
+                    messages.push(format!("saved screenshot {} with its data", path.display()))
+                }
+                Ok(()) => messages.push(format!("saved screenshot {}", path.display())),
+                Err(e) => messages.push(format!("no screenshot: {e}")),
+            }
         },
     );
 }

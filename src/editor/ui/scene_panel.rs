@@ -364,6 +364,9 @@ fn screenshot_rows(ui: &mut egui::Ui, state: &mut InspectorState, shot: &mut Scr
         }
     });
     ui.checkbox(&mut shot.with_panels, "include the panels");
+    ui.checkbox(&mut shot.with_data, "with data").on_hover_text(
+        "beside the picture: depth, normals, instance and body-part masks, OpenPose drawing and JSON, COCO keypoints with the camera",
+    );
     if ui.button("Save screenshot (F12)").clicked() {
         shot.request();
     }

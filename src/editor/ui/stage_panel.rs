@@ -66,6 +66,8 @@ fn frames_rows(ui: &mut egui::Ui, panels: &mut Panels) {
     });
     ui.add(egui::TextEdit::singleline(&mut r.pattern).desired_width(230.0))
         .on_hover_text("one %04d for the frame number");
+    ui.checkbox(&mut r.with_data, "with data")
+        .on_hover_text("each frame's depth, normals, masks and OpenPose files, and one COCO file for all");
     if ui.button("Render frames…").clicked()
         && let Err(e) = job.start(&panels.scene.capture())
     {

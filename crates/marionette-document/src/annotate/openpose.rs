@@ -181,7 +181,8 @@ pub fn drawing(camera: &Pinhole, passes: &Passes, figures: &[Figure]) -> RgbImag
             .collect();
         for (limb, colour) in LIMBS.iter().zip(COLOURS) {
             if let (Some(a), Some(b)) = (points[limb[0] - 1], points[limb[1] - 1]) {
-                let dim = colour.map(|c| (f32::from(c) * 0.6) as u8);
+                // As ControlNet's `int(float(c) * 0.6)`, in double precision.
+                let dim = colour.map(|c| (f64::from(c) * 0.6) as u8);
                 fill_ellipse(&mut canvas, a, b, 4.0, Rgb(dim));
             }
         }
