@@ -543,3 +543,45 @@ fn the_skin_phases_ideal_uses_only_the_cores_it_has_tasks_for() {
     // One body of two chunks is two tasks (in ms: vertices ÷ 1e9 per second × 1e3).
     assert!((ideal_skin_ms(1, 2 * chunk, 500.0, 8) - (2 * chunk) as f64 / 1e6).abs() < 1e-9);
 }
+
+/// The editor draws on change: with nothing playing it asks for no frame; a playing clip
+/// asks for one every frame while it plays, and none once paused (the window's own events,
+/// input among them, wake Bevy's reactive loop without asking).
+#[test]
+fn the_editor_asks_for_frames_only_while_something_moves() {
+    use bevy::prelude::*;
+    use bevy::window::RequestRedraw;
+    use marionette::editor::present::redraw::{DrawMode, RedrawPlugin};
+    use marionette::scene::keyframes::ClipPlayer;
+
+    #[derive(Resource, Default)]
+    struct Asked(usize);
+    fn count(mut asked: ResMut<Asked>, mut redraws: MessageReader<RequestRedraw>) {
+        asked.0 += redraws.read().count();
+    }
+    let mut app = App::new();
+    app.add_plugins(MinimalPlugins)
+        .add_message::<RequestRedraw>()
+        .add_plugins((marionette::scene::RigCorePlugin, marionette::scene::PlaybackPlugin, RedrawPlugin))
+        .init_resource::<Asked>()
+        .add_systems(First, count);
+    let state = marionette::formats::scene::AnimDoc { playing: false, ..Default::default() };
+    let clip = std::sync::Arc::new(marionette::rig::anim::Clip::empty(1));
+    let player = app.world_mut().spawn(ClipPlayer { clip, state }).id();
+    // Asked between the first update and the last one of `n` more (each frame's asking is
+    // counted at the start of the next).
+    let asked_over = |app: &mut App, n: usize| {
+        app.update();
+        let before = app.world().resource::<Asked>().0;
+        (0..n).for_each(|_| app.update());
+        app.world().resource::<Asked>().0 - before
+    };
+    assert_eq!(asked_over(&mut app, 10), 0, "idle: no frame asked for");
+    assert_eq!(app.world().resource::<DrawMode>().0, None);
+    app.world_mut().get_mut::<ClipPlayer>(player).unwrap().state.playing = true;
+    assert_eq!(asked_over(&mut app, 10), 10, "a playing clip asks for every frame");
+    assert_eq!(app.world().resource::<DrawMode>().0, Some("playing"));
+    app.world_mut().get_mut::<ClipPlayer>(player).unwrap().state.playing = false;
+    app.update();
+    assert_eq!(asked_over(&mut app, 10), 0, "paused: idle again");
+}

@@ -6,6 +6,7 @@ pub mod data;
 pub mod draw;
 pub mod frames_job;
 pub mod readiness;
+pub mod redraw;
 pub mod render;
 pub mod screenshot;
 pub mod skin_material;

@@ -38,6 +38,11 @@ impl ScreenshotRequest {
         self.countdown = Some(if self.panels_shown() { 0 } else { 2 });
     }
 
+    /// Whether a screenshot is counting down to its capture.
+    pub fn pending(&self) -> bool {
+        self.countdown.is_some()
+    }
+
     /// Whether the panels are in the picture: asked for, and no data pictures (whose
     /// camera is the whole window's).
     fn panels_shown(&self) -> bool {

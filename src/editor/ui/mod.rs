@@ -133,6 +133,7 @@ impl Panels<'_, '_> {
 #[derive(SystemParam)]
 pub struct ViewportOverlays<'w> {
     diagnostics: Res<'w, DiagnosticsStore>,
+    draw_mode: Option<Res<'w, crate::editor::present::redraw::DrawMode>>,
     hovered: Res<'w, crate::editor::state::HoveredJoint>,
     gizmo: Res<'w, crate::editor::interact::rotate_gizmo::RotateGizmo>,
     moving: Res<'w, crate::editor::interact::move_gizmo::MoveGizmo>,
@@ -193,7 +194,8 @@ fn inspector_ui(
     let area = ViewportArea(Some(Rect::new(central.min.x, central.min.y, central.max.x, central.max.y)));
     viewport_area.set_if_neq(area);
     dialogs::show(&ctx, &mut state, &mut panels, &mut shot);
-    frame_time_readout(&ctx, central, &overlays.diagnostics);
+    let mode = overlays.draw_mode.as_deref().copied().unwrap_or_default();
+    frame_time_readout(&ctx, central, &overlays.diagnostics, mode);
     if state.frame_guide {
         frame_guide(&ctx, central, &panels.scene.shot.0);
     }
@@ -231,8 +233,14 @@ pub fn open_dropped_files(
     }
 }
 
-/// The frame time (ms, smoothed) and frames per second in the viewport's top-right corner.
-fn frame_time_readout(ctx: &egui::Context, viewport: egui::Rect, diagnostics: &DiagnosticsStore) {
+/// The frame time (ms, smoothed) and frames per second in the viewport's top-right corner,
+/// and whether the editor draws on its own (and why) or only on change.
+fn frame_time_readout(
+    ctx: &egui::Context,
+    viewport: egui::Rect,
+    diagnostics: &DiagnosticsStore,
+    mode: crate::editor::present::redraw::DrawMode,
+) {
     let smoothed = |path| diagnostics.get(path).and_then(bevy::diagnostic::Diagnostic::smoothed);
     let (Some(ms), Some(fps)) =
         (smoothed(&FrameTimeDiagnosticsPlugin::FRAME_TIME), smoothed(&FrameTimeDiagnosticsPlugin::FPS))
@@ -242,7 +250,13 @@ fn frame_time_readout(ctx: &egui::Context, viewport: egui::Rect, diagnostics: &D
     // Pinned by its right edge, so a longer number grows leftwards, never under the panel.
     let corner = viewport.right_top() + egui::vec2(-10.0, 8.0);
     egui::Area::new("frame_time".into()).pivot(egui::Align2::RIGHT_TOP).fixed_pos(corner).show(ctx, |ui| {
-        let text = egui::RichText::new(format!("{ms:.1} ms · {fps:.0} fps")).monospace().color(egui::Color32::WHITE);
+        // Idle, the text stays the same: a text of another size would have egui lay it out
+        // again in a frame of its own, and that frame would change it again.
+        let text = match mode.0 {
+            Some(why) => format!("{ms:>7.1} ms · {fps:>3.0} fps · {why}"),
+            None => "drawn on change".to_string(),
+        };
+        let text = egui::RichText::new(text).monospace().color(egui::Color32::WHITE);
         ui.add(egui::Label::new(text).wrap_mode(egui::TextWrapMode::Extend));
     });
 }
