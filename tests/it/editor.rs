@@ -487,8 +487,17 @@ fn a_frame_sequence_writes_one_picture_per_frame_at_its_time() {
             .output()
             .unwrap();
         assert!(output.status.success(), "{}", String::from_utf8_lossy(&output.stderr));
+        String::from_utf8_lossy(&output.stderr).into_owned()
     };
-    render(&["--from", "0", "--to", "1", "--fps", "10"], &dir.join("frame_%04d.png"));
+    let said = render(&["--from", "0", "--to", "1", "--fps", "10"], &dir.join("frame_%04d.png"));
+    // After the first picture, each is captured in the frame its pose is drawn in (a frame
+    // more where the encoding of earlier pictures holds it back), not after three ready
+    // frames and a readback as before.
+    let per_picture: f64 = said
+        .lines()
+        .find_map(|l| l.strip_suffix(" frames a picture")?.rsplit(", ").next()?.parse().ok())
+        .unwrap_or_else(|| panic!("render reports its frames a picture: {said}"));
+    assert!(per_picture < 2.0, "{per_picture} frames a picture");
     let mut names: Vec<String> =
         std::fs::read_dir(&dir).unwrap().map(|e| e.unwrap().file_name().to_string_lossy().into_owned()).collect();
     names.retain(|n| n.starts_with("frame_"));

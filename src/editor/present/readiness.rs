@@ -90,6 +90,10 @@ pub fn readiness(gpu: &GpuStatus, characters_unskinned: usize, scene_pending: bo
 pub struct CaptureGate {
     ready_frames: u32,
     last_frame: u64,
+    /// Everything the frames need is on the GPU and was drawn: a new picture (a new pose,
+    /// a turned camera) needs only its own frame, and that frame is ready as soon as the
+    /// main world has skinned it.
+    settled: bool,
     /// The last reason not to capture (for a time-out's message).
     pub last_reason: Option<String>,
     /// Set when the frame can never be ready.
@@ -102,13 +106,14 @@ impl CaptureGate {
     pub fn observe(&mut self, frame: u64, readiness: Readiness) {
         match readiness {
             Readiness::Ready => {
-                if frame != self.last_frame {
+                if frame != self.last_frame || self.settled {
                     self.ready_frames += 1;
                 }
                 self.last_reason = None;
             }
             Readiness::Waiting(reason) => {
                 self.ready_frames = 0;
+                self.settled = false;
                 self.last_reason = Some(reason);
             }
             Readiness::Failed(reason) => {
@@ -119,15 +124,25 @@ impl CaptureGate {
         self.last_frame = frame;
     }
 
-    /// Counts ready frames from none again: what is drawn changed (the next frame of a
-    /// sequence), and only frames after the change count.
+    /// Counts ready frames from none again: what is drawn changed (a new pose, from the
+    /// library: its edits land in a later frame), and only frames after the change count.
     pub fn restart(&mut self) {
+        self.ready_frames = 0;
+        self.settled = false;
+    }
+
+    /// The next picture of a sequence is set up (clips at a new time, the camera turned)
+    /// after a capture: once the gate was ready, its first ready frame may be captured
+    /// (its pose is skinned in the frame it is drawn in).
+    pub fn next_picture(&mut self) {
+        self.settled = self.is_ready();
         self.ready_frames = 0;
     }
 
     /// Whether enough ready frames passed in a row.
     pub fn is_ready(&self) -> bool {
-        self.ready_frames >= READY_FRAMES && self.failed.is_none()
+        let needed = if self.settled { 1 } else { READY_FRAMES };
+        self.ready_frames >= needed && self.failed.is_none()
     }
 }
 

@@ -16,7 +16,7 @@ use crate::document::annotate;
 use crate::document::frames::{FrameSequence, PictureRequest, Pictures, frame_path};
 use crate::document::picture;
 use crate::document::scenes::{read_scene, scene_path};
-use crate::editor::present::data::{DataFrame, DataScene};
+use crate::editor::present::data::DataScene;
 use crate::editor::present::readiness::CaptureGate;
 use crate::editor::present::stage;
 use crate::editor::present::view::ViewPlugin;
@@ -41,17 +41,23 @@ struct RenderJob {
     set_up: bool,
     /// Rendered pixels a side of each saved one.
     samples: u32,
-    /// The frame being rendered.
+    /// The picture being set up or captured next (all are captured once it is their count).
     next: usize,
     sequence: Option<FrameSequence>,
     /// The camera's yaw at the first frame (a turntable turns from it).
     first_yaw: Option<f32>,
     target: Handle<Image>,
     started: std::time::Instant,
-    /// The capture of `next` was requested.
-    requested: bool,
-    /// The result of saving `next`, until the next frame is set up.
-    saved: Option<Result<(), String>>,
+    /// Pictures captured whose files are not written yet.
+    in_flight: usize,
+    /// What the threads writing pictures finished with: the picture's index, and its COCO
+    /// image and annotations (with `--data`) or why it could not be written.
+    written: Arc<Mutex<Vec<(usize, Result<Option<CocoPart>, String>)>>>,
+    /// The first failure to write a picture's files.
+    failed_save: Option<String>,
+    /// When the first and the last picture so far were captured, and the app's updates
+    /// between them.
+    captures: Option<(std::time::Instant, std::time::Instant, u64)>,
     /// The result of the whole render, once done.
     done: Option<Result<(), String>>,
     /// Where the result and the messages are left for the caller.
@@ -62,6 +68,9 @@ struct RenderJob {
     /// The saved picture's width and height.
     size: (u32, u32),
 }
+
+/// A picture's COCO image and annotations.
+type CocoPart = (serde_json::Value, Vec<serde_json::Value>);
 
 /// A render's COCO file as it fills, a picture at a time.
 #[derive(Default)]
@@ -154,20 +163,25 @@ pub fn render(
         first_yaw: None,
         target: target.clone(),
         started: std::time::Instant::now(),
-        requested: false,
-        saved: None,
+        in_flight: 0,
+        written: Default::default(),
+        failed_save: None,
+        captures: None,
         done: None,
         outcome: outcome.clone(),
         data,
         size: (width, height),
     });
+    // The sun's shadow map sized for the picture (the editor's is for a window).
+    let shadow_map = stage::shadow_map_for(width * picture.samples, height * picture.samples);
+    app.add_systems(PostStartup, move |mut commands: Commands| commands.insert_resource(shadow_map.clone()));
     app.add_systems(Startup, move |mut commands: Commands| {
         let orbit = OrbitCamera::default();
         commands.spawn((Camera3d::default(), RenderTarget::Image(target.clone().into()), orbit, orbit.transform()));
     });
     app.add_systems(
         Last,
-        (next_frame, pose_frame, capture_when_ready)
+        (capture_when_ready, next_frame, pose_frame)
             .chain()
             .after(crate::editor::present::readiness::UpdateCaptureGate),
     )
@@ -263,40 +277,104 @@ fn capture_when_ready(
         job.done = Some(Err(format!("the render was not ready within {GIVE_UP_SECONDS} s; still pending: {pending}")));
         return;
     }
-    if job.requested || job.saved.is_some() || !job.set_up || !gate.is_ready() {
+    collect_written(&mut job);
+    if let Some(e) = job.failed_save.take() {
+        job.done = Some(Err(e));
         return;
     }
-    job.requested = true;
-    let out = job.frames[job.next].1.clone();
+    if job.next == job.frames.len() {
+        if job.in_flight == 0 {
+            job.done = Some(finish(&mut job));
+        }
+        return;
+    }
+    if let Some((_, _, updates)) = job.captures.as_mut() {
+        *updates += 1;
+    }
+    if !job.set_up || !gate.is_ready() || job.in_flight >= MAX_IN_FLIGHT {
+        return;
+    }
+    let (index, out) = (job.next, job.frames[job.next].1.clone());
     let (samples, background) = (job.samples, stage.background);
     // What the data pictures show is taken now, with the frame the capture draws.
-    let frame = match job.data.is_some().then(|| scene.frame(job.size.0, job.size.1)).transpose() {
+    let mut frame = match job.data.is_some().then(|| scene.frame(job.size.0, job.size.1)).transpose() {
         Ok(frame) => frame,
         Err(e) => {
             job.done = Some(Err(e));
             return;
         }
     };
-    commands.spawn(Screenshot::image(job.target.clone())).observe(
-        move |captured: On<ScreenshotCaptured>, mut job: ResMut<RenderJob>| {
-            let saved = save_picture(&captured.image, samples, &background, &out);
-            job.saved = Some(match &frame {
-                Some(frame) => saved.and_then(|()| write_data(frame, &out, &mut job)),
-                None => saved,
-            });
-            eprintln!("progress: {}/{}", job.next + 1, job.frames.len());
-        },
-    );
+    let written = job.written.clone();
+    commands.spawn(Screenshot::image(job.target.clone())).observe(move |captured: On<ScreenshotCaptured>| {
+        // Encoded and written on a thread of its own while the next pictures are drawn.
+        let (image, out, frame, written) = (captured.image.clone(), out.clone(), frame.take(), written.clone());
+        std::thread::spawn(move || {
+            let result = save_picture(&image, samples, &background, &out)
+                .and_then(|()| frame.map(|f| f.write_beside(&out, index as u64 + 1, 0)).transpose());
+            if let Ok(mut written) = written.lock() {
+                written.push((index, result));
+            }
+        });
+    });
+    // This frame is the one captured: the next picture is set up from the next frame on.
+    job.in_flight += 1;
+    let now = std::time::Instant::now();
+    job.captures = Some(job.captures.map_or((now, now, 0), |(first, _, updates)| (first, now, updates)));
+    job.next += 1;
+    job.set_up = false;
 }
 
-/// Writes the data passes beside the picture `out` and adds it to the COCO file so far.
-fn write_data(frame: &DataFrame, out: &std::path::Path, job: &mut RenderJob) -> Result<(), String> {
-    let image_id = job.next as u64 + 1;
-    let Some(coco) = job.data.as_mut() else { return Ok(()) };
-    let (image, annotations) = frame.write_beside(out, image_id, coco.annotations.len() as u64 + 1)?;
-    coco.images.push(image);
-    coco.annotations.extend(annotations);
-    Ok(())
+/// Pictures captured and not yet written at most (their pixels held in memory).
+const MAX_IN_FLIGHT: usize = 4;
+
+/// Once every picture is written: the COCO file of `--data`, and the pictures' rate.
+fn finish(job: &mut RenderJob) -> Result<(), String> {
+    if let Some((first, last, updates)) = job.captures {
+        let after_first = job.frames.len().saturating_sub(1);
+        let seconds = (last - first).as_secs_f64();
+        if after_first > 0 && updates > 0 {
+            eprintln!(
+                "render: {:.2} pictures a second after the first, a drawn frame {:.0} ms, {:.1} frames a picture",
+                after_first as f64 / seconds,
+                seconds / updates as f64 * 1e3,
+                updates as f64 / after_first as f64
+            );
+        }
+    }
+    match job.data.take() {
+        Some(mut c) => {
+            // Written in any order by the threads: in picture order, annotations numbered.
+            c.images.sort_by_key(|i| i["id"].as_u64());
+            c.annotations.sort_by_key(|a| a["image_id"].as_u64());
+            for (k, annotation) in c.annotations.iter_mut().enumerate() {
+                annotation["id"] = serde_json::json!(k + 1);
+            }
+            annotate::write::json(&c.path, &annotate::coco::file(c.images, c.annotations))
+        }
+        None => Ok(()),
+    }
+}
+
+/// Takes in what the writing threads finished: a picture fewer in flight each, its COCO
+/// part kept, the first failure kept; and says how far the pictures are.
+fn collect_written(job: &mut RenderJob) {
+    let finished = job.written.lock().map(|mut w| std::mem::take(&mut *w)).unwrap_or_default();
+    for (index, result) in finished {
+        job.in_flight -= 1;
+        match result {
+            Ok(Some((image, annotations))) => {
+                if let Some(coco) = job.data.as_mut() {
+                    coco.images.push(image);
+                    coco.annotations.extend(annotations);
+                }
+            }
+            Ok(None) => {}
+            Err(e) => {
+                job.failed_save.get_or_insert(e);
+            }
+        }
+        eprintln!("progress: {}/{}", index + 1, job.frames.len());
+    }
 }
 
 /// The COCO file of a frame sequence: its pattern with `all` for the frame number
@@ -326,10 +404,10 @@ fn clear_behind_gradient(settings: Res<crate::editor::state::StageSettings>, mut
     }
 }
 
-/// Once a frame is saved: the render is done after the last (or a failed save); else every
-/// clip is paused at the next frame's time, a turntable's camera turned to it, and the gate
-/// counts its ready frames afresh (writes `ClipPlayer`, `SmplCharacter`, `NodeClipPlayer`,
-/// `OrbitCamera`, `CaptureGate`).
+/// Sets up the next picture of a sequence once the last was captured: every clip paused at
+/// its time, a turntable's camera turned to it, and the gate told that only the new pose
+/// must be drawn (writes `ClipPlayer`, `SmplCharacter`, `NodeClipPlayer`, `OrbitCamera`,
+/// `CaptureGate`).
 fn next_frame(
     mut job: ResMut<RenderJob>,
     mut gate: ResMut<CaptureGate>,
@@ -338,18 +416,10 @@ fn next_frame(
     mut node_clips: Query<&mut crate::scene::node_clips::NodeClipPlayer>,
     mut cameras: Query<&mut OrbitCamera>,
 ) {
-    let Some(saved) = job.saved.take() else { return };
-    if saved.is_err() || job.next + 1 == job.frames.len() {
-        let coco = job.data.take();
-        job.done = Some(saved.and_then(|()| {
-            coco.map_or(Ok(()), |c| annotate::write::json(&c.path, &annotate::coco::file(c.images, c.annotations)))
-        }));
+    if job.set_up || job.next == 0 || job.next == job.frames.len() {
         return;
     }
     let first_yaw = *job.first_yaw.get_or_insert_with(|| cameras.iter().next().map_or(0.0, |c| c.0.yaw));
-    job.next += 1;
-    job.requested = false;
-    job.set_up = false;
     let FrameAt::Time(t) = job.frames[job.next].0 else { return };
     for mut player in &mut keyframes {
         (player.state.time, player.state.playing) = (t, false);
@@ -363,7 +433,7 @@ fn next_frame(
     if let Some(sequence) = job.sequence.filter(|s| s.turntable.is_some()) {
         cameras.iter_mut().for_each(|mut c| c.0.yaw = first_yaw + sequence.turn_at(t));
     }
-    gate.restart();
+    gate.next_picture();
 }
 
 /// Sets up the frame to render: a pose frame puts the pose on every character that has its
@@ -382,7 +452,7 @@ fn pose_frame(
     mut edits: ResMut<crate::editor::edits::edit::EditQueue>,
     mut assets: ResMut<crate::editor::scene_doc::document::Library>,
 ) {
-    if job.set_up || job.done.is_some() {
+    if job.set_up || job.done.is_some() || job.next == job.frames.len() {
         return;
     }
     job.set_up = true;

@@ -91,6 +91,12 @@ pub fn fit_stage_to_scene(
     }
 }
 
+/// The sun's shadow map for a picture of `width` × `height` pixels: a cascade's side the
+/// power of two at or above the picture's longer side, from 512 to 2048 (the window's).
+pub fn shadow_map_for(width: u32, height: u32) -> DirectionalLightShadowMap {
+    DirectionalLightShadowMap { size: width.max(height).next_power_of_two().clamp(512, 2048) as usize }
+}
+
 /// How far from what it looks at a camera may be for Bevy's default shadow cascades (the
 /// first to 10 m, shadows to 150 m): people seen whole.
 pub const PEOPLE_CAMERA_DISTANCE: f32 = 10.0;
