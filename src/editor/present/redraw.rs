@@ -16,6 +16,18 @@ use crate::scene::node_clips::NodeClipPlayer;
 use crate::scene::playhead::Playhead;
 use crate::scene::smpl::SmplCharacter;
 
+/// The longest the editor may sleep, as a timed job of another room asked this frame (the
+/// autosave, due in so long): the sleep after this frame ends then at the latest.
+#[derive(Resource, Default, Debug)]
+pub struct WakeWithin(Option<std::time::Duration>);
+
+impl WakeWithin {
+    /// Wakes the editor within `within` (the shortest of the frame's asks holds).
+    pub fn ask(&mut self, within: std::time::Duration) {
+        self.0 = Some(self.0.map_or(within, |w| w.min(within)));
+    }
+}
+
 /// Why the editor draws frames unasked (none: it waits for input).
 #[derive(Resource, Default, Debug, Clone, Copy, PartialEq, Eq)]
 pub struct DrawMode(pub Option<&'static str>);
@@ -35,6 +47,7 @@ impl Plugin for RedrawPlugin {
         };
         app.insert_resource(settings)
             .init_resource::<DrawMode>()
+            .init_resource::<WakeWithin>()
             .add_systems(Last, ask_for_frames_while_busy.after(UpdateCaptureGate))
             .add_systems(
                 PreUpdate,
@@ -82,8 +95,18 @@ fn ask_for_frames_while_busy(
     frames: Option<Res<FramesJob>>,
     screenshot: Option<Res<ScreenshotRequest>>,
     mut mode: ResMut<DrawMode>,
+    mut wake: ResMut<WakeWithin>,
+    mut settings: ResMut<WinitSettings>,
     mut redraw: MessageWriter<RequestRedraw>,
 ) {
+    let sleep = wake.0.take().map_or(LONGEST_SLEEP, |w| w.clamp(std::time::Duration::from_millis(1), LONGEST_SLEEP));
+    let wanted = WinitSettings {
+        focused_mode: UpdateMode::reactive(sleep),
+        unfocused_mode: UpdateMode::reactive_low_power(sleep),
+    };
+    if settings.focused_mode != wanted.focused_mode || settings.unfocused_mode != wanted.unfocused_mode {
+        *settings = wanted;
+    }
     let busy = busy_with(&keyframes, &bodies, &node_clips, gate.as_deref(), frames.as_deref(), screenshot.as_deref());
     mode.set_if_neq(DrawMode(busy));
     if busy.is_some() {

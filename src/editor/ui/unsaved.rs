@@ -16,6 +16,7 @@ use bevy::window::{PrimaryWindow, WindowCloseRequested};
 use bevy_egui::{EguiContexts, EguiPrimaryContextPass, egui};
 
 use crate::editor::edits::history::History;
+use crate::editor::present::redraw::WakeWithin;
 use crate::editor::scene_doc::document::{PendingScene, SceneReader, save_scene_to};
 use crate::editor::state::{Messages, SavedState};
 use crate::editor::ui::InspectorState;
@@ -98,7 +99,11 @@ pub const PANIC_AFTER: &str = "MARIONETTE_TEST_PANIC_AFTER_SECONDS";
 
 /// Panics [`PANIC_AFTER`] seconds after the app started, once autosave has captured the
 /// scene (a test's crash).
-fn panic_when_asked(time: Res<Time<Real>>) {
+fn panic_when_asked(time: Res<Time<Real>>, wake: Option<ResMut<WakeWithin>>) {
+    // Awake for it, however idle the editor is.
+    if let Some(mut wake) = wake {
+        wake.ask(Duration::from_millis(500));
+    }
     let after = std::env::var(PANIC_AFTER).ok().and_then(|s| s.parse::<f32>().ok()).unwrap_or(f32::INFINITY);
     let captured = LAST_STATE.lock().is_ok_and(|s| s.is_some());
     if time.elapsed_secs() > after && captured {
@@ -244,10 +249,18 @@ fn autosave_unsaved_scene(
     history: Res<History>,
     scene: SceneReader,
     state: Option<Res<InspectorState>>,
+    wake: Option<ResMut<WakeWithin>>,
 ) {
     let Some(every) = autosave.every else { return };
     let now = history.state();
-    if !saved.unsaved(now, history.gesture_open()) || autosave.last.elapsed() < every || autosave.written == Some(now) {
+    if !saved.unsaved(now, history.gesture_open()) || autosave.written == Some(now) {
+        return;
+    }
+    if autosave.last.elapsed() < every {
+        // The editor sleeps when idle: awake when this autosave is due.
+        if let Some(mut wake) = wake {
+            wake.ask(every - autosave.last.elapsed());
+        }
         return;
     }
     autosave.last = Instant::now();
