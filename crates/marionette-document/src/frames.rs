@@ -52,6 +52,19 @@ impl FrameSequence {
 /// The path of frame `n` from `pattern`: its one `%d` or `%0Nd` (N digits, zero-padded)
 /// replaced by `n`. Refused without exactly one.
 pub fn frame_path(pattern: &Path, n: usize) -> Result<PathBuf, String> {
+    let (start, width, tail) = pattern_parts(pattern)?;
+    Ok(PathBuf::from(format!("{start}{n:0width$}{tail}")))
+}
+
+/// The file a whole sequence shares (its COCO file): the pattern with `all` for the frame
+/// number and `extension` for its own (`f_%04d.png`, `json` → `f_all.json`).
+pub fn sequence_path(pattern: &Path, extension: &str) -> Result<PathBuf, String> {
+    let (start, _, tail) = pattern_parts(pattern)?;
+    Ok(PathBuf::from(format!("{start}all{tail}")).with_extension(extension))
+}
+
+/// A pattern's text before its `%d` (or `%04d`), the number's width, and the text after.
+fn pattern_parts(pattern: &Path) -> Result<(String, usize, String), String> {
     let text = pattern.to_string_lossy();
     let expected = || format!("expected one %d or %04d in --out for the frame number, found {text}");
     let (start, rest) = text.split_once('%').ok_or_else(expected)?;
@@ -62,8 +75,7 @@ pub fn frame_path(pattern: &Path, n: usize) -> Result<PathBuf, String> {
     if !valid_width || tail.contains('%') {
         return Err(expected());
     }
-    let width: usize = width.parse().unwrap_or(0);
-    Ok(PathBuf::from(format!("{start}{n:0width$}{tail}")))
+    Ok((start.to_string(), width.parse().unwrap_or(0), tail.to_string()))
 }
 
 /// The picture's size and samples asked for on the command line (each none: the scene's).
@@ -105,7 +117,7 @@ pub enum Pictures {
 mod tests {
     use std::path::Path;
 
-    use super::{FrameSequence, frame_path};
+    use super::{FrameSequence, frame_path, sequence_path};
 
     /// Frame sequences: 0 to 1 s at 10 fps is 11 frames at k/10 s; a turntable turns once per
     /// period; the file pattern takes one `%d` or `%0Nd`; nonsense is refused with a message.
@@ -120,6 +132,7 @@ mod tests {
         assert_eq!(thirds.times().unwrap().len(), 4, "1 s at 3 fps: 0, 1/3, 2/3, 1");
         assert_eq!(frame_path(Path::new("out/frame_%04d.png"), 7).unwrap(), Path::new("out/frame_0007.png"));
         assert_eq!(frame_path(Path::new("f%d.png"), 12).unwrap(), Path::new("f12.png"));
+        assert_eq!(sequence_path(Path::new("out/f_%04d.png"), "json").unwrap(), Path::new("out/f_all.json"));
         for bad in ["frame.png", "f_%x.png", "f_%04d_%d.png", "f_%4d.png"] {
             let e = frame_path(Path::new(bad), 0).unwrap_err();
             assert!(e.contains("expected one %d or %04d"), "{bad}: {e}");

@@ -60,7 +60,6 @@ impl Plugin for RedrawPlugin {
 
 /// What keeps the editor drawing, if anything: the first of a playing clip, the renderer
 /// getting ready, a frames job, a screenshot under way.
-#[allow(clippy::too_many_arguments)]
 pub fn busy_with(
     keyframes: &Query<&ClipPlayer>,
     bodies: &Query<&SmplCharacter>,

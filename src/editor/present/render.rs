@@ -13,7 +13,7 @@ use bevy::render::view::screenshot::{Screenshot, ScreenshotCaptured};
 
 use crate::document::AssetLibrary;
 use crate::document::annotate;
-use crate::document::frames::{FrameSequence, PictureRequest, Pictures, frame_path};
+use crate::document::frames::{FrameSequence, PictureRequest, Pictures, frame_path, sequence_path};
 use crate::document::picture;
 use crate::document::scenes::{read_scene, scene_path};
 use crate::editor::present::data::DataScene;
@@ -106,7 +106,7 @@ pub fn render(
     let data = match (data, pictures) {
         (false, _) => None,
         (true, Pictures::PoseSheet) => return Err("--data: a contact sheet of poses carries no data".into()),
-        (true, Pictures::Sequence(_)) => Some(CocoSoFar { path: sequence_path(&out)?, ..default() }),
+        (true, Pictures::Sequence(_)) => Some(CocoSoFar { path: sequence_path(&out, "json")?, ..default() }),
         (true, Pictures::Still) => Some(CocoSoFar { path: annotate::write::beside(&out, "json"), ..default() }),
     };
     let (library, shot, poses) = preload(&paths, &edits)?;
@@ -375,15 +375,6 @@ fn collect_written(job: &mut RenderJob) {
         }
         eprintln!("progress: {}/{}", index + 1, job.frames.len());
     }
-}
-
-/// The COCO file of a frame sequence: its pattern with `all` for the frame number
-/// (`f_%04d.png` → `f_all.json`).
-fn sequence_path(pattern: &std::path::Path) -> Result<PathBuf, String> {
-    let text = pattern.to_string_lossy();
-    let (start, rest) = text.split_once('%').ok_or_else(|| format!("expected a %d in {text}"))?;
-    let tail = rest.split_once('d').map_or("", |(_, t)| t);
-    Ok(annotate::write::beside(std::path::Path::new(&format!("{start}all{tail}")), "json"))
 }
 
 /// The captured pixels averaged down from their samples, over the background, as PNG.
