@@ -114,6 +114,10 @@ pub enum Command {
         #[arg(long)]
         no_draw: bool,
     },
+    /// Render a data set: pictures (and their data) of scenes drawn from a spec, each
+    /// picture's depending only on the spec's seed and its number; sharded over machines,
+    /// resumable. `generate --example` prints a spec to start from.
+    Generate(GenerateArgs),
     /// Rebuild the project's own characters into a folder (normally `assets`).
     GenAssets {
         #[arg(default_value = "assets")]
@@ -370,4 +374,35 @@ pub fn finite_seconds(text: &str) -> Result<f32, String> {
         Ok(t) if t.is_finite() => Ok(t),
         _ => Err(format!("expected a finite number of seconds, found `{text}`")),
     }
+}
+
+/// `generate`.
+#[derive(clap::Args, Debug, Clone)]
+pub struct GenerateArgs {
+    /// The spec (RON): what varies from picture to picture and how.
+    #[arg(required_unless_present_any = ["example", "merge"])]
+    pub spec: Option<PathBuf>,
+    /// The data set's folder: `000000.png` (and its data and scene) for picture 0, ...
+    #[arg(long, required_unless_present_any = ["example", "merge"])]
+    pub out: Option<PathBuf>,
+    /// Render the pictures k with k mod N = I (I from 0). Without it: a Slurm job array's
+    /// task (SLURM_ARRAY_TASK_ID of SLURM_ARRAY_TASK_COUNT), a Kubernetes Indexed Job's
+    /// (JOB_COMPLETION_INDEX of --shards), else all.
+    #[arg(long, value_name = "I/N")]
+    pub shard: Option<String>,
+    /// How many shards a Kubernetes Indexed Job runs (its completions).
+    #[arg(long, value_name = "N")]
+    pub shards: Option<usize>,
+    /// How many pictures, in place of the spec's count.
+    #[arg(long)]
+    pub count: Option<usize>,
+    /// Print each picture's scene instead of rendering.
+    #[arg(long)]
+    pub dry_run: bool,
+    /// Print a commented example spec (built-in puppets only) and exit.
+    #[arg(long, conflicts_with_all = ["spec", "merge"])]
+    pub example: bool,
+    /// Join the COCO files of every picture a data set's folder holds into DIR/coco.json.
+    #[arg(long, value_name = "DIR", conflicts_with = "spec")]
+    pub merge: Option<PathBuf>,
 }

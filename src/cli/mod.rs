@@ -5,6 +5,7 @@
 pub mod args;
 pub mod bind;
 pub mod export;
+pub mod generate;
 pub mod smpl;
 pub mod smpl_tasks;
 

@@ -13,6 +13,7 @@ mod editor;
 mod edits;
 mod fbx;
 mod fuzz;
+mod generate;
 mod gizmo;
 mod gltf;
 mod gltf_fuzz;

@@ -76,6 +76,9 @@ pub(crate) struct Side {
     pub(crate) leg: f32,
     /// The hips' height over the lowest point standing in the initial pose.
     pub(crate) standing: f32,
+    /// The hips' height over the floor with the legs hanging straight down: the hips over
+    /// the thighs, the thigh and shin lengths, and the ankle over the floor at rest.
+    pub(crate) straight: f32,
 }
 
 pub(crate) fn side(library: &mut AssetLibrary, doc: &CharacterDoc, floor: f32) -> Side {
@@ -86,8 +89,18 @@ pub(crate) fn side(library: &mut AssetLibrary, doc: &CharacterDoc, floor: f32) -
     use HumanBone::*;
     let leg = |u, l, f| at[map[&u]].distance(at[map[&l]]) + at[map[&l]].distance(at[map[&f]]);
     let leg = (leg(LeftUpperLeg, LeftLowerLeg, LeftFoot) + leg(RightUpperLeg, RightLowerLeg, RightFoot)) / 2.0;
-    let standing = at[map[&Hips]].y - marionette::document::retarget::floor_of(&asset);
-    Side { asset, map, floor, leg, standing }
+    let rest_floor = marionette::document::retarget::floor_of(&asset);
+    let standing = at[map[&Hips]].y - rest_floor;
+    let straight = |u, l, f| {
+        at[map[&Hips]].y - at[map[&u]].y
+            + at[map[&u]].distance(at[map[&l]])
+            + at[map[&l]].distance(at[map[&f]])
+            + at[map[&f]].y
+            - rest_floor
+    };
+    let straight =
+        (straight(LeftUpperLeg, LeftLowerLeg, LeftFoot) + straight(RightUpperLeg, RightLowerLeg, RightFoot)) / 2.0;
+    Side { asset, map, floor, leg, standing, straight }
 }
 
 /// Whether `j` lies below `ancestor`.

@@ -8,10 +8,12 @@
 //! mapped bone with a mapped child within 2° of the source's direction (but a leg moved to
 //! keep its foot above the floor), the target's lowest point within 2 % of its leg of its
 //! floor in the frames where the source stands on its own, never below it, and the hips'
-//! height over the floor as a share of the standing height within 15 % of the source's.
-//! That share and the hips' height against the source's times the leg ratio are printed:
-//! with the feet on the floor they differ from 1 by as much as the rigs' proportions and
-//! rest poses differ (pelvis and ankle heights over the leg's length, legs apart at rest).
+//! height over the floor within 5 % of the source's times the ratio of their heights standing
+//! on straight legs (the hips over the thighs, thigh, shin and the ankle over the floor).
+//! The feet on the floor come first: the hips go where the target's own legs, aimed as the
+//! source's, put them, which differs from that ratio as the rigs' feet and pelvises differ
+//! in proportion. That ratio, the share of the standing height, and the hips against the
+//! source's times the thigh-and-shin ratio are printed.
 
 use std::path::{Path, PathBuf};
 
@@ -143,6 +145,7 @@ struct Figures {
     worst: (f32, String),
     hips: (f32, f32),
     hips_by_leg: (f32, f32),
+    by_straight: (f32, f32),
     standing: (f32, f32),
     lowest: f32,
 }
@@ -165,8 +168,14 @@ fn measure(s: &Side, source: &[Frame], t: &Side, report: &Retargeted) -> Figures
     ];
     let ratio = t.leg / s.leg;
     let range = (f32::MAX, f32::MIN);
-    let mut f =
-        Figures { worst: (0.0, String::new()), hips: range, hips_by_leg: range, standing: range, lowest: f32::MAX };
+    let mut f = Figures {
+        worst: (0.0, String::new()),
+        hips: range,
+        hips_by_leg: range,
+        by_straight: range,
+        standing: range,
+        lowest: f32::MAX,
+    };
     for (k, (sf, tf)) in source.iter().zip(target).enumerate() {
         let (_, sa) = world_frames(&s.asset.skeleton, sf.root, &sf.pose);
         let (_, ta) = world_frames(&t.asset.skeleton, tf.root, &tf.pose);
@@ -190,6 +199,8 @@ fn measure(s: &Side, source: &[Frame], t: &Side, report: &Retargeted) -> Figures
         let hips = (t_hips / t.standing) / (s_hips / s.standing);
         f.hips = (f.hips.0.min(hips), f.hips.1.max(hips));
         let by_leg = t_hips / (s_hips * ratio);
+        let by_straight = t_hips / (s_hips * t.straight / s.straight);
+        f.by_straight = (f.by_straight.0.min(by_straight), f.by_straight.1.max(by_straight));
         f.hips_by_leg = (f.hips_by_leg.0.min(by_leg), f.hips_by_leg.1.max(by_leg));
         let target_low = (lowest(t, tf) - t.floor) / t.leg;
         f.lowest = f.lowest.min(target_low);
@@ -222,7 +233,7 @@ fn carry_onto(targets: Vec<CharacterDoc>, library: &mut AssetLibrary) {
             let (s, t) = (side(library, &source, done.floors.0), side(library, target, done.floors.1));
             let f = measure(&s, &done.source_frames, &t, &done.report);
             eprintln!(
-                "{bvh} → {}: worst bone {:.2}° ({}), hips over standing against the source's {:.4}–{:.4} (over the source's × leg ratio {:.4}–{:.4}), lowest point where the source stands {:+.4}–{:+.4} legs, lowest {:+.4}",
+                "{bvh} → {}: worst bone {:.2}° ({}), hips over standing against the source's {:.4}–{:.4} (over the source's × leg ratio {:.4}–{:.4}, × straight {:.4}–{:.4}), lowest point where the source stands {:+.4}–{:+.4} legs, lowest {:+.4}",
                 target.name,
                 f.worst.0,
                 f.worst.1,
@@ -230,13 +241,15 @@ fn carry_onto(targets: Vec<CharacterDoc>, library: &mut AssetLibrary) {
                 f.hips.1,
                 f.hips_by_leg.0,
                 f.hips_by_leg.1,
+                f.by_straight.0,
+                f.by_straight.1,
                 f.standing.0,
                 f.standing.1,
                 f.lowest
             );
             let ok = f.worst.0 < 2.0
-                && f.hips.0 > 0.85
-                && f.hips.1 < 1.15
+                && f.by_straight.0 > 0.95
+                && f.by_straight.1 < 1.05
                 && f.standing.0 <= f.standing.1
                 && f.standing.1 < 0.02
                 && f.lowest > -1e-3;

@@ -9,6 +9,7 @@ pub mod crowd;
 pub mod default_scene;
 pub mod export;
 pub mod frames;
+pub mod generate;
 pub mod layout;
 pub mod library;
 pub mod options;

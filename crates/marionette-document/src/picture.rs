@@ -49,22 +49,35 @@ pub fn downsampled(rendered: &RgbaImage, samples: u32) -> RgbaImage {
 /// `drawn` over the background: a gradient fills behind it (composited in linear light);
 /// a transparent background keeps the alpha (an RGBA picture); any other is already in
 /// the picture (an RGB one).
+/// `drawn` (RGBA, sRGB) over the colour (sRGB) `behind` gives each pixel, blended in linear
+/// light; opaque.
+fn composite(drawn: RgbaImage, behind: impl Fn(u32, u32) -> [f32; 3]) -> DynamicImage {
+    let mut out = drawn;
+    for (x, y, p) in out.enumerate_pixels_mut() {
+        let alpha = p.0[3] as f32 / 255.0;
+        for (c, back) in p.0.iter_mut().zip(behind(x, y)) {
+            let front = to_linear(*c as f32 / 255.0);
+            *c = byte(to_srgb(front * alpha + to_linear(back) * (1.0 - alpha)));
+        }
+        p.0[3] = 255;
+    }
+    DynamicImage::ImageRgb8(DynamicImage::ImageRgba8(out).to_rgb8())
+}
+
+/// `drawn` over the picture `behind`, scaled to fill the frame (its middle kept where the
+/// shapes differ); opaque. A picture already opaque is returned as it is.
+pub fn over_picture(drawn: DynamicImage, behind: &DynamicImage) -> DynamicImage {
+    let (w, h) = (drawn.width(), drawn.height());
+    let filled = behind.resize_to_fill(w, h, image::imageops::FilterType::Triangle).to_rgb8();
+    composite(drawn.to_rgba8(), |x, y| filled.get_pixel(x, y).0.map(|c| c as f32 / 255.0))
+}
+
 pub fn over_background(drawn: RgbaImage, background: &BackgroundDoc) -> DynamicImage {
     match background {
         BackgroundDoc::Transparent => DynamicImage::ImageRgba8(drawn),
         BackgroundDoc::Gradient { .. } => {
             let height = drawn.height().max(2) - 1;
-            let mut out = drawn;
-            for (_, y, p) in out.enumerate_pixels_mut() {
-                let (behind, _) = background.at(y as f32 / height as f32);
-                let alpha = p.0[3] as f32 / 255.0;
-                for (c, back) in p.0.iter_mut().zip(behind) {
-                    let front = to_linear(*c as f32 / 255.0);
-                    *c = byte(to_srgb(front * alpha + to_linear(back) * (1.0 - alpha)));
-                }
-                p.0[3] = 255;
-            }
-            DynamicImage::ImageRgb8(DynamicImage::ImageRgba8(out).to_rgb8())
+            composite(drawn, |_, y| background.at(y as f32 / height as f32).0)
         }
         BackgroundDoc::Sky | BackgroundDoc::Color(_) => {
             DynamicImage::ImageRgb8(DynamicImage::ImageRgba8(drawn).to_rgb8())

@@ -23,7 +23,7 @@ use crate::editor::present::view::ViewPlugin;
 use crate::editor::scene_doc::document::Library;
 use crate::editor::state::camera::OrbitCamera;
 use crate::editor::state::{Messages, StartupEdits, StartupPaths};
-use crate::formats::scene::{BackgroundDoc, BindingDoc, ShotDoc, SourceDoc};
+use crate::formats::scene::{BackgroundDoc, BindingDoc, SceneDoc, ShotDoc, SourceDoc};
 use crate::formats::scene::{MotionSourceDoc, RetargetDoc};
 use crate::scene::{RigCorePlugin, SkinningPlugin};
 
@@ -35,8 +35,8 @@ const GIVE_UP_SECONDS: u64 = 300;
 /// puts the clips (and a turntable's camera) at the next frame's time.
 #[derive(Resource)]
 struct RenderJob {
-    /// What each picture shows and its file.
-    frames: Vec<(FrameAt, PathBuf)>,
+    /// What each picture shows, its file and the rest of what it needs.
+    frames: Vec<Frame>,
     /// The frame `next` shows what it should (its pose applied).
     set_up: bool,
     /// Rendered pixels a side of each saved one.
@@ -67,6 +67,39 @@ struct RenderJob {
     data: Option<CocoSoFar>,
     /// The saved picture's width and height.
     size: (u32, u32),
+    /// Each picture's data carries a COCO file of its own (a data set's), not a share of one
+    /// for the whole render.
+    coco_per_picture: bool,
+    /// Called with a picture's index once its files are written (a data set's manifest).
+    on_written: Option<OnWritten>,
+}
+
+/// What is called with a picture's index once its files are written.
+pub type OnWritten = Box<dyn FnMut(usize) -> Result<(), String> + Send + Sync>;
+
+/// One picture of a render: what it shows, its file, its COCO ids (the image's, the first
+/// annotation's) and a picture to put behind it.
+struct Frame {
+    at: FrameAt,
+    out: PathBuf,
+    ids: (u64, u64),
+    backdrop: Option<PathBuf>,
+}
+
+impl Frame {
+    /// The `index`-th picture of a render: COCO ids numbered from it.
+    fn new(at: FrameAt, out: PathBuf, index: usize) -> Self {
+        Frame { at, out, ids: (index as u64 + 1, 0), backdrop: None }
+    }
+}
+
+/// One picture of a data set: its scene (sources resolved), its file, its COCO ids (the
+/// image's, the first annotation's) and a picture filling the frame behind it.
+pub struct ScenePicture {
+    pub scene: SceneDoc,
+    pub out: PathBuf,
+    pub ids: (u64, u64),
+    pub backdrop: Option<PathBuf>,
 }
 
 /// A picture's COCO image and annotations.
@@ -89,6 +122,8 @@ enum FrameAt {
     Time(f32),
     /// Every character in this pose of the scene's library.
     Pose(String),
+    /// This scene, in place of the last.
+    Scene(Box<SceneDoc>),
 }
 
 /// Renders `paths` (a scene `.ron`, character files, or the default scene when empty) into
@@ -132,11 +167,72 @@ pub fn render(
         }
     };
     let picture = picture.resolved(&shot)?;
-    let (width, height) = (picture.width, picture.height);
     for out in frames.iter().map(|f| &f.1).chain([&out]) {
         crate::formats::error::refuse_overwriting_input(out).map_err(|e| e.to_string())?;
     }
     let cell_files: Vec<PathBuf> = frames.iter().map(|f| f.1.clone()).collect();
+    let frames = frames.into_iter().enumerate().map(|(k, (at, out))| Frame::new(at, out, k)).collect();
+    let setup = JobSetup { paths, library, edits, picture, frames, sequence, data, on_written: None };
+    let done = run_job(setup);
+    let done = match (pictures, done) {
+        (Pictures::PoseSheet, Ok(messages)) => contact_sheet(&cell_files, &out).map(|()| messages),
+        (_, done) => done,
+    };
+    if pictures == Pictures::PoseSheet {
+        let _ = std::fs::remove_dir_all(&cells);
+    }
+    done.map(|messages| (messages, picture))
+}
+
+/// Renders a data set's pictures, each its own scene, in one app: `first_scene` (the file
+/// of the first picture's scene) opens it; every picture after loads its scene in place of
+/// the last. Each picture's data (with `data`) carries its own COCO file; `on_written` is
+/// called with a picture's index once its files are written. Returns the notes.
+pub fn render_scenes(
+    first_scene: PathBuf,
+    library: AssetLibrary,
+    pictures: Vec<ScenePicture>,
+    picture: ShotDoc,
+    data: bool,
+    on_written: OnWritten,
+) -> Result<Vec<String>, String> {
+    let frames = pictures
+        .into_iter()
+        .map(|p| Frame { at: FrameAt::Scene(Box::new(p.scene)), out: p.out, ids: p.ids, backdrop: p.backdrop })
+        .collect();
+    let edits = StartupEdits { still: true, ..default() };
+    let data = data.then(CocoSoFar::default);
+    let setup = JobSetup {
+        paths: vec![first_scene],
+        library,
+        edits,
+        picture,
+        frames,
+        sequence: None,
+        data,
+        on_written: Some(on_written),
+    };
+    run_job(setup)
+}
+
+/// What a render's app is made from.
+struct JobSetup {
+    paths: Vec<PathBuf>,
+    library: AssetLibrary,
+    edits: StartupEdits,
+    picture: ShotDoc,
+    frames: Vec<Frame>,
+    sequence: Option<FrameSequence>,
+    /// `--data`: where the COCO file goes (none for a data set: a file per picture).
+    data: Option<CocoSoFar>,
+    on_written: Option<OnWritten>,
+}
+
+/// Builds the render's app, runs it until every picture is written or it fails, and
+/// returns the notes or what went wrong.
+fn run_job(setup: JobSetup) -> Result<Vec<String>, String> {
+    let JobSetup { paths, library, edits, picture, frames, sequence, data, on_written } = setup;
+    let (width, height) = (picture.width, picture.height);
     let mut app = App::new();
     app.add_plugins(crate::editor::windowless_plugins())
         .add_plugins(ScheduleRunnerPlugin::run_loop(Duration::from_millis(2)))
@@ -154,6 +250,7 @@ pub fn render(
         images.add(image)
     };
     let outcome = Arc::new(Mutex::new((None, Vec::new())));
+    let coco_per_picture = data.as_ref().is_some_and(|c| c.path.as_os_str().is_empty());
     app.insert_resource(RenderJob {
         frames,
         set_up: false,
@@ -171,6 +268,8 @@ pub fn render(
         outcome: outcome.clone(),
         data,
         size: (width, height),
+        coco_per_picture,
+        on_written,
     });
     // The sun's shadow map sized for the picture (the editor's is for a window).
     let shadow_map = stage::shadow_map_for(width * picture.samples, height * picture.samples);
@@ -181,7 +280,7 @@ pub fn render(
     });
     app.add_systems(
         Last,
-        (capture_when_ready, next_frame, pose_frame)
+        (capture_when_ready, next_frame, scene_frame, pose_frame)
             .chain()
             .after(crate::editor::present::readiness::UpdateCaptureGate),
     )
@@ -189,16 +288,8 @@ pub fn render(
     let exit = app.run();
     // `App::run` hands the world to the runner: the outcome comes back through `outcome`.
     let (done, messages) = outcome.lock().map(|o| o.clone()).unwrap_or_default();
-
-    let done = match (pictures, done) {
-        (Pictures::PoseSheet, Some(Ok(()))) => Some(contact_sheet(&cell_files, &out)),
-        (_, done) => done,
-    };
-    if pictures == Pictures::PoseSheet {
-        let _ = std::fs::remove_dir_all(&cells);
-    }
     match (exit, done) {
-        (AppExit::Success, Some(Ok(()))) => Ok((messages, picture)),
+        (AppExit::Success, Some(Ok(()))) => Ok(messages),
         (_, Some(Err(e))) => Err(e),
         _ => Err("the render stopped before a picture was captured".to_string()),
     }
@@ -294,8 +385,9 @@ fn capture_when_ready(
     if !job.set_up || !gate.is_ready() || job.in_flight >= MAX_IN_FLIGHT {
         return;
     }
-    let (index, out) = (job.next, job.frames[job.next].1.clone());
-    let (samples, background) = (job.samples, stage.background);
+    let (index, frame_now) = (job.next, &job.frames[job.next]);
+    let (out, ids, backdrop) = (frame_now.out.clone(), frame_now.ids, frame_now.backdrop.clone());
+    let (samples, background, coco_per_picture) = (job.samples, stage.background, job.coco_per_picture);
     // What the data pictures show is taken now, with the frame the capture draws.
     let mut frame = match job.data.is_some().then(|| scene.frame(job.size.0, job.size.1)).transpose() {
         Ok(frame) => frame,
@@ -308,9 +400,17 @@ fn capture_when_ready(
     commands.spawn(Screenshot::image(job.target.clone())).observe(move |captured: On<ScreenshotCaptured>| {
         // Encoded and written on a thread of its own while the next pictures are drawn.
         let (image, out, frame, written) = (captured.image.clone(), out.clone(), frame.take(), written.clone());
+        let backdrop = backdrop.clone();
         std::thread::spawn(move || {
-            let result = save_picture(&image, samples, &background, &out)
-                .and_then(|()| frame.map(|f| f.write_beside(&out, index as u64 + 1, 0)).transpose());
+            let result = save_picture(&image, samples, &background, backdrop.as_deref(), &out).and_then(|()| {
+                let Some(frame) = frame else { return Ok(None) };
+                let (image, annotations) = frame.write_beside(&out, ids.0, ids.1)?;
+                if !coco_per_picture {
+                    return Ok(Some((image, annotations)));
+                }
+                let coco = annotate::coco::file(vec![image], annotations);
+                annotate::write::json(&annotate::write::beside(&out, "json"), &coco).map(|()| None)
+            });
             if let Ok(mut written) = written.lock() {
                 written.push((index, result));
             }
@@ -341,7 +441,7 @@ fn finish(job: &mut RenderJob) -> Result<(), String> {
             );
         }
     }
-    match job.data.take() {
+    match job.data.take().filter(|_| !job.coco_per_picture) {
         Some(mut c) => {
             // Written in any order by the threads: in picture order, annotations numbered.
             c.images.sort_by_key(|i| i["id"].as_u64());
@@ -371,16 +471,35 @@ fn collect_written(job: &mut RenderJob) {
             Ok(None) => {}
             Err(e) => {
                 job.failed_save.get_or_insert(e);
+                continue;
             }
         }
-        eprintln!("progress: {}/{}", index + 1, job.frames.len());
+        match job.on_written.as_mut() {
+            Some(on_written) => {
+                if let Err(e) = on_written(index) {
+                    job.failed_save.get_or_insert(e);
+                }
+            }
+            None => eprintln!("progress: {}/{}", index + 1, job.frames.len()),
+        }
     }
 }
 
-/// The captured pixels averaged down from their samples, over the background, as PNG.
-fn save_picture(image: &Image, samples: u32, background: &BackgroundDoc, out: &std::path::Path) -> Result<(), String> {
+/// The captured pixels averaged down from their samples, over the background (and over
+/// `backdrop`, a picture filling the frame), as PNG.
+fn save_picture(
+    image: &Image,
+    samples: u32,
+    background: &BackgroundDoc,
+    backdrop: Option<&std::path::Path>,
+    out: &std::path::Path,
+) -> Result<(), String> {
     let rendered = image.clone().try_into_dynamic().map_err(|e| format!("unreadable capture: {e}"))?.to_rgba8();
-    let picture = picture::over_background(picture::downsampled(&rendered, samples), background);
+    let mut picture = picture::over_background(picture::downsampled(&rendered, samples), background);
+    if let Some(path) = backdrop {
+        let behind = image::open(path).map_err(|e| format!("{}: {e}", path.display()))?;
+        picture = picture::over_picture(picture, &behind);
+    }
     let mut bytes = Vec::new();
     picture.write_to(&mut std::io::Cursor::new(&mut bytes), image::ImageFormat::Png).map_err(|e| e.to_string())?;
     crate::formats::write_atomically(out, |w| std::io::Write::write_all(w, &bytes))
@@ -411,7 +530,7 @@ fn next_frame(
         return;
     }
     let first_yaw = *job.first_yaw.get_or_insert_with(|| cameras.iter().next().map_or(0.0, |c| c.0.yaw));
-    let FrameAt::Time(t) = job.frames[job.next].0 else { return };
+    let FrameAt::Time(t) = job.frames[job.next].at else { return };
     for mut player in &mut keyframes {
         (player.state.time, player.state.playing) = (t, false);
     }
@@ -425,6 +544,25 @@ fn next_frame(
         cameras.iter_mut().for_each(|mut c| c.0.yaw = first_yaw + sequence.turn_at(t));
     }
     gate.next_picture();
+}
+
+/// Sets up a data set's next picture: its scene opened in place of the last (the first is
+/// the one the app opened with), and the gate counts afresh (writes `PendingScene`,
+/// `CaptureGate`).
+fn scene_frame(
+    mut job: ResMut<RenderJob>,
+    mut gate: ResMut<CaptureGate>,
+    mut pending: ResMut<crate::editor::scene_doc::document::PendingScene>,
+) {
+    if job.set_up || job.done.is_some() || job.next == job.frames.len() {
+        return;
+    }
+    let FrameAt::Scene(doc) = &job.frames[job.next].at else { return };
+    if job.next > 0 {
+        *pending = crate::editor::scene_doc::document::PendingScene { frame: false, doc: Some((**doc).clone()) };
+        gate.restart();
+    }
+    job.set_up = true;
 }
 
 /// Sets up the frame to render: a pose frame puts the pose on every character that has its
@@ -447,7 +585,7 @@ fn pose_frame(
         return;
     }
     job.set_up = true;
-    let FrameAt::Pose(name) = &job.frames[job.next].0 else { return };
+    let FrameAt::Pose(name) = &job.frames[job.next].at else { return };
     let Some(pose) = library.0.get(name) else { return };
     let joints: Vec<_> = pose.joints.iter().map(|(k, r)| (k.clone(), *r)).collect();
     let rig = pose.rig.as_ref().and_then(|rig| assets.rig(rig).ok());

@@ -1,0 +1,109 @@
+//! `generate`'s plan, before the app renders: the spec read and checked, the shard and
+//! the pictures it still lacks, each picture's scene drawn and written beside where its
+//! picture goes; `--example`, `--dry-run` and `--merge`; and each written picture's line in
+//! the shard's manifest. No Bevy: `main.rs` hands the plan to the render.
+
+use std::path::{Path, PathBuf};
+
+use anyhow::{Context, Result, anyhow};
+
+use crate::cli::args::GenerateArgs;
+use crate::document::AssetLibrary;
+use crate::document::generate::{self, ManifestLine, Shard, Spec, picture_stem, scene_of};
+use crate::document::scenes::{read_scene, write_scene};
+use crate::formats::scene::{SceneDoc, ShotDoc};
+
+/// What the app renders for a shard.
+pub struct Plan {
+    pub dir: PathBuf,
+    pub spec: Spec,
+    pub shard: Shard,
+    /// The pictures to render: their numbers and scenes (as their files read back), and
+    /// the picture to put behind each.
+    pub pictures: Vec<(usize, SceneDoc, Option<PathBuf>)>,
+    /// The pictures the folder already holds whole, of this shard.
+    pub finished: usize,
+    /// The files every scene names, loaded.
+    pub library: AssetLibrary,
+}
+
+impl Plan {
+    pub fn picture(&self) -> ShotDoc {
+        ShotDoc { width: self.spec.width, height: self.spec.height, samples: 1 }
+    }
+
+    /// The file of picture `k`.
+    pub fn out(&self, k: usize) -> PathBuf {
+        self.dir.join(format!("{}.png", picture_stem(k)))
+    }
+
+    /// The file of picture `k`'s scene.
+    pub fn scene_file(&self, k: usize) -> PathBuf {
+        scene_file(&self.dir, k)
+    }
+
+    /// Writes picture `k`'s line into the shard's manifest (its files and their digests).
+    pub fn record(&self, k: usize) -> Result<ManifestLine, String> {
+        let line = generate::manifest_line(&self.dir, k)?;
+        generate::append_manifest(&self.dir.join(self.shard.manifest_name()), &line)?;
+        Ok(line)
+    }
+}
+
+fn scene_file(dir: &Path, k: usize) -> PathBuf {
+    dir.join(format!("{}.scene.ron", picture_stem(k)))
+}
+
+/// What `generate` does besides rendering: prints the example, merges, or prints the
+/// scenes of a dry run (then `None`); else the plan of what to render.
+pub fn plan(args: &GenerateArgs) -> Result<Option<Plan>> {
+    if args.example {
+        print!("{}", generate::EXAMPLE);
+        return Ok(None);
+    }
+    if let Some(dir) = &args.merge {
+        let n = generate::merge(dir).map_err(anyhow::Error::msg)?;
+        println!("wrote {} ({n} pictures)", dir.join("coco.json").display());
+        return Ok(None);
+    }
+    let (Some(spec_path), Some(dir)) = (&args.spec, &args.out) else {
+        return Err(anyhow!("generate: expected SPEC and --out DIR"));
+    };
+    let mut spec = generate::read_spec(spec_path)?;
+    if let Some(count) = args.count {
+        spec.count = count;
+        spec.check().map_err(|e| anyhow!("--count: {e}"))?;
+    }
+    let shard = Shard::from_environment(args.shard.as_deref(), args.shards, |k| std::env::var(k).ok())
+        .map_err(anyhow::Error::msg)?;
+    let mut library = AssetLibrary::default();
+    if args.dry_run {
+        for k in shard.pictures(spec.count) {
+            let (scene, backdrop) = scene_of(&spec, &mut library, k as u64).map_err(anyhow::Error::msg)?;
+            let text = crate::formats::scene::scene_to_string(&scene)?;
+            let behind = backdrop.map_or(String::new(), |b| format!(" over {}", b.display()));
+            println!("// picture {k}{behind}\n{text}");
+        }
+        return Ok(None);
+    }
+    std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
+    let done = generate::finished_pictures(dir);
+    let mut pictures = Vec::new();
+    let mut finished = 0;
+    for k in shard.pictures(spec.count) {
+        if done.contains(&k) {
+            finished += 1;
+            continue;
+        }
+        let (scene, backdrop) = scene_of(&spec, &mut library, k as u64).map_err(anyhow::Error::msg)?;
+        let file = scene_file(dir, k);
+        write_scene(&file, &scene)?;
+        // As the editor will read it: the picture is what its scene file shows.
+        let scene = read_scene(&file)?;
+        for c in &scene.characters {
+            library.load(&c.source)?;
+        }
+        pictures.push((k, scene, backdrop));
+    }
+    Ok(Some(Plan { dir: dir.clone(), spec, shard, pictures, finished, library }))
+}

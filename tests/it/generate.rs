@@ -1,0 +1,151 @@
+//! `marionette generate`: a data set rendered whole and as four shards (two by `--shard`,
+//! one as a Slurm array task, one as a Kubernetes Indexed Job's) gives the same files; a
+//! run killed halfway and started again finishes them, rendering only what was missing;
+//! `--merge` joins the pictures' COCO files; spec errors stop it before anything renders.
+
+use std::collections::BTreeMap;
+use std::path::Path;
+use std::process::Command;
+
+use crate::common::scratch;
+
+/// The example spec made small: `count` pictures of 96×72 with their data.
+fn small_spec(dir: &Path, count: usize) -> std::path::PathBuf {
+    let example = marionette::document::generate::EXAMPLE
+        .replacen("count: 16", &format!("count: {count}"), 1)
+        .replacen("width: 320", "width: 96", 1)
+        .replacen("height: 240", "height: 72", 1);
+    let spec = dir.join("spec.ron");
+    std::fs::write(&spec, example).unwrap();
+    spec
+}
+
+fn generate(spec: &Path, out: &Path, extra: &[&str], env: &[(&str, &str)]) -> String {
+    let output = Command::new(env!("CARGO_BIN_EXE_marionette"))
+        .arg("generate")
+        .arg(spec)
+        .arg("--out")
+        .arg(out)
+        .args(extra)
+        .env_remove("SLURM_ARRAY_TASK_ID")
+        .env_remove("JOB_COMPLETION_INDEX")
+        .envs(env.iter().copied())
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&output.stderr).into_owned();
+    assert!(output.status.success(), "{stderr}");
+    stderr
+}
+
+/// Every picture's files (not the manifests) by name, with their digests.
+fn files(dir: &Path) -> BTreeMap<String, String> {
+    std::fs::read_dir(dir)
+        .unwrap()
+        .flatten()
+        .map(|e| e.file_name().to_string_lossy().into_owned())
+        .filter(|n| n.starts_with('0') && !n.contains(".tmp"))
+        .map(|n| (n.clone(), marionette::document::generate::sha256_of(&dir.join(&n)).unwrap()))
+        .collect()
+}
+
+#[test]
+fn a_data_set_is_the_same_whole_as_in_shards_and_resumed() {
+    let dir = scratch("generate");
+    let spec = small_spec(&dir, 8);
+    let whole = dir.join("whole");
+    generate(&spec, &whole, &[], &[]);
+    let expected = files(&whole);
+    assert_eq!(expected.keys().filter(|n| n.ends_with(".png") && n.len() == 10).count(), 8, "{expected:?}");
+    for stem in ["000000", "000007"] {
+        for tail in [".png", ".json", ".scene.ron", ".depth.exr", ".mask.png", ".openpose.json"] {
+            assert!(expected.contains_key(&format!("{stem}{tail}")), "{stem}{tail}");
+        }
+    }
+
+    let shards = dir.join("shards");
+    generate(&spec, &shards, &["--shard", "0/4"], &[]);
+    generate(&spec, &shards, &["--shard", "1/4"], &[]);
+    let slurm = generate(&spec, &shards, &[], &[("SLURM_ARRAY_TASK_ID", "2"), ("SLURM_ARRAY_TASK_COUNT", "4")]);
+    assert!(slurm.contains("shard 2/4: 2 pictures"), "{slurm}");
+    let kube = generate(&spec, &shards, &["--shards", "4"], &[("JOB_COMPLETION_INDEX", "3")]);
+    assert!(kube.contains("shard 3/4: 2 pictures"), "{kube}");
+    assert_eq!(files(&shards), expected, "four shards give the files of the whole");
+
+    // Killed once some pictures are in its manifest, then started again.
+    let resumed = dir.join("resumed");
+    let mut child = Command::new(env!("CARGO_BIN_EXE_marionette"))
+        .arg("generate")
+        .arg(&spec)
+        .arg("--out")
+        .arg(&resumed)
+        .stderr(std::process::Stdio::null())
+        .spawn()
+        .unwrap();
+    let manifest = resumed.join("manifest-0000-of-0001.jsonl");
+    let lines = || std::fs::read_to_string(&manifest).map_or(0, |t| t.lines().count());
+    let started = std::time::Instant::now();
+    while lines() < 3 && started.elapsed().as_secs() < 240 {
+        std::thread::sleep(std::time::Duration::from_millis(20));
+    }
+    child.kill().unwrap();
+    child.wait().unwrap();
+    let done = lines();
+    assert!((3..8).contains(&done), "killed with {done} of 8 pictures in the manifest");
+    let again = generate(&spec, &resumed, &[], &[]);
+    let rest = 8 - done;
+    assert!(again.contains(&format!("{done} already there, {rest} to render")), "{again}");
+    assert_eq!(files(&resumed), expected, "the resumed run's files are the whole run's");
+    let text = std::fs::read_to_string(&manifest).unwrap();
+    let mut pictures: Vec<u64> = text
+        .lines()
+        .map(|l| serde_json::from_str::<serde_json::Value>(l).unwrap()["picture"].as_u64().unwrap())
+        .collect();
+    pictures.sort();
+    assert_eq!(pictures, (0..8).collect::<Vec<_>>(), "each picture recorded once");
+
+    // The shards' COCO files joined: one image per picture, the annotations of each.
+    let output =
+        Command::new(env!("CARGO_BIN_EXE_marionette")).args(["generate", "--merge"]).arg(&shards).output().unwrap();
+    assert!(output.status.success(), "{}", String::from_utf8_lossy(&output.stderr));
+    let coco: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(shards.join("coco.json")).unwrap()).unwrap();
+    let ids: Vec<u64> = coco["images"].as_array().unwrap().iter().map(|i| i["id"].as_u64().unwrap()).collect();
+    assert_eq!(ids, (1..=8).collect::<Vec<_>>());
+    let mut annotation_ids: Vec<u64> =
+        coco["annotations"].as_array().unwrap().iter().map(|a| a["id"].as_u64().unwrap()).collect();
+    let count = annotation_ids.len();
+    annotation_ids.dedup();
+    assert!(count >= 8 && annotation_ids.len() == count, "one annotation or more a picture, ids unique");
+}
+
+/// A spec that cannot be rendered is refused before any picture: the field named, nothing written.
+#[test]
+fn spec_errors_stop_generate_before_rendering() {
+    let dir = scratch("generate-errors");
+    let spec = small_spec(&dir, 4);
+    let text = std::fs::read_to_string(&spec).unwrap();
+    let cases = [
+        (text.replacen("what: Puppet", "what: File(path: \"missing.glb\")", 1), "characters[0].path"),
+        (
+            text.replacen("presets: [\"default\", \"studio\", \"overcast\", \"dusk\"]", "presets: []", 1),
+            "empty distribution",
+        ),
+        (text.replacen("per_picture: (1, 3)", "per_picture: (1, 30)", 1), "do not fit"),
+        (text.replacen("width: 96", "width: 90000", 1), "width"),
+        (text.replacen("count: 4", "count: 4,\n    colour: 3", 1), "spec.ron:"),
+    ];
+    for (bad, words) in cases {
+        std::fs::write(&spec, bad).unwrap();
+        let out = dir.join("out");
+        let output = Command::new(env!("CARGO_BIN_EXE_marionette"))
+            .arg("generate")
+            .arg(&spec)
+            .arg("--out")
+            .arg(&out)
+            .output()
+            .unwrap();
+        let stderr = String::from_utf8_lossy(&output.stderr);
+        assert!(!output.status.success() && stderr.contains(words), "{words}: {stderr}");
+        assert!(!out.exists(), "{words}: nothing written");
+    }
+}
