@@ -497,7 +497,7 @@ pub fn scene_of(spec: &Spec, library: &mut AssetLibrary, k: u64) -> Result<(Scen
         let mut c = character(who, library, &mut rng, time, format!("person {}", i + 1))?;
         c.id = Some(marionette_formats::scene::CharacterId(i as u64 + 1));
         c.placement = PlacementDoc::new(at, yaw, 1.0);
-        stand_on_floor(library, &mut c)?;
+        stand_at(library, &mut c, at)?;
         characters.push(c);
     }
     let centre = characters.iter().map(|c| c.placement.translation * Vec3::new(1.0, 0.0, 1.0)).sum::<Vec3>()
@@ -632,13 +632,16 @@ fn character(
     })
 }
 
-/// Moves `c` up or down so that the lowest point of its skin, posed, touches the floor.
-fn stand_on_floor(library: &mut AssetLibrary, c: &mut CharacterDoc) -> Result<(), String> {
+/// Moves `c` so that its skin, posed, is centred over `spot` (the middle of its box seen
+/// from above: a clip that has carried the body away from its origin is brought back) and
+/// its lowest point touches the floor.
+fn stand_at(library: &mut AssetLibrary, c: &mut CharacterDoc, spot: Vec3) -> Result<(), String> {
     let alone = SceneDoc { characters: vec![c.clone()], ..SceneDoc::default() };
     let (positions, _) = super::export::scene_mesh_from(library, &alone).map_err(|e| e.to_string())?;
-    let lowest = positions.iter().map(|p| p.y).fold(f32::INFINITY, f32::min);
-    if lowest.is_finite() {
-        c.placement.translation.y -= lowest;
+    let (lo, hi) = super::layout::union(positions.iter().map(|&p| (p, p)));
+    if lo.is_finite() && hi.is_finite() {
+        let middle = (lo + hi) / 2.0;
+        c.placement.translation += Vec3::new(spot.x - middle.x, -lo.y, spot.z - middle.z);
     }
     Ok(())
 }
@@ -840,17 +843,23 @@ mod tests {
             let (scene, _) = scene_of(&spec, &mut library, k).unwrap();
             let n = scene.characters.len();
             assert!((spec.per_picture.0..=spec.per_picture.1).contains(&n));
-            for (i, c) in scene.characters.iter().enumerate() {
-                let t = c.placement.translation;
-                assert!(t.x.abs() <= spec.area / 2.0 && t.z.abs() <= spec.area / 2.0, "{t}");
-                for d in &scene.characters[i + 1..] {
-                    let gap = (d.placement.translation - t) * Vec3::new(1.0, 0.0, 1.0);
-                    assert!(gap.length() >= spec.spacing - 1e-5, "picture {k}: {gap}");
+            // Where each stands: the middle of its posed skin seen from above.
+            let spots: Vec<Vec3> = scene
+                .characters
+                .iter()
+                .map(|c| {
+                    let alone = SceneDoc { characters: vec![c.clone()], ..SceneDoc::default() };
+                    let (positions, _) = crate::export::scene_mesh_from(&mut library, &alone).unwrap();
+                    let (lo, hi) = crate::layout::union(positions.iter().map(|&p| (p, p)));
+                    assert!(lo.y.abs() < 1e-4, "picture {k}: lowest point {}", lo.y);
+                    (lo + hi) / 2.0 * Vec3::new(1.0, 0.0, 1.0)
+                })
+                .collect();
+            for (i, s) in spots.iter().enumerate() {
+                assert!(s.x.abs() <= spec.area / 2.0 + 1e-4 && s.z.abs() <= spec.area / 2.0 + 1e-4, "{s}");
+                for t in &spots[i + 1..] {
+                    assert!(s.distance(*t) >= spec.spacing - 1e-4, "picture {k}: {s} and {t}");
                 }
-                let alone = SceneDoc { characters: vec![c.clone()], ..SceneDoc::default() };
-                let (positions, _) = crate::export::scene_mesh_from(&mut library, &alone).unwrap();
-                let lowest = positions.iter().map(|p| p.y).fold(f32::INFINITY, f32::min);
-                assert!(lowest.abs() < 1e-4, "picture {k}: lowest point {lowest}");
             }
         }
     }
@@ -884,7 +893,7 @@ mod tests {
         let base = EXAMPLE.to_string();
         let cases = [
             ("path: \"nowhere/x.glb\"", "Puppet", "characters[", "no such file"),
-            ("Uniform(3.0, 5.0)", "Uniform(5.0, 3.0)", "camera.distance", "empty distribution"),
+            ("Uniform(4.0, 6.0)", "Uniform(6.0, 4.0)", "camera.distance", "empty distribution"),
             ("per_picture: (1, 3)", "per_picture: (1, 40)", "spacing", "do not fit"),
             ("width: 320", "width: 0", "width", ""),
             ("\"studio\"", "\"disco\"", "lights.presets", "disco"),
