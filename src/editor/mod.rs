@@ -147,6 +147,7 @@ pub fn run(paths: Vec<PathBuf>, edits: StartupEdits, library: crate::document::A
             ui::unsaved::UnsavedWorkPlugin,
             present::screenshot::ScreenshotPlugin,
             present::redraw::RedrawPlugin,
+            present::fast_viewport::FastViewportPlugin,
         ))
         // The inspector's edits (bevy_egui's pass) land before the chain that animates,
         // solves, runs the matrix stack and skins: an edit is skinned the frame it is made.

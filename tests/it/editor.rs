@@ -594,3 +594,17 @@ fn the_editor_asks_for_frames_only_while_something_moves() {
     app.update();
     assert_eq!(asked_over(&mut app, 10), 0, "paused: idle again");
 }
+
+/// The fast viewport draws fast only while the view is worked (and for a moment after),
+/// at the scale's share of each side of the viewport, at least a pixel.
+#[test]
+fn the_fast_viewport_is_fast_only_while_the_view_is_worked() {
+    use marionette::editor::present::fast_viewport::{SETTLE, fast_size, fast_wanted};
+    use std::time::Duration;
+    assert!(fast_wanted(true, Some(Duration::from_millis(10))));
+    assert!(!fast_wanted(true, Some(SETTLE)), "still for the settling time: full quality");
+    assert!(!fast_wanted(true, None), "never worked");
+    assert!(!fast_wanted(false, Some(Duration::ZERO)), "switched off");
+    assert_eq!(fast_size(bevy::math::UVec2::new(1000, 800), 0.4), bevy::math::UVec2::new(400, 320));
+    assert_eq!(fast_size(bevy::math::UVec2::new(1, 1), 0.25), bevy::math::UVec2::ONE);
+}

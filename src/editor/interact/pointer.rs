@@ -16,15 +16,7 @@ pub struct PointerOwner {
     pub gizmo_typing: bool,
 }
 
-/// Whether the pointer belongs to the viewport this frame (false while egui uses it).
-#[derive(Resource)]
-pub struct ViewportHasPointer(pub bool);
-
-impl Default for ViewportHasPointer {
-    fn default() -> Self {
-        Self(true)
-    }
-}
+pub use crate::editor::state::ViewportHasPointer;
 
 /// The part of the window between the side panels (logical pixels), set by the inspector;
 /// `None` leaves the camera on the whole window.

@@ -4,6 +4,7 @@
 
 pub mod data;
 pub mod draw;
+pub mod fast_viewport;
 pub mod frames_job;
 pub mod readiness;
 pub mod redraw;

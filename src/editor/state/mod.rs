@@ -155,3 +155,14 @@ pub struct JointHit {
 /// Pinned joints per character id.
 #[derive(Resource, Default)]
 pub struct Pins(pub BTreeMap<CharacterId, Vec<usize>>);
+
+/// Whether the pointer belongs to the viewport this frame (false while egui uses it):
+/// written by the interaction room, read by the tools and the fast viewport.
+#[derive(Resource)]
+pub struct ViewportHasPointer(pub bool);
+
+impl Default for ViewportHasPointer {
+    fn default() -> Self {
+        Self(true)
+    }
+}

@@ -102,6 +102,8 @@ pub struct Panels<'w, 's> {
     pub frames: Option<ResMut<'w, crate::editor::present::frames_job::FramesJob>>,
     /// The recent files (none in an app without the inspector: nothing is remembered).
     pub recent: Option<ResMut<'w, crate::editor::ui::recent::RecentFiles>>,
+    /// The fast viewport's setting.
+    pub fast_viewport: Option<ResMut<'w, crate::editor::present::fast_viewport::FastViewport>>,
 }
 
 impl Panels<'_, '_> {
@@ -137,6 +139,7 @@ pub struct ViewportOverlays<'w> {
     hovered: Res<'w, crate::editor::state::HoveredJoint>,
     gizmo: Res<'w, crate::editor::interact::rotate_gizmo::RotateGizmo>,
     moving: Res<'w, crate::editor::interact::move_gizmo::MoveGizmo>,
+    fast: Option<Res<'w, crate::editor::present::fast_viewport::FastView>>,
 }
 
 pub struct InspectorPlugin;
@@ -193,9 +196,16 @@ fn inspector_ui(
     let central = ui.available_rect_before_wrap();
     let area = ViewportArea(Some(Rect::new(central.min.x, central.min.y, central.max.x, central.max.y)));
     viewport_area.set_if_neq(area);
+    // The fast view, drawn at a fraction of the pixels while the view moves, fills it.
+    let fast = overlays.fast.as_ref().and_then(|f| f.shown);
+    if let Some(texture) = fast {
+        let whole = egui::Rect::from_min_max(egui::pos2(0.0, 0.0), egui::pos2(1.0, 1.0));
+        ui.painter().image(texture, central, whole, egui::Color32::WHITE);
+    }
     dialogs::show(&ctx, &mut state, &mut panels, &mut shot);
     let mode = overlays.draw_mode.as_deref().copied().unwrap_or_default();
-    frame_time_readout(&ctx, central, &overlays.diagnostics, mode);
+    let fast_scale = fast.and(panels.fast_viewport.as_ref().map(|s| s.scale));
+    frame_time_readout(&ctx, central, &overlays.diagnostics, mode, fast_scale);
     if state.frame_guide {
         frame_guide(&ctx, central, &panels.scene.shot.0);
     }
@@ -240,6 +250,7 @@ fn frame_time_readout(
     viewport: egui::Rect,
     diagnostics: &DiagnosticsStore,
     mode: crate::editor::present::redraw::DrawMode,
+    fast: Option<f32>,
 ) {
     let smoothed = |path| diagnostics.get(path).and_then(bevy::diagnostic::Diagnostic::smoothed);
     let (Some(ms), Some(fps)) =
@@ -252,9 +263,10 @@ fn frame_time_readout(
     egui::Area::new("frame_time".into()).pivot(egui::Align2::RIGHT_TOP).fixed_pos(corner).show(ctx, |ui| {
         // Idle, the text stays the same: a text of another size would have egui lay it out
         // again in a frame of its own, and that frame would change it again.
-        let text = match mode.0 {
-            Some(why) => format!("{ms:>7.1} ms · {fps:>3.0} fps · {why}"),
-            None => "drawn on change".to_string(),
+        let text = match (mode.0, fast) {
+            (_, Some(scale)) => format!("{ms:>7.1} ms · {fps:>3.0} fps · fast view ×{scale:.2}"),
+            (Some(why), None) => format!("{ms:>7.1} ms · {fps:>3.0} fps · {why}"),
+            (None, None) => "drawn on change".to_string(),
         };
         let text = egui::RichText::new(text).monospace().color(egui::Color32::WHITE);
         ui.add(egui::Label::new(text).wrap_mode(egui::TextWrapMode::Extend));

@@ -21,7 +21,10 @@ pub fn stage_panel(ui: &mut egui::Ui, state: &mut InspectorState, panels: &mut P
         panels.push(Edit::Stage(stage));
     }
     if let Some(camera) = panels.scene.cameras.iter().next().map(|c| c.0) {
-        egui::CollapsingHeader::new("Camera and lens").show(ui, |ui| camera_rows(ui, state, panels, camera));
+        egui::CollapsingHeader::new("Camera and lens").show(ui, |ui| {
+            camera_rows(ui, state, panels, camera);
+            fast_viewport_rows(ui, panels);
+        });
     }
     let mut shot = panels.scene.shot.0;
     egui::CollapsingHeader::new("Shot").show(ui, |ui| {
@@ -30,6 +33,20 @@ pub fn stage_panel(ui: &mut egui::Ui, state: &mut InspectorState, panels: &mut P
     });
     if shot != panels.scene.shot.0 {
         panels.push(Edit::Shot(shot));
+    }
+}
+
+/// The fast viewport: on or off, and the share of the pixels drawn while the view moves.
+fn fast_viewport_rows(ui: &mut egui::Ui, panels: &mut Panels) {
+    let Some(fast) = panels.fast_viewport.as_deref_mut() else { return };
+    let (mut enabled, mut scale) = (fast.enabled, fast.scale);
+    ui.horizontal(|ui| {
+        ui.checkbox(&mut enabled, "Fast viewport")
+            .on_hover_text("While the view moves, draw it at a share of its pixels, without multisampling and with small shadows (for machines without a GPU); full quality once it is still.");
+        ui.add_enabled(enabled, egui::Slider::new(&mut scale, 0.2..=1.0).fixed_decimals(2));
+    });
+    if (enabled, scale) != (fast.enabled, fast.scale) {
+        (fast.enabled, fast.scale) = (enabled, scale);
     }
 }
 
