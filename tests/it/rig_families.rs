@@ -275,3 +275,57 @@ fn a_prefix_every_name_shares_is_taken_off() {
     assert_eq!(without_common_prefix(&["Bip01", "Bip01 Pelvis"]), ["Bip01", "Bip01 Pelvis"]);
     assert_eq!(without_common_prefix(&["Hips", "Head"]), ["Hips", "Head"]);
 }
+
+/// Fingers whose names say nothing are found by the hand's shape: with every joint below
+/// each hand renamed `bone_N` (but those named as controls, mechanism or ends, which keep
+/// saying so; a `DEF-` kept), each family with fingers maps every phalanx to the joint its
+/// names gave it.
+#[test]
+fn fingers_named_for_nothing_are_found_by_the_hands_shape() {
+    use marionette::rig::humanoid::detect_reported;
+    use marionette::rig::skeleton::{RawJoint, Skeleton};
+    let mut failures = Vec::new();
+    for family in families().into_iter().filter(|f| f.finger.is_some()) {
+        let asset = marionette::formats::load_character(&rig(family.file)).unwrap();
+        let skeleton = &asset.skeleton;
+        let named = detect_reported(skeleton).unwrap();
+        let hands = [named.map[&HumanBone::LeftHand], named.map[&HumanBone::RightHand]];
+        let raw: Vec<RawJoint> = skeleton
+            .joints()
+            .iter()
+            .enumerate()
+            .map(|(j, d)| {
+                let below_hand = hands.iter().any(|&h| j != h && skeleton.is_below(j, h)) && !read(&d.name).excluded;
+                let kind = d.name.split_once('-').filter(|(k, _)| *k == "DEF").map(|(k, _)| k);
+                RawJoint {
+                    name: match (below_hand, kind) {
+                        (false, _) => d.name.clone(),
+                        (true, Some(kind)) => format!("{kind}-bone_{j}"),
+                        (true, None) => format!("bone_{j}"),
+                    },
+                    parent: d.parent,
+                    rest_offset: d.rest_offset,
+                    limits: d.limits,
+                    bone_box: d.bone_box,
+                    initial_rotation: d.initial_rotation,
+                    rest_scale: d.rest_scale,
+                }
+            })
+            .collect();
+        let renamed = Skeleton::build(raw).unwrap();
+        let Some(shaped) = detect_reported(&renamed) else {
+            failures.push(format!("{}: no humanoid once renamed", family.file));
+            continue;
+        };
+        for bone in HumanBone::ALL.iter().filter(|b| b.is_finger()) {
+            let (want, got) = (named.map.get(bone), shaped.map.get(bone));
+            if want != got {
+                let name = |j: Option<&usize>| j.map(|&j| skeleton.joint(j).name.clone());
+                failures.push(format!("{}: {bone:?} is {:?}, by name {:?}", family.file, name(got), name(want)));
+            } else if got.is_some() && shaped.found[bone] != Found::Structure {
+                failures.push(format!("{}: {bone:?} not found by structure", family.file));
+            }
+        }
+    }
+    assert!(failures.is_empty(), "{}", failures.join("\n"));
+}

@@ -270,6 +270,10 @@ pub fn detect_reported(skeleton: &Skeleton) -> Option<Detected> {
     }
     for (left, hand) in [(true, out.map[&LeftHand]), (false, out.map[&RightHand])] {
         fingers(&tree, &says, left, hand, &mut out);
+        let named = (0..5).any(|f| out.map.contains_key(&HumanBone::finger(left, f, 0)));
+        if !named {
+            fingers_by_shape(&tree, left, hand, &mut out);
+        }
     }
     Some(out)
 }
@@ -510,6 +514,84 @@ fn fingers(tree: &Tree, says: &[NameSays], left: bool, hand: usize, out: &mut De
             out.put(HumanBone::finger(left, finger, phalanx), j, Found::Name);
         }
     }
+}
+
+/// The fingers of a hand whose names say none, from its shape: the hand's chains (from
+/// the first body joints below it, a palm of mechanism joints (`ORG-`, `MCH-`) passed through; each down
+/// its first body joint at each step, coinciding joints counted once), two to five of
+/// them, each of two joints or more. The thumb is the chain that leaves the hand's
+/// direction the most; the others follow from the thumb's side outwards (index, middle,
+/// ring, little). A chain of four or five joints whose last is its tip starts with a
+/// metacarpal (left out) or ends with the tip (left out); the phalanges are the three
+/// before the tip.
+fn fingers_by_shape(tree: &Tree, left: bool, hand: usize, out: &mut Detected) {
+    let solid = |j: usize| tree.body[j] && !tree.stubs[j];
+    let mut starts = Vec::new();
+    let mut open: Vec<usize> = tree.skeleton.children(hand).to_vec();
+    while let Some(j) = open.pop() {
+        let name = &tree.skeleton.joint(j).name;
+        if solid(j) {
+            starts.push(j);
+        } else if name.starts_with("ORG-") || name.starts_with("MCH-") {
+            // A mechanism joint the deforming fingers hang from (Rigify's palm).
+            open.extend_from_slice(tree.skeleton.children(j));
+        }
+    }
+    starts.sort_unstable();
+    let chains: Vec<Vec<usize>> = starts
+        .into_iter()
+        .map(|start| {
+            let mut chain = vec![start];
+            let mut at = start;
+            while let Some(&next) = tree.skeleton.children(at).iter().find(|&&c| solid(c)) {
+                if tree.at[next].distance(tree.at[at]) > 0.0 {
+                    chain.push(next);
+                } else if let Some(last) = chain.last_mut() {
+                    *last = next;
+                }
+                at = next;
+            }
+            chain
+        })
+        .filter(|c| c.len() >= 2)
+        .collect();
+    if !(2..=5).contains(&chains.len()) {
+        return;
+    }
+    let base = tree.at[hand];
+    let direction = |c: &[usize]| (tree.at[c[c.len() - 1]] - tree.at[c[0]]).normalize_or_zero();
+    let along = chains.iter().map(|c| direction(c)).sum::<Vec3>().normalize_or_zero();
+    if along == Vec3::ZERO {
+        return;
+    }
+    let thumb = (0..chains.len())
+        .min_by(|&a, &b| direction(&chains[a]).dot(along).total_cmp(&direction(&chains[b]).dot(along)))
+        .unwrap_or(0);
+    // Across the hand: from the thumb's root, square to the hand's direction.
+    let off = |c: &[usize]| {
+        let v = tree.at[c[0]] - base;
+        v - along * v.dot(along)
+    };
+    let thumb_side = off(&chains[thumb]).normalize_or_zero();
+    let mut others: Vec<usize> = (0..chains.len()).filter(|&k| k != thumb).collect();
+    others.sort_by(|&a, &b| off(&chains[b]).dot(thumb_side).total_cmp(&off(&chains[a]).dot(thumb_side)));
+    let fingers = std::iter::once((0, thumb)).chain(others.into_iter().enumerate().map(|(k, c)| (k + 1, c)));
+    for (finger, k) in fingers {
+        let chain = &chains[k];
+        let ends_in_tip = tree.is_end(chain[chain.len() - 1]);
+        let phalanges: &[usize] = match chain.len() {
+            5 if ends_in_tip => &chain[1..4],
+            4 if ends_in_tip => &chain[..3],
+            n => &chain[n.saturating_sub(3)..],
+        };
+        for (phalanx, &j) in phalanges.iter().enumerate() {
+            out.put(HumanBone::finger(left, finger, phalanx), j, Found::Structure);
+        }
+    }
+    out.doubts.push(format!(
+        "the {} hand's fingers are found by their shape (the thumb the chain most apart)",
+        if left { "left" } else { "right" }
+    ));
 }
 
 /// A vector made level (its height dropped).
