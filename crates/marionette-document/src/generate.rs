@@ -412,16 +412,20 @@ fn places(area: f32, spacing: f32) -> usize {
 
 /// The pictures (PNG, JPEG) of a folder, by name.
 pub fn image_files(folder: &Path) -> Vec<PathBuf> {
+    files_named(folder, |name| {
+        let lower = name.to_ascii_lowercase();
+        [".png", ".jpg", ".jpeg"].iter().any(|e| lower.ends_with(e))
+    })
+}
+
+/// The files of a folder whose names `keep` takes, by name (none where it cannot be read).
+fn files_named(folder: &Path, keep: impl Fn(&str) -> bool) -> Vec<PathBuf> {
     let mut files: Vec<PathBuf> = std::fs::read_dir(folder)
         .into_iter()
         .flatten()
         .flatten()
         .map(|e| e.path())
-        .filter(|p| {
-            p.extension()
-                .and_then(|e| e.to_str())
-                .is_some_and(|e| ["png", "jpg", "jpeg"].contains(&e.to_ascii_lowercase().as_str()))
-        })
+        .filter(|p| p.file_name().and_then(|n| n.to_str()).is_some_and(&keep))
         .collect();
     files.sort();
     files
@@ -737,16 +741,7 @@ pub fn finished_pictures(dir: &Path) -> BTreeSet<usize> {
 
 /// Every line of every manifest in `dir` (a torn last line is left out).
 pub fn manifest_lines(dir: &Path) -> Vec<ManifestLine> {
-    let mut manifests: Vec<PathBuf> = std::fs::read_dir(dir)
-        .into_iter()
-        .flatten()
-        .flatten()
-        .map(|e| e.path())
-        .filter(|p| {
-            p.file_name().and_then(|n| n.to_str()).is_some_and(|n| n.starts_with("manifest-") && n.ends_with(".jsonl"))
-        })
-        .collect();
-    manifests.sort();
+    let manifests = files_named(dir, |n| n.starts_with("manifest-") && n.ends_with(".jsonl"));
     manifests
         .iter()
         .filter_map(|m| std::fs::read_to_string(m).ok())

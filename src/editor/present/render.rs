@@ -172,7 +172,8 @@ pub fn render(
     }
     let cell_files: Vec<PathBuf> = frames.iter().map(|f| f.1.clone()).collect();
     let frames = frames.into_iter().enumerate().map(|(k, (at, out))| Frame::new(at, out, k)).collect();
-    let setup = JobSetup { paths, library, edits, picture, frames, sequence, data, on_written: None };
+    let setup =
+        JobSetup { paths, library, edits, picture, frames, sequence, data, coco_per_picture: false, on_written: None };
     let done = run_job(setup);
     let done = match (pictures, done) {
         (Pictures::PoseSheet, Ok(messages)) => contact_sheet(&cell_files, &out).map(|()| messages),
@@ -201,7 +202,6 @@ pub fn render_scenes(
         .map(|p| Frame { at: FrameAt::Scene(Box::new(p.scene)), out: p.out, ids: p.ids, backdrop: p.backdrop })
         .collect();
     let edits = StartupEdits { still: true, ..default() };
-    let data = data.then(CocoSoFar::default);
     let setup = JobSetup {
         paths: vec![first_scene],
         library,
@@ -209,7 +209,8 @@ pub fn render_scenes(
         picture,
         frames,
         sequence: None,
-        data,
+        data: data.then(CocoSoFar::default),
+        coco_per_picture: true,
         on_written: Some(on_written),
     };
     run_job(setup)
@@ -223,15 +224,17 @@ struct JobSetup {
     picture: ShotDoc,
     frames: Vec<Frame>,
     sequence: Option<FrameSequence>,
-    /// `--data`: where the COCO file goes (none for a data set: a file per picture).
+    /// With data: the COCO file all pictures share, as it fills.
     data: Option<CocoSoFar>,
+    /// Each picture's data has a COCO file of its own instead.
+    coco_per_picture: bool,
     on_written: Option<OnWritten>,
 }
 
 /// Builds the render's app, runs it until every picture is written or it fails, and
 /// returns the notes or what went wrong.
 fn run_job(setup: JobSetup) -> Result<Vec<String>, String> {
-    let JobSetup { paths, library, edits, picture, frames, sequence, data, on_written } = setup;
+    let JobSetup { paths, library, edits, picture, frames, sequence, data, coco_per_picture, on_written } = setup;
     let (width, height) = (picture.width, picture.height);
     let mut app = App::new();
     app.add_plugins(crate::editor::windowless_plugins())
@@ -250,7 +253,6 @@ fn run_job(setup: JobSetup) -> Result<Vec<String>, String> {
         images.add(image)
     };
     let outcome = Arc::new(Mutex::new((None, Vec::new())));
-    let coco_per_picture = data.as_ref().is_some_and(|c| c.path.as_os_str().is_empty());
     app.insert_resource(RenderJob {
         frames,
         set_up: false,
