@@ -3,7 +3,7 @@
 
 use std::path::PathBuf;
 
-use crate::document::posing::{IkSpec, PoseSpec};
+use crate::document::posing::{IkSpec, PoseSpec, TwoBoneSpec};
 
 /// The largest picture side `render` accepts (the texture limit of common GPUs).
 pub const MAX_PICTURE_SIDE: i64 = 8192;
@@ -30,6 +30,11 @@ pub enum Command {
         /// `JOINT=x,y,z` world-space IK target for every character that has the joint.
         #[arg(long = "ik", value_name = "JOINT=x,y,z")]
         ik: Vec<IkSpec>,
+        /// `JOINT=x,y,z[@x,y,z]`: the limb ending at JOINT (an ankle or a wrist) turned by
+        /// two-bone IK to reach the target, its knee or elbow bending toward the pole
+        /// (world metres), after --ik. Repeatable.
+        #[arg(long = "two-bone", value_name = "JOINT=x,y,z[@x,y,z]")]
+        two_bone: Vec<TwoBoneSpec>,
         /// Open the newest recovery file (what autosave or a crash left in
         /// `$XDG_STATE_HOME/marionette/recovery`).
         #[arg(long, conflicts_with = "paths")]
@@ -58,6 +63,11 @@ pub enum Command {
         /// `JOINT=x,y,z` world-space IK target for every character that has the joint.
         #[arg(long = "ik", value_name = "JOINT=x,y,z")]
         ik: Vec<IkSpec>,
+        /// `JOINT=x,y,z[@x,y,z]`: the limb ending at JOINT (an ankle or a wrist) turned by
+        /// two-bone IK to reach the target, its knee or elbow bending toward the pole
+        /// (world metres), after --ik. Repeatable.
+        #[arg(long = "two-bone", value_name = "JOINT=x,y,z[@x,y,z]")]
+        two_bone: Vec<TwoBoneSpec>,
         /// Skin every character by linear blend (`lbs`) or dual quaternion (`dq`) skinning
         /// (default: as the scene file says).
         #[arg(long, value_enum)]
@@ -311,6 +321,11 @@ pub struct ExportArgs {
     /// (FABRIK), after --pose. Repeatable.
     #[arg(long = "ik", value_name = "JOINT=x,y,z")]
     pub ik: Vec<IkSpec>,
+    /// `JOINT=x,y,z[@x,y,z]`: the limb ending at JOINT (an ankle or a wrist) turned by
+    /// two-bone IK to reach the target, its knee or elbow bending toward the pole
+    /// (world metres), after --ik. Repeatable.
+    #[arg(long = "two-bone", value_name = "JOINT=x,y,z[@x,y,z]")]
+    pub two_bone: Vec<TwoBoneSpec>,
     /// Linear blend (`lbs`) or dual quaternion (`dq`) skinning for every character (without
     /// it, a scene's characters keep theirs; others are `lbs`).
     #[arg(long, value_enum)]

@@ -16,7 +16,8 @@ use marionette_formats::scene::{AnimDoc, PlaybackDoc, SceneDoc, pose_key};
 use marionette_rig::dqs::SkinningMethod;
 
 use crate::AssetLibrary;
-use crate::posing::{IkSpec, PoseSpec, apply_ik_specs, apply_pose_specs, describe_ik, find_clip};
+use crate::posing::{IkSpec, PoseSpec, TwoBoneSpec, apply_ik_specs, apply_pose_specs, describe_ik, find_clip};
+use crate::posing::{apply_two_bone_specs, describe_two_bone};
 
 /// What the command line asks of the characters.
 #[derive(Clone, Debug, Default)]
@@ -25,6 +26,8 @@ pub struct PoseOptions {
     pub poses: Vec<PoseSpec>,
     /// `--ik JOINT=x,y,z`: on every character that has the joint, after `--pose`.
     pub ik: Vec<IkSpec>,
+    /// `--two-bone JOINT=x,y,z[@x,y,z]`: on every character that has the joint, after `--ik`.
+    pub two_bone: Vec<TwoBoneSpec>,
     /// `--skinning`: every character skinned this way.
     pub skinning: Option<SkinningMethod>,
     /// `--anim FILE` (or `--retarget FILE`): a clip on every character it fits.
@@ -41,7 +44,7 @@ pub struct PoseOptions {
 impl PoseOptions {
     /// Whether the options pose a still figure (which baking clips into it gives).
     pub fn poses_joints(&self) -> bool {
-        !self.poses.is_empty() || !self.ik.is_empty()
+        !self.poses.is_empty() || !self.ik.is_empty() || !self.two_bone.is_empty()
     }
 }
 
@@ -205,7 +208,7 @@ fn pose_characters(
 ) -> Result<Vec<String>, String> {
     let scene = doc.clone();
     let mut notes = Vec::new();
-    let mut used = vec![false; options.poses.len() + options.ik.len()];
+    let mut used = vec![false; options.poses.len() + options.ik.len() + options.two_bone.len()];
     let mut joints_seen = Vec::new();
     for c in &mut doc.characters {
         let asset = match library.shaped(c) {
@@ -221,10 +224,12 @@ fn pose_characters(
         let has = |joint: &str| skeleton.resolve(joint).is_some();
         let poses: Vec<PoseSpec> = options.poses.iter().filter(|p| has(&p.joint)).cloned().collect();
         let ik: Vec<IkSpec> = options.ik.iter().filter(|p| has(&p.joint)).cloned().collect();
-        if poses.is_empty() && ik.is_empty() {
+        let two_bone: Vec<TwoBoneSpec> = options.two_bone.iter().filter(|p| has(&p.joint)).cloned().collect();
+        if poses.is_empty() && ik.is_empty() && two_bone.is_empty() {
             continue;
         }
         let names = options.poses.iter().map(|p| &p.joint).chain(options.ik.iter().map(|p| &p.joint));
+        let names = names.chain(options.two_bone.iter().map(|p| &p.joint));
         names.zip(&mut used).filter(|(j, _)| has(j)).for_each(|(_, u)| *u = true);
         let (mut pose, root_shift) =
             crate::export::still_pose(library, &scene, c, &asset).map_err(|e| e.to_string())?;
@@ -232,6 +237,9 @@ fn pose_characters(
         let placement = c.placement.to_mat4() * Mat4::from_translation(root_shift);
         for report in apply_ik_specs(skeleton, &mut pose, placement, &ik).map_err(|e| e.to_string())? {
             notes.push(format!("{}: {}", c.name, describe_ik(skeleton, &report)));
+        }
+        for report in apply_two_bone_specs(skeleton, &mut pose, placement, &two_bone).map_err(|e| e.to_string())? {
+            notes.push(format!("{}: {}", c.name, describe_two_bone(skeleton, &report)));
         }
         let initial = skeleton.initial_pose();
         c.pose =
@@ -242,6 +250,7 @@ fn pose_characters(
         bake_clips(c);
     }
     let specs = options.poses.iter().map(|p| ("--pose", &p.joint)).chain(options.ik.iter().map(|p| ("--ik", &p.joint)));
+    let specs = specs.chain(options.two_bone.iter().map(|p| ("--two-bone", &p.joint)));
     if let Some((option, joint)) = specs.zip(&used).find(|(_, u)| !**u).map(|(s, _)| s) {
         let known = joints_seen.join("; ");
         return Err(format!("{option}: no character has a joint named or numbered `{joint}` ({known})"));

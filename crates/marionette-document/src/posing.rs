@@ -234,6 +234,78 @@ impl std::str::FromStr for IkSpec {
     }
 }
 
+/// A parsed `JOINT=x,y,z[@x,y,z]`: the limb ending at JOINT (an ankle or a wrist) turned
+/// by two-bone IK so that JOINT reaches the target, its middle joint bending toward the
+/// pole (world space).
+#[derive(Debug, Clone, PartialEq)]
+pub struct TwoBoneSpec {
+    pub joint: String,
+    pub target: Vec3,
+    pub pole: Option<Vec3>,
+}
+
+impl std::str::FromStr for TwoBoneSpec {
+    type Err = PoseSpecError;
+
+    fn from_str(spec: &str) -> Result<Self, Self::Err> {
+        let syntax = || PoseSpecError::Syntax { spec: format!("{spec} (expected JOINT=x,y,z or JOINT=x,y,z@x,y,z)") };
+        let (goal, pole) = match spec.split_once('@') {
+            Some((goal, pole)) => (goal, Some(pole)),
+            None => (spec, None),
+        };
+        let goal: IkSpec = goal.parse().map_err(|_| syntax())?;
+        let pole = pole
+            .map(|p| {
+                let numbers: Vec<f32> =
+                    p.split(',').map(|n| n.trim().parse::<f32>()).collect::<Result<_, _>>().map_err(|_| syntax())?;
+                match numbers[..] {
+                    [x, y, z] if [x, y, z].iter().all(|v| v.is_finite()) => Ok(Vec3::new(x, y, z)),
+                    _ => Err(syntax()),
+                }
+            })
+            .transpose()?;
+        Ok(Self { joint: goal.joint, target: goal.target, pole })
+    }
+}
+
+/// Solves the two-bone specs in turn on top of `pose`, for a character placed by
+/// `placement`; a joint without a grandparent is refused.
+pub fn apply_two_bone_specs(
+    skeleton: &Skeleton,
+    pose: &mut [JointRotation],
+    placement: Mat4,
+    specs: &[TwoBoneSpec],
+) -> Result<Vec<marionette_rig::two_bone::TwoBoneReport>, PoseSpecError> {
+    specs
+        .iter()
+        .map(|s| {
+            let unknown = || PoseSpecError::UnknownJoint {
+                spec: s.joint.clone(),
+                joint: s.joint.clone(),
+                known: joint_list(skeleton),
+            };
+            let end = skeleton.resolve(&s.joint).ok_or_else(unknown)?;
+            let goal = marionette_rig::two_bone::TwoBoneGoal { end, target: s.target, pole: s.pole, soft: 0.0 };
+            marionette_rig::two_bone::solve_two_bone(skeleton, pose, placement, goal, IK_TOLERANCE).ok_or_else(|| {
+                PoseSpecError::Syntax {
+                    spec: format!("{}: a two-bone limb needs a joint with a parent and a grandparent", s.joint),
+                }
+            })
+        })
+        .collect()
+}
+
+/// One line about a two-bone solve.
+pub fn describe_two_bone(skeleton: &Skeleton, r: &marionette_rig::two_bone::TwoBoneReport) -> String {
+    let [root, mid, end] = r.chain.map(|j| skeleton.joint(j).name.as_str());
+    format!(
+        "two-bone {root} → {mid} → {end}: {}, distance {:.5}{}",
+        if r.reached { "reached" } else { "not reached (the limb straight toward it)" },
+        r.distance,
+        if r.limited { ", stopped by joint limits" } else { "" }
+    )
+}
+
 pub use marionette_rig::ik::{IK_ROUNDS, IK_TOLERANCE};
 
 /// Solves the IK specs in turn on top of `pose` (after `--pose`), for a character placed

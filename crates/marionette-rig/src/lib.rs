@@ -32,6 +32,7 @@ pub mod skinning;
 pub mod smpl;
 pub mod triangle_tree;
 pub mod turn;
+pub mod two_bone;
 
 pub use character::{CharacterAsset, MorphTarget, Skin};
 pub use fk::{bind_world_to_joint, forward_kinematics, skinning_palette};

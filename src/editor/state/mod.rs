@@ -22,6 +22,8 @@ pub struct StartupPaths(pub Vec<PathBuf>);
 pub struct StartupEdits {
     pub poses: Vec<crate::document::posing::PoseSpec>,
     pub ik: Vec<crate::document::posing::IkSpec>,
+    /// `--two-bone`: two-bone IK with a pole, after `--ik`.
+    pub two_bone: Vec<crate::document::posing::TwoBoneSpec>,
     /// `--skinning`: every character skinned this way.
     pub skinning: Option<crate::rig::dqs::SkinningMethod>,
     /// `--match-height`: every character scaled to the first one's height.
@@ -50,6 +52,7 @@ impl StartupEdits {
         crate::document::options::PoseOptions {
             poses: self.poses.clone(),
             ik: self.ik.clone(),
+            two_bone: self.two_bone.clone(),
             skinning: self.skinning,
             anim: self.anim.clone(),
             clip: self.clip.clone(),
