@@ -21,7 +21,7 @@ fn main() -> ExitCode {
 fn run(cli: Cli) -> Result<()> {
     match cli.command {
         None => marionette::editor::run(Vec::new(), Default::default(), Default::default()),
-        Some(Command::Edit { paths, clip, poses, ik, two_bone, recover }) => {
+        Some(Command::Edit { paths, clip, poses, ik, two_bone, look_at, recover }) => {
             let paths = if recover {
                 use marionette::editor::ui::unsaved::{newest_recovery, recovery_dir};
                 let newest = newest_recovery()
@@ -34,6 +34,7 @@ fn run(cli: Cli) -> Result<()> {
                 poses,
                 ik,
                 two_bone,
+                look_at,
                 recovered: recover,
                 anim: clip.anim_doc(true),
                 time: clip.time,
@@ -49,12 +50,25 @@ fn run(cli: Cli) -> Result<()> {
         }
         Some(Command::Info { path }) => marionette::cli::info(&path)?,
         Some(Command::Export(args)) => marionette::cli::export::run(&args)?,
-        Some(Command::Render { paths, out, shot, poses, ik, two_bone, skinning, match_height, clip, frames }) => {
+        Some(Command::Render {
+            paths,
+            out,
+            shot,
+            poses,
+            ik,
+            two_bone,
+            look_at,
+            skinning,
+            match_height,
+            clip,
+            frames,
+        }) => {
             let started = std::time::Instant::now();
             let edits = marionette::editor::StartupEdits {
                 poses,
                 ik,
                 two_bone,
+                look_at,
                 skinning: skinning.map(Into::into),
                 match_height,
                 anim: clip.anim_doc(false),

@@ -3,7 +3,7 @@
 
 use std::path::PathBuf;
 
-use crate::document::posing::{IkSpec, PoseSpec, TwoBoneSpec};
+use crate::document::posing::{IkSpec, LookAtSpec, PoseSpec, TwoBoneSpec};
 
 /// The largest picture side `render` accepts (the texture limit of common GPUs).
 pub const MAX_PICTURE_SIDE: i64 = 8192;
@@ -35,6 +35,10 @@ pub enum Command {
         /// (world metres), after --ik. Repeatable.
         #[arg(long = "two-bone", value_name = "JOINT=x,y,z[@x,y,z]")]
         two_bone: Vec<TwoBoneSpec>,
+        /// `JOINT=x,y,z`: JOINT (a head) turned so that its face points at this world point
+        /// (a humanoid's head spreads the turn over its chest and neck), last. Repeatable.
+        #[arg(long = "look-at", value_name = "JOINT=x,y,z")]
+        look_at: Vec<LookAtSpec>,
         /// Open the newest recovery file (what autosave or a crash left in
         /// `$XDG_STATE_HOME/marionette/recovery`).
         #[arg(long, conflicts_with = "paths")]
@@ -68,6 +72,10 @@ pub enum Command {
         /// (world metres), after --ik. Repeatable.
         #[arg(long = "two-bone", value_name = "JOINT=x,y,z[@x,y,z]")]
         two_bone: Vec<TwoBoneSpec>,
+        /// `JOINT=x,y,z`: JOINT (a head) turned so that its face points at this world point
+        /// (a humanoid's head spreads the turn over its chest and neck), last. Repeatable.
+        #[arg(long = "look-at", value_name = "JOINT=x,y,z")]
+        look_at: Vec<LookAtSpec>,
         /// Skin every character by linear blend (`lbs`) or dual quaternion (`dq`) skinning
         /// (default: as the scene file says).
         #[arg(long, value_enum)]
@@ -326,6 +334,10 @@ pub struct ExportArgs {
     /// (world metres), after --ik. Repeatable.
     #[arg(long = "two-bone", value_name = "JOINT=x,y,z[@x,y,z]")]
     pub two_bone: Vec<TwoBoneSpec>,
+    /// `JOINT=x,y,z`: JOINT (a head) turned so that its face points at this world point
+    /// (a humanoid's head spreads the turn over its chest and neck), last. Repeatable.
+    #[arg(long = "look-at", value_name = "JOINT=x,y,z")]
+    pub look_at: Vec<LookAtSpec>,
     /// Linear blend (`lbs`) or dual quaternion (`dq`) skinning for every character (without
     /// it, a scene's characters keep theirs; others are `lbs`).
     #[arg(long, value_enum)]

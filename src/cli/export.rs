@@ -41,6 +41,7 @@ fn pose_options(a: &ExportArgs) -> PoseOptions {
         poses: a.poses.clone(),
         ik: a.ik.clone(),
         two_bone: a.two_bone.clone(),
+        look_at: a.look_at.clone(),
         skinning: a.skinning.map(Into::into),
         anim: a.clip.anim_doc(false),
         clip: a.clip.own_clip(),

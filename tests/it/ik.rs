@@ -381,3 +381,46 @@ fn export_takes_two_bone_targets_and_refuses_unknown_joints() {
     let output = run("mixamorig:LeftFoot=0,1,0@1,2");
     assert!(!output.status.success());
 }
+
+/// Look-at on the Mixamo, Unreal and VRoid rigs' heads: for targets all round, the face —
+/// where the character faces at rest, carried by the head's frame (FK here) — points at the
+/// target within 0.1°, the turn spread over chest and neck (which turn too).
+#[test]
+fn look_at_turns_a_humanoids_face_to_the_target() {
+    use marionette::document::posing::{LookAtSpec, apply_look_at_specs};
+    use marionette::rig::humanoid::{HumanBone, detect};
+    let rigs = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/data/rigs");
+    for file in ["mixamo.glb", "unreal.glb", "vroid.glb"] {
+        let asset = load_character(&rigs.join(file)).unwrap();
+        let skeleton = &asset.skeleton;
+        let map = detect(skeleton).unwrap();
+        let (head, chest) = (map[&HumanBone::Head], map[&HumanBone::Chest]);
+        let world_of = |pose: &[JointRotation]| {
+            let mut world = vec![Mat4::IDENTITY; skeleton.len()];
+            forward_kinematics(skeleton, pose, Mat4::IDENTITY, &mut world);
+            world
+        };
+        let rest = world_of(&skeleton.initial_pose());
+        let across = rest[map[&HumanBone::LeftUpperLeg]].w_axis - rest[map[&HumanBone::RightUpperLeg]].w_axis;
+        let facing = across.truncate().cross(Vec3::Y).normalize();
+        let rotation = marionette::rig::ik::rotation_of;
+        let face = rotation(rest[head]).inverse() * facing;
+        let eye = rest[head].w_axis.truncate();
+        let mut worst = 0.0f32;
+        for k in 0..100 {
+            let a = k as f32 * 0.37;
+            let target = eye + Vec3::new(2.0 * a.sin(), (a * 1.7).sin(), 2.0 * a.cos());
+            let mut pose = skeleton.initial_pose();
+            let spec = LookAtSpec { joint: skeleton.joint(head).name.clone(), target };
+            apply_look_at_specs(skeleton, &mut pose, Mat4::IDENTITY, &[spec]).unwrap();
+            let world = world_of(&pose);
+            let now = rotation(world[head]) * face;
+            worst = worst.max(now.angle_between(target - world[head].w_axis.truncate()).to_degrees());
+            if (target - eye).dot(facing) < 0.0 {
+                assert_ne!(pose[chest], skeleton.initial_pose()[chest], "{file}: the chest takes a share");
+            }
+        }
+        eprintln!("{file}: look-at worst {worst:e}°");
+        assert!(worst < 0.1, "{file}: the face {worst}° off");
+    }
+}

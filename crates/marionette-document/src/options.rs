@@ -17,7 +17,7 @@ use marionette_rig::dqs::SkinningMethod;
 
 use crate::AssetLibrary;
 use crate::posing::{IkSpec, PoseSpec, TwoBoneSpec, apply_ik_specs, apply_pose_specs, describe_ik, find_clip};
-use crate::posing::{apply_two_bone_specs, describe_two_bone};
+use crate::posing::{LookAtSpec, apply_look_at_specs, apply_two_bone_specs, describe_look_at, describe_two_bone};
 
 /// What the command line asks of the characters.
 #[derive(Clone, Debug, Default)]
@@ -28,6 +28,8 @@ pub struct PoseOptions {
     pub ik: Vec<IkSpec>,
     /// `--two-bone JOINT=x,y,z[@x,y,z]`: on every character that has the joint, after `--ik`.
     pub two_bone: Vec<TwoBoneSpec>,
+    /// `--look-at JOINT=x,y,z`: on every character that has the joint, last.
+    pub look_at: Vec<LookAtSpec>,
     /// `--skinning`: every character skinned this way.
     pub skinning: Option<SkinningMethod>,
     /// `--anim FILE` (or `--retarget FILE`): a clip on every character it fits.
@@ -44,7 +46,7 @@ pub struct PoseOptions {
 impl PoseOptions {
     /// Whether the options pose a still figure (which baking clips into it gives).
     pub fn poses_joints(&self) -> bool {
-        !self.poses.is_empty() || !self.ik.is_empty() || !self.two_bone.is_empty()
+        !self.poses.is_empty() || !self.ik.is_empty() || !self.two_bone.is_empty() || !self.look_at.is_empty()
     }
 }
 
@@ -208,7 +210,7 @@ fn pose_characters(
 ) -> Result<Vec<String>, String> {
     let scene = doc.clone();
     let mut notes = Vec::new();
-    let mut used = vec![false; options.poses.len() + options.ik.len() + options.two_bone.len()];
+    let mut used = vec![false; options.poses.len() + options.ik.len() + options.two_bone.len() + options.look_at.len()];
     let mut joints_seen = Vec::new();
     for c in &mut doc.characters {
         let asset = match library.shaped(c) {
@@ -225,11 +227,13 @@ fn pose_characters(
         let poses: Vec<PoseSpec> = options.poses.iter().filter(|p| has(&p.joint)).cloned().collect();
         let ik: Vec<IkSpec> = options.ik.iter().filter(|p| has(&p.joint)).cloned().collect();
         let two_bone: Vec<TwoBoneSpec> = options.two_bone.iter().filter(|p| has(&p.joint)).cloned().collect();
-        if poses.is_empty() && ik.is_empty() && two_bone.is_empty() {
+        let look_at: Vec<LookAtSpec> = options.look_at.iter().filter(|p| has(&p.joint)).cloned().collect();
+        if poses.is_empty() && ik.is_empty() && two_bone.is_empty() && look_at.is_empty() {
             continue;
         }
         let names = options.poses.iter().map(|p| &p.joint).chain(options.ik.iter().map(|p| &p.joint));
-        let names = names.chain(options.two_bone.iter().map(|p| &p.joint));
+        let names =
+            names.chain(options.two_bone.iter().map(|p| &p.joint)).chain(options.look_at.iter().map(|p| &p.joint));
         names.zip(&mut used).filter(|(j, _)| has(j)).for_each(|(_, u)| *u = true);
         let (mut pose, root_shift) =
             crate::export::still_pose(library, &scene, c, &asset).map_err(|e| e.to_string())?;
@@ -241,6 +245,9 @@ fn pose_characters(
         for report in apply_two_bone_specs(skeleton, &mut pose, placement, &two_bone).map_err(|e| e.to_string())? {
             notes.push(format!("{}: {}", c.name, describe_two_bone(skeleton, &report)));
         }
+        for report in apply_look_at_specs(skeleton, &mut pose, placement, &look_at).map_err(|e| e.to_string())? {
+            notes.push(format!("{}: {}", c.name, describe_look_at(skeleton, &report)));
+        }
         let initial = skeleton.initial_pose();
         c.pose =
             (0..skeleton.len()).filter(|&j| pose[j] != initial[j]).map(|j| (pose_key(skeleton, j), pose[j])).collect();
@@ -251,6 +258,7 @@ fn pose_characters(
     }
     let specs = options.poses.iter().map(|p| ("--pose", &p.joint)).chain(options.ik.iter().map(|p| ("--ik", &p.joint)));
     let specs = specs.chain(options.two_bone.iter().map(|p| ("--two-bone", &p.joint)));
+    let specs = specs.chain(options.look_at.iter().map(|p| ("--look-at", &p.joint)));
     if let Some((option, joint)) = specs.zip(&used).find(|(_, u)| !**u).map(|(s, _)| s) {
         let known = joints_seen.join("; ");
         return Err(format!("{option}: no character has a joint named or numbered `{joint}` ({known})"));

@@ -306,6 +306,84 @@ pub fn describe_two_bone(skeleton: &Skeleton, r: &marionette_rig::two_bone::TwoB
     )
 }
 
+/// A parsed `JOINT=x,y,z`: JOINT (a head) turned so that its face points at the target
+/// (world space).
+#[derive(Debug, Clone, PartialEq)]
+pub struct LookAtSpec {
+    pub joint: String,
+    pub target: Vec3,
+}
+
+impl std::str::FromStr for LookAtSpec {
+    type Err = PoseSpecError;
+
+    fn from_str(spec: &str) -> Result<Self, Self::Err> {
+        let goal: IkSpec = spec.parse()?;
+        Ok(Self { joint: goal.joint, target: goal.target })
+    }
+}
+
+/// The share of the turn the chest and then the neck take when a look-at spreads over them.
+pub const LOOK_AT_SHARES: [f32; 2] = [0.2, 0.35];
+
+/// Turns each spec's joint so that its face points at the target, on top of `pose`, for a
+/// character placed by `placement`. The face is where the character faces at rest (square
+/// to its hips' line, from the humanoid map; else +z); a joint the map calls the head
+/// spreads the turn over the chest and neck.
+pub fn apply_look_at_specs(
+    skeleton: &Skeleton,
+    pose: &mut [JointRotation],
+    placement: Mat4,
+    specs: &[LookAtSpec],
+) -> Result<Vec<marionette_rig::look_at::LookAtReport>, PoseSpecError> {
+    use marionette_rig::humanoid::HumanBone;
+    let map = marionette_rig::humanoid::detect(skeleton).unwrap_or_default();
+    let mut rest = vec![Mat4::IDENTITY; skeleton.len()];
+    marionette_rig::fk::forward_kinematics(skeleton, &skeleton.initial_pose(), Mat4::IDENTITY, &mut rest);
+    let at = |j: usize| rest[j].w_axis.truncate();
+    let facing = match (map.get(&HumanBone::RightUpperLeg), map.get(&HumanBone::LeftUpperLeg)) {
+        (Some(&r), Some(&l)) => marionette_rig::look_at::facing(at(r), at(l)),
+        _ => Vec3::Z,
+    };
+    specs
+        .iter()
+        .map(|s| {
+            let joint = skeleton.resolve(&s.joint).ok_or_else(|| PoseSpecError::UnknownJoint {
+                spec: s.joint.clone(),
+                joint: s.joint.clone(),
+                known: joint_list(skeleton),
+            })?;
+            let rotation = marionette_rig::ik::rotation_of(rest[joint]);
+            let face = rotation.inverse() * facing;
+            let spread = [HumanBone::Chest, HumanBone::Neck].map(|b| map.get(&b).copied());
+            let joints = match spread {
+                [Some(chest), Some(neck)] if map.get(&HumanBone::Head) == Some(&joint) => vec![chest, neck, joint],
+                _ => vec![joint],
+            };
+            Ok(marionette_rig::look_at::solve_look_at(
+                skeleton,
+                pose,
+                placement,
+                &joints,
+                face,
+                &LOOK_AT_SHARES,
+                s.target,
+            ))
+        })
+        .collect()
+}
+
+/// One line about a look-at.
+pub fn describe_look_at(skeleton: &Skeleton, r: &marionette_rig::look_at::LookAtReport) -> String {
+    let names: Vec<&str> = r.joints.iter().map(|&j| skeleton.joint(j).name.as_str()).collect();
+    format!(
+        "look-at {}: the face {:.3}° off the target{}",
+        names.join(" → "),
+        r.off_degrees,
+        if r.limited { ", stopped by joint limits" } else { "" }
+    )
+}
+
 pub use marionette_rig::ik::{IK_ROUNDS, IK_TOLERANCE};
 
 /// Solves the IK specs in turn on top of `pose` (after `--pose`), for a character placed

@@ -181,7 +181,7 @@ pub fn solve_ik(
 }
 
 /// The rotation part of a transform (scale removed).
-pub(crate) fn rotation_of(m: Mat4) -> Quat {
+pub fn rotation_of(m: Mat4) -> Quat {
     let m3 = Mat3::from_mat4(m);
     Quat::from_mat3(&Mat3::from_cols(m3.x_axis.normalize(), m3.y_axis.normalize(), m3.z_axis.normalize())).normalize()
 }

@@ -19,6 +19,7 @@ pub mod keyframe_splines;
 #[cfg(target_arch = "x86_64")]
 mod lanes;
 pub mod lbs;
+pub mod look_at;
 pub mod material;
 pub mod matrix_stack;
 pub mod mirror;

@@ -24,6 +24,8 @@ pub struct StartupEdits {
     pub ik: Vec<crate::document::posing::IkSpec>,
     /// `--two-bone`: two-bone IK with a pole, after `--ik`.
     pub two_bone: Vec<crate::document::posing::TwoBoneSpec>,
+    /// `--look-at`: a head turned to face a point, last.
+    pub look_at: Vec<crate::document::posing::LookAtSpec>,
     /// `--skinning`: every character skinned this way.
     pub skinning: Option<crate::rig::dqs::SkinningMethod>,
     /// `--match-height`: every character scaled to the first one's height.
@@ -53,6 +55,7 @@ impl StartupEdits {
             poses: self.poses.clone(),
             ik: self.ik.clone(),
             two_bone: self.two_bone.clone(),
+            look_at: self.look_at.clone(),
             skinning: self.skinning,
             anim: self.anim.clone(),
             clip: self.clip.clone(),
