@@ -329,3 +329,54 @@ fn fingers_named_for_nothing_are_found_by_the_hands_shape() {
     }
     assert!(failures.is_empty(), "{}", failures.join("\n"));
 }
+
+/// Hand presets on every family with fingers, both hands, checked per phalanx by the angle
+/// between each phalanx and the bone that leads into it (FK here): `fist` bends every phalanx
+/// of the four fingers at least 60° and the thumb's at least 30°, toward the palm (down at
+/// rest); `open` leaves each within 10° of straight; `point` the index straight, the others
+/// as in `fist`.
+#[test]
+fn hand_presets_bend_every_phalanx_as_defined() {
+    use marionette::rig::fk::forward_kinematics;
+    use marionette::rig::hands::{apply_hand, preset};
+    use marionette::rig::humanoid::detect_reported;
+    let mut failures = Vec::new();
+    for family in families().into_iter().filter(|f| f.finger.is_some()) {
+        let asset = marionette::formats::load_character(&rig(family.file)).unwrap();
+        let skeleton = &asset.skeleton;
+        let map = detect_reported(skeleton).unwrap().map;
+        for name in ["fist", "open", "point"] {
+            for left in [true, false] {
+                let (curl, spread) = preset(name).unwrap();
+                let mut pose = skeleton.initial_pose();
+                apply_hand(skeleton, &map, &mut pose, left, curl, spread).unwrap();
+                let mut world = vec![glam::Mat4::IDENTITY; skeleton.len()];
+                forward_kinematics(skeleton, &pose, glam::Mat4::IDENTITY, &mut world);
+                let at = |j: usize| world[j].w_axis.truncate();
+                for f in 0..5 {
+                    for p in 0..3 {
+                        let Some(&j) = map.get(&HumanBone::finger(left, f, p)) else { continue };
+                        let (Some(&child), Some(parent)) = (skeleton.children(j).first(), skeleton.parent(j)) else {
+                            continue;
+                        };
+                        let bend = (at(child) - at(j)).angle_between(at(j) - at(parent)).to_degrees();
+                        let straight = name == "open" || (name == "point" && f == 1);
+                        let least = if f == 0 { 30.0 } else { 60.0 };
+                        let mut ok = if straight { bend <= 10.0 } else { bend >= least };
+                        if name == "fist" && f > 0 && p == 2 {
+                            // The fingertip went down, toward the palm.
+                            let mut rest = vec![glam::Mat4::IDENTITY; skeleton.len()];
+                            forward_kinematics(skeleton, &skeleton.initial_pose(), glam::Mat4::IDENTITY, &mut rest);
+                            ok &= at(child).y < rest[child].w_axis.y;
+                        }
+                        if !ok {
+                            failures
+                                .push(format!("{} {name} left={left} finger {f} phalanx {p}: {bend:.1}°", family.file));
+                        }
+                    }
+                }
+            }
+        }
+    }
+    assert!(failures.is_empty(), "{}", failures.join("\n"));
+}

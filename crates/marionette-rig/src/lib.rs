@@ -11,6 +11,7 @@ pub mod bones;
 pub mod character;
 pub mod dqs;
 pub mod fk;
+pub mod hands;
 pub mod heat;
 pub mod humanoid;
 pub mod ik;
