@@ -21,7 +21,7 @@ fn main() -> ExitCode {
 fn run(cli: Cli) -> Result<()> {
     match cli.command {
         None => marionette::editor::run(Vec::new(), Default::default(), Default::default()),
-        Some(Command::Edit { paths, clip, poses, ik, two_bone, look_at, recover }) => {
+        Some(Command::Edit { paths, clip, poses, ik, two_bone, look_at, hands, recover }) => {
             let paths = if recover {
                 use marionette::editor::ui::unsaved::{newest_recovery, recovery_dir};
                 let newest = newest_recovery()
@@ -35,6 +35,7 @@ fn run(cli: Cli) -> Result<()> {
                 ik,
                 two_bone,
                 look_at,
+                hands,
                 recovered: recover,
                 anim: clip.anim_doc(true),
                 time: clip.time,
@@ -58,6 +59,7 @@ fn run(cli: Cli) -> Result<()> {
             ik,
             two_bone,
             look_at,
+            hands,
             skinning,
             match_height,
             clip,
@@ -69,6 +71,7 @@ fn run(cli: Cli) -> Result<()> {
                 ik,
                 two_bone,
                 look_at,
+                hands,
                 skinning: skinning.map(Into::into),
                 match_height,
                 anim: clip.anim_doc(false),

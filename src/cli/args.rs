@@ -3,7 +3,7 @@
 
 use std::path::PathBuf;
 
-use crate::document::posing::{IkSpec, LookAtSpec, PoseSpec, TwoBoneSpec};
+use crate::document::posing::{HandSpec, IkSpec, LookAtSpec, PoseSpec, TwoBoneSpec};
 
 /// The largest picture side `render` accepts (the texture limit of common GPUs).
 pub const MAX_PICTURE_SIDE: i64 = 8192;
@@ -39,6 +39,10 @@ pub enum Command {
         /// (a humanoid's head spreads the turn over its chest and neck), last. Repeatable.
         #[arg(long = "look-at", value_name = "JOINT=x,y,z")]
         look_at: Vec<LookAtSpec>,
+        /// `SIDE=NAME`: a hand preset on every humanoid with fingers (`left=fist`,
+        /// `right=point`; relaxed, fist, open, spread, point, pinch, grip, peace, thumbs-up).
+        #[arg(long = "hand", value_name = "SIDE=NAME")]
+        hands: Vec<HandSpec>,
         /// Open the newest recovery file (what autosave or a crash left in
         /// `$XDG_STATE_HOME/marionette/recovery`).
         #[arg(long, conflicts_with = "paths")]
@@ -76,6 +80,10 @@ pub enum Command {
         /// (a humanoid's head spreads the turn over its chest and neck), last. Repeatable.
         #[arg(long = "look-at", value_name = "JOINT=x,y,z")]
         look_at: Vec<LookAtSpec>,
+        /// `SIDE=NAME`: a hand preset on every humanoid with fingers (`left=fist`,
+        /// `right=point`; relaxed, fist, open, spread, point, pinch, grip, peace, thumbs-up).
+        #[arg(long = "hand", value_name = "SIDE=NAME")]
+        hands: Vec<HandSpec>,
         /// Skin every character by linear blend (`lbs`) or dual quaternion (`dq`) skinning
         /// (default: as the scene file says).
         #[arg(long, value_enum)]
@@ -338,6 +346,10 @@ pub struct ExportArgs {
     /// (a humanoid's head spreads the turn over its chest and neck), last. Repeatable.
     #[arg(long = "look-at", value_name = "JOINT=x,y,z")]
     pub look_at: Vec<LookAtSpec>,
+    /// `SIDE=NAME`: a hand preset on every humanoid with fingers (`left=fist`,
+    /// `right=point`; relaxed, fist, open, spread, point, pinch, grip, peace, thumbs-up).
+    #[arg(long = "hand", value_name = "SIDE=NAME")]
+    pub hands: Vec<HandSpec>,
     /// Linear blend (`lbs`) or dual quaternion (`dq`) skinning for every character (without
     /// it, a scene's characters keep theirs; others are `lbs`).
     #[arg(long, value_enum)]

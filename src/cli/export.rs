@@ -42,6 +42,7 @@ fn pose_options(a: &ExportArgs) -> PoseOptions {
         ik: a.ik.clone(),
         two_bone: a.two_bone.clone(),
         look_at: a.look_at.clone(),
+        hands: a.hands.clone(),
         skinning: a.skinning.map(Into::into),
         anim: a.clip.anim_doc(false),
         clip: a.clip.own_clip(),

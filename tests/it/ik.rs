@@ -424,3 +424,25 @@ fn look_at_turns_a_humanoids_face_to_the_target() {
         assert!(worst < 0.1, "{file}: the face {worst}° off");
     }
 }
+
+/// `--hand SIDE=NAME` on `export`: the hand posed (the note says so); a side or preset that
+/// does not exist is refused; `info` lists the presets of a rig with fingers.
+#[test]
+fn export_takes_hand_presets_and_info_lists_them() {
+    let rig = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/data/rigs/mixamo.glb");
+    let out = scratch("hands").join("fist.obj");
+    let run = |args: &[&str]| Command::new(env!("CARGO_BIN_EXE_marionette")).args(args).output().unwrap();
+    let (rig_path, out_path) = (rig.to_str().unwrap(), out.to_str().unwrap());
+    let output = run(&["export", rig_path, "--hand", "left=fist", "--hand", "right=point", "--out", out_path]);
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert!(output.status.success(), "{stderr}");
+    assert!(stderr.contains("hand left: fist") && stderr.contains("hand right: point"), "{stderr}");
+    for bad in ["middle=fist", "left=disco", "fist"] {
+        let output = run(&["export", rig_path, "--hand", bad, "--out", out_path]);
+        assert!(!output.status.success() && String::from_utf8_lossy(&output.stderr).contains("left=NAME"), "{bad}");
+    }
+    let info = run(&["info", rig_path]);
+    assert!(
+        String::from_utf8_lossy(&info.stdout).contains("hand presets (--hand left=NAME, right=NAME): relaxed, fist")
+    );
+}

@@ -30,6 +30,8 @@ pub struct PoseOptions {
     pub two_bone: Vec<TwoBoneSpec>,
     /// `--look-at JOINT=x,y,z`: on every character that has the joint, last.
     pub look_at: Vec<LookAtSpec>,
+    /// `--hand SIDE=NAME`: a hand preset on every humanoid with fingers, after `--pose`.
+    pub hands: Vec<crate::posing::HandSpec>,
     /// `--skinning`: every character skinned this way.
     pub skinning: Option<SkinningMethod>,
     /// `--anim FILE` (or `--retarget FILE`): a clip on every character it fits.
@@ -46,7 +48,11 @@ pub struct PoseOptions {
 impl PoseOptions {
     /// Whether the options pose a still figure (which baking clips into it gives).
     pub fn poses_joints(&self) -> bool {
-        !self.poses.is_empty() || !self.ik.is_empty() || !self.two_bone.is_empty() || !self.look_at.is_empty()
+        !self.poses.is_empty()
+            || !self.ik.is_empty()
+            || !self.two_bone.is_empty()
+            || !self.look_at.is_empty()
+            || !self.hands.is_empty()
     }
 }
 
@@ -228,7 +234,7 @@ fn pose_characters(
         let ik: Vec<IkSpec> = options.ik.iter().filter(|p| has(&p.joint)).cloned().collect();
         let two_bone: Vec<TwoBoneSpec> = options.two_bone.iter().filter(|p| has(&p.joint)).cloned().collect();
         let look_at: Vec<LookAtSpec> = options.look_at.iter().filter(|p| has(&p.joint)).cloned().collect();
-        if poses.is_empty() && ik.is_empty() && two_bone.is_empty() && look_at.is_empty() {
+        if poses.is_empty() && ik.is_empty() && two_bone.is_empty() && look_at.is_empty() && options.hands.is_empty() {
             continue;
         }
         let names = options.poses.iter().map(|p| &p.joint).chain(options.ik.iter().map(|p| &p.joint));
@@ -238,6 +244,8 @@ fn pose_characters(
         let (mut pose, root_shift) =
             crate::export::still_pose(library, &scene, c, &asset).map_err(|e| e.to_string())?;
         apply_pose_specs(skeleton, &mut pose, &poses).map_err(|e| e.to_string())?;
+        let hands = crate::posing::apply_hand_specs(skeleton, &mut pose, &options.hands);
+        notes.extend(hands.into_iter().map(|n| format!("{}: {n}", c.name)));
         let placement = c.placement.to_mat4() * Mat4::from_translation(root_shift);
         for report in apply_ik_specs(skeleton, &mut pose, placement, &ik).map_err(|e| e.to_string())? {
             notes.push(format!("{}: {}", c.name, describe_ik(skeleton, &report)));

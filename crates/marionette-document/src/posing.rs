@@ -213,6 +213,10 @@ pub fn describe_humanoid(asset: &CharacterAsset) -> String {
     for doubt in &found.doubts {
         out += &format!("humanoid doubt: {doubt}\n");
     }
+    if found.map.keys().any(|b| b.is_finger()) {
+        let names: Vec<&str> = marionette_rig::hands::PRESETS.iter().map(|p| p.0).collect();
+        out += &format!("hand presets (--hand left=NAME, right=NAME): {}\n", names.join(", "));
+    }
     out
 }
 
@@ -321,6 +325,52 @@ impl std::str::FromStr for LookAtSpec {
         let goal: IkSpec = spec.parse()?;
         Ok(Self { joint: goal.joint, target: goal.target })
     }
+}
+
+/// A parsed `SIDE=NAME`: a hand preset (`fist`, `open`, …) on the left or right hand.
+#[derive(Debug, Clone, PartialEq)]
+pub struct HandSpec {
+    pub left: bool,
+    pub preset: String,
+}
+
+impl std::str::FromStr for HandSpec {
+    type Err = PoseSpecError;
+
+    fn from_str(spec: &str) -> Result<Self, Self::Err> {
+        let names: Vec<&str> = marionette_rig::hands::PRESETS.iter().map(|p| p.0).collect();
+        let syntax = || PoseSpecError::Syntax {
+            spec: format!("{spec} (expected left=NAME or right=NAME, NAME one of {})", names.join(", ")),
+        };
+        let (side, preset) = spec.split_once('=').ok_or_else(syntax)?;
+        let left = match side.trim() {
+            "left" | "l" => true,
+            "right" | "r" => false,
+            _ => return Err(syntax()),
+        };
+        if marionette_rig::hands::preset(preset.trim()).is_none() {
+            return Err(syntax());
+        }
+        Ok(Self { left, preset: preset.trim().to_string() })
+    }
+}
+
+/// Puts the hand presets on `pose` through the skeleton's humanoid map. Returns a note per
+/// hand, or why a hand could not be posed (no humanoid, no fingers mapped).
+pub fn apply_hand_specs(skeleton: &Skeleton, pose: &mut [JointRotation], specs: &[HandSpec]) -> Vec<String> {
+    let map = marionette_rig::humanoid::detect(skeleton).unwrap_or_default();
+    specs
+        .iter()
+        .map(|s| {
+            let side = if s.left { "left" } else { "right" };
+            let (curl, spread) = marionette_rig::hands::preset(&s.preset).unwrap_or(([0.0; 5], 0.0));
+            match marionette_rig::hands::apply_hand(skeleton, &map, pose, s.left, curl, spread) {
+                Some(false) => format!("hand {side}: {}", s.preset),
+                Some(true) => format!("hand {side}: {}, stopped by joint limits", s.preset),
+                None => format!("hand {side}: no fingers mapped; {} skipped", s.preset),
+            }
+        })
+        .collect()
 }
 
 /// The share of the turn the chest and then the neck take when a look-at spreads over them.

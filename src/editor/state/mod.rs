@@ -26,6 +26,8 @@ pub struct StartupEdits {
     pub two_bone: Vec<crate::document::posing::TwoBoneSpec>,
     /// `--look-at`: a head turned to face a point, last.
     pub look_at: Vec<crate::document::posing::LookAtSpec>,
+    /// `--hand`: hand presets.
+    pub hands: Vec<crate::document::posing::HandSpec>,
     /// `--skinning`: every character skinned this way.
     pub skinning: Option<crate::rig::dqs::SkinningMethod>,
     /// `--match-height`: every character scaled to the first one's height.
@@ -56,6 +58,7 @@ impl StartupEdits {
             ik: self.ik.clone(),
             two_bone: self.two_bone.clone(),
             look_at: self.look_at.clone(),
+            hands: self.hands.clone(),
             skinning: self.skinning,
             anim: self.anim.clone(),
             clip: self.clip.clone(),
