@@ -21,7 +21,7 @@ fn main() -> ExitCode {
 fn run(cli: Cli) -> Result<()> {
     match cli.command {
         None => marionette::editor::run(Vec::new(), Default::default(), Default::default()),
-        Some(Command::Edit { paths, clip, poses, ik, two_bone, look_at, hands, recover }) => {
+        Some(Command::Edit { paths, clip, pose, recover }) => {
             let paths = if recover {
                 use marionette::editor::ui::unsaved::{newest_recovery, recovery_dir};
                 let newest = newest_recovery()
@@ -31,11 +31,7 @@ fn run(cli: Cli) -> Result<()> {
                 paths
             };
             let edits = marionette::editor::StartupEdits {
-                poses,
-                ik,
-                two_bone,
-                look_at,
-                hands,
+                pose: pose.specs(),
                 recovered: recover,
                 anim: clip.anim_doc(true),
                 time: clip.time,
@@ -51,27 +47,10 @@ fn run(cli: Cli) -> Result<()> {
         }
         Some(Command::Info { path }) => marionette::cli::info(&path)?,
         Some(Command::Export(args)) => marionette::cli::export::run(&args)?,
-        Some(Command::Render {
-            paths,
-            out,
-            shot,
-            poses,
-            ik,
-            two_bone,
-            look_at,
-            hands,
-            skinning,
-            match_height,
-            clip,
-            frames,
-        }) => {
+        Some(Command::Render { paths, out, shot, pose, skinning, match_height, clip, frames }) => {
             let started = std::time::Instant::now();
             let edits = marionette::editor::StartupEdits {
-                poses,
-                ik,
-                two_bone,
-                look_at,
-                hands,
+                pose: pose.specs(),
                 skinning: skinning.map(Into::into),
                 match_height,
                 anim: clip.anim_doc(false),

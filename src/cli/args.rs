@@ -23,26 +23,10 @@ pub enum Command {
         paths: Vec<PathBuf>,
         #[command(flatten)]
         clip: ClipArgs,
-        /// `JOINT=rx,ry,rz` applied to every character that has the joint (the scene opens
-        /// with unsaved changes). Repeatable.
-        #[arg(long = "pose", value_name = "JOINT=rx,ry,rz")]
-        poses: Vec<PoseSpec>,
-        /// `JOINT=x,y,z` world-space IK target for every character that has the joint.
-        #[arg(long = "ik", value_name = "JOINT=x,y,z")]
-        ik: Vec<IkSpec>,
-        /// `JOINT=x,y,z[@x,y,z]`: the limb ending at JOINT (an ankle or a wrist) turned by
-        /// two-bone IK to reach the target, its knee or elbow bending toward the pole
-        /// (world metres), after --ik. Repeatable.
-        #[arg(long = "two-bone", value_name = "JOINT=x,y,z[@x,y,z]")]
-        two_bone: Vec<TwoBoneSpec>,
-        /// `JOINT=x,y,z`: JOINT (a head) turned so that its face points at this world point
-        /// (a humanoid's head spreads the turn over its chest and neck), last. Repeatable.
-        #[arg(long = "look-at", value_name = "JOINT=x,y,z")]
-        look_at: Vec<LookAtSpec>,
-        /// `SIDE=NAME`: a hand preset on every humanoid with fingers (`left=fist`,
-        /// `right=point`; relaxed, fist, open, spread, point, pinch, grip, peace, thumbs-up).
-        #[arg(long = "hand", value_name = "SIDE=NAME")]
-        hands: Vec<HandSpec>,
+        /// `--pose`, `--hand`, `--ik`, `--two-bone`, `--look-at` (the scene opens with
+        /// unsaved changes).
+        #[command(flatten)]
+        pose: PoseArgs,
         /// Open the newest recovery file (what autosave or a crash left in
         /// `$XDG_STATE_HOME/marionette/recovery`).
         #[arg(long, conflicts_with = "paths")]
@@ -65,25 +49,8 @@ pub enum Command {
         out: PathBuf,
         #[command(flatten)]
         shot: ShotArgs,
-        /// `JOINT=rx,ry,rz` applied to every character that has the joint. Repeatable.
-        #[arg(long = "pose", value_name = "JOINT=rx,ry,rz")]
-        poses: Vec<PoseSpec>,
-        /// `JOINT=x,y,z` world-space IK target for every character that has the joint.
-        #[arg(long = "ik", value_name = "JOINT=x,y,z")]
-        ik: Vec<IkSpec>,
-        /// `JOINT=x,y,z[@x,y,z]`: the limb ending at JOINT (an ankle or a wrist) turned by
-        /// two-bone IK to reach the target, its knee or elbow bending toward the pole
-        /// (world metres), after --ik. Repeatable.
-        #[arg(long = "two-bone", value_name = "JOINT=x,y,z[@x,y,z]")]
-        two_bone: Vec<TwoBoneSpec>,
-        /// `JOINT=x,y,z`: JOINT (a head) turned so that its face points at this world point
-        /// (a humanoid's head spreads the turn over its chest and neck), last. Repeatable.
-        #[arg(long = "look-at", value_name = "JOINT=x,y,z")]
-        look_at: Vec<LookAtSpec>,
-        /// `SIDE=NAME`: a hand preset on every humanoid with fingers (`left=fist`,
-        /// `right=point`; relaxed, fist, open, spread, point, pinch, grip, peace, thumbs-up).
-        #[arg(long = "hand", value_name = "SIDE=NAME")]
-        hands: Vec<HandSpec>,
+        #[command(flatten)]
+        pose: PoseArgs,
         /// Skin every character by linear blend (`lbs`) or dual quaternion (`dq`) skinning
         /// (default: as the scene file says).
         #[arg(long, value_enum)]
@@ -329,27 +296,8 @@ pub struct ExportArgs {
     pub path: PathBuf,
     #[arg(long)]
     pub out: PathBuf,
-    /// `JOINT=rx,ry,rz` in radians (x applied first); JOINT is a name or an index.
-    /// Angles outside the joint's limits are clamped. Repeatable.
-    #[arg(long = "pose", value_name = "JOINT=rx,ry,rz")]
-    pub poses: Vec<PoseSpec>,
-    /// `JOINT=x,y,z`: move JOINT to this world-space point by inverse kinematics
-    /// (FABRIK), after --pose. Repeatable.
-    #[arg(long = "ik", value_name = "JOINT=x,y,z")]
-    pub ik: Vec<IkSpec>,
-    /// `JOINT=x,y,z[@x,y,z]`: the limb ending at JOINT (an ankle or a wrist) turned by
-    /// two-bone IK to reach the target, its knee or elbow bending toward the pole
-    /// (world metres), after --ik. Repeatable.
-    #[arg(long = "two-bone", value_name = "JOINT=x,y,z[@x,y,z]")]
-    pub two_bone: Vec<TwoBoneSpec>,
-    /// `JOINT=x,y,z`: JOINT (a head) turned so that its face points at this world point
-    /// (a humanoid's head spreads the turn over its chest and neck), last. Repeatable.
-    #[arg(long = "look-at", value_name = "JOINT=x,y,z")]
-    pub look_at: Vec<LookAtSpec>,
-    /// `SIDE=NAME`: a hand preset on every humanoid with fingers (`left=fist`,
-    /// `right=point`; relaxed, fist, open, spread, point, pinch, grip, peace, thumbs-up).
-    #[arg(long = "hand", value_name = "SIDE=NAME")]
-    pub hands: Vec<HandSpec>,
+    #[command(flatten)]
+    pub pose: PoseArgs,
     /// Linear blend (`lbs`) or dual quaternion (`dq`) skinning for every character (without
     /// it, a scene's characters keep theirs; others are `lbs`).
     #[arg(long, value_enum)]
@@ -444,4 +392,45 @@ pub struct GenerateArgs {
     /// Join the COCO files of every picture a data set's folder holds into DIR/coco.json.
     #[arg(long, value_name = "DIR", conflicts_with = "spec")]
     pub merge: Option<PathBuf>,
+}
+
+/// The posing options every command takes, applied to every character that has the joint
+/// (or, for `--hand`, mapped fingers), in this order: `--pose`, `--hand`, `--ik`,
+/// `--two-bone`, `--look-at`.
+#[derive(clap::Args, Debug, Clone, Default)]
+pub struct PoseArgs {
+    /// `JOINT=rx,ry,rz` in radians (x applied first); JOINT is a name or an index. Angles
+    /// outside the joint's limits are clamped. Repeatable.
+    #[arg(long = "pose", value_name = "JOINT=rx,ry,rz")]
+    pub poses: Vec<PoseSpec>,
+    /// `SIDE=NAME`: a hand preset on every humanoid with fingers (`left=fist`,
+    /// `right=point`; relaxed, fist, open, spread, point, pinch, grip, peace, thumbs-up).
+    #[arg(long = "hand", value_name = "SIDE=NAME")]
+    pub hands: Vec<HandSpec>,
+    /// `JOINT=x,y,z`: move JOINT to this world-space point by inverse kinematics (FABRIK).
+    /// Repeatable.
+    #[arg(long = "ik", value_name = "JOINT=x,y,z")]
+    pub ik: Vec<IkSpec>,
+    /// `JOINT=x,y,z[@x,y,z]`: the limb ending at JOINT (an ankle or a wrist) turned by
+    /// two-bone IK to reach the target, its knee or elbow bending toward the pole (world
+    /// metres). Repeatable.
+    #[arg(long = "two-bone", value_name = "JOINT=x,y,z[@x,y,z]")]
+    pub two_bone: Vec<TwoBoneSpec>,
+    /// `JOINT=x,y,z`: JOINT (a head) turned so that its face points at this world point (a
+    /// humanoid's head spreads the turn over its chest and neck). Repeatable.
+    #[arg(long = "look-at", value_name = "JOINT=x,y,z")]
+    pub look_at: Vec<LookAtSpec>,
+}
+
+impl PoseArgs {
+    /// The specs as every command applies them.
+    pub fn specs(&self) -> crate::document::options::PoseSpecs {
+        crate::document::options::PoseSpecs {
+            poses: self.poses.clone(),
+            hands: self.hands.clone(),
+            ik: self.ik.clone(),
+            two_bone: self.two_bone.clone(),
+            look_at: self.look_at.clone(),
+        }
+    }
 }

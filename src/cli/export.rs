@@ -38,11 +38,7 @@ pub fn run(a: &ExportArgs) -> Result<()> {
 /// The posing options `export` was given.
 fn pose_options(a: &ExportArgs) -> PoseOptions {
     PoseOptions {
-        poses: a.poses.clone(),
-        ik: a.ik.clone(),
-        two_bone: a.two_bone.clone(),
-        look_at: a.look_at.clone(),
-        hands: a.hands.clone(),
+        specs: a.pose.specs(),
         skinning: a.skinning.map(Into::into),
         anim: a.clip.anim_doc(false),
         clip: a.clip.own_clip(),

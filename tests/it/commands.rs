@@ -23,10 +23,9 @@ impl Options {
         args.extend(["--out".into(), "unused.png".into()]);
         args.extend(self.0.iter().map(|s| s.to_string()));
         let cli = <Cli as clap::Parser>::try_parse_from(&args).unwrap();
-        let Some(Command::Render { poses, ik, skinning, clip, .. }) = cli.command else { unreachable!() };
+        let Some(Command::Render { pose, skinning, clip, .. }) = cli.command else { unreachable!() };
         StartupEdits {
-            poses,
-            ik,
+            pose: pose.specs(),
             skinning: skinning.map(Into::into),
             anim: clip.anim_doc(false),
             time: clip.time,

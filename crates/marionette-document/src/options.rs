@@ -19,19 +19,27 @@ use crate::AssetLibrary;
 use crate::posing::{IkSpec, PoseSpec, TwoBoneSpec, apply_ik_specs, apply_pose_specs, describe_ik, find_clip};
 use crate::posing::{LookAtSpec, apply_look_at_specs, apply_two_bone_specs, describe_look_at, describe_two_bone};
 
+/// The posing specs of the command line, applied to every character that has the joint
+/// (or, for the hands, mapped fingers) in this order.
+#[derive(Clone, Debug, Default)]
+pub struct PoseSpecs {
+    /// `--pose JOINT=rx,ry,rz`.
+    pub poses: Vec<PoseSpec>,
+    /// `--hand SIDE=NAME`.
+    pub hands: Vec<crate::posing::HandSpec>,
+    /// `--ik JOINT=x,y,z`.
+    pub ik: Vec<IkSpec>,
+    /// `--two-bone JOINT=x,y,z[@x,y,z]`.
+    pub two_bone: Vec<TwoBoneSpec>,
+    /// `--look-at JOINT=x,y,z`.
+    pub look_at: Vec<LookAtSpec>,
+}
+
 /// What the command line asks of the characters.
 #[derive(Clone, Debug, Default)]
 pub struct PoseOptions {
-    /// `--pose JOINT=rx,ry,rz`: on every character that has the joint.
-    pub poses: Vec<PoseSpec>,
-    /// `--ik JOINT=x,y,z`: on every character that has the joint, after `--pose`.
-    pub ik: Vec<IkSpec>,
-    /// `--two-bone JOINT=x,y,z[@x,y,z]`: on every character that has the joint, after `--ik`.
-    pub two_bone: Vec<TwoBoneSpec>,
-    /// `--look-at JOINT=x,y,z`: on every character that has the joint, last.
-    pub look_at: Vec<LookAtSpec>,
-    /// `--hand SIDE=NAME`: a hand preset on every humanoid with fingers, after `--pose`.
-    pub hands: Vec<crate::posing::HandSpec>,
+    /// `--pose`, `--hand`, `--ik`, `--two-bone`, `--look-at`.
+    pub specs: PoseSpecs,
     /// `--skinning`: every character skinned this way.
     pub skinning: Option<SkinningMethod>,
     /// `--anim FILE` (or `--retarget FILE`): a clip on every character it fits.
@@ -48,11 +56,11 @@ pub struct PoseOptions {
 impl PoseOptions {
     /// Whether the options pose a still figure (which baking clips into it gives).
     pub fn poses_joints(&self) -> bool {
-        !self.poses.is_empty()
-            || !self.ik.is_empty()
-            || !self.two_bone.is_empty()
-            || !self.look_at.is_empty()
-            || !self.hands.is_empty()
+        !self.specs.poses.is_empty()
+            || !self.specs.ik.is_empty()
+            || !self.specs.two_bone.is_empty()
+            || !self.specs.look_at.is_empty()
+            || !self.specs.hands.is_empty()
     }
 }
 
@@ -216,7 +224,13 @@ fn pose_characters(
 ) -> Result<Vec<String>, String> {
     let scene = doc.clone();
     let mut notes = Vec::new();
-    let mut used = vec![false; options.poses.len() + options.ik.len() + options.two_bone.len() + options.look_at.len()];
+    let mut used = vec![
+        false;
+        options.specs.poses.len()
+            + options.specs.ik.len()
+            + options.specs.two_bone.len()
+            + options.specs.look_at.len()
+    ];
     let mut joints_seen = Vec::new();
     for c in &mut doc.characters {
         let asset = match library.shaped(c) {
@@ -230,21 +244,27 @@ fn pose_characters(
         let names: Vec<&str> = skeleton.joints().iter().map(|j| j.name.as_str()).collect();
         joints_seen.push(format!("{}: {}", c.name, crate::posing::name_list(&names)));
         let has = |joint: &str| skeleton.resolve(joint).is_some();
-        let poses: Vec<PoseSpec> = options.poses.iter().filter(|p| has(&p.joint)).cloned().collect();
-        let ik: Vec<IkSpec> = options.ik.iter().filter(|p| has(&p.joint)).cloned().collect();
-        let two_bone: Vec<TwoBoneSpec> = options.two_bone.iter().filter(|p| has(&p.joint)).cloned().collect();
-        let look_at: Vec<LookAtSpec> = options.look_at.iter().filter(|p| has(&p.joint)).cloned().collect();
-        if poses.is_empty() && ik.is_empty() && two_bone.is_empty() && look_at.is_empty() && options.hands.is_empty() {
+        let poses: Vec<PoseSpec> = options.specs.poses.iter().filter(|p| has(&p.joint)).cloned().collect();
+        let ik: Vec<IkSpec> = options.specs.ik.iter().filter(|p| has(&p.joint)).cloned().collect();
+        let two_bone: Vec<TwoBoneSpec> = options.specs.two_bone.iter().filter(|p| has(&p.joint)).cloned().collect();
+        let look_at: Vec<LookAtSpec> = options.specs.look_at.iter().filter(|p| has(&p.joint)).cloned().collect();
+        if poses.is_empty()
+            && ik.is_empty()
+            && two_bone.is_empty()
+            && look_at.is_empty()
+            && options.specs.hands.is_empty()
+        {
             continue;
         }
-        let names = options.poses.iter().map(|p| &p.joint).chain(options.ik.iter().map(|p| &p.joint));
-        let names =
-            names.chain(options.two_bone.iter().map(|p| &p.joint)).chain(options.look_at.iter().map(|p| &p.joint));
+        let names = options.specs.poses.iter().map(|p| &p.joint).chain(options.specs.ik.iter().map(|p| &p.joint));
+        let names = names
+            .chain(options.specs.two_bone.iter().map(|p| &p.joint))
+            .chain(options.specs.look_at.iter().map(|p| &p.joint));
         names.zip(&mut used).filter(|(j, _)| has(j)).for_each(|(_, u)| *u = true);
         let (mut pose, root_shift) =
             crate::export::still_pose(library, &scene, c, &asset).map_err(|e| e.to_string())?;
         apply_pose_specs(skeleton, &mut pose, &poses).map_err(|e| e.to_string())?;
-        let hands = crate::posing::apply_hand_specs(skeleton, &mut pose, &options.hands);
+        let hands = crate::posing::apply_hand_specs(skeleton, &mut pose, &options.specs.hands);
         notes.extend(hands.into_iter().map(|n| format!("{}: {n}", c.name)));
         let placement = c.placement.to_mat4() * Mat4::from_translation(root_shift);
         for report in apply_ik_specs(skeleton, &mut pose, placement, &ik).map_err(|e| e.to_string())? {
@@ -264,9 +284,14 @@ fn pose_characters(
         }
         bake_clips(c);
     }
-    let specs = options.poses.iter().map(|p| ("--pose", &p.joint)).chain(options.ik.iter().map(|p| ("--ik", &p.joint)));
-    let specs = specs.chain(options.two_bone.iter().map(|p| ("--two-bone", &p.joint)));
-    let specs = specs.chain(options.look_at.iter().map(|p| ("--look-at", &p.joint)));
+    let specs = options
+        .specs
+        .poses
+        .iter()
+        .map(|p| ("--pose", &p.joint))
+        .chain(options.specs.ik.iter().map(|p| ("--ik", &p.joint)));
+    let specs = specs.chain(options.specs.two_bone.iter().map(|p| ("--two-bone", &p.joint)));
+    let specs = specs.chain(options.specs.look_at.iter().map(|p| ("--look-at", &p.joint)));
     if let Some((option, joint)) = specs.zip(&used).find(|(_, u)| !**u).map(|(s, _)| s) {
         let known = joints_seen.join("; ");
         return Err(format!("{option}: no character has a joint named or numbered `{joint}` ({known})"));

@@ -69,12 +69,8 @@ pub fn apply_hand(
                 continue;
             }
             let turn = Quat::from_rotation_arc(now.normalize(), wanted.normalize());
-            let parent = crate::ik::rotation_of(skeleton.parent(j).map_or(Mat4::IDENTITY, |q| world[q]));
-            let local = (parent.inverse() * turn * parent * pose[j].to_quat()).normalize();
-            let asked = pose[j].with_rotation_of(local);
-            let clamped = asked.clamped(&skeleton.joint(j).limits);
-            limited |= clamped != asked;
-            pose[j] = clamped;
+            let parent_world = skeleton.parent(j).map_or(Mat4::IDENTITY, |q| world[q]);
+            limited |= crate::ik::turn_joint(skeleton, pose, j, parent_world, turn);
         }
     }
     Some(limited)

@@ -160,15 +160,7 @@ pub fn solve_ik(
                     }
                     let delta = Quat::from_rotation_arc(from.normalize(), to.normalize());
                     let parent_world = skeleton.parent(j).map_or(placement, |p| world[p]);
-                    let parent_rotation = rotation_of(parent_world);
-                    let local = pose[j].to_quat();
-                    let new_local = (parent_rotation.inverse() * delta * parent_rotation * local).normalize();
-                    let wanted = pose[j].with_rotation_of(new_local);
-                    let clamped = wanted.clamped(&skeleton.joint(j).limits);
-                    if clamped != wanted {
-                        report.limited = true;
-                    }
-                    pose[j] = clamped;
+                    report.limited |= turn_joint(skeleton, pose, j, parent_world, delta);
                     forward_kinematics_along(skeleton, pose, placement, &[j], &mut world);
                 }
             }
@@ -178,6 +170,26 @@ pub fn solve_ik(
             report
         })
         .collect()
+}
+
+/// Turns joint `joint` by `turn`, a rotation in the world, its parent's world transform
+/// being `parent_world`: its local rotation becomes `P⁻¹ · turn · P · local` (P the
+/// parent's world rotation), in the joint's own rotation type, clamped to its limits.
+/// Returns whether the limits clamped it.
+pub fn turn_joint(
+    skeleton: &Skeleton,
+    pose: &mut [JointRotation],
+    joint: usize,
+    parent_world: Mat4,
+    turn: Quat,
+) -> bool {
+    let parent = rotation_of(parent_world);
+    let local = (parent.inverse() * turn * parent * pose[joint].to_quat()).normalize();
+    let wanted = pose[joint].with_rotation_of(local);
+    let clamped = wanted.clamped(&skeleton.joint(joint).limits);
+    let limited = clamped != wanted;
+    pose[joint] = clamped;
+    limited
 }
 
 /// The rotation part of a transform (scale removed).

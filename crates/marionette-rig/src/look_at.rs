@@ -54,12 +54,8 @@ pub fn solve_look_at(
         let share = shares.get(k).copied().unwrap_or(1.0).clamp(0.0, 1.0);
         let share = if joint == head { 1.0 } else { share };
         let turn = Quat::IDENTITY.slerp(Quat::from_rotation_arc(now.normalize(), wanted.normalize()), share);
-        let parent = crate::ik::rotation_of(skeleton.parent(joint).map_or(placement, |p| world[p]));
-        let local = (parent.inverse() * turn * parent * pose[joint].to_quat()).normalize();
-        let asked = pose[joint].with_rotation_of(local);
-        let clamped = asked.clamped(&skeleton.joint(joint).limits);
-        limited |= clamped != asked;
-        pose[joint] = clamped;
+        let parent_world = skeleton.parent(joint).map_or(placement, |q| world[q]);
+        limited |= crate::ik::turn_joint(skeleton, pose, joint, parent_world, turn);
     }
     forward_kinematics(skeleton, pose, placement, &mut world);
     let eye = world[head].w_axis.truncate();

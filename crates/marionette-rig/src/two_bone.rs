@@ -114,12 +114,8 @@ pub fn solve_two_bone(
             continue;
         }
         let turn = Quat::from_rotation_arc(from.normalize(), to.normalize());
-        let parent = crate::ik::rotation_of(skeleton.parent(joint).map_or(placement, |p| world[p]));
-        let local = (parent.inverse() * turn * parent * pose[joint].to_quat()).normalize();
-        let wanted = pose[joint].with_rotation_of(local);
-        let clamped = wanted.clamped(&skeleton.joint(joint).limits);
-        limited |= clamped != wanted;
-        pose[joint] = clamped;
+        let parent_world = skeleton.parent(joint).map_or(placement, |q| world[q]);
+        limited |= crate::ik::turn_joint(skeleton, pose, joint, parent_world, turn);
     }
     forward_kinematics(skeleton, pose, placement, &mut world);
     let distance = at(&world, end).distance(target);

@@ -20,14 +20,8 @@ pub struct StartupPaths(pub Vec<PathBuf>);
 /// scene that has the named joint (`--pose`, then `--ik`), and the skinning method.
 #[derive(Resource, Clone, Debug, Default)]
 pub struct StartupEdits {
-    pub poses: Vec<crate::document::posing::PoseSpec>,
-    pub ik: Vec<crate::document::posing::IkSpec>,
-    /// `--two-bone`: two-bone IK with a pole, after `--ik`.
-    pub two_bone: Vec<crate::document::posing::TwoBoneSpec>,
-    /// `--look-at`: a head turned to face a point, last.
-    pub look_at: Vec<crate::document::posing::LookAtSpec>,
-    /// `--hand`: hand presets.
-    pub hands: Vec<crate::document::posing::HandSpec>,
+    /// `--pose`, `--hand`, `--ik`, `--two-bone`, `--look-at`.
+    pub pose: crate::document::options::PoseSpecs,
     /// `--skinning`: every character skinned this way.
     pub skinning: Option<crate::rig::dqs::SkinningMethod>,
     /// `--match-height`: every character scaled to the first one's height.
@@ -54,11 +48,7 @@ impl StartupEdits {
     /// The posing options, as every command applies them.
     pub fn pose_options(&self) -> crate::document::options::PoseOptions {
         crate::document::options::PoseOptions {
-            poses: self.poses.clone(),
-            ik: self.ik.clone(),
-            two_bone: self.two_bone.clone(),
-            look_at: self.look_at.clone(),
-            hands: self.hands.clone(),
+            specs: self.pose.clone(),
             skinning: self.skinning,
             anim: self.anim.clone(),
             clip: self.clip.clone(),
