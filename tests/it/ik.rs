@@ -412,7 +412,7 @@ fn look_at_turns_a_humanoids_face_to_the_target() {
             let target = eye + Vec3::new(2.0 * a.sin(), (a * 1.7).sin(), 2.0 * a.cos());
             let mut pose = skeleton.initial_pose();
             let spec = LookAtSpec { joint: skeleton.joint(head).name.clone(), target };
-            apply_look_at_specs(skeleton, &mut pose, Mat4::IDENTITY, &[spec]).unwrap();
+            apply_look_at_specs(skeleton, &map, &mut pose, Mat4::IDENTITY, &[spec]).unwrap();
             let world = world_of(&pose);
             let now = rotation(world[head]) * face;
             worst = worst.max(now.angle_between(target - world[head].w_axis.truncate()).to_degrees());

@@ -406,8 +406,13 @@ fn weights(at: &str, weights: impl Iterator<Item = f32>) -> Result<(), String> {
 /// How many characters fit in a square of side `area`, `spacing` apart: the cells of a
 /// grid whose cells are at least `spacing` wide.
 fn places(area: f32, spacing: f32) -> usize {
-    let side = (area / spacing).floor().max(1.0) as usize;
-    if spacing > area * std::f32::consts::SQRT_2 { 1 } else { side * side }
+    grid_side(area, spacing).pow(2)
+}
+
+/// The cells along a side of the square of side `area` cut into cells at least `spacing`
+/// wide (at least one).
+fn grid_side(area: f32, spacing: f32) -> usize {
+    (area / spacing).floor().max(1.0) as usize
 }
 
 /// The pictures (PNG, JPEG) of a folder, by name.
@@ -555,7 +560,7 @@ pub fn scene_of(spec: &Spec, library: &mut AssetLibrary, k: u64) -> Result<(Scen
 /// the others: distinct cells of a grid of cells at least `spacing` wide, each place moved
 /// within its cell by no more than keeps it `spacing` from its neighbours'.
 fn spots(rng: &mut Rng, n: usize, area: f32, spacing: f32) -> Vec<Vec3> {
-    let side = (area / spacing).floor().max(1.0) as usize;
+    let side = grid_side(area, spacing);
     let cell = area / side as f32;
     let mut cells: Vec<usize> = (0..side * side).collect();
     // The first n of a shuffle.

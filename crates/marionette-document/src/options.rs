@@ -264,7 +264,13 @@ fn pose_characters(
         let (mut pose, root_shift) =
             crate::export::still_pose(library, &scene, c, &asset).map_err(|e| e.to_string())?;
         apply_pose_specs(skeleton, &mut pose, &poses).map_err(|e| e.to_string())?;
-        let hands = crate::posing::apply_hand_specs(skeleton, &mut pose, &options.specs.hands);
+        // The humanoid map, once, for the hands and the look-at.
+        let map = if options.specs.hands.is_empty() && look_at.is_empty() {
+            Default::default()
+        } else {
+            marionette_rig::humanoid::detect(skeleton).unwrap_or_default()
+        };
+        let hands = crate::posing::apply_hand_specs(skeleton, &map, &mut pose, &options.specs.hands);
         notes.extend(hands.into_iter().map(|n| format!("{}: {n}", c.name)));
         let placement = c.placement.to_mat4() * Mat4::from_translation(root_shift);
         for report in apply_ik_specs(skeleton, &mut pose, placement, &ik).map_err(|e| e.to_string())? {
@@ -273,7 +279,7 @@ fn pose_characters(
         for report in apply_two_bone_specs(skeleton, &mut pose, placement, &two_bone).map_err(|e| e.to_string())? {
             notes.push(format!("{}: {}", c.name, describe_two_bone(skeleton, &report)));
         }
-        for report in apply_look_at_specs(skeleton, &mut pose, placement, &look_at).map_err(|e| e.to_string())? {
+        for report in apply_look_at_specs(skeleton, &map, &mut pose, placement, &look_at).map_err(|e| e.to_string())? {
             notes.push(format!("{}: {}", c.name, describe_look_at(skeleton, &report)));
         }
         let initial = skeleton.initial_pose();

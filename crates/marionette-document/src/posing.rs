@@ -355,16 +355,20 @@ impl std::str::FromStr for HandSpec {
     }
 }
 
-/// Puts the hand presets on `pose` through the skeleton's humanoid map. Returns a note per
+/// Puts the hand presets on `pose` through the skeleton's humanoid map `map`. Returns a note per
 /// hand, or why a hand could not be posed (no humanoid, no fingers mapped).
-pub fn apply_hand_specs(skeleton: &Skeleton, pose: &mut [JointRotation], specs: &[HandSpec]) -> Vec<String> {
-    let map = marionette_rig::humanoid::detect(skeleton).unwrap_or_default();
+pub fn apply_hand_specs(
+    skeleton: &Skeleton,
+    map: &marionette_rig::humanoid::HumanoidMap,
+    pose: &mut [JointRotation],
+    specs: &[HandSpec],
+) -> Vec<String> {
     specs
         .iter()
         .map(|s| {
             let side = if s.left { "left" } else { "right" };
             let (curl, spread) = marionette_rig::hands::preset(&s.preset).unwrap_or(([0.0; 5], 0.0));
-            match marionette_rig::hands::apply_hand(skeleton, &map, pose, s.left, curl, spread) {
+            match marionette_rig::hands::apply_hand(skeleton, map, pose, s.left, curl, spread) {
                 Some(false) => format!("hand {side}: {}", s.preset),
                 Some(true) => format!("hand {side}: {}, stopped by joint limits", s.preset),
                 None => format!("hand {side}: no fingers mapped; {} skipped", s.preset),
@@ -378,16 +382,16 @@ pub const LOOK_AT_SHARES: [f32; 2] = [0.2, 0.35];
 
 /// Turns each spec's joint so that its face points at the target, on top of `pose`, for a
 /// character placed by `placement`. The face is where the character faces at rest (square
-/// to its hips' line, from the humanoid map; else +z); a joint the map calls the head
+/// to its hips' line, from the humanoid map `map`; else +z); a joint the map calls the head
 /// spreads the turn over the chest and neck.
 pub fn apply_look_at_specs(
     skeleton: &Skeleton,
+    map: &marionette_rig::humanoid::HumanoidMap,
     pose: &mut [JointRotation],
     placement: Mat4,
     specs: &[LookAtSpec],
 ) -> Result<Vec<marionette_rig::look_at::LookAtReport>, PoseSpecError> {
     use marionette_rig::humanoid::HumanBone;
-    let map = marionette_rig::humanoid::detect(skeleton).unwrap_or_default();
     let mut rest = vec![Mat4::IDENTITY; skeleton.len()];
     marionette_rig::fk::forward_kinematics(skeleton, &skeleton.initial_pose(), Mat4::IDENTITY, &mut rest);
     let at = |j: usize| rest[j].w_axis.truncate();
