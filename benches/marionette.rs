@@ -289,12 +289,13 @@ fn capture_scene_document(reader: marionette::editor::scene_doc::document::Scene
 /// An editing frame through the editor's own path: a scene of the puppet and three SMPL
 /// bodies each playing its own clip with its own β (from `MARIONETTE_DATA`; without it only
 /// the puppet), opened from a document; each frame the puppet's hand is dragged by IK (the
-/// solve, then an `Edit::Pose` applied in `Animate`), the chain runs and packs the vertices
+/// solve, then an pose edit applied in `Animate`), the chain runs and packs the vertices
 /// handed to the GPU. `before`: the same frame plus the scene document the editor captured
 /// every frame before edits became commands.
 #[divan::bench(args = ["after", "before"])]
 fn editing_frame_3_smpl_playing_1_puppet_dragged(bencher: Bencher, variant: &str) {
-    use marionette::editor::edits::commands::{Edit, EditQueue};
+    use marionette::editor::edits::commands::EditQueue;
+    use marionette::editor::edits::edit;
     use marionette::editor::scene_doc::document::{CharacterIndex, PendingScene};
     use marionette::formats::scene::{CharacterDoc, CharacterId, SceneDoc, SmplDoc, SourceDoc};
     use marionette::rig::ik::{IkGoal, solve_ik};
@@ -342,7 +343,7 @@ fn editing_frame_3_smpl_playing_1_puppet_dragged(bencher: Bencher, variant: &str
         let target = Vec3::new(0.3 + 0.1 * step.sin(), 1.2, 0.2 * step.cos());
         solve_ik(&puppet.asset.skeleton, &mut pose, Mat4::IDENTITY, &[IkGoal { end: hand, target }], 1e-4, 8);
         let joints = pose.into_iter().enumerate().filter(|&(j, p)| p != before[j]).collect();
-        world.resource_mut::<EditQueue>().push(Edit::Pose { character: CharacterId(1), joints });
+        world.resource_mut::<EditQueue>().push(edit::Pose { character: CharacterId(1), joints });
         app.update();
     };
     let mut bytes = 0;

@@ -280,7 +280,10 @@ mod moving {
         for k in 1..=6 {
             drag.follow(ray_to(s.translation + Vec3::X * 0.1 * k as f32));
             let placement = drag.placement(Snap::default());
-            crate::edits::edit(&mut app, Edit::Place { character: CharacterId(1), placement });
+            crate::edits::edit(
+                &mut app,
+                Edit::Place(marionette::editor::edits::edit::Place { character: CharacterId(1), placement }),
+            );
         }
         let moved = app.world().get::<Placement>(entity).unwrap().translation - s.translation;
         assert!((moved - Vec3::new(0.6, 0.0, 0.0)).length() < 1e-4, "{moved}");

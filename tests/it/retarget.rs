@@ -387,7 +387,10 @@ mod editor {
         let (retargeted, count) = state(&mut app);
 
         let baked = AnimDoc { keys: Some(oracle.clone()), retarget: None, ..playing.state.clone() };
-        edit(&mut app, Edit::Clip { character: CharacterId(2), anim: Some(baked.clone()) });
+        edit(
+            &mut app,
+            Edit::Clip(marionette::editor::edits::edit::Clip { character: CharacterId(2), anim: Some(baked.clone()) }),
+        );
         let now = player(&app, 2);
         assert!(
             *now.clip == oracle,
@@ -403,7 +406,7 @@ mod editor {
         assert!(*player(&app, 2).clip == oracle);
 
         let bones = [(HumanBone::LeftHand, "l_hand".to_string())].into_iter().collect();
-        edit(&mut app, Edit::Humanoid { character: CharacterId(2), bones });
+        edit(&mut app, Edit::Humanoid(marionette::editor::edits::edit::Humanoid { character: CharacterId(2), bones }));
         app.update();
         let (mapped, _) = state(&mut app);
         assert_eq!(mapped.characters[1].humanoid[&HumanBone::LeftHand], "l_hand");
@@ -421,7 +424,10 @@ mod editor {
         let mut keys = source_anim.keys.take().unwrap();
         keys = keys.with_pose_keyed(&[1, 2], &[JointRotation::euler_xyz(0.5, 0.0, 0.0); 3], 2.0);
         source_anim.keys = Some(keys);
-        edit(&mut app, Edit::Clip { character: CharacterId(1), anim: Some(source_anim) });
+        edit(
+            &mut app,
+            Edit::Clip(marionette::editor::edits::edit::Clip { character: CharacterId(1), anim: Some(source_anim) }),
+        );
         app.update();
         let (changed, _) = state(&mut app);
         let oracle = marionette::document::retarget::anim_clip(&mut library, &changed, target, &asset, anim).unwrap();

@@ -1,139 +1,168 @@
-//! Edits: each user action on the scene as a value ([`Edit`]), the queue they wait in for
-//! the next `Animate`, and what holds a gesture open. Shared by the panels, the viewport's
-//! tools, the pose library and the history; applied by `commands`.
+//! Edits: each user action on the scene as a command that knows how to make itself and
+//! what undoes it ([`Command`]; the kinds are in `character_edits` and `scene_edits`), the
+//! [`Edit`] that holds any of them, the queue they wait in for the next `Animate`, and
+//! what holds a gesture open. Shared by the panels, the viewport's tools, the pose library
+//! and the history; applied by `commands`.
 
 use bevy::prelude::*;
 
-use crate::formats::scene::{
-    AnimDoc, AttachDoc, BindingDoc, CameraDoc, CharacterDoc, CharacterId, LibraryPoseDoc, PlacementDoc, PlaybackDoc,
-    ShotDoc, SkinningDoc, SmplDoc, StageDoc, ViewDoc,
+use crate::formats::scene::CharacterId;
+
+pub use crate::editor::edits::character_edits::{
+    Add, Attach, Clip, Humanoid, Morph, Place, Playback, Pose, Rebind, Remove, Rename, SkinOnGpu, Skinning, Smpl, View,
 };
+pub use crate::editor::edits::scene_edits::{Bookmark, Library, Shot, Stage};
 
-use crate::rig::JointRotation;
+/// A change to the scene that makes itself and tells what undoes it.
+pub trait Command: Into<Edit> {
+    /// The character it edits (none for the stage and the libraries).
+    fn character(&self) -> Option<CharacterId> {
+        None
+    }
 
-/// One user action on the scene.
-#[derive(Clone, Debug, PartialEq)]
-pub enum Edit {
-    /// Turn joints (by index) to these rotations, clamped to their limits.
-    Pose {
-        character: CharacterId,
-        joints: Vec<(usize, JointRotation)>,
-    },
-    /// Move, turn or scale a character.
-    Place {
-        character: CharacterId,
-        placement: PlacementDoc,
-    },
-    /// Display mode, visibility, weight colours, heat map, tint.
-    View {
-        character: CharacterId,
-        view: ViewDoc,
-    },
-    Rename {
-        character: CharacterId,
-        name: String,
-    },
-    /// β, clips, time, playback and blend of an SMPL body.
-    Smpl {
-        character: CharacterId,
-        state: SmplDoc,
-    },
-    /// Weights from the file (`None`) or computed from the bones.
-    Rebind {
-        character: CharacterId,
-        binding: Option<BindingDoc>,
-    },
-    /// Linear blend or dual quaternion skinning.
-    Skinning {
-        character: CharacterId,
-        method: SkinningDoc,
-    },
-    /// Skinning by the GPU compute shader (`true`) or on the CPU.
-    SkinOnGpu {
-        character: CharacterId,
-        on: bool,
-    },
-    /// A keyframed clip on a character, its time and playback (none: no clip).
-    Clip {
-        character: CharacterId,
-        anim: Option<AnimDoc>,
-    },
-    /// Clip, time, playback and blend of a source's own clips (glTF animations).
-    Playback {
-        character: CharacterId,
-        state: PlaybackDoc,
-    },
-    /// Morph target weights.
-    Morph {
-        character: CharacterId,
-        weights: Vec<f32>,
-    },
-    /// A pose kept in the scene's library under `name` (none: taken out).
-    Library {
-        name: String,
-        pose: Option<LibraryPoseDoc>,
-    },
-    /// Held by a joint of another character (none: let go), standing at `placement` (where
-    /// it stands when attached or let go, so that undo puts it back exactly).
-    Attach {
-        character: CharacterId,
-        attached: Option<AttachDoc>,
-        placement: PlacementDoc,
-    },
-    /// Standard bones assigned by hand (bone → pose key; an empty key takes the bone off),
-    /// over those found from the skeleton.
-    Humanoid {
-        character: CharacterId,
-        bones: std::collections::BTreeMap<crate::rig::humanoid::HumanBone, String>,
-    },
-    /// Floor, lights, background, axes.
-    Stage(StageDoc),
-    /// The picture `render` takes.
-    Shot(ShotDoc),
-    /// A camera view kept under `name` (none: taken out).
-    Bookmark {
-        name: String,
-        camera: Option<CameraDoc>,
-    },
-    /// A character from its document (a fresh id is given when it has none).
-    Add(Box<CharacterDoc>),
-    Remove(CharacterId),
+    /// The named entry it sets, for edits of a library kept by name.
+    fn entry(&self) -> Option<&str> {
+        None
+    }
+
+    /// What undoes it in the scene as it is now, to be applied last first; empty when it
+    /// would change nothing.
+    fn undo(&self, world: &mut World) -> Result<Vec<Edit>, String>;
+
+    /// Makes the change.
+    fn write(self, world: &mut World) -> Result<(), String>;
 }
 
-impl Edit {
-    /// The character it edits (none for the stage).
-    pub fn character(&self) -> Option<CharacterId> {
-        match self {
-            Edit::Pose { character, .. }
-            | Edit::Place { character, .. }
-            | Edit::View { character, .. }
-            | Edit::Rename { character, .. }
-            | Edit::Smpl { character, .. }
-            | Edit::Rebind { character, .. }
-            | Edit::Skinning { character, .. }
-            | Edit::SkinOnGpu { character, .. }
-            | Edit::Clip { character, .. }
-            | Edit::Morph { character, .. }
-            | Edit::Playback { character, .. }
-            | Edit::Attach { character, .. }
-            | Edit::Humanoid { character, .. }
-            | Edit::Remove(character) => Some(*character),
-            Edit::Add(doc) => doc.id,
-            Edit::Stage(_) | Edit::Shot(_) | Edit::Library { .. } | Edit::Bookmark { .. } => None,
-        }
+/// A command that sets one thing: the same command holding what is there now undoes it.
+pub trait Setter: Sized + PartialEq + Into<Edit> {
+    /// Setting it poses the joints (from a clip): undo gives them back their rotations.
+    const POSES: bool = false;
+
+    fn character(&self) -> Option<CharacterId>;
+
+    /// The named entry it sets, for edits of a library kept by name.
+    fn entry(&self) -> Option<&str> {
+        None
     }
+
+    /// This command with the value the scene has now.
+    fn read(&self, world: &World) -> Result<Self, String>;
+
+    fn set(self, world: &mut World) -> Result<(), String>;
+}
+
+impl<S: Setter> Command for S {
+    fn character(&self) -> Option<CharacterId> {
+        Setter::character(self)
+    }
+
+    fn entry(&self) -> Option<&str> {
+        Setter::entry(self)
+    }
+
+    fn undo(&self, world: &mut World) -> Result<Vec<Edit>, String> {
+        let now = self.read(world)?;
+        if now == *self {
+            return Ok(Vec::new());
+        }
+        let mut undo = Vec::with_capacity(2);
+        if let (true, Some(id)) = (S::POSES, Setter::character(self)) {
+            undo.push(crate::editor::edits::access::current_pose(world, id)?);
+        }
+        undo.push(now.into());
+        Ok(undo)
+    }
+
+    fn write(self, world: &mut World) -> Result<(), String> {
+        self.set(world)
+    }
+}
+
+/// Declares [`Edit`], one variant per command kind, and hands each call to the kind.
+macro_rules! edits {
+    ($($(#[$doc:meta])* $kind:ident,)*) => {
+        /// One user action on the scene: one of the commands.
+        #[derive(Clone, Debug, PartialEq)]
+        pub enum Edit {
+            $($(#[$doc])* $kind($kind),)*
+        }
+
+        $(impl From<$kind> for Edit {
+            fn from(command: $kind) -> Edit {
+                Edit::$kind(command)
+            }
+        })*
+
+        impl Edit {
+            /// The character it edits (none for the stage and the libraries).
+            pub fn character(&self) -> Option<CharacterId> {
+                match self { $(Edit::$kind(c) => Command::character(c),)* }
+            }
+
+            fn entry(&self) -> Option<&str> {
+                match self { $(Edit::$kind(c) => Command::entry(c),)* }
+            }
+
+            /// What undoes it in the scene as it is now (see [`Command::undo`]).
+            pub fn undo(&self, world: &mut World) -> Result<Vec<Edit>, String> {
+                match self { $(Edit::$kind(c) => c.undo(world),)* }
+            }
+
+            /// Makes the change.
+            pub fn write(self, world: &mut World) -> Result<(), String> {
+                match self { $(Edit::$kind(c) => c.write(world),)* }
+            }
+        }
+    };
+}
+
+edits! {
+    /// Turn joints (by index) to these rotations, clamped to their limits.
+    Pose,
+    /// Move, turn or scale a character.
+    Place,
+    /// Display mode, visibility, weight colours, heat map, tint.
+    View,
+    Rename,
+    /// β, clips, time, playback and blend of an SMPL body.
+    Smpl,
+    /// Weights from the file or computed from the bones.
+    Rebind,
+    /// Linear blend or dual quaternion skinning.
+    Skinning,
+    /// Skinning by the GPU compute shader or on the CPU.
+    SkinOnGpu,
+    /// A keyframed clip on a character, its time and playback (none: no clip).
+    Clip,
+    /// Clip, time, playback and blend of a source's own clips (glTF animations).
+    Playback,
+    /// Morph target weights.
+    Morph,
+    /// A pose kept in the scene's library by name (none: taken out).
+    Library,
+    /// Held by a joint of another character, or let go.
+    Attach,
+    /// Standard bones assigned by hand.
+    Humanoid,
+    /// Floor, lights, background, axes.
+    Stage,
+    /// The picture `render` takes.
+    Shot,
+    /// A camera view kept by name (none: taken out).
+    Bookmark,
+    /// A character from its document (a fresh id is given when it has none).
+    Add,
+    Remove,
 }
 
 impl Edit {
     /// Whether `self` and `other` set the same thing (within a gesture, only the first
     /// value of each thing is kept): the same kind of edit of the same character, or the
-    /// same pose of the library. Poses, adds and removes are judged by the history itself.
+    /// same entry of a library. Poses, adds and removes are judged by the history itself.
     pub fn same_slot(&self, other: &Edit) -> bool {
-        match (self, other) {
-            (Edit::Library { name: a, .. }, Edit::Library { name: b, .. }) => a == b,
-            (Edit::Bookmark { name: a, .. }, Edit::Bookmark { name: b, .. }) => a == b,
-            _ => std::mem::discriminant(self) == std::mem::discriminant(other) && self.character() == other.character(),
-        }
+        std::mem::discriminant(self) == std::mem::discriminant(other)
+            && self.character() == other.character()
+            && self.entry() == other.entry()
     }
 }
 
@@ -142,8 +171,8 @@ impl Edit {
 pub struct EditQueue(pub Vec<Edit>);
 
 impl EditQueue {
-    pub fn push(&mut self, edit: Edit) {
-        self.0.push(edit);
+    pub fn push(&mut self, edit: impl Into<Edit>) {
+        self.0.push(edit.into());
     }
 }
 

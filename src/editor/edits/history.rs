@@ -4,7 +4,7 @@
 
 use bevy::prelude::*;
 
-use crate::editor::edits::edit::Edit;
+use crate::editor::edits::edit::{self, Edit};
 
 /// The undo and redo steps, and what undoes the gesture under way.
 #[derive(Resource, Default, Debug)]
@@ -70,21 +70,21 @@ impl History {
     pub fn record(&mut self, inverse: Edit) {
         let recent = &self.gesture[self.barrier..];
         match inverse {
-            Edit::Add(_) | Edit::Remove(_) => {
+            Edit::Add(edit::Add(_)) | Edit::Remove(edit::Remove(_)) => {
                 self.gesture.push(inverse);
                 self.barrier = self.gesture.len();
             }
-            Edit::Pose { character, mut joints } => {
+            Edit::Pose(edit::Pose { character, mut joints }) => {
                 joints.retain(|&(j, _)| {
                     !recent.iter().any(|e| match e {
-                        Edit::Pose { character: c, joints: earlier } => {
+                        Edit::Pose(edit::Pose { character: c, joints: earlier }) => {
                             *c == character && earlier.iter().any(|&(k, _)| k == j)
                         }
                         _ => false,
                     })
                 });
                 if !joints.is_empty() {
-                    self.gesture.push(Edit::Pose { character, joints });
+                    self.gesture.push(edit::Pose { character, joints }.into());
                 }
             }
             other => {

@@ -3,6 +3,7 @@
 //! character with the same joint names, or through the humanoid maps onto any other, as
 //! it was or mirrored left to right.
 
+use crate::editor::edits::edit;
 use bevy::prelude::*;
 
 use crate::formats::scene::{CharacterId, LibraryPoseDoc, pose_key};
@@ -51,5 +52,5 @@ pub fn apply_named_pose(
 ) -> Option<Edit> {
     let (skeleton, map, current) = target;
     let joints = crate::document::retarget::pose_onto((skeleton, map), current, pose, source, mirrored);
-    (!joints.is_empty()).then_some(Edit::Pose { character: id, joints })
+    (!joints.is_empty()).then_some(Edit::Pose(edit::Pose { character: id, joints }))
 }

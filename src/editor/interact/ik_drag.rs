@@ -3,9 +3,10 @@
 //! towards the cursor). Pinned joints (P) hold their place meanwhile. Each frame's solve is
 //! an ordinary pose `Edit`, applied in `Animate`; the whole drag is one undo step.
 
+use crate::editor::edits::edit;
 use bevy::prelude::*;
 
-use crate::editor::edits::edit::{Edit, EditQueue};
+use crate::editor::edits::edit::EditQueue;
 use crate::editor::interact::picking::{CLICK_SLOP_PX, JointPicker, PICK_RADIUS_PX};
 use crate::editor::interact::pointer::{PointerOwner, ViewportHasPointer};
 use crate::editor::present::draw::SkeletonGizmos;
@@ -137,7 +138,7 @@ fn drag_joint(
     drag.note = reports.first().map(|r| crate::document::posing::describe_ik(skeleton, r)).unwrap_or_default();
     let joints: Vec<_> = pose.into_iter().enumerate().filter(|&(j, p)| p != before[j]).collect();
     if !joints.is_empty() {
-        edits.push(Edit::Pose { character: active.character, joints });
+        edits.push(edit::Pose { character: active.character, joints });
     }
 }
 

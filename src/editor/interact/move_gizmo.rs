@@ -9,10 +9,11 @@
 //! systems find what the pointer grabs and push each frame's placement as an ordinary
 //! [`Edit::Place`].
 
+use crate::editor::edits::edit;
 use bevy::math::Ray3d;
 use bevy::prelude::*;
 
-use crate::editor::edits::edit::{Edit, EditQueue, GestureHold};
+use crate::editor::edits::edit::{EditQueue, GestureHold};
 use crate::editor::interact::picking::JointPicker;
 use crate::editor::interact::pointer::ViewportHasPointer;
 use crate::editor::interact::rotate_gizmo::{distance_to_segment, read_typing};
@@ -356,7 +357,7 @@ fn follow_move(
     let Some(mut active) = gizmo.active.clone() else { return };
     let typed = matches!(active.grip, MoveGrip::Typed { .. });
     if !typed && (keys.just_pressed(KeyCode::Escape) || buttons.just_pressed(MouseButton::Right)) {
-        edits.push(Edit::Place { character: active.character, placement: active.start });
+        edits.push(edit::Place { character: active.character, placement: active.start });
         (gizmo.active, gizmo.readout) = (None, None);
         return;
     }
@@ -376,7 +377,7 @@ fn follow_move(
     let snap = snap_of(&keys, stage.floor_height, view.lowest);
     let placement = active.placement(snap);
     if placement != view.placement {
-        edits.push(Edit::Place { character: active.character, placement });
+        edits.push(edit::Place { character: active.character, placement });
     }
     gizmo.readout = Some(active.describe(&view.name, snap));
     gizmo.active = Some(active);
@@ -424,7 +425,7 @@ fn type_move(
     }
     let Some(mut active) = gizmo.active.clone() else { return };
     if keys.just_pressed(KeyCode::Escape) || buttons.just_pressed(MouseButton::Right) {
-        edits.push(Edit::Place { character: active.character, placement: active.start });
+        edits.push(edit::Place { character: active.character, placement: active.start });
         finish(&mut gizmo, &mut hold);
         return;
     }
@@ -446,7 +447,7 @@ fn type_move(
         active.moved = Vec3::new(p.x - from.x, 0.0, p.z - from.z);
     }
     let placement = active.placement(Snap::default());
-    edits.push(Edit::Place { character: active.character, placement });
+    edits.push(edit::Place { character: active.character, placement });
     let name = MoveView::of_selection(&selection, &picker, &skins).map_or_else(String::new, |v| v.name);
     gizmo.readout = Some(active.describe(&name, Snap::default()));
     gizmo.active = Some(active);

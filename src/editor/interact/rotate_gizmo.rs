@@ -9,10 +9,11 @@
 //! The turning itself is [`crate::rig::turn`]; this module finds what the pointer grabs,
 //! follows it and pushes each frame's rotation as an ordinary pose [`Edit`].
 
+use crate::editor::edits::edit;
 use bevy::input::mouse::AccumulatedMouseMotion;
 use bevy::prelude::*;
 
-use crate::editor::edits::edit::{Edit, EditQueue, GestureHold};
+use crate::editor::edits::edit::{EditQueue, GestureHold};
 use crate::editor::interact::picking::{JointPicker, PICK_RADIUS_PX};
 use crate::editor::interact::pointer::ViewportHasPointer;
 use crate::editor::present::draw::SkeletonGizmos;
@@ -340,7 +341,7 @@ fn follow_gizmo(
     }
     let Some(mut turn) = gizmo.turn.clone().filter(|t| !matches!(t.grip, Grip::Typed { .. })) else { return };
     if keys.just_pressed(KeyCode::Escape) || buttons.just_pressed(MouseButton::Right) {
-        edits.push(Edit::Pose { character: turn.character, joints: vec![(turn.joint, turn.start)] });
+        edits.push(edit::Pose { character: turn.character, joints: vec![(turn.joint, turn.start)] });
         gizmo.turn = None;
         gizmo.readout = None;
         return;
@@ -380,7 +381,7 @@ fn follow_gizmo(
 fn push_turn(edits: &mut EditQueue, turn: &Turn, now: &JointRotation) {
     let rotation = turn.rotation();
     if rotation != *now {
-        edits.push(Edit::Pose { character: turn.character, joints: vec![(turn.joint, rotation)] });
+        edits.push(edit::Pose { character: turn.character, joints: vec![(turn.joint, rotation)] });
     }
 }
 
@@ -434,7 +435,7 @@ fn type_rotation(
         return;
     };
     if keys.just_pressed(KeyCode::Escape) || buttons.just_pressed(MouseButton::Right) {
-        edits.push(Edit::Pose { character: turn.character, joints: vec![(turn.joint, turn.start)] });
+        edits.push(edit::Pose { character: turn.character, joints: vec![(turn.joint, turn.start)] });
         finish_typing(&mut gizmo, &mut hold);
         return;
     }

@@ -4,9 +4,10 @@
 //! F frames the selection; the numpad's views (as in Blender): 1 front, 3 right, 7 top, with
 //! Ctrl the opposite side, 9 three-quarter, 5 perspective / orthographic.
 
+use crate::editor::edits::edit;
 use bevy::prelude::*;
 
-use crate::editor::edits::edit::{Edit, EditQueue};
+use crate::editor::edits::edit::EditQueue;
 use crate::editor::edits::history::{History, HistoryRequest};
 use crate::editor::present::screenshot::ScreenshotRequest;
 use crate::editor::scene_doc::document::SceneReader;
@@ -56,10 +57,10 @@ pub fn scene_shortcuts(
         let pose: Vec<_> =
             character.joints.iter().map(|&e| scene.poses.get(e).map_or(Default::default(), |p| p.0)).collect();
         let anim = crate::scene::keyframes::keyed(c.player, character.joints.len(), &selection.joints, &pose);
-        edits.push(Edit::Clip { character: id, anim: Some(anim) });
+        edits.push(edit::Clip { character: id, anim: Some(anim) });
     }
     if keys.just_pressed(KeyCode::KeyA) {
-        edits.push(Edit::Stage(crate::formats::scene::StageDoc { axes: !scene.stage.axes, ..scene.stage.0.clone() }));
+        edits.push(edit::Stage(crate::formats::scene::StageDoc { axes: !scene.stage.axes, ..scene.stage.0.clone() }));
     }
     if keys.just_pressed(KeyCode::KeyS) {
         // The selected character, or every character when none is selected.
@@ -67,7 +68,7 @@ pub fn scene_shortcuts(
             let (sc, view) = (c.scene, c.view);
             if selection.character.is_none_or(|id| id == sc.id) {
                 let view = ViewDoc { display: view.display.next(), ..view.0.clone() };
-                edits.push(Edit::View { character: sc.id, view });
+                edits.push(edit::View { character: sc.id, view });
             }
         }
     }

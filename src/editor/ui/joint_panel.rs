@@ -1,10 +1,10 @@
 //! The joint panel: one slider per DOF of the selected joints within their limits, resets,
 //! and the joint tree.
 
+use crate::editor::edits::edit;
 use bevy_egui::egui;
 
 use super::{InspectorState, Panels};
-use crate::editor::edits::edit::Edit;
 use crate::editor::state::Selection;
 use crate::formats::scene::CharacterId;
 use crate::rig::{EulerOrder, JointRotation, Skeleton};
@@ -27,17 +27,17 @@ pub fn joint_panel(ui: &mut egui::Ui, state: &mut InspectorState, panels: &mut P
     ui.horizontal(|ui| {
         if ui.button("Reset the whole pose").on_hover_text("to the pose the file gives").clicked() {
             let joints = skeleton.joints().iter().enumerate().map(|(j, def)| (j, def.initial_rotation)).collect();
-            edits.push(Edit::Pose { character: id, joints });
+            edits.push(edit::Pose { character: id, joints });
         }
         if ui.button("Rest").on_hover_text("every joint unturned (within its limits)").clicked() {
             let joints = (0..skeleton.len()).map(|j| (j, JointRotation::IDENTITY)).collect();
-            edits.push(Edit::Pose { character: id, joints });
+            edits.push(edit::Pose { character: id, joints });
         }
     });
     ui.separator();
     for &j in &panels.selection.joints {
         if let Some(rotation) = joint_sliders(ui, state, panels, &character, j) {
-            edits.push(Edit::Pose { character: id, joints: vec![(j, rotation)] });
+            edits.push(edit::Pose { character: id, joints: vec![(j, rotation)] });
         }
         ui.separator();
     }

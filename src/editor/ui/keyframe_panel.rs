@@ -4,10 +4,10 @@
 //! chosen by rule) and its channel's extrapolation are set. Every change is an
 //! `Edit::Clip` with the new keys, so it is undone like any edit; `.anim` export.
 
+use crate::editor::edits::edit;
 use bevy_egui::egui;
 
 use super::{InspectorState, Panels};
-use crate::editor::edits::edit::Edit;
 use crate::formats::scene::{AnimDoc, CharacterId};
 use crate::rig::JointRotation;
 use crate::rig::anim::{Channel, Clip, Extrapolation, Key, SAME_TIME, Tangent};
@@ -92,7 +92,7 @@ pub fn keyframe_panel(ui: &mut egui::Ui, state: &mut InspectorState, panels: &mu
         });
     });
     if let Some(anim) = anim {
-        panels.push(Edit::Clip { character: id, anim: Some(anim) });
+        panels.push(edit::Clip { character: id, anim: Some(anim) });
     }
 }
 

@@ -107,7 +107,7 @@ pub struct Panels<'w, 's> {
 }
 
 impl Panels<'_, '_> {
-    pub fn push(&mut self, edit: Edit) {
+    pub fn push(&mut self, edit: impl Into<Edit>) {
         self.edits.push(edit);
     }
 

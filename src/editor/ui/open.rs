@@ -1,10 +1,10 @@
 //! What a path given to the editor does (typed in Add, picked in a dialog, dropped on the
 //! window): open a scene, play a clip, or add characters.
 
+use crate::editor::edits::edit;
 use std::path::Path;
 
 use super::{InspectorState, Panels};
-use crate::editor::edits::edit::Edit;
 use crate::editor::scene_doc::arrange::beside;
 use crate::editor::state::Selection;
 use crate::formats::scene::{AnimDoc, CharacterDoc, PlacementDoc};
@@ -12,7 +12,7 @@ use crate::formats::scene::{AnimDoc, CharacterDoc, PlacementDoc};
 /// Puts the clip at `path` on the selected character, playing.
 fn add_clip(path: &str, panels: &mut Panels) {
     match panels.selection.character {
-        Some(character) => panels.push(Edit::Clip { character, anim: Some(AnimDoc::of(path)) }),
+        Some(character) => panels.push(edit::Clip { character, anim: Some(AnimDoc::of(path)) }),
         None => panels.messages.push(format!("select the character that {path} should play on")),
     }
 }
@@ -56,7 +56,7 @@ fn add_character(path: &str, state: &mut InspectorState, panels: &mut Panels) {
         panels.messages.0.extend(asset.warnings.iter().cloned());
         let id = panels.ids.take();
         let doc = panels.library.new_character_doc(source, &asset);
-        panels.push(Edit::Add(Box::new(CharacterDoc {
+        panels.push(edit::Add(Box::new(CharacterDoc {
             id: Some(id),
             placement: PlacementDoc::new(translation, 0.0, 1.0),
             ..doc

@@ -3,10 +3,10 @@
 //! maps), as it was or mirrored; keep poses in the scene's library with a thumbnail, apply
 //! or remove them.
 
+use crate::editor::edits::edit;
 use bevy_egui::egui;
 
 use super::{InspectorState, Panels};
-use crate::editor::edits::edit::Edit;
 use crate::editor::edits::pose_library::{apply_named_pose, library_pose, pose_by_name};
 use crate::formats::scene::{CharacterId, LibraryPoseDoc};
 use crate::rig::JointRotation;
@@ -52,7 +52,7 @@ pub fn pose_panel(ui: &mut egui::Ui, state: &mut InspectorState, panels: &mut Pa
             {
                 let mut kept = library_pose(skeleton, &positions, pose_by_name(skeleton, &pose, &selected));
                 kept.rig = Some(source.clone());
-                edits.push(Edit::Library { name: state.pose_name.trim().to_string(), pose: Some(kept) });
+                edits.push(edit::Library { name: state.pose_name.trim().to_string(), pose: Some(kept) }.into());
             }
         });
         let kept_rigs: Vec<_> = panels
@@ -77,7 +77,7 @@ pub fn pose_panel(ui: &mut egui::Ui, state: &mut InspectorState, panels: &mut Pa
                             edits.extend(apply_named_pose(id, target, &named, from, true));
                         }
                         if ui.small_button("Remove").clicked() {
-                            edits.push(Edit::Library { name: name.clone(), pose: None });
+                            edits.push(edit::Library { name: name.clone(), pose: None }.into());
                         }
                     });
                 });
