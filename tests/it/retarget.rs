@@ -305,6 +305,27 @@ fn a_clip_retargeted_onto_its_own_character_is_itself() {
     }
 }
 
+/// A retargeting is worked out once per command: checking the options and posing after
+/// get the same one, wherever the source's clip is paused and whatever motion the target
+/// had; other settings work out another.
+#[test]
+fn a_retargeting_is_worked_out_once_per_command() {
+    let doc = editor::two_puppets();
+    let mut library = AssetLibrary::default();
+    let (source, target) = (&doc.characters[0], &doc.characters[1]);
+    let asset = library.shaped(target).unwrap();
+    let settings = target.anim.as_ref().unwrap().retarget.clone().unwrap();
+    let first = retarget(&mut library, source, target, &asset, &settings).unwrap();
+    let mut paused_later = source.clone();
+    paused_later.anim.iter_mut().for_each(|a| (a.time, a.playing) = (0.7, true));
+    let before_its_clip = CharacterDoc { anim: None, ..target.clone() };
+    let again = retarget(&mut library, &paused_later, &before_its_clip, &asset, &settings).unwrap();
+    assert!(std::sync::Arc::ptr_eq(&first, &again));
+    let unplanted = RetargetDoc { plant_feet: !settings.plant_feet, ..settings.clone() };
+    let other = retarget(&mut library, source, target, &asset, &unplanted).unwrap();
+    assert!(!std::sync::Arc::ptr_eq(&first, &other));
+}
+
 mod editor {
     //! The editor's retargeted clip against the document layer's (the oracle), and its
     //! edits: bake, stop, the humanoid map; all undoable; scene files keep them.
@@ -327,7 +348,7 @@ mod editor {
 
     /// Two puppets: the first (id 1, small) waves its left arm and bends its knee over a
     /// second, keyed; the second (id 2, tall) plays its motion.
-    fn two_puppets() -> SceneDoc {
+    pub(super) fn two_puppets() -> SceneDoc {
         let skeleton = marionette::formats::puppet::embedded_puppet().skeleton;
         let keyed: Vec<usize> =
             ["l_shoulder", "l_elbow", "l_knee", "pelvis"].iter().map(|n| skeleton.find(n).unwrap()).collect();

@@ -20,6 +20,8 @@ pub struct AssetLibrary {
     keyframe_clips: HashMap<PathBuf, Arc<marionette_rig::anim::Clip>>,
     parts: HashMap<PathBuf, Vec<LoadedPart>>,
     humanoids: HashMap<SourceDoc, Arc<marionette_rig::humanoid::HumanoidMap>>,
+    /// Motions carried from one character onto another, by what they were worked out from.
+    pub(crate) retargetings: HashMap<String, Arc<crate::retarget::Retargeting>>,
 }
 
 /// One part of a glTF or FBX file, loaded: its asset, its clips and its morph weights.

@@ -3,6 +3,7 @@
 //! and baked into a keyframed clip the target plays like any other.
 
 use std::path::Path;
+use std::sync::Arc;
 
 use marionette_formats::FormatError;
 use marionette_formats::scene::{
@@ -286,8 +287,42 @@ pub fn motion_source_doc(
 }
 
 /// The motion of `source` carried onto `target` (whose asset is `target_asset`) as
-/// `settings` ask, baked into a keyframed clip of the joints the source drives.
+/// `settings` ask, baked into a keyframed clip of the joints the source drives. Worked out
+/// once per command for each source, target and settings: the library keeps it.
 pub fn retarget(
+    library: &mut super::AssetLibrary,
+    source: &CharacterDoc,
+    target: &CharacterDoc,
+    target_asset: &CharacterAsset,
+    settings: &RetargetDoc,
+) -> Result<Arc<Retargeting>, FormatError> {
+    let key = retargeting_key(source, target, settings);
+    if let Some(done) = library.retargetings.get(&key) {
+        return Ok(done.clone());
+    }
+    let done = Arc::new(work_out_retargeting(library, source, target, target_asset, settings)?);
+    library.retargetings.insert(key, done.clone());
+    Ok(done)
+}
+
+/// What a retargeting depends on: the source's document and the target's less where their
+/// clips are playing (the whole motion is carried), the target's less the motion it is
+/// about to be given, and the settings.
+fn retargeting_key(source: &CharacterDoc, target: &CharacterDoc, settings: &RetargetDoc) -> String {
+    let target = CharacterDoc { anim: None, playback: None, ..target.clone() };
+    let (source, target) = (without_playhead(source), without_playhead(&target));
+    ron::to_string(&(source, target, settings)).expect("scene documents serialise")
+}
+
+fn without_playhead(doc: &CharacterDoc) -> CharacterDoc {
+    let mut doc = doc.clone();
+    doc.anim.iter_mut().for_each(|a| (a.time, a.playing) = (0.0, false));
+    doc.smpl.iter_mut().for_each(|s| (s.time, s.playing) = (0.0, false));
+    doc.playback.iter_mut().for_each(|p| (p.time, p.playing) = (0.0, false));
+    doc
+}
+
+fn work_out_retargeting(
     library: &mut super::AssetLibrary,
     source: &CharacterDoc,
     target: &CharacterDoc,
@@ -342,7 +377,7 @@ pub fn anim_clip(
         (Some(keys), _) => Ok(keys.clone()),
         (None, Some(settings)) => {
             let source = motion_source_doc(library, scene, &settings.from)?;
-            Ok(retarget(library, &source, target, target_asset, settings)?.clip)
+            Ok(retarget(library, &source, target, target_asset, settings)?.clip.clone())
         }
         (None, None) => Ok((*library.keyframe_clip(&anim.file)?).clone()),
     }

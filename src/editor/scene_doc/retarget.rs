@@ -37,7 +37,7 @@ pub fn resolve_retargets(
         let worked = library.shaped(&target).and_then(|asset| {
             let source = motion_source_doc(&mut library, doc, &wanted.from)?;
             let done = retarget(&mut library, &source, &target, &asset, wanted)?;
-            Ok((describe(&done, &source.name, &target.name, &asset.skeleton), done.clip))
+            Ok((describe(&done, &source.name, &target.name, &asset.skeleton), done.clip.clone()))
         });
         let report = match worked {
             Ok((report, clip)) => {
