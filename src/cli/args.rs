@@ -399,6 +399,10 @@ pub struct GenerateArgs {
 /// `--two-bone`, `--look-at`.
 #[derive(clap::Args, Debug, Clone, Default)]
 pub struct PoseArgs {
+    /// `NAME` or `NAME:mirrored`: a built-in body pose on every humanoid (`t-pose`,
+    /// `sit-chair`, `wave`, …; `marionette info` lists them), feet on the floor.
+    #[arg(long = "preset", value_name = "NAME[:mirrored]")]
+    pub preset: Option<crate::document::posing::BodyPoseSpec>,
     /// `JOINT=rx,ry,rz` in radians (x applied first); JOINT is a name or an index. Angles
     /// outside the joint's limits are clamped. Repeatable.
     #[arg(long = "pose", value_name = "JOINT=rx,ry,rz")]
@@ -426,6 +430,7 @@ impl PoseArgs {
     /// The specs as every command applies them.
     pub fn specs(&self) -> crate::document::options::PoseSpecs {
         crate::document::options::PoseSpecs {
+            preset: self.preset.clone(),
             poses: self.poses.clone(),
             hands: self.hands.clone(),
             ik: self.ik.clone(),

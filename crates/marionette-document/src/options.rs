@@ -23,6 +23,8 @@ use crate::posing::{LookAtSpec, apply_look_at_specs, apply_two_bone_specs, descr
 /// (or, for the hands, mapped fingers) in this order.
 #[derive(Clone, Debug, Default)]
 pub struct PoseSpecs {
+    /// `--preset NAME[:mirrored]`: a built-in body pose on every humanoid, stood on the floor.
+    pub preset: Option<crate::posing::BodyPoseSpec>,
     /// `--pose JOINT=rx,ry,rz`.
     pub poses: Vec<PoseSpec>,
     /// `--hand SIDE=NAME`.
@@ -61,6 +63,7 @@ impl PoseOptions {
             || !self.specs.two_bone.is_empty()
             || !self.specs.look_at.is_empty()
             || !self.specs.hands.is_empty()
+            || self.specs.preset.is_some()
     }
 }
 
@@ -232,6 +235,7 @@ fn pose_characters(
             + options.specs.look_at.len()
     ];
     let mut joints_seen = Vec::new();
+    let mut preset_used = false;
     for c in &mut doc.characters {
         let asset = match library.shaped(c) {
             Ok(asset) => asset,
@@ -253,6 +257,7 @@ fn pose_characters(
             && two_bone.is_empty()
             && look_at.is_empty()
             && options.specs.hands.is_empty()
+            && options.specs.preset.is_none()
         {
             continue;
         }
@@ -263,13 +268,23 @@ fn pose_characters(
         names.zip(&mut used).filter(|(j, _)| has(j)).for_each(|(_, u)| *u = true);
         let (mut pose, root_shift) =
             crate::export::still_pose(library, &scene, c, &asset).map_err(|e| e.to_string())?;
-        apply_pose_specs(skeleton, &mut pose, &poses).map_err(|e| e.to_string())?;
-        // The humanoid map, once, for the hands and the look-at.
-        let map = if options.specs.hands.is_empty() && look_at.is_empty() {
+        // The humanoid map, once, for the body pose, the hands and the look-at.
+        let map = if options.specs.hands.is_empty() && look_at.is_empty() && options.specs.preset.is_none() {
             Default::default()
         } else {
-            marionette_rig::humanoid::detect(skeleton).unwrap_or_default()
+            crate::retarget::humanoid_map(&asset, &c.humanoid)
         };
+        if let Some(spec) = &options.specs.preset {
+            match crate::posing::body_posed(skeleton, &map, &pose, spec, 1.0) {
+                Some((posed, limited)) => {
+                    pose = posed;
+                    notes.push(format!("{}: {}", c.name, crate::posing::describe_body_pose(skeleton, spec, &limited)));
+                    preset_used = true;
+                }
+                None => notes.push(format!("{}: no humanoid map (hips, two legs); {} skipped", c.name, spec.name)),
+            }
+        }
+        apply_pose_specs(skeleton, &mut pose, &poses).map_err(|e| e.to_string())?;
         let hands = crate::posing::apply_hand_specs(skeleton, &map, &mut pose, &options.specs.hands);
         notes.extend(hands.into_iter().map(|n| format!("{}: {n}", c.name)));
         let placement = c.placement.to_mat4() * Mat4::from_translation(root_shift);
@@ -282,10 +297,14 @@ fn pose_characters(
         for report in apply_look_at_specs(skeleton, &map, &mut pose, placement, &look_at).map_err(|e| e.to_string())? {
             notes.push(format!("{}: {}", c.name, describe_look_at(skeleton, &report)));
         }
+        let placement = match options.specs.preset.is_some() {
+            true => crate::posing::stood_on_floor(&asset, &pose, placement),
+            false => placement,
+        };
         let initial = skeleton.initial_pose();
         c.pose =
             (0..skeleton.len()).filter(|&j| pose[j] != initial[j]).map(|j| (pose_key(skeleton, j), pose[j])).collect();
-        if root_shift != Vec3::ZERO {
+        if root_shift != Vec3::ZERO || options.specs.preset.is_some() {
             c.placement = marionette_formats::scene::PlacementDoc::from_mat4(placement);
         }
         bake_clips(c);
@@ -298,6 +317,9 @@ fn pose_characters(
         .chain(options.specs.ik.iter().map(|p| ("--ik", &p.joint)));
     let specs = specs.chain(options.specs.two_bone.iter().map(|p| ("--two-bone", &p.joint)));
     let specs = specs.chain(options.specs.look_at.iter().map(|p| ("--look-at", &p.joint)));
+    if let (Some(spec), false) = (&options.specs.preset, preset_used) {
+        return Err(format!("--preset {}: no character has a humanoid map (hips, two legs)", spec.name));
+    }
     if let Some((option, joint)) = specs.zip(&used).find(|(_, u)| !**u).map(|(s, _)| s) {
         let known = joints_seen.join("; ");
         return Err(format!("{option}: no character has a joint named or numbered `{joint}` ({known})"));

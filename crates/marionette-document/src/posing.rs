@@ -213,6 +213,10 @@ pub fn describe_humanoid(asset: &CharacterAsset) -> String {
     for doubt in &found.doubts {
         out += &format!("humanoid doubt: {doubt}\n");
     }
+    if found.map.contains_key(&marionette_rig::humanoid::HumanBone::Hips) {
+        let names: Vec<&str> = marionette_rig::body_poses::POSES.iter().map(|p| p.name).collect();
+        out += &format!("body poses (--preset NAME[:mirrored]): {}\n", names.join(", "));
+    }
     if found.map.keys().any(|b| b.is_finger()) {
         let names: Vec<&str> = marionette_rig::hands::PRESETS.iter().map(|p| p.0).collect();
         out += &format!("hand presets (--hand left=NAME, right=NAME): {}\n", names.join(", "));
@@ -325,6 +329,81 @@ impl std::str::FromStr for LookAtSpec {
         let goal: IkSpec = spec.parse()?;
         Ok(Self { joint: goal.joint, target: goal.target })
     }
+}
+
+/// A parsed `NAME` or `NAME:mirrored`: a built-in body pose (`sit-chair`, `wave`, …).
+#[derive(Debug, Clone, PartialEq)]
+pub struct BodyPoseSpec {
+    pub name: String,
+    pub mirrored: bool,
+}
+
+impl std::str::FromStr for BodyPoseSpec {
+    type Err = PoseSpecError;
+
+    fn from_str(spec: &str) -> Result<Self, Self::Err> {
+        let (name, mirrored) = match spec.trim().split_once(':') {
+            Some((name, "mirrored" | "mirror")) => (name, true),
+            Some(_) => ("", false),
+            None => (spec.trim(), false),
+        };
+        if marionette_rig::body_poses::body_pose(name).is_none() {
+            let names: Vec<&str> = marionette_rig::body_poses::POSES.iter().map(|p| p.name).collect();
+            return Err(PoseSpecError::Syntax {
+                spec: format!("{spec} (expected NAME or NAME:mirrored, NAME one of {})", names.join(", ")),
+            });
+        }
+        Ok(Self { name: name.to_string(), mirrored })
+    }
+}
+
+/// `pose` with the built-in body pose `spec` put on it through the humanoid map `map`,
+/// blended from the pose as it was by `blend` (0: as it was, 1: the body pose; each joint
+/// turned the shortest way). Returns the new pose and the joints the limits held short, or
+/// `None` when the map lacks hips or legs.
+pub fn body_posed(
+    skeleton: &Skeleton,
+    map: &marionette_rig::humanoid::HumanoidMap,
+    pose: &[JointRotation],
+    spec: &BodyPoseSpec,
+    blend: f32,
+) -> Option<(Vec<JointRotation>, Vec<usize>)> {
+    let body = marionette_rig::body_poses::body_pose(&spec.name)?;
+    let mut posed = pose.to_vec();
+    let report = marionette_rig::body_poses::apply_body_pose(skeleton, map, &mut posed, body, spec.mirrored)?;
+    if blend < 1.0 {
+        for (to, from) in posed.iter_mut().zip(pose) {
+            let (a, b) = (from.to_quat(), to.to_quat());
+            *to = from.with_rotation_of(a.slerp(b, blend.clamp(0.0, 1.0)));
+        }
+    }
+    Some((posed, report.limited))
+}
+
+/// What a body pose did, for the notes.
+pub fn describe_body_pose(skeleton: &Skeleton, spec: &BodyPoseSpec, limited: &[usize]) -> String {
+    let name = if spec.mirrored { format!("{} (mirrored)", spec.name) } else { spec.name.clone() };
+    match limited {
+        [] => format!("pose {name}"),
+        _ => {
+            let joints: Vec<&str> = limited.iter().map(|&j| skeleton.joint(j).name.as_str()).collect();
+            format!("pose {name}, held short by the limits of {}", joints.join(", "))
+        }
+    }
+}
+
+/// `placement` moved up or down so that the skin at `pose` (its joints, for a skeleton
+/// without skin) rests on the floor, y = 0.
+pub fn stood_on_floor(asset: &CharacterAsset, pose: &[JointRotation], placement: Mat4) -> Mat4 {
+    let skin = posed_positions(asset, pose, placement);
+    let lowest = if skin.is_empty() {
+        let mut world = vec![Mat4::IDENTITY; asset.skeleton.len()];
+        marionette_rig::fk::forward_kinematics(&asset.skeleton, pose, placement, &mut world);
+        world.iter().map(|m| m.w_axis.y).fold(f32::INFINITY, f32::min)
+    } else {
+        skin.iter().map(|p| p.y).fold(f32::INFINITY, f32::min)
+    };
+    if lowest.is_finite() { Mat4::from_translation(Vec3::new(0.0, -lowest, 0.0)) * placement } else { placement }
 }
 
 /// A parsed `SIDE=NAME`: a hand preset (`fist`, `open`, …) on the left or right hand.

@@ -7,6 +7,7 @@ mod avx2;
 #[cfg(target_arch = "x86_64")]
 mod avx512;
 pub mod bind;
+pub mod body_poses;
 pub mod bones;
 pub mod character;
 pub mod dqs;
