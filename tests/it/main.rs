@@ -3,6 +3,7 @@
 mod alloc;
 mod anim;
 mod arrange;
+mod body_poses;
 mod commands;
 mod common;
 mod data;

@@ -442,13 +442,21 @@ pub fn aim_end(map: &HumanoidMap, bone: HumanBone) -> Option<usize> {
     }
 }
 
-/// The joint turned to aim a bone: its own, or for the chest the spine where the rig has no
-/// chest.
-pub fn aim_joint(map: &HumanoidMap, bone: HumanBone) -> Option<usize> {
+/// The joint a bone's direction starts at: its own, or for the chest the spine where the
+/// rig has no chest.
+pub fn aim_start(map: &HumanoidMap, bone: HumanBone) -> Option<usize> {
     match bone {
         Chest => map.get(&Chest).or_else(|| map.get(&Spine)).copied(),
         _ => map.get(&bone).copied(),
     }
+}
+
+/// The joint turned to aim from `start` to `end`: the lowest joint above both (`start`
+/// itself on a chain; the root where a rig hangs its hips and its spine side by side).
+pub fn turned_joint(skeleton: &Skeleton, start: usize, end: usize) -> usize {
+    let above = |j: usize| std::iter::successors(Some(j), |&k| skeleton.parent(k)).collect::<Vec<_>>();
+    let over_end = above(end);
+    above(start).into_iter().find(|j| over_end.contains(j)).unwrap_or(0)
 }
 
 /// What putting a body pose on a character did.
@@ -482,9 +490,10 @@ pub fn apply_body_pose(
     let mut rest_world = vec![Mat4::IDENTITY; skeleton.len()];
     forward_kinematics(skeleton, &rest, Mat4::IDENTITY, &mut rest_world);
     let mut report = BodyPoseReport::default();
-    let mut aim = |pose: &mut [JointRotation], joint: usize, end: usize, wanted: Vec3, report: &mut BodyPoseReport| {
+    let mut aim = |pose: &mut [JointRotation], start: usize, end: usize, wanted: Vec3, report: &mut BodyPoseReport| {
+        let joint = turned_joint(skeleton, start, end);
         forward_kinematics(skeleton, pose, Mat4::IDENTITY, &mut world);
-        let now = world[end].w_axis.truncate() - world[joint].w_axis.truncate();
+        let now = world[end].w_axis.truncate() - world[start].w_axis.truncate();
         if now.length_squared() < 1e-12 {
             return;
         }
@@ -495,8 +504,12 @@ pub fn apply_body_pose(
         }
     };
     for (bone, direction) in body.directions(mirrored) {
-        let (Some(joint), Some(end)) = (aim_joint(map, bone), aim_end(map, bone)) else { continue };
-        aim(pose, joint, end, frame * direction, &mut report);
+        if bone == LeftUpperArm {
+            // The look turns the chest and neck, before the limbs hung from them are aimed.
+            look(skeleton, map, pose, body, mirrored, frame, &rest_world, &mut report);
+        }
+        let (Some(start), Some(end)) = (aim_start(map, bone), aim_end(map, bone)) else { continue };
+        aim(pose, start, end, frame * direction, &mut report);
     }
     for (shin, foot) in [(LeftLowerLeg, LeftFoot), (RightLowerLeg, RightFoot)] {
         let (Some(&shin), Some(&foot)) = (map.get(&shin), map.get(&foot)) else { continue };
@@ -510,17 +523,37 @@ pub fn apply_body_pose(
             }
         }
     }
-    if let (Some(look), Some(&head)) = (body.look(mirrored), map.get(&Head)) {
-        forward_kinematics(skeleton, pose, Mat4::IDENTITY, &mut world);
-        let face = rotation_of(rest_world[head]).inverse() * (frame * Vec3::Z);
-        let joints: Vec<usize> = [Chest, Neck, Head].iter().filter_map(|b| map.get(b).copied()).collect();
-        let target = world[head].w_axis.truncate() + frame * look * 10.0;
-        let done = crate::look_at::solve_look_at(skeleton, pose, Mat4::IDENTITY, &joints, face, &[0.2, 0.35], target);
-        if done.limited {
-            report.limited.push(head);
-        }
-    }
     Some(report)
+}
+
+/// Turns the head (with shares of the chest and neck) to face along the pose's look.
+#[allow(clippy::too_many_arguments)]
+fn look(
+    skeleton: &Skeleton,
+    map: &HumanoidMap,
+    pose: &mut [JointRotation],
+    body: &BodyPose,
+    mirrored: bool,
+    frame: Quat,
+    rest_world: &[Mat4],
+    report: &mut BodyPoseReport,
+) {
+    let (Some(look), Some(&head)) = (body.look(mirrored), map.get(&Head)) else { return };
+    let mut world = vec![Mat4::IDENTITY; skeleton.len()];
+    forward_kinematics(skeleton, pose, Mat4::IDENTITY, &mut world);
+    let face = rotation_of(rest_world[head]).inverse() * (frame * Vec3::Z);
+    // Not a joint the hips hang from (a rig whose chest is its root).
+    let hips = map.get(&Hips).map(|&h| std::iter::successors(Some(h), |&k| skeleton.parent(k)).collect::<Vec<_>>());
+    let joints: Vec<usize> = [Chest, Neck, Head]
+        .iter()
+        .filter_map(|b| map.get(b).copied())
+        .filter(|j| !hips.as_ref().is_some_and(|above| above.contains(j)))
+        .collect();
+    let target = world[head].w_axis.truncate() + frame * look * 10.0;
+    let done = crate::look_at::solve_look_at(skeleton, pose, Mat4::IDENTITY, &joints, face, &[0.2, 0.35], target);
+    if done.limited {
+        report.limited.push(head);
+    }
 }
 
 #[cfg(test)]

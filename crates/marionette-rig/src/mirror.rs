@@ -12,10 +12,26 @@ use super::pose::JointRotation;
 const PREFIXES: [(&str, &str); 2] = [("l_", "r_"), ("L_", "R_")];
 const SUFFIXES: [(&str, &str); 4] = [(".L", ".R"), (".l", ".r"), ("_l", "_r"), ("_L", "_R")];
 const WORDS: [(&str, &str); 3] = [("left", "right"), ("Left", "Right"), ("LEFT", "RIGHT")];
+/// Side marks inside a name (`upper_arm.L.001`, `arm_l_twist`).
+const INFIXES: [(&str, &str); 4] = [(".L.", ".R."), (".l.", ".r."), ("_L_", "_R_"), ("_l_", "_r_")];
 
 /// The name of the joint on the other side (`l_elbow` ↔ `r_elbow`, `hand.L` ↔ `hand.R`,
-/// `hip_01_l` ↔ `hip_01_r`, `LeftArm` ↔ `RightArm`), or none for a joint on the middle.
+/// `hip_01_l` ↔ `hip_01_r`, `LeftArm` ↔ `RightArm`, `upper_arm.L.001` ↔ `upper_arm.R.001`,
+/// Daz's `lShldrBend` ↔ `rShldrBend`), or none for a joint on the middle.
 pub fn mirrored_name(name: &str) -> Option<String> {
+    for (a, b) in INFIXES {
+        for (from, to) in [(a, b), (b, a)] {
+            if name.contains(from) {
+                return Some(name.replacen(from, to, 1));
+            }
+        }
+    }
+    let mut chars = name.chars();
+    if let (Some(side @ ('l' | 'r')), Some(next)) = (chars.next(), chars.next())
+        && next.is_ascii_uppercase()
+    {
+        return Some(format!("{}{}", if side == 'l' { 'r' } else { 'l' }, &name[1..]));
+    }
     for (a, b) in PREFIXES {
         for (from, to) in [(a, b), (b, a)] {
             if let Some(rest) = name.strip_prefix(from) {
