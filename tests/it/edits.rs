@@ -534,3 +534,55 @@ fn the_humanoid_map_is_kept_and_follows_assigned_bones() {
     app.update();
     assert_eq!(map(&app), found, "undone, the map is the found one again");
 }
+
+/// With symmetry on, turning the left arm turns the right one mirrored (each twin turned
+/// from rest in the model as its joint is, reflected across the body), and one undo takes
+/// both back; with it off, only the left turns.
+#[test]
+fn an_edit_with_symmetry_turns_the_twin_in_the_same_undo_step() {
+    let mut app = scene_app();
+    open_puppets(&mut app, &[Some(1)]);
+    let (left, right) = (joint(&app, 1, "l_shoulder"), joint(&app, 1, "r_shoulder"));
+    let (elbow, r_elbow) = (joint(&app, 1, "l_elbow"), joint(&app, 1, "r_elbow"));
+    let pose_of = |app: &App| {
+        let c = app.world().get::<Character>(entity(app, 1)).unwrap();
+        c.joints.iter().map(|&e| app.world().get::<JointPose>(e).unwrap().0).collect::<Vec<_>>()
+    };
+    let skeleton = app.world().get::<Character>(entity(&app, 1)).unwrap().asset.skeleton.clone();
+    let rest = pose_of(&app);
+    let turns = |pose: &[JointRotation]| {
+        let model = |pose: &[JointRotation]| {
+            let mut world = vec![glam::Mat4::IDENTITY; skeleton.len()];
+            marionette::rig::fk::forward_kinematics(&skeleton, pose, glam::Mat4::IDENTITY, &mut world);
+            world.iter().map(|&m| marionette::rig::ik::rotation_of(m)).collect::<Vec<_>>()
+        };
+        let (now, at_rest) = (model(pose), model(&skeleton.initial_pose()));
+        now.iter().zip(&at_rest).map(|(n, r)| *n * r.inverse()).collect::<Vec<_>>()
+    };
+    let arm = Edit::Pose(edit::Pose {
+        character: CharacterId(1),
+        joints: vec![
+            (left, JointRotation::euler_xyz(0.3, -0.4, -0.7)),
+            (elbow, JointRotation::euler_xyz(0.0, 0.9, 0.1)),
+        ],
+    });
+    app.world_mut().resource_mut::<marionette::editor::state::Symmetry>().0 = true;
+    edit(&mut app, arm.clone());
+    app.update();
+    let posed = pose_of(&app);
+    assert_ne!(posed[right], rest[right], "the twin turned");
+    let t = turns(&posed);
+    for (j, k) in [(left, right), (elbow, r_elbow)] {
+        let want = marionette::rig::mirror::reflected(t[j], glam::Vec3::X);
+        assert!(1.0 - t[k].dot(want).abs() < 1e-5, "joint {k}: {:?} against {want:?}", t[k]);
+    }
+    assert_eq!(app.world().resource::<History>().undo_steps(), 1);
+    request(&mut app, HistoryRequest::Undo);
+    assert_eq!(pose_of(&app), rest, "one undo takes both sides back");
+
+    app.world_mut().resource_mut::<marionette::editor::state::Symmetry>().0 = false;
+    edit(&mut app, arm);
+    let posed = pose_of(&app);
+    assert_ne!(posed[left], rest[left]);
+    assert_eq!(posed[right], rest[right], "without symmetry the twin stays");
+}

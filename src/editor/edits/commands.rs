@@ -24,6 +24,7 @@ impl Plugin for CommandsPlugin {
             .init_resource::<GestureHold>()
             .init_resource::<CharacterIndex>()
             .init_resource::<NextCharacterId>()
+            .init_resource::<crate::editor::state::Symmetry>()
             .add_systems(PostUpdate, apply_edits.in_set(crate::editor::order::EditorSystems::Edits));
     }
 }
@@ -101,6 +102,12 @@ pub fn apply(world: &mut World, mut edit: Edit) -> Result<Vec<Edit>, String> {
         && doc.id.is_none()
     {
         doc.id = Some(world.resource_mut::<NextCharacterId>().take());
+    }
+    if let Edit::Pose(pose) = &mut edit
+        && world.get_resource::<crate::editor::state::Symmetry>().is_some_and(|s| s.0)
+    {
+        let twins = crate::editor::edits::access::twins_of(world, pose)?;
+        pose.joints.extend(twins);
     }
     let undo = edit.undo(world)?;
     if !undo.is_empty() {

@@ -133,6 +133,11 @@ pub struct StageSettings(pub crate::formats::scene::StageDoc);
 #[derive(Resource, Clone, Copy, Debug, Default, PartialEq, Deref, DerefMut)]
 pub struct ShotSettings(pub crate::formats::scene::ShotDoc);
 
+/// Posing with symmetry: a joint turned on one side turns its twin on the other, mirrored
+/// through the humanoid map, in the same undo step.
+#[derive(Resource, Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Symmetry(pub bool);
+
 /// The scene's poses by name (the scene file's `poses`).
 #[derive(Resource, Clone, Debug, Default, PartialEq)]
 pub struct PoseLibrary(pub BTreeMap<String, crate::formats::scene::LibraryPoseDoc>);
