@@ -217,8 +217,9 @@ pub struct FrameArgs {
     /// (from `--from`, or 0), or the turn over `--from`/`--to`.
     #[arg(long, value_name = "SECONDS", value_parser = finite_seconds)]
     pub turntable: Option<f32>,
-    /// A contact sheet into `--out`: every pose of the scene's library on its characters,
-    /// one cell each (of `--width`×`--height`), in a grid by name.
+    /// A contact sheet into `--out`: every pose of the scene's library on its characters
+    /// (the built-in body poses where it keeps none), one cell each (of
+    /// `--width`×`--height`), in a grid.
     #[arg(long = "poses", id = "pose_sheet", conflicts_with_all = ["from", "turntable", "time"])]
     pub pose_sheet: bool,
 }

@@ -54,3 +54,49 @@ pub fn apply_named_pose(
     let joints = crate::document::retarget::pose_onto((skeleton, map), current, pose, source, mirrored);
     (!joints.is_empty()).then_some(Edit::Pose(edit::Pose { character: id, joints }))
 }
+
+/// The edits that put the built-in body pose `spec` on character `id` (of `asset`, its
+/// humanoid map `map`, its pose now and its placement), blended from the pose now by
+/// `blend`: its joints, and its placement stood on the floor. One gesture, so one undo
+/// step. None when the map lacks hips or legs.
+pub fn body_pose_edits(
+    id: CharacterId,
+    target: (&crate::rig::CharacterAsset, &HumanoidMap, &[JointRotation]),
+    placement: crate::formats::scene::PlacementDoc,
+    spec: &crate::document::posing::BodyPoseSpec,
+    blend: f32,
+) -> Option<Vec<Edit>> {
+    let (asset, map, current) = target;
+    let (posed, _) = crate::document::posing::body_posed(&asset.skeleton, map, current, spec, blend)?;
+    let stood = crate::document::posing::stood_on_floor(asset, &posed, placement.to_mat4());
+    let joints = (0..posed.len()).filter(|&j| posed[j] != current[j]).map(|j| (j, posed[j])).collect();
+    Some(vec![
+        edit::Pose { character: id, joints }.into(),
+        edit::Place { character: id, placement: crate::formats::scene::PlacementDoc::from_mat4(stood) }.into(),
+    ])
+}
+
+/// The edit that flips character `id`'s pose left to right through its humanoid map (see
+/// `rig::mirror::flipped_pose`); none without hips and legs in the map.
+pub fn flip_edit(id: CharacterId, skeleton: &Skeleton, map: &HumanoidMap, current: &[JointRotation]) -> Option<Edit> {
+    let left = crate::rig::body_poses::facing_frame(skeleton, map)? * Vec3::X;
+    let twin = crate::rig::mirror::counterparts(skeleton, map);
+    let flipped = crate::rig::mirror::flipped_pose(skeleton, &twin, current, left);
+    let joints = (0..flipped.len()).filter(|&j| flipped[j] != current[j]).map(|j| (j, flipped[j])).collect();
+    Some(edit::Pose { character: id, joints }.into())
+}
+
+/// A stick-figure thumbnail of each built-in body pose on this character.
+pub fn body_pose_thumbnails(skeleton: &Skeleton, map: &HumanoidMap) -> Vec<LibraryPoseDoc> {
+    crate::rig::body_poses::POSES
+        .iter()
+        .filter_map(|body| {
+            let mut pose = skeleton.initial_pose();
+            crate::rig::body_poses::apply_body_pose(skeleton, map, &mut pose, body, false)?;
+            let mut world = vec![Mat4::IDENTITY; skeleton.len()];
+            crate::rig::fk::forward_kinematics(skeleton, &pose, Mat4::IDENTITY, &mut world);
+            let positions: Vec<Vec3> = world.iter().map(|m| m.w_axis.truncate()).collect();
+            Some(library_pose(skeleton, &positions, Vec::new()))
+        })
+        .collect()
+}

@@ -158,9 +158,11 @@ pub fn render(
             (vec![(FrameAt::AsOpened, out.clone())], None)
         }
         Pictures::PoseSheet => {
-            if poses.is_empty() {
-                return Err("the scene keeps no poses to show (keep some with \"Keep pose\" in the editor)".into());
-            }
+            // The scene's library, else the built-in body poses.
+            let poses = match poses.is_empty() {
+                true => crate::rig::body_poses::POSES.iter().map(|p| p.name.to_string()).collect(),
+                false => poses,
+            };
             std::fs::create_dir_all(&cells).map_err(|e| format!("{}: {e}", cells.display()))?;
             let at = |k: usize| cells.join(format!("pose_{k:04}.png"));
             (poses.iter().enumerate().map(|(k, name)| (FrameAt::Pose(name.clone()), at(k))).collect(), None)
@@ -578,6 +580,7 @@ fn pose_frame(
         &crate::editor::scene_doc::document::SceneCharacter,
         &crate::scene::Character,
         Option<&crate::editor::scene_doc::document::HumanoidMapOf>,
+        &crate::scene::Placement,
     )>,
     poses: Query<&crate::scene::JointPose>,
     mut edits: ResMut<crate::editor::edits::edit::EditQueue>,
@@ -588,17 +591,24 @@ fn pose_frame(
     }
     job.set_up = true;
     let FrameAt::Pose(name) = &job.frames[job.next].at else { return };
-    let Some(pose) = library.0.get(name) else { return };
-    let joints: Vec<_> = pose.joints.iter().map(|(k, r)| (k.clone(), *r)).collect();
-    let rig = pose.rig.as_ref().and_then(|rig| assets.rig(rig).ok());
+    let kept = library.0.get(name);
+    let joints: Vec<_> = kept.iter().flat_map(|pose| pose.joints.iter().map(|(k, r)| (k.clone(), *r))).collect();
+    let rig = kept.and_then(|pose| pose.rig.as_ref()).and_then(|rig| assets.rig(rig).ok());
     let from = rig.as_ref().map(|(a, m)| (&a.skeleton, &**m));
-    for (sc, character, map) in &characters {
+    // A pose of the scene's library, else the built-in body pose of that name.
+    let body = crate::document::posing::BodyPoseSpec { name: name.clone(), mirrored: false };
+    for (sc, character, map, placement) in &characters {
         let map = map.map(|m| m.0.clone()).unwrap_or_default();
         let current: Vec<_> =
             character.joints.iter().map(|&e| poses.get(e).map_or(Default::default(), |p| p.0)).collect();
         let target = (&character.asset.skeleton, &map, &current[..]);
-        if let Some(edit) = crate::editor::edits::pose_library::apply_named_pose(sc.id, target, &joints, from, false) {
-            edits.push(edit);
+        use crate::editor::edits::pose_library::{apply_named_pose, body_pose_edits};
+        match kept {
+            Some(_) => edits.0.extend(apply_named_pose(sc.id, target, &joints, from, false)),
+            None => {
+                let target = (&*character.asset, &map, &current[..]);
+                edits.0.extend(body_pose_edits(sc.id, target, placement.0, &body, 1.0).into_iter().flatten())
+            }
         }
     }
     gate.restart();

@@ -56,6 +56,11 @@ pub struct InspectorState {
     pub bookmark_name: String,
     /// Show the shot's frame in the viewport.
     pub frame_guide: bool,
+    /// The built-in body poses: mirrored, how much of each to blend in, and their
+    /// thumbnails on the character they were drawn for.
+    pub body_mirrored: bool,
+    pub body_blend: f32,
+    pub body_thumbnails: Option<(crate::formats::scene::CharacterId, Vec<crate::formats::scene::LibraryPoseDoc>)>,
 }
 
 impl Default for InspectorState {
@@ -75,6 +80,9 @@ impl Default for InspectorState {
             crowd_size: 16,
             bookmark_name: "view 1".into(),
             frame_guide: true,
+            body_mirrored: false,
+            body_blend: 1.0,
+            body_thumbnails: None,
         }
     }
 }
@@ -104,6 +112,8 @@ pub struct Panels<'w, 's> {
     pub recent: Option<ResMut<'w, crate::editor::ui::recent::RecentFiles>>,
     /// The fast viewport's setting.
     pub fast_viewport: Option<ResMut<'w, crate::editor::present::fast_viewport::FastViewport>>,
+    /// Posing with symmetry.
+    pub symmetry: Option<ResMut<'w, crate::editor::state::Symmetry>>,
 }
 
 impl Panels<'_, '_> {

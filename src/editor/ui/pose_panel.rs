@@ -7,7 +7,9 @@ use crate::editor::edits::edit;
 use bevy_egui::egui;
 
 use super::{InspectorState, Panels};
-use crate::editor::edits::pose_library::{apply_named_pose, library_pose, pose_by_name};
+use crate::editor::edits::pose_library::{
+    apply_named_pose, body_pose_edits, body_pose_thumbnails, flip_edit, library_pose, pose_by_name,
+};
 use crate::formats::scene::{CharacterId, LibraryPoseDoc};
 use crate::rig::JointRotation;
 
@@ -30,6 +32,22 @@ pub fn pose_panel(ui: &mut egui::Ui, state: &mut InspectorState, panels: &mut Pa
     let selected = panels.selection.joints.clone();
     let target = (skeleton, &map, &pose[..]);
     let mut edits = Vec::new();
+    egui::CollapsingHeader::new("Body poses").default_open(true).show(ui, |ui| {
+        if map.contains_key(&crate::rig::humanoid::HumanBone::Hips) {
+            let placement = c.placement.0;
+            body_poses(
+                ui,
+                state,
+                panels.symmetry.as_deref_mut(),
+                &mut edits,
+                id,
+                (&character.asset, &map, &pose),
+                placement,
+            );
+        } else {
+            ui.label("No humanoid map (hips, two legs): assign bones under Retarget.");
+        }
+    });
     egui::CollapsingHeader::new("Poses").default_open(false).show(ui, |ui| {
         ui.horizontal(|ui| {
             if ui.button("Copy").on_hover_text("the selected joints' rotations (all when none)").clicked() {
@@ -87,9 +105,55 @@ pub fn pose_panel(ui: &mut egui::Ui, state: &mut InspectorState, panels: &mut Pa
     edits.into_iter().for_each(|e| panels.push(e));
 }
 
-/// The pose's stick figure.
-fn thumbnail(ui: &mut egui::Ui, pose: &LibraryPoseDoc) {
-    let (response, painter) = ui.allocate_painter(egui::vec2(THUMBNAIL, THUMBNAIL), egui::Sense::hover());
+/// The built-in body poses as a grid of thumbnails to click, with the blend, mirrored,
+/// flip and symmetry.
+fn body_poses(
+    ui: &mut egui::Ui,
+    state: &mut InspectorState,
+    symmetry: Option<&mut crate::editor::state::Symmetry>,
+    edits: &mut Vec<crate::editor::edits::edit::Edit>,
+    id: CharacterId,
+    target: (&crate::rig::CharacterAsset, &crate::rig::humanoid::HumanoidMap, &[JointRotation]),
+    placement: crate::formats::scene::PlacementDoc,
+) {
+    let (asset, map, pose) = target;
+    ui.horizontal(|ui| {
+        ui.add(egui::Slider::new(&mut state.body_blend, 0.0..=1.0).text("blend"))
+            .on_hover_text("how far from the pose now to the one clicked");
+        ui.checkbox(&mut state.body_mirrored, "mirrored");
+    });
+    ui.horizontal(|ui| {
+        if ui.button("Flip pose").on_hover_text("left and right swapped, through the humanoid map").clicked() {
+            edits.extend(flip_edit(id, &asset.skeleton, map, pose));
+        }
+        if let Some(symmetry) = symmetry {
+            ui.checkbox(&mut symmetry.0, "Symmetry").on_hover_text("a joint turned on one side turns its twin");
+        }
+    });
+    if state.body_thumbnails.as_ref().is_none_or(|(of, _)| *of != id) {
+        state.body_thumbnails = Some((id, body_pose_thumbnails(&asset.skeleton, map)));
+    }
+    let Some((_, thumbnails)) = &state.body_thumbnails else { return };
+    let mut clicked = None;
+    egui::Grid::new("body poses").spacing(egui::vec2(4.0, 4.0)).show(ui, |ui| {
+        for (k, (body, kept)) in crate::rig::body_poses::POSES.iter().zip(thumbnails).enumerate() {
+            if thumbnail(ui, kept).on_hover_text(body.name).clicked() {
+                clicked = Some(body.name);
+            }
+            if k % 5 == 4 {
+                ui.end_row();
+            }
+        }
+    });
+    if let Some(name) = clicked {
+        let spec = crate::document::posing::BodyPoseSpec { name: name.into(), mirrored: state.body_mirrored };
+        edits.extend(body_pose_edits(id, target, placement, &spec, state.body_blend).into_iter().flatten());
+    }
+}
+
+/// The pose's stick figure (clickable).
+fn thumbnail(ui: &mut egui::Ui, pose: &LibraryPoseDoc) -> egui::Response {
+    let (response, painter) = ui.allocate_painter(egui::vec2(THUMBNAIL, THUMBNAIL), egui::Sense::click());
     let rect = response.rect;
     painter.rect_filled(rect, 3.0, egui::Color32::from_gray(28));
     let at = |x: f32, y: f32| egui::pos2(rect.left() + x * rect.width(), rect.bottom() - y * rect.height());
@@ -99,4 +163,5 @@ fn thumbnail(ui: &mut egui::Ui, pose: &LibraryPoseDoc) {
             egui::Stroke::new(1.5, egui::Color32::from_rgb(235, 225, 200)),
         );
     }
+    response
 }
