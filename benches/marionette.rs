@@ -295,7 +295,7 @@ fn capture_scene_document(reader: marionette::editor::scene_doc::document::Scene
 #[divan::bench(args = ["after", "before"])]
 fn editing_frame_3_smpl_playing_1_puppet_dragged(bencher: Bencher, variant: &str) {
     use marionette::editor::edits::commands::EditQueue;
-    use marionette::editor::edits::edit;
+    use marionette::editor::edits::kinds;
     use marionette::editor::scene_doc::document::{CharacterIndex, PendingScene};
     use marionette::formats::scene::{CharacterDoc, CharacterId, SceneDoc, SmplDoc, SourceDoc};
     use marionette::rig::ik::{IkGoal, solve_ik};
@@ -343,7 +343,7 @@ fn editing_frame_3_smpl_playing_1_puppet_dragged(bencher: Bencher, variant: &str
         let target = Vec3::new(0.3 + 0.1 * step.sin(), 1.2, 0.2 * step.cos());
         solve_ik(&puppet.asset.skeleton, &mut pose, Mat4::IDENTITY, &[IkGoal { end: hand, target }], 1e-4, 8);
         let joints = pose.into_iter().enumerate().filter(|&(j, p)| p != before[j]).collect();
-        world.resource_mut::<EditQueue>().push(edit::Pose { character: CharacterId(1), joints });
+        world.resource_mut::<EditQueue>().push(kinds::Pose { character: CharacterId(1), joints });
         app.update();
     };
     let mut bytes = 0;

@@ -3,8 +3,8 @@
 
 use bevy::prelude::*;
 use marionette::editor::edits::commands::{Edit, EditQueue, GestureHold};
-use marionette::editor::edits::edit;
 use marionette::editor::edits::history::{History, HistoryRequest};
+use marionette::editor::edits::kinds;
 use marionette::editor::scene_doc::document::{CharacterIndex, PendingScene, SceneCharacter, SceneReader};
 use marionette::editor::state::Pins;
 use marionette::editor::{Messages, ScenePlugin, Selection};
@@ -82,32 +82,32 @@ fn commands_then_undo_all_return_the_ecs_to_its_start_and_redo_to_its_end() {
     added.id = Some(CharacterId(10));
     added.placement.translation.x = 3.0;
     let edits = vec![
-        Edit::Pose(edit::Pose {
+        Edit::from(kinds::Pose {
             character: CharacterId(1),
             joints: vec![(elbow, JointRotation::euler_xyz(0.0, 0.7, 0.0))],
         }),
-        Edit::Place(edit::Place {
+        Edit::from(kinds::Place {
             character: CharacterId(2),
             placement: Placement::new(Vec3::new(1.0, 0.0, 2.0), 0.5, 1.5).0,
         }),
-        Edit::View(edit::View {
+        Edit::from(kinds::View {
             character: CharacterId(1),
             view: ViewDoc { display: DisplayDoc::Both, tint: [0.1, 0.2, 0.3], ..ViewDoc::default() },
         }),
-        Edit::Rename(edit::Rename { character: CharacterId(2), name: "Bea".into() }),
-        Edit::Stage(edit::Stage(StageDoc { axes: true, floor: false, ..StageDoc::default() })),
-        Edit::Rebind(edit::Rebind { character: CharacterId(1), binding: Some(BindingDoc::Nearest) }),
-        Edit::Skinning(edit::Skinning {
+        Edit::from(kinds::Rename { character: CharacterId(2), name: "Bea".into() }),
+        Edit::from(kinds::Stage(StageDoc { axes: true, floor: false, ..StageDoc::default() })),
+        Edit::from(kinds::Rebind { character: CharacterId(1), binding: Some(BindingDoc::Nearest) }),
+        Edit::from(kinds::Skinning {
             character: CharacterId(2),
             method: marionette::formats::scene::SkinningDoc::DualQuaternion,
         }),
-        Edit::SkinOnGpu(edit::SkinOnGpu { character: CharacterId(1), on: true }),
-        Edit::Add(edit::Add(Box::new(added))),
-        Edit::Pose(edit::Pose {
+        Edit::from(kinds::SkinOnGpu { character: CharacterId(1), on: true }),
+        Edit::from(kinds::Add(Box::new(added))),
+        Edit::from(kinds::Pose {
             character: CharacterId(10),
             joints: vec![(elbow, JointRotation::euler_xyz(0.3, 0.0, 0.0))],
         }),
-        Edit::Remove(edit::Remove(CharacterId(2))),
+        Edit::from(kinds::Remove(CharacterId(2))),
     ];
     let n = edits.len();
     for e in edits {
@@ -147,7 +147,7 @@ fn a_gesture_is_one_undo_step_and_a_click_is_none() {
     };
     let before = pose_of(&app);
     let turn = |a: f32| {
-        Edit::Pose(edit::Pose {
+        Edit::from(kinds::Pose {
             character: CharacterId(1),
             joints: vec![(elbow, JointRotation::euler_xyz(0.0, a, 0.0))],
         })
@@ -168,13 +168,13 @@ fn a_gesture_is_one_undo_step_and_a_click_is_none() {
 
     // A click on the slider: the same value again.
     app.world_mut().resource_mut::<GestureHold>().panels = true;
-    edit(&mut app, Edit::Pose(edit::Pose { character: CharacterId(1), joints: vec![(elbow, before)] }));
+    edit(&mut app, Edit::from(kinds::Pose { character: CharacterId(1), joints: vec![(elbow, before)] }));
     app.world_mut().resource_mut::<GestureHold>().panels = false;
     app.update();
     // A drag that comes back to where it began.
     app.world_mut().resource_mut::<GestureHold>().panels = true;
     edit(&mut app, turn(0.4));
-    edit(&mut app, Edit::Pose(edit::Pose { character: CharacterId(1), joints: vec![(elbow, before)] }));
+    edit(&mut app, Edit::from(kinds::Pose { character: CharacterId(1), joints: vec![(elbow, before)] }));
     app.world_mut().resource_mut::<GestureHold>().panels = false;
     app.update();
     app.update();
@@ -191,7 +191,7 @@ fn selecting_is_no_edit_and_edits_of_missing_characters_are_reported() {
     *app.world_mut().resource_mut::<Selection>() = Selection { character: Some(CharacterId(1)), joints: vec![3] };
     app.update();
     assert!(!app.world().resource::<History>().can_undo(), "selecting is no undo step");
-    edit(&mut app, Edit::Rename(edit::Rename { character: CharacterId(99), name: "x".into() }));
+    edit(&mut app, Edit::from(kinds::Rename { character: CharacterId(99), name: "x".into() }));
     assert!(!app.world().resource::<History>().can_undo());
     let messages = &app.world().resource::<Messages>().0;
     assert!(messages.iter().any(|m| m.contains("character #99 is not in the scene")), "{messages:?}");
@@ -207,7 +207,7 @@ fn opening_a_scene_clears_selection_pins_and_history_and_keeps_unloadable_charac
     // What the previous scene left behind.
     *app.world_mut().resource_mut::<Selection>() = Selection { character: Some(CharacterId(7)), joints: vec![4] };
     app.world_mut().resource_mut::<Pins>().0.insert(CharacterId(7), vec![4]);
-    edit(&mut app, Edit::Rename(edit::Rename { character: CharacterId(7), name: "renamed".into() }));
+    edit(&mut app, Edit::from(kinds::Rename { character: CharacterId(7), name: "renamed".into() }));
     app.update();
     assert!(app.world().resource::<History>().can_undo());
 
@@ -275,7 +275,7 @@ fn smpl_shape_and_clip_edits_undo_and_redo() {
     let start = (state(&mut app), shape(&app));
     let clip = marionette::formats::smpl::clip_paths(&dir)[0].file_name().unwrap().to_string_lossy().into_owned();
     let wanted = SmplDoc { betas: vec![2.0, -1.0], clip: Some(clip), time: 12.0, ..SmplDoc::default() };
-    edit(&mut app, Edit::Smpl(edit::Smpl { character: CharacterId(1), state: wanted.clone() }));
+    edit(&mut app, Edit::from(kinds::Smpl { character: CharacterId(1), state: wanted.clone() }));
     assert_eq!(app.world().get::<SmplCharacter>(e).unwrap().state, wanted);
     let end = (state(&mut app), shape(&app));
     assert_ne!(end.1, start.1, "β reshaped the body");
@@ -306,7 +306,7 @@ fn a_gizmo_drag_is_one_undo_step_and_a_cancelled_one_none() {
         app.world_mut().resource_mut::<GestureHold>().typing = true;
         for &a in angles {
             turn.ring_to(a);
-            edit(app, Edit::Pose(edit::Pose { character: CharacterId(1), joints: vec![(elbow, turn.rotation())] }));
+            edit(app, Edit::from(kinds::Pose { character: CharacterId(1), joints: vec![(elbow, turn.rotation())] }));
         }
         turn
     };
@@ -317,7 +317,7 @@ fn a_gizmo_drag_is_one_undo_step_and_a_cancelled_one_none() {
     };
 
     let turn = drag(&mut app, &[0.1, 0.2, 0.3]);
-    edit(&mut app, Edit::Pose(edit::Pose { character: CharacterId(1), joints: vec![(elbow, turn.start)] }));
+    edit(&mut app, Edit::from(kinds::Pose { character: CharacterId(1), joints: vec![(elbow, turn.start)] }));
     release(&mut app);
     assert_eq!(pose_of(&app), start, "cancel restores the pose exactly");
     assert_eq!(app.world().resource::<History>().undo_steps(), 0, "a cancelled drag is no step");
@@ -341,7 +341,7 @@ fn keying_a_pose_is_undone_and_redone_like_any_edit() {
     let elbow = joint(&app, 1, "l_elbow");
     edit(
         &mut app,
-        Edit::Pose(edit::Pose {
+        Edit::from(kinds::Pose {
             character: CharacterId(1),
             joints: vec![(elbow, JointRotation::euler_xyz(0.0, -0.5, 0.0))],
         }),
@@ -349,7 +349,7 @@ fn keying_a_pose_is_undone_and_redone_like_any_edit() {
     let character = app.world().get::<Character>(entity(&app, 1)).unwrap().clone();
     let pose: Vec<_> = character.joints.iter().map(|&e| app.world().get::<JointPose>(e).unwrap().0).collect();
     let anim = keyed(None, pose.len(), &[elbow], &pose);
-    edit(&mut app, Edit::Clip(edit::Clip { character: CharacterId(1), anim: Some(anim.clone()) }));
+    edit(&mut app, Edit::from(kinds::Clip { character: CharacterId(1), anim: Some(anim.clone()) }));
     app.update();
     let player = |app: &App| app.world().get::<ClipPlayer>(entity(app, 1)).map(|p| p.state.clone());
     assert_eq!(player(&app), Some(anim.clone()));
@@ -376,11 +376,11 @@ fn morph_weights_are_undone_and_survive_a_rebind() {
     app.update();
     let bind = |app: &App| app.world().get::<Character>(entity(app, 1)).unwrap().asset.skin.bind_positions.clone();
     let base = bind(&app);
-    edit(&mut app, Edit::Morph(edit::Morph { character: CharacterId(1), weights: vec![1.0, 0.0] }));
+    edit(&mut app, Edit::from(kinds::Morph { character: CharacterId(1), weights: vec![1.0, 0.0] }));
     app.update();
     let morphed = bind(&app);
     assert_ne!(morphed, base, "the morph moves vertices");
-    edit(&mut app, Edit::Rebind(edit::Rebind { character: CharacterId(1), binding: Some(BindingDoc::Nearest) }));
+    edit(&mut app, Edit::from(kinds::Rebind { character: CharacterId(1), binding: Some(BindingDoc::Nearest) }));
     app.update();
     assert_eq!(bind(&app), morphed, "still morphed after the rebind");
     request(&mut app, HistoryRequest::Undo);
@@ -469,7 +469,7 @@ fn a_glb_of_two_characters_plays_its_clips_in_the_ecs_as_the_rig_samples_them() 
 
     let clip = app.world().get::<NodeClipPlayer>(e).unwrap().clips[0].clone();
     let playing = PlaybackDoc { clip: Some(clip.name.clone()), time: 0.5, ..PlaybackDoc::default() };
-    edit(&mut app, Edit::Playback(edit::Playback { character: waver, state: playing.clone() }));
+    edit(&mut app, Edit::from(kinds::Playback { character: waver, state: playing.clone() }));
     let expected = clip.sample(skeleton, 0.5).joint_to_world(skeleton, Mat4::IDENTITY);
     let posed = matrices(&app);
     posed.iter().zip(&expected).for_each(|(a, b)| crate::common::assert_mat_close(*a, *b, 1e-6));
@@ -527,7 +527,7 @@ fn the_humanoid_map_is_kept_and_follows_assigned_bones() {
     let elsewhere = (0..asset.skeleton.len()).find(|&j| j != hand).unwrap();
     let key = marionette::formats::scene::pose_key(&asset.skeleton, elsewhere);
     let bones = [(HumanBone::LeftHand, key)].into_iter().collect();
-    edit(&mut app, Edit::Humanoid(edit::Humanoid { character: CharacterId(1), bones }));
+    edit(&mut app, Edit::from(kinds::Humanoid { character: CharacterId(1), bones }));
     app.update();
     assert_eq!(map(&app)[&HumanBone::LeftHand], elsewhere, "an assigned bone is in the map");
     request(&mut app, HistoryRequest::Undo);
@@ -559,7 +559,7 @@ fn an_edit_with_symmetry_turns_the_twin_in_the_same_undo_step() {
         let (now, at_rest) = (model(pose), model(&skeleton.initial_pose()));
         now.iter().zip(&at_rest).map(|(n, r)| *n * r.inverse()).collect::<Vec<_>>()
     };
-    let arm = Edit::Pose(edit::Pose {
+    let arm = Edit::from(kinds::Pose {
         character: CharacterId(1),
         joints: vec![
             (left, JointRotation::euler_xyz(0.3, -0.4, -0.7)),

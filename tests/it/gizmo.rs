@@ -282,7 +282,7 @@ mod moving {
             let placement = drag.placement(Snap::default());
             crate::edits::edit(
                 &mut app,
-                Edit::Place(marionette::editor::edits::edit::Place { character: CharacterId(1), placement }),
+                Edit::from(marionette::editor::edits::kinds::Place { character: CharacterId(1), placement }),
             );
         }
         let moved = app.world().get::<Placement>(entity).unwrap().translation - s.translation;

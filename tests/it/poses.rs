@@ -2,8 +2,7 @@
 //! kept pose reapplied gives the same matrices.
 
 use glam::{Mat4, Quat, Vec3};
-use marionette::editor::edits::commands::Edit;
-use marionette::editor::edits::edit;
+use marionette::editor::edits::kinds;
 use marionette::editor::edits::pose_library::{apply_named_pose, library_pose, pose_by_name};
 use marionette::formats::scene::CharacterId;
 use marionette::rig::mirror::{mirrored_name, mirrored_pose, mirrored_rotation};
@@ -59,13 +58,14 @@ fn paste_mirrored_puts_the_other_arm_in_the_mirror_image() {
     let left =
         [skeleton.find("l_shoulder").unwrap(), skeleton.find("l_elbow").unwrap(), skeleton.find("l_wrist").unwrap()];
     let copied = pose_by_name(skeleton, &posed, &left);
-    let Some(Edit::Pose(edit::Pose { joints, .. })) = apply_named_pose(
+    let Some(kinds::Pose { joints, .. }) = apply_named_pose(
         CharacterId(1),
         (skeleton, &Default::default(), &skeleton.initial_pose()),
         &copied,
         None,
         true,
-    ) else {
+    )
+    .and_then(|e| e.get::<kinds::Pose>().cloned()) else {
         panic!()
     };
     let mut mirrored = rest.clone();
@@ -98,13 +98,14 @@ fn a_kept_pose_reapplied_gives_the_same_matrices() {
     assert_eq!(kept.thumbnail.len(), skeleton.len() - 1, "a segment per bone");
     assert!(kept.thumbnail.iter().flatten().all(|v| (-1e-6..=1.0 + 1e-6).contains(v)));
     let named: Vec<_> = kept.joints.into_iter().collect();
-    let Some(Edit::Pose(edit::Pose { joints, .. })) = apply_named_pose(
+    let Some(kinds::Pose { joints, .. }) = apply_named_pose(
         CharacterId(1),
         (skeleton, &Default::default(), &skeleton.initial_pose()),
         &named,
         None,
         false,
-    ) else {
+    )
+    .and_then(|e| e.get::<kinds::Pose>().cloned()) else {
         panic!()
     };
     let mut again = skeleton.initial_pose();

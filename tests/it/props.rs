@@ -4,8 +4,8 @@
 
 use bevy::prelude::*;
 use marionette::editor::edits::commands::Edit;
-use marionette::editor::edits::edit;
 use marionette::editor::edits::history::HistoryRequest;
+use marionette::editor::edits::kinds;
 use marionette::editor::scene_doc::attach::Attached;
 use marionette::editor::scene_doc::document::PendingScene;
 use marionette::formats::scene::{AttachDoc, CharacterDoc, CharacterId, PlacementDoc, SceneDoc, SourceDoc};
@@ -59,7 +59,7 @@ fn placement(app: &App, id: u64) -> PlacementDoc {
 fn hold_in_right_hand(app: &App) -> Edit {
     let here = placement(app, 2);
     let attached = AttachDoc::holding(CharacterId(1), "r_hand".into(), joint_world(app, "r_hand"), &here);
-    Edit::Attach(edit::Attach { character: CharacterId(2), attached: Some(attached), placement: here })
+    Edit::from(kinds::Attach { character: CharacterId(2), attached: Some(attached), placement: here })
 }
 
 #[test]
@@ -82,13 +82,13 @@ fn a_held_prop_follows_its_joint_in_the_ecs_and_in_the_exported_mesh() {
     let mut app = scene_app();
     open(&mut app, puppet_and_prop(&obj));
     let attach = hold_in_right_hand(&app);
-    let Edit::Attach(edit::Attach { attached: Some(held), .. }) = &attach else { unreachable!() };
+    let Some(kinds::Attach { attached: Some(held), .. }) = attach.get::<kinds::Attach>() else { unreachable!() };
     let offset = held.offset;
     edit(&mut app, attach.clone());
     let (wrist, elbow) = (joint(&app, 1, "r_wrist"), joint(&app, 1, "r_elbow"));
     let bend =
         vec![(elbow, JointRotation::euler_xyz(0.2, -0.9, 0.4)), (wrist, JointRotation::euler_xyz(0.5, 0.3, -0.7))];
-    edit(&mut app, Edit::Pose(edit::Pose { character: CharacterId(1), joints: bend }));
+    edit(&mut app, Edit::from(kinds::Pose { character: CharacterId(1), joints: bend }));
     app.update();
 
     // The ECS: the prop stands at the hand's transform times its attach-time offset.
@@ -127,17 +127,17 @@ fn detach_keeps_the_prop_where_it_stands_and_every_prop_edit_undoes_exactly() {
     edit(&mut app, attach);
     edit(
         &mut app,
-        Edit::Pose(edit::Pose {
+        Edit::from(kinds::Pose {
             character: CharacterId(1),
             joints: vec![(elbow, JointRotation::euler_xyz(0.0, -1.1, 0.3))],
         }),
     );
     app.update();
     let held_at = placement(&app, 2);
-    edit(&mut app, Edit::Attach(edit::Attach { character: CharacterId(2), attached: None, placement: held_at }));
+    edit(&mut app, Edit::from(kinds::Attach { character: CharacterId(2), attached: None, placement: held_at }));
     edit(
         &mut app,
-        Edit::Pose(edit::Pose {
+        Edit::from(kinds::Pose {
             character: CharacterId(1),
             joints: vec![(elbow, JointRotation::euler_xyz(0.0, 0.5, 0.0))],
         }),
@@ -145,10 +145,10 @@ fn detach_keeps_the_prop_where_it_stands_and_every_prop_edit_undoes_exactly() {
     app.update();
     assert_eq!(placement(&app, 2), held_at, "let go, it stays where it was when detached");
     assert!(app.world().get::<Attached>(entity(&app, 2)).is_none());
-    edit(&mut app, Edit::Rename(edit::Rename { character: CharacterId(2), name: "sword".into() }));
+    edit(&mut app, Edit::from(kinds::Rename { character: CharacterId(2), name: "sword".into() }));
     edit(
         &mut app,
-        Edit::Place(edit::Place { character: CharacterId(2), placement: PlacementDoc::new(Vec3::X, 1.0, 2.0) }),
+        Edit::from(kinds::Place { character: CharacterId(2), placement: PlacementDoc::new(Vec3::X, 1.0, 2.0) }),
     );
     let end = state(&mut app);
 
@@ -175,7 +175,7 @@ fn a_held_prop_round_trips_through_a_scene_file() {
     let wrist = joint(&app, 1, "r_wrist");
     edit(
         &mut app,
-        Edit::Pose(edit::Pose {
+        Edit::from(kinds::Pose {
             character: CharacterId(1),
             joints: vec![(wrist, JointRotation::euler_xyz(0.9, 0.0, 0.0))],
         }),

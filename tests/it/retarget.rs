@@ -410,7 +410,7 @@ mod editor {
         let baked = AnimDoc { keys: Some(oracle.clone()), retarget: None, ..playing.state.clone() };
         edit(
             &mut app,
-            Edit::Clip(marionette::editor::edits::edit::Clip { character: CharacterId(2), anim: Some(baked.clone()) }),
+            Edit::from(marionette::editor::edits::kinds::Clip { character: CharacterId(2), anim: Some(baked.clone()) }),
         );
         let now = player(&app, 2);
         assert!(
@@ -427,7 +427,7 @@ mod editor {
         assert!(*player(&app, 2).clip == oracle);
 
         let bones = [(HumanBone::LeftHand, "l_hand".to_string())].into_iter().collect();
-        edit(&mut app, Edit::Humanoid(marionette::editor::edits::edit::Humanoid { character: CharacterId(2), bones }));
+        edit(&mut app, Edit::from(marionette::editor::edits::kinds::Humanoid { character: CharacterId(2), bones }));
         app.update();
         let (mapped, _) = state(&mut app);
         assert_eq!(mapped.characters[1].humanoid[&HumanBone::LeftHand], "l_hand");
@@ -447,7 +447,7 @@ mod editor {
         source_anim.keys = Some(keys);
         edit(
             &mut app,
-            Edit::Clip(marionette::editor::edits::edit::Clip { character: CharacterId(1), anim: Some(source_anim) }),
+            Edit::from(marionette::editor::edits::kinds::Clip { character: CharacterId(1), anim: Some(source_anim) }),
         );
         app.update();
         let (changed, _) = state(&mut app);

@@ -5,7 +5,7 @@
 //! answers; autosave writes a recovery file that reads back as
 //! the scene in memory.
 
-use marionette::editor::edits::edit;
+use marionette::editor::edits::kinds;
 use std::time::Duration;
 
 use bevy::prelude::*;
@@ -46,7 +46,7 @@ fn unsaved(app: &App) -> bool {
 fn bend_elbow(app: &mut App, angle: f32) {
     let elbow = joint(app, 1, "l_elbow");
     let rotation = JointRotation::Euler(glam::Vec3::new(0.0, angle, 0.0), marionette::rig::EulerOrder::Xyz);
-    edit(app, Edit::Pose(edit::Pose { character: CharacterId(1), joints: vec![(elbow, rotation)] }));
+    edit(app, Edit::from(kinds::Pose { character: CharacterId(1), joints: vec![(elbow, rotation)] }));
     app.update();
 }
 

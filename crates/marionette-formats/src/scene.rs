@@ -180,6 +180,8 @@ pub struct ViewDoc {
     /// Show the selected joint's weights as a heat map.
     pub heat_of_selected: bool,
     pub tint: [f32; 3],
+    /// How opaque the skin is drawn (1: solid; less: a ghost to draw over a reference).
+    pub opacity: f32,
 }
 
 impl Default for ViewDoc {
@@ -190,6 +192,7 @@ impl Default for ViewDoc {
             weight_colors: false,
             heat_of_selected: false,
             tint: [0.8, 0.62, 0.45],
+            opacity: 1.0,
         }
     }
 }

@@ -41,6 +41,40 @@ pub fn apply_hand(
     curl: [f32; 5],
     spread: f32,
 ) -> Option<bool> {
+    apply_hand_shape(skeleton, map, pose, left, HandShape::of_preset(curl, spread))
+}
+
+/// A hand's shape: each finger's curl (radians per phalanx, thumb first) and its fan away
+/// from the middle finger (radians, toward the thumb's side positive; the thumb's and the
+/// middle's turn their proximal phalanx the same way).
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct HandShape {
+    pub curl: [f32; 5],
+    pub fan: [f32; 5],
+}
+
+impl HandShape {
+    /// A preset's shape: `spread` between neighbouring fingers, fanned from the middle.
+    pub fn of_preset(curl: [f32; 5], spread: f32) -> HandShape {
+        let fan = std::array::from_fn(|f| if f == 0 { 0.0 } else { spread * (2.0 - f as f32) });
+        HandShape { curl, fan }
+    }
+
+    /// The shape of the preset of that name.
+    pub fn preset(name: &str) -> Option<HandShape> {
+        preset(name).map(|(curl, spread)| HandShape::of_preset(curl, spread))
+    }
+}
+
+/// Puts `shape` on the `left` (else right) hand, as [`apply_hand`] does a preset.
+pub fn apply_hand_shape(
+    skeleton: &Skeleton,
+    map: &HumanoidMap,
+    pose: &mut [JointRotation],
+    left: bool,
+    shape: HandShape,
+) -> Option<bool> {
+    let HandShape { curl, fan } = shape;
     let hand = *map.get(if left { &HumanBone::LeftHand } else { &HumanBone::RightHand })?;
     let phalanx = |f: usize, p: usize| map.get(&HumanBone::finger(left, f, p)).copied();
     (0..5).any(|f| phalanx(f, 0).is_some()).then_some(())?;
@@ -61,9 +95,9 @@ pub fn apply_hand(
                 if incoming.length_squared() > 1e-12 { incoming.normalize() } else { now.normalize_or(Vec3::X) };
             let axis = incoming.cross(palm).normalize_or(Vec3::Z);
             let mut wanted = Quat::from_axis_angle(axis, bend) * incoming;
-            if p == 0 && f > 0 && spread != 0.0 {
-                let fan = spread * (f as f32 - 2.0) * if left { 1.0 } else { -1.0 };
-                wanted = Quat::from_axis_angle(palm, fan) * wanted;
+            if p == 0 && fan[f] != 0.0 {
+                let turn = -fan[f] * if left { 1.0 } else { -1.0 };
+                wanted = Quat::from_axis_angle(palm, turn) * wanted;
             }
             if now.length_squared() < 1e-12 {
                 continue;

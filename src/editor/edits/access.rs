@@ -3,7 +3,6 @@
 
 use bevy::prelude::*;
 
-use crate::editor::edits::edit::{self, Edit};
 use crate::editor::scene_doc::document::CharacterIndex;
 use crate::formats::scene::CharacterId;
 use crate::rig::{DofLimits, JointRotation};
@@ -42,21 +41,17 @@ pub fn joint_state(world: &World, character: &Character, j: usize) -> Result<(Jo
     Ok((pose, limits))
 }
 
-/// A pose edit that sets every joint of a character to its rotation now.
-pub fn current_pose(world: &World, id: CharacterId) -> Result<Edit, String> {
-    let found = character_of(world, id)?;
-    let joints =
-        (0..found.joints.len()).map(|j| Ok((j, joint_state(world, &found, j)?.0))).collect::<Result<_, String>>()?;
-    Ok(edit::Pose { character: id, joints }.into())
-}
-
 /// The rotations that mirror a pose edit's joints onto their twins across the body (see
 /// `rig::mirror::mirrored_joint`), each worked out with the edit's own joints turned; none
 /// for joints on the middle, twins the edit sets itself, or a character without hips and
 /// legs in its humanoid map.
-pub fn twins_of(world: &World, edit: &edit::Pose) -> Result<Vec<(usize, JointRotation)>, String> {
-    let found = character_of(world, edit.character)?;
-    let entity = entity_of(world, edit.character)?;
+pub fn twins_of(
+    world: &World,
+    character: CharacterId,
+    joints: &[(usize, JointRotation)],
+) -> Result<Vec<(usize, JointRotation)>, String> {
+    let found = character_of(world, character)?;
+    let entity = entity_of(world, character)?;
     let Some(map) = world.get::<crate::editor::scene_doc::document::HumanoidMapOf>(entity) else {
         return Ok(Vec::new());
     };
@@ -64,12 +59,12 @@ pub fn twins_of(world: &World, edit: &edit::Pose) -> Result<Vec<(usize, JointRot
     let Some(frame) = crate::rig::body_poses::facing_frame(skeleton, &map.0) else { return Ok(Vec::new()) };
     let mut pose =
         (0..found.joints.len()).map(|j| Ok(joint_state(world, &found, j)?.0)).collect::<Result<Vec<_>, String>>()?;
-    for &(j, rotation) in &edit.joints {
+    for &(j, rotation) in joints {
         let (_, limits) = joint_state(world, &found, j)?;
         pose[j] = rotation.clamped(&limits);
     }
     let twin = crate::rig::mirror::counterparts(skeleton, &map.0);
-    let set: Vec<usize> = edit.joints.iter().map(|&(j, _)| j).collect();
+    let set: Vec<usize> = joints.iter().map(|&(j, _)| j).collect();
     let mut mirrored: Vec<usize> = set.iter().copied().filter(|&j| !set.contains(&twin[j])).collect();
     // Parents' twins first: each twin turns under its parent as already mirrored.
     mirrored.sort_by_key(|&j| twin[j]);

@@ -6,9 +6,9 @@
 
 use bevy::prelude::*;
 
-use crate::editor::edits::edit;
 pub use crate::editor::edits::edit::{Edit, EditQueue, GestureHold};
 use crate::editor::edits::history::History;
+use crate::editor::edits::kinds;
 use crate::editor::scene_doc::document::{CharacterIndex, NextCharacterId};
 use crate::editor::state::Messages;
 
@@ -98,16 +98,16 @@ fn apply_reporting(world: &mut World, edit: Edit) -> Vec<Edit> {
 /// Applies `edit` to the live scene. Returns what undoes it, to be applied last first
 /// (empty when it changed nothing), or why it could not be applied.
 pub fn apply(world: &mut World, mut edit: Edit) -> Result<Vec<Edit>, String> {
-    if let Edit::Add(edit::Add(doc)) = &mut edit
+    if let Some(kinds::Add(doc)) = edit.get_mut::<kinds::Add>()
         && doc.id.is_none()
     {
         doc.id = Some(world.resource_mut::<NextCharacterId>().take());
     }
-    if let Edit::Pose(pose) = &mut edit
-        && world.get_resource::<crate::editor::state::Symmetry>().is_some_and(|s| s.0)
+    if world.get_resource::<crate::editor::state::Symmetry>().is_some_and(|s| s.0)
+        && let Some(pose) = edit.get::<kinds::Pose>()
     {
-        let twins = crate::editor::edits::access::twins_of(world, pose)?;
-        pose.joints.extend(twins);
+        let twins = crate::editor::edits::access::twins_of(world, pose.character, &pose.joints)?;
+        edit.get_mut::<kinds::Pose>().expect("a pose edit").joints.extend(twins);
     }
     let undo = edit.undo(world)?;
     if !undo.is_empty() {

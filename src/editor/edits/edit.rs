@@ -1,20 +1,17 @@
 //! Edits: each user action on the scene as a command that knows how to make itself and
-//! what undoes it ([`Command`]; the kinds are in `character_edits` and `scene_edits`), the
-//! [`Edit`] that holds any of them, the queue they wait in for the next `Animate`, and
-//! what holds a gesture open. Shared by the panels, the viewport's tools, the pose library
-//! and the history; applied by `commands`.
+//! what undoes it ([`Command`]; the kinds are in `kinds`), the [`Edit`] that holds any of
+//! them, the queue they wait in for the next `Animate`, and what holds a gesture open.
+//! Shared by the panels, the viewport's tools, the pose library and the history; applied
+//! by `commands`.
+
+use std::any::Any;
 
 use bevy::prelude::*;
 
 use crate::formats::scene::CharacterId;
 
-pub use crate::editor::edits::character_edits::{
-    Add, Attach, Clip, Humanoid, Morph, Place, Playback, Pose, Rebind, Remove, Rename, SkinOnGpu, Skinning, Smpl, View,
-};
-pub use crate::editor::edits::scene_edits::{Bookmark, Library, Shot, Stage};
-
 /// A change to the scene that makes itself and tells what undoes it.
-pub trait Command: Into<Edit> {
+pub trait Command: Any + std::fmt::Debug + Send + Sync {
     /// The character it edits (none for the stage and the libraries).
     fn character(&self) -> Option<CharacterId> {
         None
@@ -30,14 +27,11 @@ pub trait Command: Into<Edit> {
     fn undo(&self, world: &mut World) -> Result<Vec<Edit>, String>;
 
     /// Makes the change.
-    fn write(self, world: &mut World) -> Result<(), String>;
+    fn write(self: Box<Self>, world: &mut World) -> Result<(), String>;
 }
 
 /// A command that sets one thing: the same command holding what is there now undoes it.
-pub trait Setter: Sized + PartialEq + Into<Edit> {
-    /// Setting it poses the joints (from a clip): undo gives them back their rotations.
-    const POSES: bool = false;
-
+pub trait Setter: Sized + Clone + PartialEq + std::fmt::Debug + Send + Sync + 'static {
     fn character(&self) -> Option<CharacterId>;
 
     /// The named entry it sets, for edits of a library kept by name.
@@ -49,6 +43,12 @@ pub trait Setter: Sized + PartialEq + Into<Edit> {
     fn read(&self, world: &World) -> Result<Self, String>;
 
     fn set(self, world: &mut World) -> Result<(), String>;
+
+    /// What else undo must give back, applied after the value (a clip setting the joints
+    /// gives back their rotations).
+    fn also_undo(&self, _world: &World) -> Result<Vec<Edit>, String> {
+        Ok(Vec::new())
+    }
 }
 
 impl<S: Setter> Command for S {
@@ -65,104 +65,101 @@ impl<S: Setter> Command for S {
         if now == *self {
             return Ok(Vec::new());
         }
-        let mut undo = Vec::with_capacity(2);
-        if let (true, Some(id)) = (S::POSES, Setter::character(self)) {
-            undo.push(crate::editor::edits::access::current_pose(world, id)?);
-        }
-        undo.push(now.into());
+        let mut undo = self.also_undo(world)?;
+        undo.push(Edit::from(now));
         Ok(undo)
     }
 
-    fn write(self, world: &mut World) -> Result<(), String> {
+    fn write(self: Box<Self>, world: &mut World) -> Result<(), String> {
         self.set(world)
     }
 }
 
-/// Declares [`Edit`], one variant per command kind, and hands each call to the kind.
-macro_rules! edits {
-    ($($(#[$doc:meta])* $kind:ident,)*) => {
-        /// One user action on the scene: one of the commands.
-        #[derive(Clone, Debug, PartialEq)]
-        pub enum Edit {
-            $($(#[$doc])* $kind($kind),)*
-        }
-
-        $(impl From<$kind> for Edit {
-            fn from(command: $kind) -> Edit {
-                Edit::$kind(command)
-            }
-        })*
-
-        impl Edit {
-            /// The character it edits (none for the stage and the libraries).
-            pub fn character(&self) -> Option<CharacterId> {
-                match self { $(Edit::$kind(c) => Command::character(c),)* }
-            }
-
-            fn entry(&self) -> Option<&str> {
-                match self { $(Edit::$kind(c) => Command::entry(c),)* }
-            }
-
-            /// What undoes it in the scene as it is now (see [`Command::undo`]).
-            pub fn undo(&self, world: &mut World) -> Result<Vec<Edit>, String> {
-                match self { $(Edit::$kind(c) => c.undo(world),)* }
-            }
-
-            /// Makes the change.
-            pub fn write(self, world: &mut World) -> Result<(), String> {
-                match self { $(Edit::$kind(c) => c.write(world),)* }
-            }
-        }
-    };
+/// A command as a value: cloned, compared, told apart by its kind.
+trait Held: Command {
+    fn clone_edit(&self) -> Edit;
+    fn same_as(&self, other: &dyn Held) -> bool;
+    fn as_any(&self) -> &dyn Any;
+    fn as_any_mut(&mut self) -> &mut dyn Any;
 }
 
-edits! {
-    /// Turn joints (by index) to these rotations, clamped to their limits.
-    Pose,
-    /// Move, turn or scale a character.
-    Place,
-    /// Display mode, visibility, weight colours, heat map, tint.
-    View,
-    Rename,
-    /// β, clips, time, playback and blend of an SMPL body.
-    Smpl,
-    /// Weights from the file or computed from the bones.
-    Rebind,
-    /// Linear blend or dual quaternion skinning.
-    Skinning,
-    /// Skinning by the GPU compute shader or on the CPU.
-    SkinOnGpu,
-    /// A keyframed clip on a character, its time and playback (none: no clip).
-    Clip,
-    /// Clip, time, playback and blend of a source's own clips (glTF animations).
-    Playback,
-    /// Morph target weights.
-    Morph,
-    /// A pose kept in the scene's library by name (none: taken out).
-    Library,
-    /// Held by a joint of another character, or let go.
-    Attach,
-    /// Standard bones assigned by hand.
-    Humanoid,
-    /// Floor, lights, background, axes.
-    Stage,
-    /// The picture `render` takes.
-    Shot,
-    /// A camera view kept by name (none: taken out).
-    Bookmark,
-    /// A character from its document (a fresh id is given when it has none).
-    Add,
-    Remove,
+impl<C: Command + Clone + PartialEq> Held for C {
+    fn clone_edit(&self) -> Edit {
+        Edit(Box::new(self.clone()))
+    }
+
+    fn same_as(&self, other: &dyn Held) -> bool {
+        other.as_any().downcast_ref::<C>() == Some(self)
+    }
+
+    fn as_any(&self) -> &dyn Any {
+        self
+    }
+
+    fn as_any_mut(&mut self) -> &mut dyn Any {
+        self
+    }
+}
+
+/// One user action on the scene: any command.
+pub struct Edit(Box<dyn Held>);
+
+impl<C: Command + Clone + PartialEq> From<C> for Edit {
+    fn from(command: C) -> Edit {
+        Edit(Box::new(command))
+    }
+}
+
+impl Clone for Edit {
+    fn clone(&self) -> Edit {
+        self.0.clone_edit()
+    }
+}
+
+impl PartialEq for Edit {
+    fn eq(&self, other: &Edit) -> bool {
+        self.0.same_as(&*other.0)
+    }
+}
+
+impl std::fmt::Debug for Edit {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        self.0.fmt(f)
+    }
 }
 
 impl Edit {
+    /// The character it edits (none for the stage and the libraries).
+    pub fn character(&self) -> Option<CharacterId> {
+        self.0.character()
+    }
+
+    /// What undoes it in the scene as it is now (see [`Command::undo`]).
+    pub fn undo(&self, world: &mut World) -> Result<Vec<Edit>, String> {
+        self.0.undo(world)
+    }
+
+    /// Makes the change.
+    pub fn write(self, world: &mut World) -> Result<(), String> {
+        self.0.write(world)
+    }
+
+    /// The command, when it is of kind `C`.
+    pub fn get<C: Command>(&self) -> Option<&C> {
+        self.0.as_any().downcast_ref()
+    }
+
+    pub fn get_mut<C: Command>(&mut self) -> Option<&mut C> {
+        self.0.as_any_mut().downcast_mut()
+    }
+
     /// Whether `self` and `other` set the same thing (within a gesture, only the first
     /// value of each thing is kept): the same kind of edit of the same character, or the
     /// same entry of a library. Poses, adds and removes are judged by the history itself.
     pub fn same_slot(&self, other: &Edit) -> bool {
-        std::mem::discriminant(self) == std::mem::discriminant(other)
+        self.0.as_any().type_id() == other.0.as_any().type_id()
             && self.character() == other.character()
-            && self.entry() == other.entry()
+            && self.0.entry() == other.0.entry()
     }
 }
 

@@ -4,7 +4,8 @@
 
 use bevy::prelude::*;
 
-use crate::editor::edits::edit::{self, Edit};
+use crate::editor::edits::edit::Edit;
+use crate::editor::edits::kinds;
 
 /// The undo and redo steps, and what undoes the gesture under way.
 #[derive(Resource, Default, Debug)]
@@ -69,29 +70,22 @@ impl History {
     /// is one value to return to.
     pub fn record(&mut self, inverse: Edit) {
         let recent = &self.gesture[self.barrier..];
-        match inverse {
-            Edit::Add(edit::Add(_)) | Edit::Remove(edit::Remove(_)) => {
-                self.gesture.push(inverse);
-                self.barrier = self.gesture.len();
+        if inverse.get::<kinds::Add>().is_some() || inverse.get::<kinds::Remove>().is_some() {
+            self.gesture.push(inverse);
+            self.barrier = self.gesture.len();
+        } else if let Some(kinds::Pose { character, joints }) = inverse.get::<kinds::Pose>() {
+            let earlier = |j: usize| {
+                recent
+                    .iter()
+                    .filter_map(|e| e.get::<kinds::Pose>())
+                    .any(|e| e.character == *character && e.joints.iter().any(|&(k, _)| k == j))
+            };
+            let joints: Vec<_> = joints.iter().copied().filter(|&(j, _)| !earlier(j)).collect();
+            if !joints.is_empty() {
+                self.gesture.push(kinds::Pose { character: *character, joints }.into());
             }
-            Edit::Pose(edit::Pose { character, mut joints }) => {
-                joints.retain(|&(j, _)| {
-                    !recent.iter().any(|e| match e {
-                        Edit::Pose(edit::Pose { character: c, joints: earlier }) => {
-                            *c == character && earlier.iter().any(|&(k, _)| k == j)
-                        }
-                        _ => false,
-                    })
-                });
-                if !joints.is_empty() {
-                    self.gesture.push(edit::Pose { character, joints }.into());
-                }
-            }
-            other => {
-                if !recent.iter().any(|e| e.same_slot(&other)) {
-                    self.gesture.push(other);
-                }
-            }
+        } else if !recent.iter().any(|e| e.same_slot(&inverse)) {
+            self.gesture.push(inverse);
         }
     }
 

@@ -2,9 +2,8 @@
 //! their inverses, the undo history, and the scene's pose library.
 
 mod access;
-pub mod character_edits;
 pub mod commands;
 pub mod edit;
 pub mod history;
+pub mod kinds;
 pub mod pose_library;
-pub mod scene_edits;

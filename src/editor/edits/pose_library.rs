@@ -3,7 +3,7 @@
 //! character with the same joint names, or through the humanoid maps onto any other, as
 //! it was or mirrored left to right.
 
-use crate::editor::edits::edit;
+use crate::editor::edits::kinds;
 use bevy::prelude::*;
 
 use crate::formats::scene::{CharacterId, LibraryPoseDoc, pose_key};
@@ -52,7 +52,7 @@ pub fn apply_named_pose(
 ) -> Option<Edit> {
     let (skeleton, map, current) = target;
     let joints = crate::document::retarget::pose_onto((skeleton, map), current, pose, source, mirrored);
-    (!joints.is_empty()).then_some(Edit::Pose(edit::Pose { character: id, joints }))
+    (!joints.is_empty()).then_some(Edit::from(kinds::Pose { character: id, joints }))
 }
 
 /// The edits that put the built-in body pose `spec` on character `id` (of `asset`, its
@@ -71,8 +71,8 @@ pub fn body_pose_edits(
     let stood = crate::document::posing::stood_on_floor(asset, &posed, placement.to_mat4());
     let joints = (0..posed.len()).filter(|&j| posed[j] != current[j]).map(|j| (j, posed[j])).collect();
     Some(vec![
-        edit::Pose { character: id, joints }.into(),
-        edit::Place { character: id, placement: crate::formats::scene::PlacementDoc::from_mat4(stood) }.into(),
+        kinds::Pose { character: id, joints }.into(),
+        kinds::Place { character: id, placement: crate::formats::scene::PlacementDoc::from_mat4(stood) }.into(),
     ])
 }
 
@@ -83,7 +83,7 @@ pub fn flip_edit(id: CharacterId, skeleton: &Skeleton, map: &HumanoidMap, curren
     let twin = crate::rig::mirror::counterparts(skeleton, map);
     let flipped = crate::rig::mirror::flipped_pose(skeleton, &twin, current, left);
     let joints = (0..flipped.len()).filter(|&j| flipped[j] != current[j]).map(|j| (j, flipped[j])).collect();
-    Some(edit::Pose { character: id, joints }.into())
+    Some(kinds::Pose { character: id, joints }.into())
 }
 
 /// A stick-figure thumbnail of each built-in body pose on this character.

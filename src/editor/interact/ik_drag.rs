@@ -3,7 +3,7 @@
 //! towards the cursor). Pinned joints (P) hold their place meanwhile. Each frame's solve is
 //! an ordinary pose `Edit`, applied in `Animate`; the whole drag is one undo step.
 
-use crate::editor::edits::edit;
+use crate::editor::edits::kinds;
 use bevy::prelude::*;
 
 use crate::editor::edits::edit::EditQueue;
@@ -138,7 +138,7 @@ fn drag_joint(
     drag.note = reports.first().map(|r| crate::document::posing::describe_ik(skeleton, r)).unwrap_or_default();
     let joints: Vec<_> = pose.into_iter().enumerate().filter(|&(j, p)| p != before[j]).collect();
     if !joints.is_empty() {
-        edits.push(edit::Pose { character: active.character, joints });
+        edits.push(kinds::Pose { character: active.character, joints });
     }
 }
 

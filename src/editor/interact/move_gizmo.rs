@@ -9,7 +9,7 @@
 //! systems find what the pointer grabs and push each frame's placement as an ordinary
 //! [`Edit::Place`].
 
-use crate::editor::edits::edit;
+use crate::editor::edits::kinds;
 use bevy::math::Ray3d;
 use bevy::prelude::*;
 
@@ -357,7 +357,7 @@ fn follow_move(
     let Some(mut active) = gizmo.active.clone() else { return };
     let typed = matches!(active.grip, MoveGrip::Typed { .. });
     if !typed && (keys.just_pressed(KeyCode::Escape) || buttons.just_pressed(MouseButton::Right)) {
-        edits.push(edit::Place { character: active.character, placement: active.start });
+        edits.push(kinds::Place { character: active.character, placement: active.start });
         (gizmo.active, gizmo.readout) = (None, None);
         return;
     }
@@ -377,7 +377,7 @@ fn follow_move(
     let snap = snap_of(&keys, stage.floor_height, view.lowest);
     let placement = active.placement(snap);
     if placement != view.placement {
-        edits.push(edit::Place { character: active.character, placement });
+        edits.push(kinds::Place { character: active.character, placement });
     }
     gizmo.readout = Some(active.describe(&view.name, snap));
     gizmo.active = Some(active);
@@ -425,7 +425,7 @@ fn type_move(
     }
     let Some(mut active) = gizmo.active.clone() else { return };
     if keys.just_pressed(KeyCode::Escape) || buttons.just_pressed(MouseButton::Right) {
-        edits.push(edit::Place { character: active.character, placement: active.start });
+        edits.push(kinds::Place { character: active.character, placement: active.start });
         finish(&mut gizmo, &mut hold);
         return;
     }
@@ -447,7 +447,7 @@ fn type_move(
         active.moved = Vec3::new(p.x - from.x, 0.0, p.z - from.z);
     }
     let placement = active.placement(Snap::default());
-    edits.push(edit::Place { character: active.character, placement });
+    edits.push(kinds::Place { character: active.character, placement });
     let name = MoveView::of_selection(&selection, &picker, &skins).map_or_else(String::new, |v| v.name);
     gizmo.readout = Some(active.describe(&name, Snap::default()));
     gizmo.active = Some(active);

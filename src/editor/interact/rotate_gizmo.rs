@@ -9,7 +9,7 @@
 //! The turning itself is [`crate::rig::turn`]; this module finds what the pointer grabs,
 //! follows it and pushes each frame's rotation as an ordinary pose [`Edit`].
 
-use crate::editor::edits::edit;
+use crate::editor::edits::kinds;
 use bevy::input::mouse::AccumulatedMouseMotion;
 use bevy::prelude::*;
 
@@ -341,7 +341,7 @@ fn follow_gizmo(
     }
     let Some(mut turn) = gizmo.turn.clone().filter(|t| !matches!(t.grip, Grip::Typed { .. })) else { return };
     if keys.just_pressed(KeyCode::Escape) || buttons.just_pressed(MouseButton::Right) {
-        edits.push(edit::Pose { character: turn.character, joints: vec![(turn.joint, turn.start)] });
+        edits.push(kinds::Pose { character: turn.character, joints: vec![(turn.joint, turn.start)] });
         gizmo.turn = None;
         gizmo.readout = None;
         return;
@@ -381,7 +381,7 @@ fn follow_gizmo(
 fn push_turn(edits: &mut EditQueue, turn: &Turn, now: &JointRotation) {
     let rotation = turn.rotation();
     if rotation != *now {
-        edits.push(edit::Pose { character: turn.character, joints: vec![(turn.joint, rotation)] });
+        edits.push(kinds::Pose { character: turn.character, joints: vec![(turn.joint, rotation)] });
     }
 }
 
@@ -435,7 +435,7 @@ fn type_rotation(
         return;
     };
     if keys.just_pressed(KeyCode::Escape) || buttons.just_pressed(MouseButton::Right) {
-        edits.push(edit::Pose { character: turn.character, joints: vec![(turn.joint, turn.start)] });
+        edits.push(kinds::Pose { character: turn.character, joints: vec![(turn.joint, turn.start)] });
         finish_typing(&mut gizmo, &mut hold);
         return;
     }

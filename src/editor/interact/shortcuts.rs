@@ -4,7 +4,7 @@
 //! F frames the selection; the numpad's views (as in Blender): 1 front, 3 right, 7 top, with
 //! Ctrl the opposite side, 9 three-quarter, 5 perspective / orthographic.
 
-use crate::editor::edits::edit;
+use crate::editor::edits::kinds;
 use bevy::prelude::*;
 
 use crate::editor::edits::edit::EditQueue;
@@ -57,10 +57,10 @@ pub fn scene_shortcuts(
         let pose: Vec<_> =
             character.joints.iter().map(|&e| scene.poses.get(e).map_or(Default::default(), |p| p.0)).collect();
         let anim = crate::scene::keyframes::keyed(c.player, character.joints.len(), &selection.joints, &pose);
-        edits.push(edit::Clip { character: id, anim: Some(anim) });
+        edits.push(kinds::Clip { character: id, anim: Some(anim) });
     }
     if keys.just_pressed(KeyCode::KeyA) {
-        edits.push(edit::Stage(crate::formats::scene::StageDoc { axes: !scene.stage.axes, ..scene.stage.0.clone() }));
+        edits.push(kinds::Stage(crate::formats::scene::StageDoc { axes: !scene.stage.axes, ..scene.stage.0.clone() }));
     }
     if keys.just_pressed(KeyCode::KeyS) {
         // The selected character, or every character when none is selected.
@@ -68,7 +68,7 @@ pub fn scene_shortcuts(
             let (sc, view) = (c.scene, c.view);
             if selection.character.is_none_or(|id| id == sc.id) {
                 let view = ViewDoc { display: view.display.next(), ..view.0.clone() };
-                edits.push(edit::View { character: sc.id, view });
+                edits.push(kinds::View { character: sc.id, view });
             }
         }
     }

@@ -47,6 +47,7 @@ impl Plugin for ScenePlugin {
             .init_resource::<FramingView>()
             .init_resource::<crate::editor::scene_doc::arrange::ArrangeWhenSkinned>()
             .init_resource::<crate::editor::state::PoseLibrary>()
+            .init_resource::<GhostMaterials>()
             .add_plugins((crate::scene::PlaybackPlugin, crate::editor::edits::commands::CommandsPlugin))
             .add_systems(
                 PostUpdate,
@@ -92,7 +93,7 @@ impl Plugin for ViewPlugin {
                 (
                     attach_skin_material,
                     store_skin_attributes,
-                    show_weights_in_plain_material,
+                    choose_skin_material,
                     apply_display_mode,
                     apply_stage_settings,
                     frame_when_skinned,
@@ -444,23 +445,56 @@ fn store_skin_attributes(
     }
 }
 
-/// Draws skins in the shared material while they show weights or heat, else in their own
-/// (reads `CharacterView`, `HeatJoint`; writes `MeshMaterial3d`).
-fn show_weights_in_plain_material(
+/// Draws skins in the shared material while they show weights or heat, else in their own;
+/// a ghost (opacity below 1) in a see-through copy of that (reads `CharacterView`,
+/// `HeatJoint`; writes `MeshMaterial3d`, `GhostMaterials`).
+fn choose_skin_material(
     characters: Query<(&Character, &CharacterView, &HeatJoint), Or<(Changed<CharacterView>, Changed<HeatJoint>)>>,
     material: Res<SkinMaterial>,
+    mut ghosts: ResMut<GhostMaterials>,
+    mut materials: ResMut<Assets<SkinMaterialAsset>>,
     mut skins: Query<(&OwnMaterial, &mut MeshMaterial3d<SkinMaterialAsset>)>,
 ) {
     for (character, view, heat) in &characters {
         let plain = view.weight_colors || heat.0.is_some();
         for part in &character.skins {
             if let Ok((own, mut drawn)) = skins.get_mut(part.entity) {
-                let wanted = if plain { &material.0 } else { &own.0 };
-                if drawn.0 != *wanted {
-                    drawn.0 = wanted.clone();
+                let solid = if plain { &material.0 } else { &own.0 };
+                let wanted = match view.opacity < 1.0 {
+                    true => ghosts.of(solid, view.opacity, &mut materials),
+                    false => solid.clone(),
+                };
+                if drawn.0 != wanted {
+                    drawn.0 = wanted;
                 }
             }
         }
+    }
+}
+
+/// See-through copies of skin materials, by material and opacity (in hundredths).
+#[derive(Resource, Default)]
+pub struct GhostMaterials(std::collections::HashMap<(AssetId<SkinMaterialAsset>, u8), Handle<SkinMaterialAsset>>);
+
+impl GhostMaterials {
+    /// `solid` drawn at `opacity` (alpha blended, casting no shadow of its own).
+    fn of(
+        &mut self,
+        solid: &Handle<SkinMaterialAsset>,
+        opacity: f32,
+        materials: &mut Assets<SkinMaterialAsset>,
+    ) -> Handle<SkinMaterialAsset> {
+        let key = (solid.id(), (opacity.clamp(0.0, 1.0) * 100.0).round() as u8);
+        if let Some(ghost) = self.0.get(&key) {
+            return ghost.clone();
+        }
+        let Some(mut ghost) = materials.get(solid).cloned() else { return solid.clone() };
+        let alpha = ghost.base.base_color.alpha() * f32::from(key.1) / 100.0;
+        ghost.base.base_color.set_alpha(alpha);
+        ghost.base.alpha_mode = AlphaMode::Blend;
+        let handle = materials.add(ghost);
+        self.0.insert(key, handle.clone());
+        handle
     }
 }
 

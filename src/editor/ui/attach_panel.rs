@@ -1,7 +1,7 @@
 //! Holding a prop in a joint: attach the selected character to a joint of another one, or
 //! let it go where it stands.
 
-use crate::editor::edits::edit;
+use crate::editor::edits::kinds;
 use bevy::prelude::*;
 use bevy_egui::egui;
 
@@ -27,7 +27,7 @@ pub fn attach_rows(ui: &mut egui::Ui, panels: &Panels, entity: Entity, id: Chara
         ui.horizontal(|ui| {
             ui.label(format!("Held by {name}, joint {}", attached.joint));
             if ui.button("Detach").on_hover_text("let go: it stays where it is").clicked() {
-                edit = Some(Edit::Attach(edit::Attach { character: id, attached: None, placement: c.placement.0 }));
+                edit = Some(Edit::from(kinds::Attach { character: id, attached: None, placement: c.placement.0 }));
             }
         });
         return edit;
@@ -67,5 +67,5 @@ pub fn attach_rows(ui: &mut egui::Ui, panels: &Panels, entity: Entity, id: Chara
     let key = pose_key(skeleton, choice.joint);
     let joint_world = holding_joint_world((holder.character, holder.placement), &key, &panels.joint_matrices)?;
     let attached = AttachDoc::holding(holder.scene.id, key, joint_world, &c.placement.0);
-    Some(Edit::Attach(edit::Attach { character: id, attached: Some(attached), placement: c.placement.0 }))
+    Some(Edit::from(kinds::Attach { character: id, attached: Some(attached), placement: c.placement.0 }))
 }

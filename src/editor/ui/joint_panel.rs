@@ -1,7 +1,7 @@
 //! The joint panel: one slider per DOF of the selected joints within their limits, resets,
 //! and the joint tree.
 
-use crate::editor::edits::edit;
+use crate::editor::edits::kinds;
 use bevy_egui::egui;
 
 use super::{InspectorState, Panels};
@@ -27,17 +27,17 @@ pub fn joint_panel(ui: &mut egui::Ui, state: &mut InspectorState, panels: &mut P
     ui.horizontal(|ui| {
         if ui.button("Reset the whole pose").on_hover_text("to the pose the file gives").clicked() {
             let joints = skeleton.joints().iter().enumerate().map(|(j, def)| (j, def.initial_rotation)).collect();
-            edits.push(edit::Pose { character: id, joints });
+            edits.push(kinds::Pose { character: id, joints });
         }
         if ui.button("Rest").on_hover_text("every joint unturned (within its limits)").clicked() {
             let joints = (0..skeleton.len()).map(|j| (j, JointRotation::IDENTITY)).collect();
-            edits.push(edit::Pose { character: id, joints });
+            edits.push(kinds::Pose { character: id, joints });
         }
     });
     ui.separator();
     for &j in &panels.selection.joints {
         if let Some(rotation) = joint_sliders(ui, state, panels, &character, j) {
-            edits.push(edit::Pose { character: id, joints: vec![(j, rotation)] });
+            edits.push(kinds::Pose { character: id, joints: vec![(j, rotation)] });
         }
         ui.separator();
     }

@@ -4,7 +4,7 @@
 //! chosen by rule) and its channel's extrapolation are set. Every change is an
 //! `Edit::Clip` with the new keys, so it is undone like any edit; `.anim` export.
 
-use crate::editor::edits::edit;
+use crate::editor::edits::kinds;
 use bevy_egui::egui;
 
 use super::{InspectorState, Panels};
@@ -92,7 +92,7 @@ pub fn keyframe_panel(ui: &mut egui::Ui, state: &mut InspectorState, panels: &mu
         });
     });
     if let Some(anim) = anim {
-        panels.push(edit::Clip { character: id, anim: Some(anim) });
+        panels.push(kinds::Clip { character: id, anim: Some(anim) });
     }
 }
 

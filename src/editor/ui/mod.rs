@@ -61,6 +61,8 @@ pub struct InspectorState {
     pub body_mirrored: bool,
     pub body_blend: f32,
     pub body_thumbnails: Option<(crate::formats::scene::CharacterId, Vec<crate::formats::scene::LibraryPoseDoc>)>,
+    /// The hands' shapes the sliders show (left, right).
+    pub hand_shapes: [crate::rig::hands::HandShape; 2],
 }
 
 impl Default for InspectorState {
@@ -83,6 +85,7 @@ impl Default for InspectorState {
             body_mirrored: false,
             body_blend: 1.0,
             body_thumbnails: None,
+            hand_shapes: [crate::rig::hands::HandShape::preset("relaxed").unwrap_or_default(); 2],
         }
     }
 }

@@ -1,7 +1,7 @@
 //! Another humanoid's motion on the selected character ("Play the motion of …", baking it
 //! into keys), and its humanoid map, a row per standard bone.
 
-use crate::editor::edits::edit;
+use crate::editor::edits::kinds;
 use bevy::prelude::*;
 use bevy_egui::egui;
 
@@ -49,13 +49,13 @@ pub fn motion_rows(ui: &mut egui::Ui, panels: &Panels, entity: Entity, id: Chara
             ui.horizontal(|ui| {
                 if ui.button("Bake into keys").on_hover_text("the clip becomes this character's own keys").clicked() {
                     let keys = Some((*player.clip).clone());
-                    edit = Some(Edit::Clip(edit::Clip {
+                    edit = Some(Edit::from(kinds::Clip {
                         character: id,
                         anim: Some(AnimDoc { keys, retarget: None, ..player.state.clone() }),
                     }));
                 }
                 if ui.button("Stop").clicked() {
-                    edit = Some(Edit::Clip(edit::Clip { character: id, anim: None }));
+                    edit = Some(Edit::from(kinds::Clip { character: id, anim: None }));
                 }
             });
         }
@@ -117,7 +117,7 @@ fn start_rows(ui: &mut egui::Ui, panels: &Panels, id: CharacterId) -> Option<Edi
         None => return None,
     };
     let retarget = Some(RetargetDoc { from, rest: choice.rest, plant_feet: choice.plant_feet });
-    Some(Edit::Clip(edit::Clip { character: id, anim: Some(AnimDoc { retarget, ..AnimDoc::default() }) }))
+    Some(Edit::from(kinds::Clip { character: id, anim: Some(AnimDoc { retarget, ..AnimDoc::default() }) }))
 }
 
 /// A motion source as the panel names it.
@@ -165,7 +165,7 @@ pub fn humanoid_rows(ui: &mut egui::Ui, panels: &Panels, entity: Entity, id: Cha
                     if chosen != now {
                         let mut bones = assigned.clone();
                         bones.insert(bone, chosen.map_or_else(String::new, |j| pose_key(skeleton, j)));
-                        edit = Some(Edit::Humanoid(edit::Humanoid { character: id, bones }));
+                        edit = Some(Edit::from(kinds::Humanoid { character: id, bones }));
                     }
                 }
             });

@@ -1,7 +1,7 @@
 //! What a path given to the editor does (typed in Add, picked in a dialog, dropped on the
 //! window): open a scene, play a clip, or add characters.
 
-use crate::editor::edits::edit;
+use crate::editor::edits::kinds;
 use std::path::Path;
 
 use super::{InspectorState, Panels};
@@ -12,7 +12,7 @@ use crate::formats::scene::{AnimDoc, CharacterDoc, PlacementDoc};
 /// Puts the clip at `path` on the selected character, playing.
 fn add_clip(path: &str, panels: &mut Panels) {
     match panels.selection.character {
-        Some(character) => panels.push(edit::Clip { character, anim: Some(AnimDoc::of(path)) }),
+        Some(character) => panels.push(kinds::Clip { character, anim: Some(AnimDoc::of(path)) }),
         None => panels.messages.push(format!("select the character that {path} should play on")),
     }
 }
@@ -56,7 +56,7 @@ fn add_character(path: &str, state: &mut InspectorState, panels: &mut Panels) {
         panels.messages.0.extend(asset.warnings.iter().cloned());
         let id = panels.ids.take();
         let doc = panels.library.new_character_doc(source, &asset);
-        panels.push(edit::Add(Box::new(CharacterDoc {
+        panels.push(kinds::Add(Box::new(CharacterDoc {
             id: Some(id),
             placement: PlacementDoc::new(translation, 0.0, 1.0),
             ..doc

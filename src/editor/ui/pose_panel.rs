@@ -3,7 +3,7 @@
 //! maps), as it was or mirrored; keep poses in the scene's library with a thumbnail, apply
 //! or remove them.
 
-use crate::editor::edits::edit;
+use crate::editor::edits::kinds;
 use bevy_egui::egui;
 
 use super::{InspectorState, Panels};
@@ -48,6 +48,13 @@ pub fn pose_panel(ui: &mut egui::Ui, state: &mut InspectorState, panels: &mut Pa
             ui.label("No humanoid map (hips, two legs): assign bones under Retarget.");
         }
     });
+    if map.keys().any(|b| b.is_finger()) {
+        egui::CollapsingHeader::new("Hands").default_open(false).show(ui, |ui| {
+            for left in [true, false] {
+                hand(ui, &mut state.hand_shapes[usize::from(!left)], &mut edits, id, (skeleton, &map, &pose), left);
+            }
+        });
+    }
     egui::CollapsingHeader::new("Poses").default_open(false).show(ui, |ui| {
         ui.horizontal(|ui| {
             if ui.button("Copy").on_hover_text("the selected joints' rotations (all when none)").clicked() {
@@ -70,7 +77,7 @@ pub fn pose_panel(ui: &mut egui::Ui, state: &mut InspectorState, panels: &mut Pa
             {
                 let mut kept = library_pose(skeleton, &positions, pose_by_name(skeleton, &pose, &selected));
                 kept.rig = Some(source.clone());
-                edits.push(edit::Library { name: state.pose_name.trim().to_string(), pose: Some(kept) }.into());
+                edits.push(kinds::Library { name: state.pose_name.trim().to_string(), pose: Some(kept) }.into());
             }
         });
         let kept_rigs: Vec<_> = panels
@@ -95,7 +102,7 @@ pub fn pose_panel(ui: &mut egui::Ui, state: &mut InspectorState, panels: &mut Pa
                             edits.extend(apply_named_pose(id, target, &named, from, true));
                         }
                         if ui.small_button("Remove").clicked() {
-                            edits.push(edit::Library { name: name.clone(), pose: None }.into());
+                            edits.push(kinds::Library { name: name.clone(), pose: None }.into());
                         }
                     });
                 });
@@ -148,6 +155,55 @@ fn body_poses(
     if let Some(name) = clicked {
         let spec = crate::document::posing::BodyPoseSpec { name: name.into(), mirrored: state.body_mirrored };
         edits.extend(body_pose_edits(id, target, placement, &spec, state.body_blend).into_iter().flatten());
+    }
+}
+
+/// One hand's presets, its curl and spread, and each finger's: a change poses the hand's
+/// fingers (one pose edit; a slider's drag is one undo step).
+fn hand(
+    ui: &mut egui::Ui,
+    shape: &mut crate::rig::hands::HandShape,
+    edits: &mut Vec<crate::editor::edits::edit::Edit>,
+    id: CharacterId,
+    target: (&crate::rig::Skeleton, &crate::rig::humanoid::HumanoidMap, &[JointRotation]),
+    left: bool,
+) {
+    use crate::rig::hands::{HandShape, PRESETS};
+    let (skeleton, map, pose) = target;
+    let before = *shape;
+    ui.label(if left { "Left hand" } else { "Right hand" });
+    ui.horizontal_wrapped(|ui| {
+        for (name, ..) in PRESETS {
+            if ui.small_button(name).clicked() {
+                *shape = HandShape::preset(name).unwrap_or_default();
+            }
+        }
+    });
+    let mut curl = shape.curl.iter().sum::<f32>() / 5.0;
+    let mut spread = (shape.fan[1] - shape.fan[3]) / 2.0;
+    ui.horizontal(|ui| {
+        if ui.add(egui::Slider::new(&mut curl, 0.0..=1.6).text("curl")).changed() {
+            shape.curl = [curl; 5];
+        }
+        if ui.add(egui::Slider::new(&mut spread, -0.3..=0.4).text("spread")).changed() {
+            shape.fan = HandShape::of_preset(shape.curl, spread).fan;
+        }
+    });
+    egui::Grid::new(("fingers", left)).show(ui, |ui| {
+        for (f, name) in ["thumb", "index", "middle", "ring", "little"].iter().enumerate() {
+            ui.label(*name);
+            ui.add(egui::Slider::new(&mut shape.curl[f], 0.0..=1.6).text("curl"));
+            ui.add(egui::Slider::new(&mut shape.fan[f], -0.6..=0.6).text("spread"));
+            ui.end_row();
+        }
+    });
+    if *shape != before {
+        let mut posed = pose.to_vec();
+        crate::rig::hands::apply_hand_shape(skeleton, map, &mut posed, left, *shape);
+        let joints: Vec<_> = (0..posed.len()).filter(|&j| posed[j] != pose[j]).map(|j| (j, posed[j])).collect();
+        if !joints.is_empty() {
+            edits.push(crate::editor::edits::kinds::Pose { character: id, joints }.into());
+        }
     }
 }
 

@@ -2,7 +2,7 @@
 //! the selected character's name, placement, view, weights and SMPL state, the stage's view
 //! options, screenshots and messages.
 
-use crate::editor::edits::edit;
+use crate::editor::edits::kinds;
 use std::path::{Path, PathBuf};
 
 use bevy::prelude::*;
@@ -139,7 +139,7 @@ fn add_crowd(state: &InspectorState, panels: &mut Panels) {
     for mut c in crowd.characters {
         c.id = Some(panels.ids.take());
         c.placement.translation.x += shift;
-        panels.push(edit::Add(Box::new(c)));
+        panels.push(kinds::Add(Box::new(c)));
     }
 }
 
@@ -155,7 +155,7 @@ fn character_row(ui: &mut egui::Ui, panels: &mut Panels, entity: Entity, id: Cha
             *panels.selection = Selection { character: Some(id), joints: Vec::new() };
         }
         if ui.checkbox(&mut shown, "").on_hover_text("show").changed() {
-            panels.push(edit::View { character: id, view: ViewDoc { visible: shown, ..view } });
+            panels.push(kinds::View { character: id, view: ViewDoc { visible: shown, ..view } });
         }
     });
 }
@@ -183,7 +183,7 @@ fn selected_character(ui: &mut egui::Ui, panels: &mut Panels, entity: Entity, id
         ui.horizontal(|ui| {
             ui.label("Name");
             if ui.text_edit_singleline(&mut name).changed() {
-                edits.push(edit::Rename { character: id, name: name.clone() }.into());
+                edits.push(kinds::Rename { character: id, name: name.clone() }.into());
             }
         });
         ui.label(egui::RichText::new(source).small());
@@ -207,12 +207,14 @@ fn selected_character(ui: &mut egui::Ui, panels: &mut Panels, entity: Entity, id
         });
         ui.checkbox(&mut v.weight_colors, "weight colours");
         ui.checkbox(&mut v.heat_of_selected, "weights of the selected joint");
+        ui.add(egui::Slider::new(&mut v.opacity, 0.1..=1.0).text("opacity"))
+            .on_hover_text("below 1 the character is a ghost, to draw over a reference picture");
     });
     if p != placement.0 {
-        edits.push(edit::Place { character: id, placement: p }.into());
+        edits.push(kinds::Place { character: id, placement: p }.into());
     }
     if v != view.0 {
-        edits.push(edit::View { character: id, view: v }.into());
+        edits.push(kinds::View { character: id, view: v }.into());
     }
     edits.extend(held);
     ui.horizontal_wrapped(|ui| {
@@ -224,7 +226,7 @@ fn selected_character(ui: &mut egui::Ui, panels: &mut Panels, entity: Entity, id
             ("smooth", Some(BindingDoc::Smooth)),
         ] {
             if ui.selectable_label(binding == b, label).clicked() && binding != b {
-                edits.push(edit::Rebind { character: id, binding: b }.into());
+                edits.push(kinds::Rebind { character: id, binding: b }.into());
             }
         }
     });
@@ -232,7 +234,7 @@ fn selected_character(ui: &mut egui::Ui, panels: &mut Panels, entity: Entity, id
         ui.label("Skinning:");
         for (label, m) in [("linear blend", SkinningDoc::Linear), ("dual quaternion", SkinningDoc::DualQuaternion)] {
             if ui.selectable_label(skinning == m, label).clicked() && skinning != m {
-                edits.push(edit::Skinning { character: id, method: m }.into());
+                edits.push(kinds::Skinning { character: id, method: m }.into());
             }
         }
     });
@@ -240,7 +242,7 @@ fn selected_character(ui: &mut egui::Ui, panels: &mut Panels, entity: Entity, id
         ui.label("Skinned by:");
         for (label, on) in [("the CPU", false), ("a GPU compute shader", true)] {
             if ui.selectable_label(on_gpu == on, label).clicked() && on_gpu != on {
-                edits.push(edit::SkinOnGpu { character: id, on }.into());
+                edits.push(kinds::SkinOnGpu { character: id, on }.into());
             }
         }
     })
@@ -251,24 +253,24 @@ fn selected_character(ui: &mut egui::Ui, panels: &mut Panels, entity: Entity, id
     if let Some(body) = smpl
         && let Some(state) = super::smpl_panel::smpl_panel(ui, body)
     {
-        edits.push(edit::Smpl { character: id, state }.into());
+        edits.push(kinds::Smpl { character: id, state }.into());
     }
     if let Some(player) = player
         && let Some(anim) = super::clip_panel::clip_panel(ui, player)
     {
-        edits.push(edit::Clip { character: id, anim }.into());
+        edits.push(kinds::Clip { character: id, anim }.into());
     }
     if let Some(player) = node_clips
         && let Some(state) = super::clip_panel::playback_panel(ui, player)
     {
-        edits.push(edit::Playback { character: id, state }.into());
+        edits.push(kinds::Playback { character: id, state }.into());
     }
     edits.extend(super::motion_panel::motion_rows(ui, panels, entity, id));
     edits.extend(super::motion_panel::humanoid_rows(ui, panels, entity, id));
     if let Some(morphs) = morphs
         && let Some(weights) = morph_sliders(ui, morphs)
     {
-        edits.push(edit::Morph { character: id, weights }.into());
+        edits.push(kinds::Morph { character: id, weights }.into());
     }
     if duplicate && let Some(mut copy) = panels.scene.character_doc(entity) {
         let copy_id = panels.ids.take();
@@ -279,14 +281,14 @@ fn selected_character(ui: &mut egui::Ui, panels: &mut Panels, entity: Entity, id
             copy.placement.translation = beside(&panels.world_boxes(), lo, hi, copy.placement.scale);
             copy.placement.yaw = 0.0;
         }
-        edits.push(edit::Add(Box::new(copy)).into());
+        edits.push(kinds::Add(Box::new(copy)).into());
         *panels.selection = Selection { character: Some(copy_id), joints: Vec::new() };
     }
     if match_height && height > 0.0 {
         edits.extend(match_heights(panels, entity, height));
     }
     if remove {
-        edits.push(edit::Remove(id).into());
+        edits.push(kinds::Remove(id).into());
         *panels.selection = Selection::default();
     }
     edits.into_iter().for_each(|e| panels.push(e));
@@ -305,7 +307,7 @@ fn match_heights(panels: &Panels, entity: Entity, height: f32) -> Vec<Edit> {
             let own = panels.height(other).filter(|&h| h > 0.0)?;
             let lowest = panels.skins.get(other).ok()?.bounds.0.y;
             let placement = rescaled_keeping_feet(&placement.0, lowest, placement.scale * height / own);
-            Some(Edit::Place(edit::Place { character: sc.id, placement }))
+            Some(Edit::from(kinds::Place { character: sc.id, placement }))
         })
         .collect()
 }

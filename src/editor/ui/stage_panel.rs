@@ -2,7 +2,7 @@
 //! the scene's `StageDoc`), the lens, views and bookmarks (the camera itself), and the
 //! picture `render` takes (size presets, samples, the viewport's frame guide).
 
-use crate::editor::edits::edit;
+use crate::editor::edits::kinds;
 use bevy_egui::egui;
 
 use super::{InspectorState, Panels};
@@ -18,7 +18,7 @@ pub fn stage_panel(ui: &mut egui::Ui, state: &mut InspectorState, panels: &mut P
         light_rows(ui, &mut stage);
     });
     if stage != panels.scene.stage.0 {
-        panels.push(edit::Stage(stage));
+        panels.push(kinds::Stage(stage));
     }
     if let Some(camera) = panels.scene.cameras.iter().next().map(|c| c.0) {
         egui::CollapsingHeader::new("Camera and lens").show(ui, |ui| {
@@ -32,7 +32,7 @@ pub fn stage_panel(ui: &mut egui::Ui, state: &mut InspectorState, panels: &mut P
         frames_rows(ui, panels);
     });
     if shot != panels.scene.shot.0 {
-        panels.push(edit::Shot(shot));
+        panels.push(kinds::Shot(shot));
     }
 }
 
@@ -266,7 +266,7 @@ fn bookmark_rows(ui: &mut egui::Ui, state: &mut InspectorState, panels: &mut Pan
     ui.horizontal(|ui| {
         ui.add(egui::TextEdit::singleline(&mut state.bookmark_name).desired_width(110.0));
         if ui.button("Keep view").clicked() && !state.bookmark_name.trim().is_empty() {
-            panels.push(edit::Bookmark { name: state.bookmark_name.trim().to_string(), camera: Some(*camera) });
+            panels.push(kinds::Bookmark { name: state.bookmark_name.trim().to_string(), camera: Some(*camera) });
         }
     });
     let kept: Vec<(String, CameraDoc)> = panels.scene.bookmarks.0.iter().map(|(n, c)| (n.clone(), *c)).collect();
@@ -276,7 +276,7 @@ fn bookmark_rows(ui: &mut egui::Ui, state: &mut InspectorState, panels: &mut Pan
                 *camera = kept;
             }
             if ui.small_button("×").on_hover_text("forget this view").clicked() {
-                panels.push(edit::Bookmark { name, camera: None });
+                panels.push(kinds::Bookmark { name, camera: None });
             }
         });
     }

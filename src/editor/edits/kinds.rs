@@ -1,5 +1,6 @@
-//! Commands on one character: its pose, placement, view, name, motion, weights,
-//! skinning, morphs, attachment and humanoid bones; adding and removing it.
+//! The commands: on one character (its pose, placement, view, name, motion, weights,
+//! skinning, morphs, attachment and humanoid bones; adding and removing it), and on the
+//! scene as a whole (the pose library, the stage, the shot, the camera's bookmarks).
 
 use std::collections::BTreeMap;
 
@@ -10,12 +11,14 @@ use crate::editor::edits::access::{character_of, component, component_mut, entit
 use crate::editor::edits::edit::{Command, Edit, Setter};
 use crate::editor::scene_doc::attach::Attached;
 use crate::editor::scene_doc::document::{
-    CharacterIndex, HumanoidBones, Library, SceneCharacter, SceneReader, clip_player, spawn_from_doc,
+    CharacterIndex, HumanoidBones, Library as LoadedAssets, SceneCharacter, SceneReader, clip_player, spawn_from_doc,
 };
 use crate::editor::scene_doc::retarget::RetargetedFrom;
-use crate::editor::state::Messages;
+use crate::editor::state::camera::Bookmarks;
+use crate::editor::state::{Messages, PoseLibrary, ShotSettings, StageSettings};
 use crate::formats::scene::{
-    AnimDoc, AttachDoc, BindingDoc, CharacterDoc, CharacterId, PlacementDoc, PlaybackDoc, SkinningDoc, SmplDoc, ViewDoc,
+    AnimDoc, AttachDoc, BindingDoc, CameraDoc, CharacterDoc, CharacterId, LibraryPoseDoc, PlacementDoc, PlaybackDoc,
+    ShotDoc, SkinningDoc, SmplDoc, StageDoc, ViewDoc,
 };
 use crate::rig::JointRotation;
 use crate::rig::humanoid::HumanBone;
@@ -30,6 +33,17 @@ use crate::scene::{Character, CharacterSkinning, CharacterView, JointPose, Place
 pub struct Pose {
     pub character: CharacterId,
     pub joints: Vec<(usize, JointRotation)>,
+}
+
+impl Pose {
+    /// Every joint of a character at its rotation now.
+    pub fn now(world: &World, id: CharacterId) -> Result<Pose, String> {
+        let found = character_of(world, id)?;
+        let joints = (0..found.joints.len())
+            .map(|j| Ok((j, joint_state(world, &found, j)?.0)))
+            .collect::<Result<_, String>>()?;
+        Ok(Pose { character: id, joints })
+    }
 }
 
 impl Command for Pose {
@@ -51,7 +65,7 @@ impl Command for Pose {
     }
 
     /// Not clamped here: `Solve` clamps every changed pose (once).
-    fn write(self, world: &mut World) -> Result<(), String> {
+    fn write(self: Box<Self>, world: &mut World) -> Result<(), String> {
         let found = character_of(world, self.character)?;
         for (j, rotation) in self.joints {
             joint_state(world, &found, j)?;
@@ -74,7 +88,13 @@ macro_rules! component_setter {
         }
 
         impl Setter for $kind {
-            $(const POSES: bool = $poses;)?
+            $(
+            /// Playback poses the joints from the clip; without a clip to return to, undo
+            /// gives the joints back their rotations.
+            fn also_undo(&self, world: &World) -> Result<Vec<Edit>, String> {
+                Ok(if $poses { vec![Pose::now(world, self.character)?.into()] } else { Vec::new() })
+            }
+            )?
 
             fn character(&self) -> Option<CharacterId> {
                 Some(self.character)
@@ -166,7 +186,8 @@ impl Setter for Rebind {
     fn set(self, world: &mut World) -> Result<(), String> {
         let entity = entity_of(world, self.character)?;
         let source = component::<SceneCharacter>(world, self.character)?.source.clone();
-        let asset = world.resource_mut::<Library>().load_bound(&source, self.binding).map_err(|e| e.to_string())?;
+        let asset =
+            world.resource_mut::<LoadedAssets>().load_bound(&source, self.binding).map_err(|e| e.to_string())?;
         let mut character = world.entity_mut(entity);
         if let Some(mut morphs) = character.get_mut::<Morphs>() {
             // The morphs blend from the rebound asset (and put it on the character).
@@ -221,8 +242,8 @@ impl Setter for Clip {
         }
         let found = character_of(world, id)?;
         let name = component::<SceneCharacter>(world, id)?.name.clone();
-        let (player, note) =
-            clip_player(&mut world.resource_mut::<Library>(), &found.asset, &name, &anim).map_err(|e| e.to_string())?;
+        let (player, note) = clip_player(&mut world.resource_mut::<LoadedAssets>(), &found.asset, &name, &anim)
+            .map_err(|e| e.to_string())?;
         if let Some(note) = note {
             world.resource_mut::<Messages>().push(note);
         }
@@ -310,9 +331,9 @@ impl Command for Add {
     }
 
     /// Spawns the character (same entity layout as any scene character).
-    fn write(self, world: &mut World) -> Result<(), String> {
+    fn write(self: Box<Self>, world: &mut World) -> Result<(), String> {
         let id = self.0.id.ok_or("a character to add has an id")?;
-        let spawned = world.resource_scope(|world, mut library: Mut<Library>| {
+        let spawned = world.resource_scope(|world, mut library: Mut<LoadedAssets>| {
             world.resource_scope(|world, mut meshes: Mut<Assets<Mesh>>| {
                 spawn_from_doc(&mut world.commands(), &mut meshes, &mut library, &self.0, id)
             })
@@ -341,11 +362,109 @@ impl Command for Remove {
         Ok(vec![Add(Box::new(doc)).into()])
     }
 
-    fn write(self, world: &mut World) -> Result<(), String> {
+    fn write(self: Box<Self>, world: &mut World) -> Result<(), String> {
         let entity = entity_of(world, self.0)?;
         let found = character_of(world, self.0)?;
         crate::scene::despawn_character(&mut world.commands(), entity, &found);
         world.flush();
+        Ok(())
+    }
+}
+
+/// A pose kept in the scene's library under `name` (none: taken out).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Library {
+    pub name: String,
+    pub pose: Option<LibraryPoseDoc>,
+}
+
+impl Setter for Library {
+    fn character(&self) -> Option<CharacterId> {
+        None
+    }
+
+    fn entry(&self) -> Option<&str> {
+        Some(&self.name)
+    }
+
+    fn read(&self, world: &World) -> Result<Self, String> {
+        Ok(Library { name: self.name.clone(), pose: world.resource::<PoseLibrary>().0.get(&self.name).cloned() })
+    }
+
+    fn set(self, world: &mut World) -> Result<(), String> {
+        let mut library = world.resource_mut::<PoseLibrary>();
+        match self.pose {
+            Some(pose) => library.0.insert(self.name, pose),
+            None => library.0.remove(&self.name),
+        };
+        Ok(())
+    }
+}
+
+/// A camera view kept under `name` (none: taken out).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Bookmark {
+    pub name: String,
+    pub camera: Option<CameraDoc>,
+}
+
+impl Setter for Bookmark {
+    fn character(&self) -> Option<CharacterId> {
+        None
+    }
+
+    fn entry(&self) -> Option<&str> {
+        Some(&self.name)
+    }
+
+    fn read(&self, world: &World) -> Result<Self, String> {
+        Ok(Bookmark { name: self.name.clone(), camera: world.resource::<Bookmarks>().0.get(&self.name).copied() })
+    }
+
+    fn set(self, world: &mut World) -> Result<(), String> {
+        let mut bookmarks = world.resource_mut::<Bookmarks>();
+        match self.camera {
+            Some(camera) => bookmarks.0.insert(self.name, camera),
+            None => bookmarks.0.remove(&self.name),
+        };
+        Ok(())
+    }
+}
+
+/// Floor, lights, background, axes.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Stage(pub StageDoc);
+
+impl Setter for Stage {
+    fn character(&self) -> Option<CharacterId> {
+        None
+    }
+
+    fn read(&self, world: &World) -> Result<Self, String> {
+        Ok(Stage(world.resource::<StageSettings>().0.clone()))
+    }
+
+    fn set(self, world: &mut World) -> Result<(), String> {
+        world.resource_mut::<StageSettings>().0 = self.0;
+        Ok(())
+    }
+}
+
+/// The picture `render` takes.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Shot(pub ShotDoc);
+
+impl Setter for Shot {
+    fn character(&self) -> Option<CharacterId> {
+        None
+    }
+
+    fn read(&self, world: &World) -> Result<Self, String> {
+        Ok(Shot(world.resource::<ShotSettings>().0))
+    }
+
+    fn set(self, world: &mut World) -> Result<(), String> {
+        world.resource_mut::<ShotSettings>().0 = self.0;
         Ok(())
     }
 }
