@@ -194,3 +194,41 @@ fn each_characters_colours_reach_the_picture_from_its_own_buffer() {
     assert!(r > 2 * g.max(b), "the left puppet is red: {:?}", sums[0]);
     assert!(b2 > 2 * r2.max(g2), "the right puppet is blue: {:?}", sums[1]);
 }
+
+/// A reference picture behind the scene: filling the frame (its middle kept) or fitted
+/// inside it with the sky around; the scene file keeps its path relative to its folder.
+#[test]
+fn a_reference_picture_fills_or_fits_behind_the_characters() {
+    let dir = scratch("shot-reference");
+    std::fs::create_dir_all(dir.join("refs")).unwrap();
+    // Left half red, right half blue, square.
+    let reference =
+        image::RgbImage::from_fn(30, 30, |x, _| if x < 15 { image::Rgb([255, 0, 0]) } else { image::Rgb([0, 0, 255]) });
+    reference.save(dir.join("refs/ref.png")).unwrap();
+    let mut doc = puppet_lit_from(30.0);
+    // Far away: a speck in the middle, the edges all background.
+    doc.camera = Some(CameraDoc { focus: glam::Vec3::new(0.0, 0.5, 0.0), distance: 60.0, ..CameraDoc::default() });
+    let near = |p: [u8; 4], want: [u8; 3]| p[..3].iter().zip(want).all(|(&a, b)| a.abs_diff(b) <= 2);
+    let sky = marionette::formats::stage::SKY.map(|c| (c * 255.0).round() as u8);
+    for fill in [true, false] {
+        doc.stage.background = BackgroundDoc::Image { path: dir.join("refs/ref.png"), fill };
+        let scene = scene_file(&dir, "r.ron", &doc);
+        assert!(std::fs::read_to_string(&scene).unwrap().contains("\"refs/ref.png\""), "kept relative");
+        let picture = render(&scene, &[], &dir.join(format!("r{fill}.png")));
+        // 64×96: filled, the square is 96 high and its middle 64 columns show; fitted,
+        // it is 64 square from row 16, the sky above and below.
+        let (left, right) = (picture.get_pixel(1, 40).0, picture.get_pixel(62, 40).0);
+        assert!(near(left, [255, 0, 0]) && near(right, [0, 0, 255]), "fill {fill}: {left:?} {right:?}");
+        let top = picture.get_pixel(1, 4).0;
+        assert!(near(top, if fill { [255, 0, 0] } else { sky }), "fill {fill}: the top {top:?}");
+    }
+    doc.stage.background = BackgroundDoc::Image { path: dir.join("refs/missing.png"), fill: false };
+    let output = std::process::Command::new(env!("CARGO_BIN_EXE_marionette"))
+        .args(["render", "--width", "64", "--height", "96", "--out"])
+        .arg(dir.join("missing.png"))
+        .arg(scene_file(&dir, "missing.ron", &doc))
+        .output()
+        .unwrap();
+    let said = String::from_utf8_lossy(&output.stderr);
+    assert!(!output.status.success() && said.contains("missing.png"), "{said}");
+}

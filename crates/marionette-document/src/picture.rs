@@ -67,13 +67,32 @@ fn composite(drawn: RgbaImage, behind: impl Fn(u32, u32) -> [f32; 3]) -> Dynamic
 /// `drawn` over the picture `behind`, scaled to fill the frame (its middle kept where the
 /// shapes differ); opaque. A picture already opaque is returned as it is.
 pub fn over_picture(drawn: DynamicImage, behind: &DynamicImage) -> DynamicImage {
-    let (w, h) = (drawn.width(), drawn.height());
-    let filled = behind.resize_to_fill(w, h, image::imageops::FilterType::Triangle).to_rgb8();
+    let filled = reference_picture(behind, true, drawn.width(), drawn.height());
     composite(drawn.to_rgba8(), |x, y| filled.get_pixel(x, y).0.map(|c| c as f32 / 255.0))
 }
 
-pub fn over_background(drawn: RgbaImage, background: &BackgroundDoc) -> DynamicImage {
-    match background {
+/// `picture` at `w`×`h`: scaled to cover it (`fill`, its middle kept), else to fit inside it,
+/// centred on the sky's colour.
+pub fn reference_picture(picture: &DynamicImage, fill: bool, w: u32, h: u32) -> image::RgbImage {
+    use image::imageops::FilterType::Triangle;
+    if fill {
+        return picture.resize_to_fill(w, h, Triangle).to_rgb8();
+    }
+    let fitted = picture.resize(w, h, Triangle).to_rgb8();
+    let sky = marionette_formats::stage::SKY.map(|c| (c * 255.0).round() as u8);
+    let mut out = image::RgbImage::from_pixel(w, h, image::Rgb(sky));
+    let (x, y) = ((w - fitted.width()) / 2, (h - fitted.height()) / 2);
+    image::imageops::replace(&mut out, &fitted, i64::from(x), i64::from(y));
+    out
+}
+
+pub fn over_background(drawn: RgbaImage, background: &BackgroundDoc) -> Result<DynamicImage, String> {
+    Ok(match background {
+        BackgroundDoc::Image { path, fill } => {
+            let behind = image::open(path).map_err(|e| format!("{}: {e}", path.display()))?;
+            let behind = reference_picture(&behind, *fill, drawn.width(), drawn.height());
+            composite(drawn, |x, y| behind.get_pixel(x, y).0.map(|c| c as f32 / 255.0))
+        }
         BackgroundDoc::Transparent => DynamicImage::ImageRgba8(drawn),
         BackgroundDoc::Gradient { .. } => {
             let height = drawn.height().max(2) - 1;
@@ -82,5 +101,5 @@ pub fn over_background(drawn: RgbaImage, background: &BackgroundDoc) -> DynamicI
         BackgroundDoc::Sky | BackgroundDoc::Color(_) => {
             DynamicImage::ImageRgb8(DynamicImage::ImageRgba8(drawn).to_rgb8())
         }
-    }
+    })
 }

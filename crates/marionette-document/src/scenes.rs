@@ -9,7 +9,7 @@ use glam::Vec3;
 
 use super::library::AssetLibrary;
 use marionette_formats::FormatError;
-use marionette_formats::scene::{CharacterDoc, PlacementDoc, SceneDoc, SourceDoc, joint_of_pose_key};
+use marionette_formats::scene::{BackgroundDoc, CharacterDoc, PlacementDoc, SceneDoc, SourceDoc, joint_of_pose_key};
 use marionette_rig::{CharacterAsset, JointRotation};
 
 /// The pose a document gives a character: the source's pose with the listed joints
@@ -119,10 +119,16 @@ pub fn initial_save_path(paths: &[PathBuf], cwd: &Path) -> PathBuf {
     cwd.join(scene_path(paths).unwrap_or(Path::new("scene.ron")))
 }
 
-/// Reads a scene file and resolves its sources against its folder.
+/// Reads a scene file and resolves its sources (and a background picture) against its
+/// folder.
 pub fn read_scene(path: &Path) -> Result<SceneDoc, FormatError> {
     let mut doc = marionette_formats::scene::parse_scene(marionette_formats::error::open(path)?, path)?;
     let dir = path.parent().unwrap_or(Path::new("."));
+    if let BackgroundDoc::Image { path, .. } = &mut doc.stage.background
+        && path.is_relative()
+    {
+        *path = dir.join(&*path);
+    }
     for c in &mut doc.characters {
         c.source = c.source.resolved(dir);
         if let Some(anim) = c.anim.as_mut() {
@@ -141,6 +147,9 @@ pub fn read_scene(path: &Path) -> Result<SceneDoc, FormatError> {
 pub fn write_scene(path: &Path, doc: &SceneDoc) -> Result<(), FormatError> {
     let mut doc = doc.clone();
     let dir = path.parent().filter(|d| !d.as_os_str().is_empty()).unwrap_or(Path::new("."));
+    if let BackgroundDoc::Image { path, .. } = &mut doc.stage.background {
+        *path = marionette_formats::scene::relative_path(path, dir);
+    }
     for c in &mut doc.characters {
         c.source = c.source.relative_to(dir);
         if let Some(anim) = c.anim.as_mut() {

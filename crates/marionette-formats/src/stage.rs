@@ -245,9 +245,9 @@ pub struct SpotDoc {
 /// The most lamps a scene has besides the sun.
 pub const MAX_LAMPS: usize = 3;
 
-/// Behind everything: the sky colour, a colour, a vertical gradient, or nothing (a PNG
-/// with alpha).
-#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
+/// Behind everything: the sky colour, a colour, a vertical gradient, nothing (a PNG
+/// with alpha), or a reference picture.
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
 pub enum BackgroundDoc {
     #[default]
     Sky,
@@ -257,6 +257,13 @@ pub enum BackgroundDoc {
         bottom: [f32; 3],
     },
     Transparent,
+    /// A picture file (PNG, JPEG), scaled to fit inside the frame (the sky around it) or,
+    /// with `fill`, to cover it (its middle kept).
+    Image {
+        path: std::path::PathBuf,
+        #[serde(default)]
+        fill: bool,
+    },
 }
 
 /// The sky's colour (sRGB).
@@ -272,6 +279,8 @@ impl BackgroundDoc {
                 (std::array::from_fn(|k| top[k] + (bottom[k] - top[k]) * v), 1.0)
             }
             BackgroundDoc::Transparent => ([0.0; 3], 0.0),
+            // Around a picture that fits inside the frame.
+            BackgroundDoc::Image { .. } => (SKY, 1.0),
         }
     }
 }
@@ -410,13 +419,16 @@ impl StageDoc {
                 }
             }
         }
-        match self.background {
-            BackgroundDoc::Color(c) => unit_color("stage.background", c),
+        match &self.background {
+            BackgroundDoc::Color(c) => unit_color("stage.background", *c),
             BackgroundDoc::Gradient { top, bottom } => {
-                unit_color("stage.background.top", top)?;
-                unit_color("stage.background.bottom", bottom)
+                unit_color("stage.background.top", *top)?;
+                unit_color("stage.background.bottom", *bottom)
             }
-            BackgroundDoc::Sky | BackgroundDoc::Transparent => Ok(()),
+            BackgroundDoc::Image { path, .. } if path.as_os_str().is_empty() => {
+                Err("stage.background.path: expected a picture file, found none".into())
+            }
+            BackgroundDoc::Sky | BackgroundDoc::Transparent | BackgroundDoc::Image { .. } => Ok(()),
         }
     }
 }

@@ -391,7 +391,7 @@ fn capture_when_ready(
     }
     let (index, frame_now) = (job.next, &job.frames[job.next]);
     let (out, ids, backdrop) = (frame_now.out.clone(), frame_now.ids, frame_now.backdrop.clone());
-    let (samples, background, coco_per_picture) = (job.samples, stage.background, job.coco_per_picture);
+    let (samples, background, coco_per_picture) = (job.samples, stage.background.clone(), job.coco_per_picture);
     // What the data pictures show is taken now, with the frame the capture draws.
     let mut frame = match job.data.is_some().then(|| scene.frame(job.size.0, job.size.1)).transpose() {
         Ok(frame) => frame,
@@ -404,7 +404,7 @@ fn capture_when_ready(
     commands.spawn(Screenshot::image(job.target.clone())).observe(move |captured: On<ScreenshotCaptured>| {
         // Encoded and written on a thread of its own while the next pictures are drawn.
         let (image, out, frame, written) = (captured.image.clone(), out.clone(), frame.take(), written.clone());
-        let backdrop = backdrop.clone();
+        let (backdrop, background) = (backdrop.clone(), background.clone());
         std::thread::spawn(move || {
             let result = save_picture(&image, samples, &background, backdrop.as_deref(), &out).and_then(|()| {
                 let Some(frame) = frame else { return Ok(None) };
@@ -499,7 +499,7 @@ fn save_picture(
     out: &std::path::Path,
 ) -> Result<(), String> {
     let rendered = image.clone().try_into_dynamic().map_err(|e| format!("unreadable capture: {e}"))?.to_rgba8();
-    let mut picture = picture::over_background(picture::downsampled(&rendered, samples), background);
+    let mut picture = picture::over_background(picture::downsampled(&rendered, samples), background)?;
     if let Some(path) = backdrop {
         let behind = image::open(path).map_err(|e| format!("{}: {e}", path.display()))?;
         picture = picture::over_picture(picture, &behind);
@@ -510,10 +510,12 @@ fn save_picture(
         .map_err(|e| format!("{}: {e}", out.display()))
 }
 
-/// A gradient goes behind the picture once captured: the render clears to nothing
-/// (reads `StageSettings`; writes `ClearColor`).
+/// A gradient or a picture goes behind the picture once captured: the render clears to
+/// nothing (reads `StageSettings`; writes `ClearColor`).
 fn clear_behind_gradient(settings: Res<crate::editor::state::StageSettings>, mut clear: ResMut<ClearColor>) {
-    if settings.is_changed() && matches!(settings.background, BackgroundDoc::Gradient { .. }) {
+    if settings.is_changed()
+        && matches!(settings.background, BackgroundDoc::Gradient { .. } | BackgroundDoc::Image { .. })
+    {
         clear.0 = Color::NONE;
     }
 }

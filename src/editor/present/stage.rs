@@ -253,41 +253,96 @@ pub fn draw_grid_and_axes(settings: Res<StageSettings>, extent: Res<StageExtent>
     }
 }
 
-/// The viewport's gradient background: a quad of the gradient's colours far behind
-/// everything, carried by the camera (the render instead puts the exact gradient behind its
-/// picture once captured).
+/// The viewport's gradient or picture background: a quad of the gradient's colours, or
+/// showing the picture, far behind everything, carried by the camera (the render instead
+/// puts the exact background behind its picture once captured).
 #[derive(Component)]
 pub struct Backdrop;
 
 /// How far behind the camera's focus the backdrop stands (within every lens's far plane).
 const BACKDROP_DEPTH: f32 = 800.0;
 
-/// Keeps a backdrop on the orbit camera showing the stage's gradient, sized to its lens;
-/// hidden for any other background (reads `StageSettings`, the camera; writes the
-/// backdrop).
+/// The reference picture the backdrop shows: its file, its pixels, its width over height.
+#[derive(Default)]
+pub struct BackdropPicture(Option<(std::path::PathBuf, Handle<Image>, f32)>);
+
+/// Keeps a backdrop on the orbit camera showing the stage's gradient or picture, sized to
+/// its lens (a picture fitted inside the view or filling it); hidden for any other
+/// background, or a picture that does not load (said once) (reads `StageSettings`, the
+/// camera; writes the backdrop, `Messages`).
+#[allow(clippy::too_many_arguments)]
 pub fn show_gradient_backdrop(
     mut commands: Commands,
     settings: Res<StageSettings>,
-    cameras: Query<(Entity, Ref<OrbitCamera>)>,
-    mut backdrops: Query<(Entity, &mut Transform, &mut Visibility, &Mesh3d), With<Backdrop>>,
+    cameras: Query<(Entity, Ref<OrbitCamera>, Option<&Projection>)>,
+    mut backdrops: Query<
+        (Entity, &mut Transform, &mut Visibility, &Mesh3d, &MeshMaterial3d<StandardMaterial>),
+        With<Backdrop>,
+    >,
     mut meshes: ResMut<Assets<Mesh>>,
     mut materials: ResMut<Assets<StandardMaterial>>,
+    mut images: ResMut<Assets<Image>>,
+    mut picture: Local<BackdropPicture>,
+    mut messages: ResMut<crate::editor::state::Messages>,
 ) {
-    let Some((camera, orbit)) = cameras.iter().next() else { return };
-    let crate::formats::scene::BackgroundDoc::Gradient { top, bottom } = settings.background else {
-        backdrops.iter_mut().for_each(|(.., mut v, _)| *v = Visibility::Hidden);
-        return;
+    let Some((camera, orbit, projection)) = cameras.iter().next() else { return };
+    let view_aspect = match projection {
+        Some(Projection::Perspective(p)) => p.aspect_ratio,
+        _ => 16.0 / 9.0,
+    };
+    let white = [1.0; 3];
+    let (top, bottom, texture, width_over_height) = match &settings.background {
+        crate::formats::scene::BackgroundDoc::Gradient { top, bottom } => (*top, *bottom, None, 8.0),
+        crate::formats::scene::BackgroundDoc::Image { path, fill } => {
+            if picture.0.as_ref().is_none_or(|(p, ..)| p != path) {
+                picture.0 = match image::open(path) {
+                    Ok(pixels) => {
+                        let aspect = pixels.width() as f32 / pixels.height().max(1) as f32;
+                        let image = Image::from_dynamic(
+                            pixels,
+                            true,
+                            bevy::asset::RenderAssetUsages::RENDER_WORLD | bevy::asset::RenderAssetUsages::MAIN_WORLD,
+                        );
+                        Some((path.clone(), images.add(image), aspect))
+                    }
+                    Err(e) => {
+                        if settings.is_changed() && !path.as_os_str().is_empty() {
+                            messages.push(format!("{}: {e}", path.display()));
+                        }
+                        None
+                    }
+                };
+            }
+            match &picture.0 {
+                // Fitted inside the view, or covering it: the height's share of the view's.
+                Some((_, handle, aspect)) => {
+                    let widths = view_aspect / aspect;
+                    let share = if *fill { widths.max(1.0) } else { widths.min(1.0) };
+                    (white, white, Some((handle.clone(), share)), *aspect)
+                }
+                None => {
+                    backdrops.iter_mut().for_each(|(.., mut v, _, _)| *v = Visibility::Hidden);
+                    return;
+                }
+            }
+        }
+        _ => {
+            backdrops.iter_mut().for_each(|(.., mut v, _, _)| *v = Visibility::Hidden);
+            return;
+        }
     };
     if !settings.is_changed() && !orbit.is_changed() && !backdrops.is_empty() {
         return;
     }
-    let height = match orbit.ortho {
+    let view_height = match orbit.ortho {
         Some(h) => h,
         None => 2.0 * (orbit.distance + BACKDROP_DEPTH) * (orbit.fov.to_radians() / 2.0).tan(),
     };
+    let grow = texture.as_ref().map_or(1.02, |(_, grow)| *grow);
+    let height = view_height * grow;
     let at = Transform::from_xyz(0.0, 0.0, -(orbit.distance + BACKDROP_DEPTH)).with_scale(Vec3::new(
-        height * 8.0,
-        height * 1.02,
+        height * width_over_height,
+        height,
         1.0,
     ));
     let colors = |c: [f32; 3]| {
@@ -296,16 +351,22 @@ pub fn show_gradient_backdrop(
     };
     // Rectangle vertices: top right, top left, bottom left, bottom right.
     let vertex_colors = vec![colors(top), colors(top), colors(bottom), colors(bottom)];
-    if let Some((_, mut transform, mut visibility, mesh)) = backdrops.iter_mut().next() {
+    let texture = texture.map(|(handle, _)| handle);
+    if let Some((_, mut transform, mut visibility, mesh, material)) = backdrops.iter_mut().next() {
         *transform = at;
         *visibility = Visibility::Inherited;
         if let Some(mut m) = meshes.get_mut(&mesh.0) {
             m.insert_attribute(Mesh::ATTRIBUTE_COLOR, vertex_colors);
         }
+        if let Some(mut m) = materials.get_mut(&material.0)
+            && m.base_color_texture != texture
+        {
+            m.base_color_texture = texture;
+        }
         return;
     }
     let mesh = Mesh::from(Rectangle::new(1.0, 1.0)).with_inserted_attribute(Mesh::ATTRIBUTE_COLOR, vertex_colors);
-    let material = StandardMaterial { unlit: true, ..default() };
+    let material = StandardMaterial { unlit: true, base_color_texture: texture, ..default() };
     let backdrop = commands
         .spawn((
             Backdrop,

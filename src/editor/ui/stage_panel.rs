@@ -125,6 +125,7 @@ fn background_rows(ui: &mut egui::Ui, background: &mut BackgroundDoc) {
             ("colour", BackgroundDoc::Color(sky)),
             ("gradient", BackgroundDoc::Gradient { top: sky, bottom: [0.9, 0.9, 0.88] }),
             ("transparent", BackgroundDoc::Transparent),
+            ("picture", BackgroundDoc::Image { path: Default::default(), fill: false }),
         ];
         for (label, kind) in kinds {
             let same = std::mem::discriminant(background) == std::mem::discriminant(&kind);
@@ -137,6 +138,14 @@ fn background_rows(ui: &mut egui::Ui, background: &mut BackgroundDoc) {
             BackgroundDoc::Gradient { top, bottom } => {
                 color(ui, top);
                 color(ui, bottom);
+            }
+            BackgroundDoc::Image { path, fill } => {
+                let mut text = path.display().to_string();
+                let typed = ui.add(egui::TextEdit::singleline(&mut text).hint_text("a PNG or JPEG file"));
+                if typed.changed() {
+                    *path = text.into();
+                }
+                ui.checkbox(fill, "fill").on_hover_text("cover the frame (else fit inside it)");
             }
             BackgroundDoc::Sky | BackgroundDoc::Transparent => {}
         }
