@@ -43,6 +43,7 @@ impl Plugin for InteractionPlugin {
         order::add_editor_order(app);
         app.add_plugins((
             interact::ik_drag::IkDragPlugin,
+            interact::limb_handles::LimbHandlesPlugin,
             interact::rotate_gizmo::RotateGizmoPlugin,
             interact::move_gizmo::MoveGizmoPlugin,
         ));

@@ -446,3 +446,70 @@ fn export_takes_hand_presets_and_info_lists_them() {
         String::from_utf8_lossy(&info.stdout).contains("hand presets (--hand left=NAME, right=NAME): relaxed, fist")
     );
 }
+
+/// The viewport's limb handles on the Mixamo-named fixture, placed and turned: made where
+/// the character stands (each limb's target at its end, the head's point ahead of it), a
+/// moved target brings the wrist or ankle there (1e-4 of the limb) with the elbow or knee
+/// in the plane of the limb's root, the target and the pole (0.5°); a moved look-at point
+/// turns the face to it (0.1°).
+#[test]
+fn limb_handles_pose_the_limb_and_the_head_they_hold() {
+    use marionette::editor::interact::limb_handles::handles_of;
+    use marionette::editor::state::LimbHandle;
+    use marionette::formats::scene::CharacterId;
+    let path = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/data/rigs/mixamo.glb");
+    let asset = load_character(&path).unwrap();
+    let skeleton = &asset.skeleton;
+    let map = marionette::rig::humanoid::detect(skeleton).unwrap();
+    let placement = Mat4::from_scale_rotation_translation(
+        Vec3::splat(1.3),
+        glam::Quat::from_rotation_y(0.7),
+        Vec3::new(0.5, 0.0, -1.0),
+    );
+    let pose = skeleton.initial_pose();
+    let world = |pose: &[JointRotation]| {
+        let mut w = vec![Mat4::IDENTITY; skeleton.len()];
+        forward_kinematics(skeleton, pose, placement, &mut w);
+        w.iter().map(|m| m.w_axis.truncate()).collect::<Vec<_>>()
+    };
+    let rest = world(&pose);
+    let ahead = placement.transform_vector3(Vec3::Z).normalize();
+    let handles = handles_of(CharacterId(1), skeleton, &map, ahead, |j| rest[j]);
+    assert_eq!(handles.len(), 5, "four limbs and the head");
+    for handle in handles {
+        let mut pose = pose.clone();
+        match handle {
+            LimbHandle::TwoBone { character, end, target, pole } => {
+                assert!(target.distance(rest[end]) < 1e-6, "made at the limb's end");
+                let mid = skeleton.parent(end).unwrap();
+                let root = skeleton.parent(mid).unwrap();
+                let length = rest[root].distance(rest[mid]) + rest[mid].distance(rest[end]);
+                let moved = rest[root] + (target - rest[root]) * 0.8 + ahead * 0.1 * length;
+                let moved_handle = LimbHandle::TwoBone { character, end, target: moved, pole };
+                moved_handle.solve(skeleton, &map, &mut pose, placement).unwrap();
+                let now = world(&pose);
+                assert!(
+                    now[end].distance(moved) < 1e-4 * length,
+                    "{}: {}",
+                    skeleton.joint(end).name,
+                    now[end].distance(moved)
+                );
+                let normal = (moved - now[root]).cross(pole - now[root]).normalize();
+                let off = (now[mid] - now[root]).normalize().dot(normal).asin().to_degrees().abs();
+                assert!(off < 0.5, "{}: the middle joint {off}° off the plane", skeleton.joint(end).name);
+            }
+            LimbHandle::LookAt { character, head, target } => {
+                let moved = target + Vec3::new(0.6, 0.4, 0.0);
+                let moved_handle = LimbHandle::LookAt { character, head, target: moved };
+                let note = moved_handle.solve(skeleton, &map, &mut pose, placement).unwrap();
+                let off: f32 = note
+                    .split("face ")
+                    .nth(1)
+                    .and_then(|s| s.split('°').next())
+                    .and_then(|s| s.trim().parse().ok())
+                    .unwrap_or(f32::NAN);
+                assert!(off < 0.1, "the face {off}° off the point ({note})");
+            }
+        }
+    }
+}

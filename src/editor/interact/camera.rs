@@ -15,17 +15,20 @@ pub fn apply_camera_request(mut request: ResMut<CameraRequest>, mut cameras: Que
 }
 
 /// Reads mouse drags and the wheel into the orbit (reads input; writes `OrbitCamera`).
+#[allow(clippy::too_many_arguments)]
 pub fn orbit_camera_input(
     buttons: Res<ButtonInput<MouseButton>>,
     motion: Res<AccumulatedMouseMotion>,
     scroll: Res<AccumulatedMouseScroll>,
     pointer: Option<Res<ViewportHasPointer>>,
     drag: Option<Res<crate::editor::state::JointDrag>>,
+    handles: Option<Res<crate::editor::state::LimbHandles>>,
     owner: Option<Res<PointerOwner>>,
     mut cameras: Query<&mut OrbitCamera>,
 ) {
     if pointer.is_some_and(|p| !p.0)
         || drag.is_some_and(|d| d.active.is_some())
+        || handles.is_some_and(|h| h.dragged.is_some())
         || owner.is_some_and(|o| o.gizmo_holds_pointer || o.gizmo_turning)
     {
         return;

@@ -5,6 +5,7 @@
 
 pub mod camera;
 pub mod ik_drag;
+pub mod limb_handles;
 pub mod move_gizmo;
 pub mod picking;
 pub mod pointer;

@@ -133,6 +133,24 @@ pub struct StageSettings(pub crate::formats::scene::StageDoc);
 #[derive(Resource, Clone, Copy, Debug, Default, PartialEq, Deref, DerefMut)]
 pub struct ShotSettings(pub crate::formats::scene::ShotDoc);
 
+/// A handle in the viewport that poses a limb or the head: a two-bone limb's target and
+/// pole, or where the head looks (world points; a handle moved re-solves its limb).
+#[derive(Clone, Debug, PartialEq)]
+pub enum LimbHandle {
+    TwoBone { character: CharacterId, end: usize, target: Vec3, pole: Vec3 },
+    LookAt { character: CharacterId, head: usize, target: Vec3 },
+}
+
+/// The handles shown, and the one being dragged (its index, its drag plane's point and
+/// normal).
+#[derive(Resource, Default, Debug)]
+pub struct LimbHandles {
+    pub handles: Vec<LimbHandle>,
+    pub dragged: Option<(usize, Vec3, Vec3)>,
+    /// Handles moved since their limb was last solved.
+    pub moved: Vec<usize>,
+}
+
 /// Posing with symmetry: a joint turned on one side turns its twin on the other, mirrored
 /// through the humanoid map, in the same undo step.
 #[derive(Resource, Clone, Copy, Debug, Default, PartialEq, Eq)]

@@ -115,8 +115,15 @@ pub struct Panels<'w, 's> {
     pub recent: Option<ResMut<'w, crate::editor::ui::recent::RecentFiles>>,
     /// The fast viewport's setting.
     pub fast_viewport: Option<ResMut<'w, crate::editor::present::fast_viewport::FastViewport>>,
-    /// Posing with symmetry.
+    /// Symmetry and the limb handles.
+    pub posing: PosingTools<'w>,
+}
+
+/// The posing tools' settings the panels change.
+#[derive(SystemParam)]
+pub struct PosingTools<'w> {
     pub symmetry: Option<ResMut<'w, crate::editor::state::Symmetry>>,
+    pub handles: Option<ResMut<'w, crate::editor::state::LimbHandles>>,
 }
 
 impl Panels<'_, '_> {

@@ -35,15 +35,7 @@ pub fn pose_panel(ui: &mut egui::Ui, state: &mut InspectorState, panels: &mut Pa
     egui::CollapsingHeader::new("Body poses").default_open(true).show(ui, |ui| {
         if map.contains_key(&crate::rig::humanoid::HumanBone::Hips) {
             let placement = c.placement.0;
-            body_poses(
-                ui,
-                state,
-                panels.symmetry.as_deref_mut(),
-                &mut edits,
-                id,
-                (&character.asset, &map, &pose),
-                placement,
-            );
+            body_poses(ui, state, &mut panels.posing, &mut edits, id, (&character.asset, &map, &pose), placement);
         } else {
             ui.label("No humanoid map (hips, two legs): assign bones under Retarget.");
         }
@@ -117,7 +109,7 @@ pub fn pose_panel(ui: &mut egui::Ui, state: &mut InspectorState, panels: &mut Pa
 fn body_poses(
     ui: &mut egui::Ui,
     state: &mut InspectorState,
-    symmetry: Option<&mut crate::editor::state::Symmetry>,
+    posing: &mut super::PosingTools,
     edits: &mut Vec<crate::editor::edits::edit::Edit>,
     id: CharacterId,
     target: (&crate::rig::CharacterAsset, &crate::rig::humanoid::HumanoidMap, &[JointRotation]),
@@ -133,8 +125,19 @@ fn body_poses(
         if ui.button("Flip pose").on_hover_text("left and right swapped, through the humanoid map").clicked() {
             edits.extend(flip_edit(id, &asset.skeleton, map, pose));
         }
-        if let Some(symmetry) = symmetry {
+        if let Some(symmetry) = posing.symmetry.as_deref_mut() {
             ui.checkbox(&mut symmetry.0, "Symmetry").on_hover_text("a joint turned on one side turns its twin");
+        }
+        if let Some(handles) = posing.handles.as_deref_mut() {
+            let mut shown = handles.handles.iter().any(|h| h.character() == id);
+            let hint = "targets and poles for the arms and legs, a point the head looks at: drag them";
+            if ui.checkbox(&mut shown, "Limb handles").on_hover_text(hint).changed() {
+                handles.handles.retain(|h| h.character() != id);
+                handles.dragged = None;
+                if shown {
+                    handles.handles.extend(limb_handles(id, target, placement));
+                }
+            }
         }
     });
     if state.body_thumbnails.as_ref().is_none_or(|(of, _)| *of != id) {
@@ -205,6 +208,22 @@ fn hand(
             edits.push(crate::editor::edits::kinds::Pose { character: id, joints }.into());
         }
     }
+}
+
+/// The limb handles of a character where it stands.
+fn limb_handles(
+    id: CharacterId,
+    target: (&crate::rig::CharacterAsset, &crate::rig::humanoid::HumanoidMap, &[JointRotation]),
+    placement: crate::formats::scene::PlacementDoc,
+) -> Vec<crate::editor::state::LimbHandle> {
+    let (asset, map, pose) = target;
+    let skeleton = &asset.skeleton;
+    let placed = placement.to_mat4();
+    let mut world = vec![glam::Mat4::IDENTITY; skeleton.len()];
+    crate::rig::fk::forward_kinematics(skeleton, pose, placed, &mut world);
+    let frame = crate::rig::body_poses::facing_frame(skeleton, map).unwrap_or_default();
+    let ahead = placed.transform_vector3(frame * glam::Vec3::Z).normalize_or(glam::Vec3::Z);
+    crate::editor::interact::limb_handles::handles_of(id, skeleton, map, ahead, |j| world[j].w_axis.truncate())
 }
 
 /// The pose's stick figure (clickable).
