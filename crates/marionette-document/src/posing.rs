@@ -16,6 +16,9 @@ pub enum PoseSpecError {
     Syntax { spec: String },
     #[error("`{spec}`: no joint named or numbered `{joint}` (joints: {known})")]
     UnknownJoint { spec: String, joint: String, known: String },
+    /// A spec of another shape, and what it expects.
+    #[error("`{spec}`: {expected}")]
+    Expected { spec: String, expected: String },
 }
 
 /// A parsed `JOINT=rx,ry,rz` (angles in radians, x applied first).
@@ -295,8 +298,9 @@ pub fn apply_two_bone_specs(
             let end = skeleton.resolve(&s.joint).ok_or_else(unknown)?;
             let goal = marionette_rig::two_bone::TwoBoneGoal { end, target: s.target, pole: s.pole, soft: 0.0 };
             marionette_rig::two_bone::solve_two_bone(skeleton, pose, placement, goal, IK_TOLERANCE).ok_or_else(|| {
-                PoseSpecError::Syntax {
-                    spec: format!("{}: a two-bone limb needs a joint with a parent and a grandparent", s.joint),
+                PoseSpecError::Expected {
+                    spec: s.joint.clone(),
+                    expected: "expected the end of a limb: a joint with a parent and a grandparent".into(),
                 }
             })
         })
@@ -349,8 +353,9 @@ impl std::str::FromStr for BodyPoseSpec {
         };
         if marionette_rig::body_poses::body_pose(name).is_none() {
             let names: Vec<&str> = marionette_rig::body_poses::POSES.iter().map(|p| p.name).collect();
-            return Err(PoseSpecError::Syntax {
-                spec: format!("{spec} (expected NAME or NAME:mirrored, NAME one of {})", names.join(", ")),
+            return Err(PoseSpecError::Expected {
+                spec: spec.to_string(),
+                expected: format!("expected NAME or NAME:mirrored, NAME one of {}", names.join(", ")),
             });
         }
         Ok(Self { name: name.to_string(), mirrored })
@@ -418,8 +423,9 @@ impl std::str::FromStr for HandSpec {
 
     fn from_str(spec: &str) -> Result<Self, Self::Err> {
         let names: Vec<&str> = marionette_rig::hands::PRESETS.iter().map(|p| p.0).collect();
-        let syntax = || PoseSpecError::Syntax {
-            spec: format!("{spec} (expected left=NAME or right=NAME, NAME one of {})", names.join(", ")),
+        let syntax = || PoseSpecError::Expected {
+            spec: spec.to_string(),
+            expected: format!("expected left=NAME or right=NAME, NAME one of {}", names.join(", ")),
         };
         let (side, preset) = spec.split_once('=').ok_or_else(syntax)?;
         let left = match side.trim() {
@@ -456,8 +462,7 @@ pub fn apply_hand_specs(
         .collect()
 }
 
-/// The share of the turn the chest and then the neck take when a look-at spreads over them.
-pub const LOOK_AT_SHARES: [f32; 2] = [0.2, 0.35];
+pub use marionette_rig::look_at::LOOK_AT_SHARES;
 
 /// Turns each spec's joint so that its face points at the target, on top of `pose`, for a
 /// character placed by `placement`. The face is where the character faces at rest (square

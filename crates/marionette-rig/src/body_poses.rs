@@ -550,7 +550,15 @@ fn look(
         .filter(|j| !hips.as_ref().is_some_and(|above| above.contains(j)))
         .collect();
     let target = world[head].w_axis.truncate() + frame * look * 10.0;
-    let done = crate::look_at::solve_look_at(skeleton, pose, Mat4::IDENTITY, &joints, face, &[0.2, 0.35], target);
+    let done = crate::look_at::solve_look_at(
+        skeleton,
+        pose,
+        Mat4::IDENTITY,
+        &joints,
+        face,
+        &crate::look_at::LOOK_AT_SHARES,
+        target,
+    );
     if done.limited {
         report.limited.push(head);
     }

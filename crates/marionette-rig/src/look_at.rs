@@ -6,6 +6,10 @@ use glam::{Mat4, Quat, Vec3};
 use crate::fk::forward_kinematics;
 use crate::{JointRotation, Skeleton};
 
+/// The share of the turn the chest and then the neck take when a humanoid's look-at
+/// spreads over them.
+pub const LOOK_AT_SHARES: [f32; 2] = [0.2, 0.35];
+
 /// What a look-at did.
 #[derive(Debug, Clone, PartialEq)]
 pub struct LookAtReport {

@@ -57,10 +57,10 @@ pub struct InspectorState {
     /// Show the shot's frame in the viewport.
     pub frame_guide: bool,
     /// The built-in body poses: mirrored, how much of each to blend in, and their
-    /// thumbnails on the character they were drawn for.
+    /// thumbnails on the character (and humanoid map) they were drawn for.
     pub body_mirrored: bool,
     pub body_blend: f32,
-    pub body_thumbnails: Option<(crate::formats::scene::CharacterId, Vec<crate::formats::scene::LibraryPoseDoc>)>,
+    pub body_thumbnails: Option<BodyThumbnails>,
     /// The hands' shapes the sliders show (left, right).
     pub hand_shapes: [crate::rig::hands::HandShape; 2],
 }
@@ -118,6 +118,10 @@ pub struct Panels<'w, 's> {
     /// Symmetry and the limb handles.
     pub posing: PosingTools<'w>,
 }
+
+/// The body poses' thumbnails, drawn for one character with one humanoid map.
+pub type BodyThumbnails =
+    (crate::formats::scene::CharacterId, crate::rig::humanoid::HumanoidMap, Vec<crate::formats::scene::LibraryPoseDoc>);
 
 /// The posing tools' settings the panels change.
 #[derive(SystemParam)]

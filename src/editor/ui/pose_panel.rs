@@ -140,10 +140,10 @@ fn body_poses(
             }
         }
     });
-    if state.body_thumbnails.as_ref().is_none_or(|(of, _)| *of != id) {
-        state.body_thumbnails = Some((id, body_pose_thumbnails(&asset.skeleton, map)));
+    if state.body_thumbnails.as_ref().is_none_or(|(of, drawn_with, _)| *of != id || drawn_with != map) {
+        state.body_thumbnails = Some((id, map.clone(), body_pose_thumbnails(&asset.skeleton, map)));
     }
-    let Some((_, thumbnails)) = &state.body_thumbnails else { return };
+    let Some((.., thumbnails)) = &state.body_thumbnails else { return };
     let mut clicked = None;
     egui::Grid::new("body poses").spacing(egui::vec2(4.0, 4.0)).show(ui, |ui| {
         for (k, (body, kept)) in crate::rig::body_poses::POSES.iter().zip(thumbnails).enumerate() {
