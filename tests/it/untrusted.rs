@@ -171,6 +171,8 @@ const SCENE_CASES: &[(&str, &str)] = &[
     ("scene-shot-too-wide.ron", "shot.width: expected 1 to 4096 pixels at 2 samples, found 8000"),
     ("scene-bookmark-ortho-negative.ron", "bookmarks[\"side\"].ortho: expected a positive finite number, found -2"),
     ("scene-background-colour-2.ron", "stage.background: expected colour parts in 0..=1, found 2"),
+    ("scene-view-opacity-nan.ron", "characters[0].view.opacity: expected an opacity in 0..=1, found NaN"),
+    ("scene-background-image-empty.ron", "stage.background.path: expected a picture file, found none"),
 ];
 
 #[test]

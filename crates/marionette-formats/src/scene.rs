@@ -583,6 +583,9 @@ impl SceneDoc {
             positive(&at("placement.scale"), c.placement.scale)?;
             rotations(&at("pose"), &c.pose)?;
             finite(&at("view.tint"), &c.view.tint)?;
+            if !(0.0..=1.0).contains(&c.view.opacity) {
+                return Err(format!("{}: expected an opacity in 0..=1, found {}", at("view.opacity"), c.view.opacity));
+            }
             if let Some(smpl) = &c.smpl {
                 finite(&at("smpl.betas"), &smpl.betas)?;
                 finite(&at("smpl.time"), &[smpl.time])?;
