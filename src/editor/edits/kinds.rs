@@ -36,6 +36,14 @@ pub struct Pose {
 }
 
 impl Pose {
+    /// The joints of `after` that differ from `before`, at their rotations in `after`;
+    /// none when no joint changed.
+    pub fn change(character: CharacterId, before: &[JointRotation], after: &[JointRotation]) -> Option<Pose> {
+        let joints: Vec<_> =
+            after.iter().zip(before).enumerate().filter(|(_, (a, b))| a != b).map(|(j, (a, _))| (j, *a)).collect();
+        (!joints.is_empty()).then_some(Pose { character, joints })
+    }
+
     /// Every joint of a character at its rotation now.
     pub fn now(world: &World, id: CharacterId) -> Result<Pose, String> {
         let found = character_of(world, id)?;

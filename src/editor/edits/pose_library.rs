@@ -69,21 +69,18 @@ pub fn body_pose_edits(
     let (asset, map, current) = target;
     let (posed, _) = crate::document::posing::body_posed(&asset.skeleton, map, current, spec, blend)?;
     let stood = crate::document::posing::stood_on_floor(asset, &posed, placement.to_mat4());
-    let joints = (0..posed.len()).filter(|&j| posed[j] != current[j]).map(|j| (j, posed[j])).collect();
-    Some(vec![
-        kinds::Pose { character: id, joints }.into(),
-        kinds::Place { character: id, placement: crate::formats::scene::PlacementDoc::from_mat4(stood) }.into(),
-    ])
+    let place = kinds::Place { character: id, placement: crate::formats::scene::PlacementDoc::from_mat4(stood) };
+    Some(kinds::Pose::change(id, current, &posed).map(Edit::from).into_iter().chain([place.into()]).collect())
 }
 
 /// The edit that flips character `id`'s pose left to right through its humanoid map (see
-/// `rig::mirror::flipped_pose`); none without hips and legs in the map.
+/// `rig::mirror::flipped_pose`); none without hips and legs in the map, or when the flip
+/// changes nothing.
 pub fn flip_edit(id: CharacterId, skeleton: &Skeleton, map: &HumanoidMap, current: &[JointRotation]) -> Option<Edit> {
     let left = crate::rig::body_poses::facing_frame(skeleton, map)? * Vec3::X;
     let twin = crate::rig::mirror::counterparts(skeleton, map);
     let flipped = crate::rig::mirror::flipped_pose(skeleton, &twin, current, left);
-    let joints = (0..flipped.len()).filter(|&j| flipped[j] != current[j]).map(|j| (j, flipped[j])).collect();
-    Some(kinds::Pose { character: id, joints }.into())
+    kinds::Pose::change(id, current, &flipped).map(Edit::from)
 }
 
 /// A stick-figure thumbnail of each built-in body pose on this character.

@@ -136,9 +136,8 @@ fn drag_joint(
     goals.extend(active.pins.iter().map(|&(end, target)| IkGoal { end, target }));
     let reports = solve_ik(skeleton, &mut pose, placement.to_mat4(), &goals, IK_TOLERANCE, IK_ROUNDS.min(8));
     drag.note = reports.first().map(|r| crate::document::posing::describe_ik(skeleton, r)).unwrap_or_default();
-    let joints: Vec<_> = pose.into_iter().enumerate().filter(|&(j, p)| p != before[j]).collect();
-    if !joints.is_empty() {
-        edits.push(kinds::Pose { character: active.character, joints });
+    if let Some(change) = kinds::Pose::change(active.character, &before, &pose) {
+        edits.push(change);
     }
 }
 

@@ -200,9 +200,8 @@ fn solve_moved_handles(
         if let Some(note) = note.filter(|n| n.contains("not reached") || n.contains("limit")) {
             messages.push(note);
         }
-        let joints: Vec<_> = pose.into_iter().enumerate().filter(|&(j, p)| p != before[j]).collect();
-        if !joints.is_empty() {
-            edits.push(kinds::Pose { character: handle.character(), joints });
+        if let Some(change) = kinds::Pose::change(handle.character(), &before, &pose) {
+            edits.push(change);
         }
     }
 }

@@ -203,10 +203,7 @@ fn hand(
     if *shape != before {
         let mut posed = pose.to_vec();
         crate::rig::hands::apply_hand_shape(skeleton, map, &mut posed, left, *shape);
-        let joints: Vec<_> = (0..posed.len()).filter(|&j| posed[j] != pose[j]).map(|j| (j, posed[j])).collect();
-        if !joints.is_empty() {
-            edits.push(crate::editor::edits::kinds::Pose { character: id, joints }.into());
-        }
+        edits.extend(crate::editor::edits::kinds::Pose::change(id, pose, &posed).map(Into::into));
     }
 }
 
