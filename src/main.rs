@@ -96,58 +96,8 @@ fn run(cli: Cli) -> Result<()> {
                 println!("{}", bench::table(&report));
             }
         }
-        Some(Command::Generate(args)) => generate(&args)?,
+        Some(Command::Generate(args)) => marionette::cli::generate::run(&args)?,
         Some(Command::GenAssets { dir }) => marionette::cli::gen_assets(&dir)?,
     }
-    Ok(())
-}
-
-/// `generate`: the plan's pictures rendered in one app, each recorded in the shard's
-/// manifest as its files are written, a progress bar with pictures a second and the time left.
-fn generate(args: &marionette::cli::args::GenerateArgs) -> Result<()> {
-    use marionette::editor::present::render::{ScenePicture, render_scenes};
-    let Some(mut plan) = marionette::cli::generate::plan(args)? else { return Ok(()) };
-    let (todo, finished, shard) = (plan.pictures.len(), plan.finished, plan.shard);
-    eprintln!(
-        "generate: shard {}/{}: {} pictures, {finished} already there, {todo} to render into {}",
-        shard.index,
-        shard.count,
-        finished + todo,
-        plan.dir.display()
-    );
-    if todo == 0 {
-        return Ok(());
-    }
-    let started = std::time::Instant::now();
-    let numbers: Vec<usize> = plan.pictures.iter().map(|p| p.0).collect();
-    let pictures: Vec<ScenePicture> = std::mem::take(&mut plan.pictures)
-        .into_iter()
-        .map(|(k, scene, backdrop)| ScenePicture {
-            scene,
-            out: plan.out(k),
-            ids: marionette::document::generate::coco_ids(k),
-            backdrop,
-        })
-        .collect();
-    let first_scene = plan.scene_file(numbers[0]);
-    let library = std::mem::take(&mut plan.library);
-    let (picture, data) = (plan.picture(), plan.spec.data);
-    let bar = indicatif::ProgressBar::new(todo as u64);
-    bar.set_style(
-        indicatif::ProgressStyle::with_template("{bar:40} {pos}/{len} pictures, {per_sec}, {elapsed} (left {eta})")
-            .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
-    );
-    let recorder = bar.clone();
-    let on_written = Box::new(move |index: usize| {
-        plan.record(numbers[index])?;
-        recorder.inc(1);
-        Ok(())
-    });
-    let notes = render_scenes(first_scene, library, pictures, picture, data, on_written).map_err(anyhow::Error::msg)?;
-    bar.finish();
-    for n in notes {
-        eprintln!("note: {n}");
-    }
-    println!("wrote {todo} pictures in {:.2} s", started.elapsed().as_secs_f64());
     Ok(())
 }

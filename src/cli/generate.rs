@@ -1,7 +1,7 @@
 //! `generate`'s plan, before the app renders: the spec read and checked, the shard and
 //! the pictures it still lacks, each picture's scene drawn and written beside where its
 //! picture goes; `--example`, `--dry-run` and `--merge`; and each written picture's line in
-//! the shard's manifest. No Bevy: `main.rs` hands the plan to the render.
+//! the shard's manifest; then [`run`] hands the plan to the render, with a progress bar.
 
 use std::path::{Path, PathBuf};
 
@@ -44,8 +44,8 @@ impl Plan {
 
     /// Writes picture `k`'s line into the shard's manifest (its files and their digests).
     pub fn record(&self, k: usize) -> Result<ManifestLine, String> {
-        let line = generate::manifest_line(&self.dir, k)?;
-        generate::append_manifest(&self.dir.join(self.shard.manifest_name()), &line)?;
+        let line = generate::manifest_line(&self.dir, k).map_err(|e| e.to_string())?;
+        generate::append_manifest(&self.dir.join(self.shard.manifest_name()), &line).map_err(|e| e.to_string())?;
         Ok(line)
     }
 }
@@ -106,4 +106,49 @@ pub fn plan(args: &GenerateArgs) -> Result<Option<Plan>> {
         pictures.push((k, scene, backdrop));
     }
     Ok(Some(Plan { dir: dir.clone(), spec, shard, pictures, finished, library }))
+}
+
+/// `generate`: the plan's pictures rendered in one app, each recorded in the shard's
+/// manifest as its files are written, a progress bar with pictures a second and the time left.
+pub fn run(args: &GenerateArgs) -> Result<()> {
+    use crate::editor::present::render::{ScenePicture, render_scenes};
+    let Some(mut plan) = plan(args)? else { return Ok(()) };
+    let (todo, finished, shard) = (plan.pictures.len(), plan.finished, plan.shard);
+    eprintln!(
+        "generate: shard {}/{}: {} pictures, {finished} already there, {todo} to render into {}",
+        shard.index,
+        shard.count,
+        finished + todo,
+        plan.dir.display()
+    );
+    if todo == 0 {
+        return Ok(());
+    }
+    let started = std::time::Instant::now();
+    let numbers: Vec<usize> = plan.pictures.iter().map(|p| p.0).collect();
+    let pictures: Vec<ScenePicture> = std::mem::take(&mut plan.pictures)
+        .into_iter()
+        .map(|(k, scene, backdrop)| ScenePicture { scene, out: plan.out(k), ids: generate::coco_ids(k), backdrop })
+        .collect();
+    let first_scene = plan.scene_file(numbers[0]);
+    let library = std::mem::take(&mut plan.library);
+    let (picture, data) = (plan.picture(), plan.spec.data);
+    let bar = indicatif::ProgressBar::new(todo as u64);
+    bar.set_style(
+        indicatif::ProgressStyle::with_template("{bar:40} {pos}/{len} pictures, {per_sec}, {elapsed} (left {eta})")
+            .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
+    );
+    let recorder = bar.clone();
+    let on_written = Box::new(move |index: usize| {
+        plan.record(numbers[index])?;
+        recorder.inc(1);
+        Ok(())
+    });
+    let notes = render_scenes(first_scene, library, pictures, picture, data, on_written).map_err(anyhow::Error::msg)?;
+    bar.finish();
+    for n in notes {
+        eprintln!("note: {n}");
+    }
+    println!("wrote {todo} pictures in {:.2} s", started.elapsed().as_secs_f64());
+    Ok(())
 }

@@ -36,8 +36,7 @@ pub fn info(path: &Path) -> Result<()> {
         if crate::formats::smpl::is_smpl_dir(path) {
             let mut library = crate::document::AssetLibrary::default();
             for (name, clip) in library.smpl(path)?.clips {
-                let frames = clip.frame_count();
-                let seconds = frames.saturating_sub(1) as f32 / crate::rig::smpl::CLIP_FPS;
+                let (frames, seconds) = (clip.frame_count(), crate::document::motion::smpl_span(&clip).end);
                 println!("clip `{name}`: {frames} frames at {} per second, {seconds:.3} s", crate::rig::smpl::CLIP_FPS);
             }
         }

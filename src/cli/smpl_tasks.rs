@@ -161,13 +161,23 @@ pub fn task_frames(model: &SmplModel, data_dir: &Path, task: u32) -> Result<Vec<
             let clip = parse_clip(open(&clip_path)?, &clip_path, n)?;
             (0..3)
                 .flat_map(|b| (0..clip.frame_count()).map(move |f| (b, f)))
-                .map(|(b, f)| FrameSpec { rotations: clip.frame(f).to_vec(), ..spec(b) })
+                .map(|(b, f)| FrameSpec { rotations: clip_frame(&model.skeleton, &clip, f), ..spec(b) })
                 .collect()
         }
         _ => {
             return Err(FormatError::other(data_dir, format!("expected a task 1..=6, found {task}")));
         }
     })
+}
+
+/// Frame `f` of an SMPL clip as the motion service plays it (not stood upright).
+fn clip_frame(skeleton: &Skeleton, clip: &Clip, f: usize) -> Vec<Quat> {
+    use crate::document::motion::{Clock, Playing, SmplMotion, pose_at};
+    let clock = Clock { time: f as f32 / crate::rig::smpl::CLIP_FPS, playing: false, speed: 1.0, looping: false };
+    let smpl = SmplMotion { clip, blend: None, upright: false };
+    let playing = Playing { smpl: Some((smpl, clock)), ..Playing::default() };
+    let still = skeleton.initial_pose();
+    pose_at(skeleton, &still, &[], &playing).rotations.iter().map(JointRotation::to_quat).collect()
 }
 
 /// Task 4's shoulder rotation, (x, y, z, w) = (0, 0, −0.3827, 0.9239).
@@ -263,7 +273,7 @@ pub fn sequence_frames(
             (seg.from..=to)
                 .map(|f| FrameSpec {
                     betas: seg.betas,
-                    rotations: clip.frame(f).to_vec(),
+                    rotations: clip_frame(&model.skeleton, clip, f),
                     translation: None,
                     skinned: true,
                 })

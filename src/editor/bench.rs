@@ -166,7 +166,7 @@ pub fn run(setup: &Setup) -> Result<BenchReport, String> {
         CrowdOf::Puppets => None,
     };
     let (mut doc, kind) = match &smpl_dir {
-        Some(dir) => (smpl_crowd(dir, characters)?, "SMPL body"),
+        Some(dir) => (smpl_crowd(dir, characters).map_err(|e| e.to_string())?, "SMPL body"),
         None => (puppet_crowd(characters), "puppet"),
     };
     // No shadows: the drawing (not what is measured) stays affordable on llvmpipe.
@@ -290,8 +290,8 @@ pub fn table(r: &BenchReport) -> String {
 /// boundaries.
 fn crowd_app(sway: bool) -> App {
     let mut app = App::new();
-    app.add_plugins(crate::editor::windowless_plugins().disable::<PipelinedRenderingPlugin>())
-        .add_plugins((RigCorePlugin, SkinningPlugin, crate::editor::ViewPlugin))
+    app.add_plugins(crate::editor::cores::windowless_plugins().disable::<PipelinedRenderingPlugin>())
+        .add_plugins((RigCorePlugin, SkinningPlugin, crate::editor::present::view::ViewPlugin))
         .init_resource::<MainClock>()
         .add_systems(Startup, spawn_offscreen_camera)
         .add_systems(PostUpdate, stamp::<0>.before(MarionetteSystems::Animate))

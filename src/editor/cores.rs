@@ -6,6 +6,8 @@
 use std::sync::Arc;
 use std::sync::atomic::{AtomicUsize, Ordering};
 
+use bevy::prelude::*;
+
 /// A callback for the compute pool's threads as they start: the k-th pins itself to the
 /// k-th core this process may run on (wrapping round). None where pinning is not
 /// available (not Linux) or the process may run on one core only.
@@ -55,3 +57,43 @@ fn pin_this_thread_to(cores: &[usize]) {
 
 #[cfg(not(target_os = "linux"))]
 fn pin_this_thread_to(_cores: &[usize]) {}
+
+/// Bevy's task pools with every core for compute (systems and the parallel skinning),
+/// each compute worker on a core of its own ([`pin_each_worker_to_a_core`]): one thread each for IO and async
+/// tasks on top, instead of taking them from the cores (on 2 cores Bevy's default leaves
+/// compute a single thread).
+pub fn task_pools() -> bevy::app::TaskPoolPlugin {
+    let one = |policy: bevy::app::TaskPoolThreadAssignmentPolicy| bevy::app::TaskPoolThreadAssignmentPolicy {
+        min_threads: 1,
+        max_threads: 1,
+        ..policy
+    };
+    let defaults = bevy::app::TaskPoolOptions::default();
+    let core_count = bevy::tasks::available_parallelism();
+    bevy::app::TaskPoolPlugin {
+        task_pool_options: bevy::app::TaskPoolOptions {
+            min_total_threads: core_count + 2,
+            max_total_threads: core_count + 2,
+            io: one(defaults.io),
+            async_compute: one(defaults.async_compute),
+            compute: bevy::app::TaskPoolThreadAssignmentPolicy {
+                on_thread_spawn: pin_each_worker_to_a_core(),
+                ..defaults.compute
+            },
+        },
+    }
+}
+
+/// Bevy's default plugins without a window (the headless renderer, the bench, tests):
+/// rendering into images, with [`task_pools`].
+pub fn windowless_plugins() -> bevy::app::PluginGroupBuilder {
+    DefaultPlugins
+        .set(task_pools())
+        .set(WindowPlugin {
+            primary_window: None,
+            exit_condition: bevy::window::ExitCondition::DontExit,
+            close_when_requested: false,
+            ..default()
+        })
+        .disable::<bevy::winit::WinitPlugin>()
+}

@@ -30,6 +30,7 @@ use bevy::prelude::*;
 use bevy::window::WindowResolution;
 
 use crate::scene::{MarionetteSystems, RigCorePlugin, SkinningPlugin};
+pub use cores::{task_pools, windowless_plugins};
 use interact::camera::orbit_camera_input;
 pub use present::view::{ScenePlugin, ViewPlugin, apply_pending_scene};
 use state::camera::OrbitCamera;
@@ -71,46 +72,6 @@ impl Plugin for InteractionPlugin {
                     .in_set(order::EditorSystems::Viewport),
             );
     }
-}
-
-/// Bevy's task pools with every core for compute (systems and the parallel skinning),
-/// each compute worker on a core of its own ([`cores`]): one thread each for IO and async
-/// tasks on top, instead of taking them from the cores (on 2 cores Bevy's default leaves
-/// compute a single thread).
-pub fn task_pools() -> bevy::app::TaskPoolPlugin {
-    let one = |policy: bevy::app::TaskPoolThreadAssignmentPolicy| bevy::app::TaskPoolThreadAssignmentPolicy {
-        min_threads: 1,
-        max_threads: 1,
-        ..policy
-    };
-    let defaults = bevy::app::TaskPoolOptions::default();
-    let core_count = bevy::tasks::available_parallelism();
-    bevy::app::TaskPoolPlugin {
-        task_pool_options: bevy::app::TaskPoolOptions {
-            min_total_threads: core_count + 2,
-            max_total_threads: core_count + 2,
-            io: one(defaults.io),
-            async_compute: one(defaults.async_compute),
-            compute: bevy::app::TaskPoolThreadAssignmentPolicy {
-                on_thread_spawn: cores::pin_each_worker_to_a_core(),
-                ..defaults.compute
-            },
-        },
-    }
-}
-
-/// Bevy's default plugins without a window (the headless renderer, the bench, tests):
-/// rendering into images, with [`task_pools`].
-pub fn windowless_plugins() -> bevy::app::PluginGroupBuilder {
-    DefaultPlugins
-        .set(task_pools())
-        .set(WindowPlugin {
-            primary_window: None,
-            exit_condition: bevy::window::ExitCondition::DontExit,
-            close_when_requested: false,
-            ..default()
-        })
-        .disable::<bevy::winit::WinitPlugin>()
 }
 
 /// Opens the editor window on `paths` (or on the default scene), with the files `library`

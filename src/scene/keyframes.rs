@@ -9,9 +9,6 @@ use bevy::prelude::*;
 use crate::formats::scene::AnimDoc;
 use crate::rig::JointRotation;
 use crate::rig::anim::Clip;
-use crate::rig::playback::{Clock, Span};
-use crate::scene::playhead::{Playhead, advance_playheads};
-use crate::scene::{Character, JointPose};
 
 /// A keyframed clip on a character and its playback state (the scene file's `AnimDoc`).
 #[derive(Component, Clone)]
@@ -29,53 +26,6 @@ impl RootTranslation {
     /// What the matrix stack starts from: the move from the root's offset to here.
     pub fn origin(&self, root_offset: Vec3) -> Mat4 {
         self.0.map_or(Mat4::IDENTITY, |t| Mat4::from_translation(t - root_offset))
-    }
-}
-
-/// Its clock runs in seconds over the clip's keyed range.
-impl Playhead for ClipPlayer {
-    fn clock(&self) -> Clock {
-        let s = &self.state;
-        Clock { time: s.time, playing: s.playing, speed: s.speed, looping: s.looping }
-    }
-
-    fn set_clock(&mut self, clock: Clock) {
-        (self.state.time, self.state.playing) = (clock.time, clock.playing);
-    }
-
-    fn span(&self) -> Option<Span> {
-        Some(Span::keyed(self.clip.range.0, self.clip.range.1))
-    }
-}
-
-pub struct KeyframePlugin;
-
-impl Plugin for KeyframePlugin {
-    fn build(&self, app: &mut App) {
-        app.add_systems(
-            PostUpdate,
-            (advance_playheads::<ClipPlayer>, pose_from_keyframes).chain().in_set(super::AnimateSteps::Keyframes),
-        );
-    }
-}
-
-/// Poses the joints and moves the root from the clip at its time, when the clip or time
-/// changed (writes `JointPose`, `RootTranslation`). A paused clip keeps slider edits.
-pub fn pose_from_keyframes(
-    mut players: Query<(&ClipPlayer, &Character, &mut RootTranslation), Changed<ClipPlayer>>,
-    mut poses: Query<&mut JointPose>,
-) {
-    for (player, character, mut root) in &mut players {
-        let skeleton = &character.asset.skeleton;
-        let now: Vec<_> = character.joints.iter().map(|&e| poses.get(e).map_or(Default::default(), |p| p.0)).collect();
-        // Not clamped here: `Solve` clamps every changed pose.
-        let (translation, pose) = player.clip.pose_at_unclamped(skeleton, player.state.time, &now);
-        root.set_if_neq(RootTranslation(Some(translation)));
-        for (&entity, rotation) in character.joints.iter().zip(pose) {
-            if let Ok(mut p) = poses.get_mut(entity) {
-                p.set_if_neq(JointPose(rotation));
-            }
-        }
     }
 }
 

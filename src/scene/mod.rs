@@ -19,8 +19,8 @@ pub mod gpu_skinning;
 pub mod handoff;
 pub mod keyframes;
 pub mod morphs;
+pub mod motion;
 pub mod node_clips;
-pub mod playhead;
 pub mod smpl;
 pub mod spawn;
 pub mod systems;
@@ -48,25 +48,24 @@ pub enum MarionetteSystems {
 }
 
 /// The steps of `Animate`, in the order they run (declared here, once): what builds the
-/// scene and applies its edits, then SMPL playback, keyframed clips, the sources' own clips
-/// (glTF, FBX, BVH), and last the morph weights those clips and edits set, so a shape never
-/// lags its pose by a frame.
+/// scene and applies its edits, then motion (every clock, then every character's pose by
+/// the one motion service: SMPL playback, keyframed clips, the sources' own clips), and
+/// last the morph weights that motion and the edits set, so a shape never lags its pose by
+/// a frame.
 #[derive(SystemSet, Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub enum AnimateSteps {
     Document,
-    Smpl,
-    Keyframes,
-    NodeClips,
+    Motion,
     Morphs,
 }
 
-/// Every kind of playback in `Animate`: SMPL clips, keyframed clips, a glTF file's own
-/// clips, and morph weights (each its own plugin, in the order their sets give).
+/// Every kind of playback in `Animate`: motion (SMPL clips, keyframed clips, a glTF
+/// file's own clips) and morph weights.
 pub struct PlaybackPlugin;
 
 impl Plugin for PlaybackPlugin {
     fn build(&self, app: &mut App) {
-        app.add_plugins((smpl::SmplPlugin, keyframes::KeyframePlugin, node_clips::NodeClipPlugin, morphs::MorphPlugin));
+        app.add_plugins((motion::MotionPlugin, morphs::MorphPlugin));
     }
 }
 
@@ -89,13 +88,7 @@ impl Plugin for RigCorePlugin {
         )
         .configure_sets(
             PostUpdate,
-            (
-                AnimateSteps::Document,
-                AnimateSteps::Smpl,
-                AnimateSteps::Keyframes,
-                AnimateSteps::NodeClips,
-                AnimateSteps::Morphs,
-            )
+            (AnimateSteps::Document, AnimateSteps::Motion, AnimateSteps::Morphs)
                 .chain()
                 .in_set(MarionetteSystems::Animate),
         )

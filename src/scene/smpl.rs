@@ -1,16 +1,16 @@
 //! SMPL characters in the ECS: live shape (β) and clip playback with a second clip blended
-//! in; used by the editor and the headless renderer alike. Scene files keep β, clips, time.
+//! in (posed by [`crate::scene::motion`]); used by the editor and the headless renderer
+//! alike. Scene files keep β, clips, time.
 
 use std::path::PathBuf;
 use std::sync::Arc;
 
 use bevy::prelude::*;
 
+use crate::document::motion::{Clock, Clocked, SmplMotion};
 use crate::formats::scene::SmplDoc;
-use crate::rig::playback::{Clock, Span};
 use crate::rig::smpl::{Clip, SmplModel};
-use crate::scene::playhead::{Playhead, advance_playheads};
-use crate::scene::{Character, JointPose, PoseDirty};
+use crate::scene::{Character, PoseDirty};
 
 pub use crate::rig::smpl::CLIP_FPS;
 
@@ -51,42 +51,21 @@ impl SmplCharacter {
     pub fn clip_frames(&self) -> usize {
         self.clip().map_or(0, Clip::frame_count)
     }
-}
 
-/// Its clock runs in frames, at [`CLIP_FPS`] times its speed; it loops through the step
-/// from the last frame back to the first.
-impl Playhead for SmplCharacter {
-    fn clock(&self) -> Clock {
-        let s = &self.state;
-        Clock { time: s.time, playing: s.playing, speed: s.speed * CLIP_FPS, looping: s.looping }
-    }
-
-    fn set_clock(&mut self, clock: Clock) {
-        (self.state.time, self.state.playing) = (clock.time, clock.playing);
-    }
-
-    fn span(&self) -> Option<Span> {
-        Some(self.clip_frames()).filter(|&n| n > 0).map(Span::frames)
-    }
-}
-
-/// SMPL bodies: β reshaping and clip playback.
-pub struct SmplPlugin;
-
-impl Plugin for SmplPlugin {
-    fn build(&self, app: &mut App) {
-        app.add_systems(
-            PostUpdate,
-            (advance_playheads::<SmplCharacter>, reshape_bodies, pose_from_clips)
-                .chain()
-                .in_set(super::AnimateSteps::Smpl),
-        );
+    /// What it plays, for the motion service: its clip, the clip blended in, upright or
+    /// not, on its clock; none without a clip.
+    pub fn motion(&self) -> Option<(SmplMotion<'_>, Clock)> {
+        let blend = self.blend_clip().map(|k| (k, self.state.blend));
+        let motion = SmplMotion { clip: self.clip()?, blend, upright: self.state.upright };
+        Some((motion, self.state.clock()))
     }
 }
 
 /// Rebuilds the shaped mesh, skeleton and inverse binds when β changed (writes
 /// `Character`'s asset and `PoseDirty`; the bind pass, matrix stack and skinning follow).
-fn reshape_bodies(mut bodies: Query<(&mut SmplCharacter, &mut Character, &mut PoseDirty), Changed<SmplCharacter>>) {
+pub(super) fn reshape_bodies(
+    mut bodies: Query<(&mut SmplCharacter, &mut Character, &mut PoseDirty), Changed<SmplCharacter>>,
+) {
     for (mut body, mut character, mut dirty) in &mut bodies {
         if same_shape(&body.built_betas, &body.state.betas)
             && character.asset.skin.bind_positions.len() == body.model.base_positions.len()
@@ -107,24 +86,4 @@ fn reshape_bodies(mut bodies: Query<(&mut SmplCharacter, &mut Character, &mut Po
 /// Whether two β lists give the same shape (missing coefficients are zero).
 fn same_shape(a: &[f32], b: &[f32]) -> bool {
     (0..a.len().max(b.len())).all(|i| a.get(i).unwrap_or(&0.0) == b.get(i).unwrap_or(&0.0))
-}
-
-/// Writes the clip pose (blended with the second clip) into the joints when the clip,
-/// time or blend changed (writes `JointPose`). A paused body keeps slider edits.
-fn pose_from_clips(
-    bodies: Query<(&SmplCharacter, &Character), Changed<SmplCharacter>>,
-    mut poses: Query<&mut JointPose>,
-) {
-    let mut sampler = crate::rig::smpl::BlendSampler::default();
-    for (body, character) in &bodies {
-        let Some(clip) = body.clip() else { continue };
-        let state = &body.state;
-        let blend = body.blend_clip().map(|other| (other, state.blend));
-        let rotations = sampler.playback_pose(clip, blend, state.time, state.looping, state.upright);
-        for (&e, rotation) in character.joints.iter().zip(rotations) {
-            if let Ok(mut pose) = poses.get_mut(e) {
-                pose.set_if_neq(JointPose(rotation));
-            }
-        }
-    }
 }

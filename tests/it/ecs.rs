@@ -327,7 +327,8 @@ fn ecs_matches_the_kernel(file: &str) -> usize {
 fn smpl_body_in_the_ecs_matches_the_poser() {
     use marionette::cli::smpl_tasks::{FrameSpec, SmplPoser, exercise_beta};
     use marionette::formats::scene::SmplDoc;
-    use marionette::scene::smpl::{SmplCharacter, SmplPlugin};
+    use marionette::scene::PlaybackPlugin;
+    use marionette::scene::smpl::SmplCharacter;
     let data = data_dir();
     let dir = data.join("smpl");
     let (model, _) = marionette::formats::smpl::load_smpl_dir(&dir).unwrap();
@@ -343,12 +344,12 @@ fn smpl_body_in_the_ecs_matches_the_poser() {
     );
     let asset = Arc::new(model.asset("smpl", &[]).unwrap());
     let mut app = app();
-    app.add_plugins(SmplPlugin);
+    app.add_plugins(PlaybackPlugin);
     let character = spawn(&mut app, asset.clone(), Placement::default());
     let doc = SmplDoc {
         betas: exercise_beta(2).to_vec(),
         clip: Some("c".into()),
-        time: 42.0,
+        time: 42.0 / 30.0,
         upright: false,
         ..SmplDoc::default()
     };

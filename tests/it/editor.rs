@@ -608,3 +608,40 @@ fn the_fast_viewport_is_fast_only_while_the_view_is_worked() {
     assert_eq!(fast_size(bevy::math::UVec2::new(1000, 800), 0.4), bevy::math::UVec2::new(400, 320));
     assert_eq!(fast_size(bevy::math::UVec2::new(1, 1), 0.25), bevy::math::UVec2::ONE);
 }
+
+/// "Render frames…" renders in the editor's own process, on a thread, through the same
+/// render as `marionette render --from --to --fps`: every frame written, the progress
+/// counted, the scene set aside removed.
+#[test]
+fn the_editor_renders_frames_in_its_own_process() {
+    use marionette::editor::present::frames_job::{FramesJob, FramesRequest};
+    use marionette::formats::scene::{CharacterDoc, SceneDoc, ShotDoc, SourceDoc};
+    let dir = scratch("frames-in-process");
+    let puppet = CharacterDoc::new(SourceDoc::Embedded("puppet".into()), "p");
+    let doc = SceneDoc {
+        characters: vec![puppet],
+        shot: ShotDoc { width: 64, height: 48, samples: 1 },
+        ..SceneDoc::default()
+    };
+    let pattern = dir.join("f_%02d.png").display().to_string();
+    let request = FramesRequest { from: 0.0, to: 0.25, fps: 4.0, turntable: None, pattern, with_data: false };
+    let mut job = FramesJob::default();
+    job.request = request;
+    job.start(&doc).unwrap();
+    assert!(job.running());
+    let started = std::time::Instant::now();
+    let ended = loop {
+        if let Some(ended) = job.finished() {
+            break ended;
+        }
+        assert!(started.elapsed().as_secs() < 240, "the frames took over 240 s");
+        std::thread::sleep(std::time::Duration::from_millis(50));
+    };
+    ended.unwrap();
+    assert_eq!(job.progress(), (2, 2));
+    for n in 0..2 {
+        let picture = image::open(dir.join(format!("f_{n:02}.png"))).unwrap();
+        assert_eq!((picture.width(), picture.height()), (64, 48));
+    }
+    assert!(!job.running());
+}

@@ -274,7 +274,7 @@ fn smpl_shape_and_clip_edits_undo_and_redo() {
     let shape = |app: &App| app.world().get::<Character>(e).unwrap().asset.skin.bind_positions.clone();
     let start = (state(&mut app), shape(&app));
     let clip = marionette::formats::smpl::clip_paths(&dir)[0].file_name().unwrap().to_string_lossy().into_owned();
-    let wanted = SmplDoc { betas: vec![2.0, -1.0], clip: Some(clip), time: 12.0, ..SmplDoc::default() };
+    let wanted = SmplDoc { betas: vec![2.0, -1.0], clip: Some(clip), time: 12.0 / 30.0, ..SmplDoc::default() };
     edit(&mut app, Edit::from(kinds::Smpl { character: CharacterId(1), state: wanted.clone() }));
     assert_eq!(app.world().get::<SmplCharacter>(e).unwrap().state, wanted);
     let end = (state(&mut app), shape(&app));

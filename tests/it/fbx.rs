@@ -247,10 +247,10 @@ fn clips_are_numbered_alike_and_a_missing_clip_fails_naming_the_clips() {
         let doc = clip(&[path], "0").unwrap();
         assert_eq!(doc.characters[0].playback.as_ref().unwrap().clip.as_ref(), Some(&parts[0].clips[0].name));
     }
-    let e = clip(&[&fbx, &glb], "7").unwrap_err();
+    let e = clip(&[&fbx, &glb], "7").unwrap_err().to_string();
     assert!(e.contains("one_key.fbx: no clip `7` (its clips: 0 `Scene`)"), "{e}");
     // A file of several whose clips it names one of, and one whose it names none of.
-    let e = clip(&[&fbx, &glb], "Scene").unwrap_err();
+    let e = clip(&[&fbx, &glb], "Scene").unwrap_err().to_string();
     assert!(
         e.contains("blender_pair.glb: no clip `Scene` (its clips: 0 `walker_rig_action`, 1 `waver_rig_action`)"),
         "{e}"

@@ -673,8 +673,9 @@ fn an_smpl_body_with_a_blend_clip_upright_goes_out_as_the_editor_plays_it() {
         let body = CharacterDoc { smpl: Some(smpl), ..CharacterDoc::new(SourceDoc::File(dir.clone()), "b") };
         SceneDoc { characters: vec![body], ..SceneDoc::default() }
     };
-    // The editor's playback, paused at `time` frames.
-    let played = |time: f32| -> Vec<Quat> {
+    // The editor's playback, paused at `frames` (the clip's frames, 30 a second).
+    let played = |frames: f32| -> Vec<Quat> {
+        let time = frames / 30.0;
         let mut app = crate::edits::scene_app();
         *app.world_mut().resource_mut::<PendingScene>() = PendingScene { doc: Some(doc_at(time)), frame: false };
         app.update();
@@ -723,7 +724,7 @@ fn an_smpl_body_with_a_blend_clip_upright_goes_out_as_the_editor_plays_it() {
     // A still export paused between frames stands as the paused editor does.
     let between = 12.6;
     let (json, bin) =
-        chunks(&marionette::document::export::scene_glb(&doc_at(between), GltfMesh::Skinned, false).unwrap());
+        chunks(&marionette::document::export::scene_glb(&doc_at(between / 30.0), GltfMesh::Skinned, false).unwrap());
     let _ = bin;
     let expected = played(between);
     for (j, &node) in joint_nodes.iter().enumerate() {

@@ -26,6 +26,7 @@ mod ik;
 mod kernel;
 mod khronos;
 mod layers;
+mod motion;
 mod order;
 mod poses;
 mod props;

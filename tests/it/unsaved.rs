@@ -179,7 +179,9 @@ fn a_killed_editor_leaves_a_recovery_file_that_holds_its_pose_and_renders() {
     let mut found = None;
     for _ in 0..180 {
         std::thread::sleep(Duration::from_millis(500));
-        found = std::fs::read_dir(&recovery).ok().and_then(|mut d| d.next()).and_then(Result::ok).map(|e| e.path());
+        // The recovery file, not the temporary file it is written through.
+        let whole = |p: &std::path::PathBuf| !p.to_string_lossy().ends_with(".tmp");
+        found = std::fs::read_dir(&recovery).ok().and_then(|d| d.flatten().map(|e| e.path()).find(whole));
         if found.is_some() || editor.try_wait().unwrap().is_some() {
             break;
         }

@@ -26,20 +26,25 @@ fn crowd_member(i: usize, n: usize, source: SourceDoc, spacing: f32, lift: f32, 
 
 /// `n` SMPL bodies, each with its own β and clip (every third blends a second clip), all
 /// playing from different times.
-pub fn smpl_crowd(dir: &Path, n: usize) -> Result<SceneDoc, String> {
+/// A folder without SMPL clips to play.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[error("{}: expected SMPL clips (smpl_quaternions_*.txt), found none", .0.display())]
+pub struct NoClips(pub std::path::PathBuf);
+
+pub fn smpl_crowd(dir: &Path, n: usize) -> Result<SceneDoc, NoClips> {
     let clips: Vec<String> = marionette_formats::smpl::clip_paths(dir)
         .iter()
         .filter_map(|p| Some(p.file_name()?.to_string_lossy().into_owned()))
         .collect();
     if clips.is_empty() {
-        return Err(format!("{}: expected SMPL clips (smpl_quaternions_*.txt), found none", dir.display()));
+        return Err(NoClips(dir.to_owned()));
     }
     let characters = (0..n)
         .map(|i| {
             let state = SmplDoc {
                 betas: (0..10).map(|k| (((i * 7 + k * 3) % 11) as f32 - 5.0) * 0.3).collect(),
                 clip: Some(clips[i % clips.len()].clone()),
-                time: (i * 13 % 60) as f32,
+                time: (i * 13 % 60) as f32 / marionette_rig::smpl::CLIP_FPS,
                 playing: true,
                 blend_clip: (i % 3 == 0).then(|| clips[(i + 1) % clips.len()].clone()),
                 blend: if i % 3 == 0 { 0.5 } else { 0.0 },

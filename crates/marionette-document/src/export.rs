@@ -7,7 +7,10 @@ use marionette_formats::gltf::{GltfCharacter, GltfMesh, Motion, write_glb};
 use marionette_formats::limits::MAX_SAMPLED_FRAMES;
 use marionette_formats::scene::{CharacterDoc, SceneDoc};
 use marionette_rig::fk::RestOverride;
-use marionette_rig::node_clip::{NodeClip, NodePose, pose_mix};
+use marionette_rig::node_clip::NodeClip;
+
+use crate::motion::{CharacterMotion, MotionPose};
+use crate::retarget::FPS;
 
 /// The name a clip from `file` goes out under: the file's stem, else `otherwise`.
 pub fn clip_name(file: &std::path::Path, otherwise: &str) -> String {
@@ -23,16 +26,21 @@ pub fn keyframes_as_splines(
     skeleton: &marionette_rig::Skeleton,
     rest: &[marionette_rig::JointRotation],
     name: &str,
-) -> Result<NodeClip, String> {
-    marionette_rig::keyframe_splines::spline_clip(clip, skeleton, rest, name, MAX_SAMPLED_FRAMES)
-        .map_err(|e| format!("{e} (MAX_SAMPLED_FRAMES)"))
+) -> Result<NodeClip, TooManyKeys> {
+    marionette_rig::keyframe_splines::spline_clip(clip, skeleton, rest, name, MAX_SAMPLED_FRAMES).map_err(TooManyKeys)
 }
+
+/// A keyframed clip with more keys a track than an export writes.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[error("{0} (MAX_SAMPLED_FRAMES)")]
+pub struct TooManyKeys(pub String);
 
 /// A character's pose, motion and keyed rest for export.
 struct Posed {
     /// Where it stands (its document's placement, or where its holder carries it).
     placement: marionette_formats::scene::PlacementDoc,
-    pose: Vec<marionette_rig::JointRotation>,
+    /// Its pose now, from the motion service.
+    now: MotionPose,
     root: glam::Vec3,
     /// Rest offsets and scales a clip keys (the root's offset is `root`).
     rest: Option<(Vec<glam::Vec3>, Vec<glam::Vec3>)>,
@@ -41,8 +49,6 @@ struct Posed {
     motion_name: String,
     /// The source's own clips, written key for key (with `animated`).
     clips: std::sync::Arc<[marionette_rig::node_clip::NodeClip]>,
-    /// Its morph weights now: its document's, or as its clip keys them at its time.
-    weights: Vec<f32>,
 }
 
 /// Every character of a scene document as glTF: its shape, its pose, its clip (keyframes,
@@ -65,7 +71,7 @@ pub fn scene_glb_from(
         .map(|(c, asset, posed)| GltfCharacter {
             name: &c.name,
             asset,
-            pose: &posed.pose,
+            pose: &posed.now.rotations,
             root: posed.root,
             rest: posed.rest_override(),
             placement: posed.placement,
@@ -73,7 +79,7 @@ pub fn scene_glb_from(
             motion: posed.motion.clone(),
             motion_name: posed.motion_name.clone(),
             clips: &posed.clips,
-            morph_weights: &posed.weights,
+            morph_weights: &posed.now.weights,
         })
         .collect();
     write_glb(&characters, mesh).map_err(|e| FormatError::other(std::path::Path::new("the exported scene"), e))
@@ -96,14 +102,14 @@ pub fn scene_mesh_from(
     for (c, asset, posed) in load_posed(library, doc, false)? {
         let first = positions.len() as u32;
         let mut asset = asset;
-        if posed.weights.iter().any(|&w| w != 0.0) {
-            std::sync::Arc::make_mut(&mut asset).skin.bind_positions = asset.morphed_positions(&posed.weights);
+        if posed.now.weights.iter().any(|&w| w != 0.0) {
+            std::sync::Arc::make_mut(&mut asset).skin.bind_positions = asset.morphed_positions(&posed.now.weights);
         }
-        let world = posed.placement.to_mat4() * posed.root_shift(&asset);
+        let world = posed.placement.to_mat4() * posed.now.origin(&asset.skeleton);
         positions.extend(crate::posing::posed_positions_with_rest(
             &asset,
-            &posed.pose,
-            posed.rest_override(),
+            &posed.now.rotations,
+            posed.now.rest_override(),
             world,
             c.skinning,
         ));
@@ -138,20 +144,38 @@ fn load_posed<'a>(
     Ok(loaded)
 }
 
-/// A character's still pose now — its document's pose under its clips at their times — and
-/// how far its clip has moved its root from the skeleton's rest offset (model space).
+/// A character's still pose now — its document's pose under its motion at its clocks'
+/// times ([`crate::motion`]) — and how far its motion has moved its root from the
+/// skeleton's rest offset (model space).
 pub fn still_pose(
     library: &mut super::AssetLibrary,
     scene: &SceneDoc,
     c: &CharacterDoc,
     asset: &marionette_rig::CharacterAsset,
 ) -> Result<(Vec<marionette_rig::JointRotation>, glam::Vec3), FormatError> {
-    let posed = posed(library, scene, c, asset, false)?;
-    Ok((posed.pose, posed.root - asset.skeleton.joint(0).rest_offset))
+    let (motion, _) = character_motion(library, scene, c, asset)?;
+    let now = motion.pose_now(&asset.skeleton);
+    let root = now.root_translation(&asset.skeleton);
+    Ok((now.rotations, root - asset.skeleton.joint(0).rest_offset))
 }
 
-/// A character's pose from its document and clips at their times, and (with `animated`)
-/// its clip sampled over its length.
+/// What `c` plays in `scene` (its keyframed clip worked out: its keys, its file's, or the
+/// motion it retargets), and the pose keys that name no joint.
+pub fn character_motion(
+    library: &mut super::AssetLibrary,
+    scene: &SceneDoc,
+    c: &CharacterDoc,
+    asset: &marionette_rig::CharacterAsset,
+) -> Result<(CharacterMotion, Vec<String>), FormatError> {
+    let keyframes = match &c.anim {
+        Some(anim) => Some(super::retarget::anim_clip(library, scene, c, asset, anim)?),
+        None => None,
+    };
+    CharacterMotion::of(library, c, asset, keyframes)
+}
+
+/// A character's pose from its document and its motion at its clocks' times, and (with
+/// `animated`) its clips to write as animations.
 fn posed(
     library: &mut super::AssetLibrary,
     scene: &SceneDoc,
@@ -160,113 +184,67 @@ fn posed(
     animated: bool,
 ) -> Result<Posed, FormatError> {
     let skeleton = &asset.skeleton;
-    let (pose, notes) = super::scenes::pose_from_doc(asset, c);
+    let (motion, notes) = character_motion(library, scene, c, asset)?;
     notes.iter().for_each(|n| eprintln!("warning: {n}"));
+    let now = motion.pose_now(skeleton);
+    let root = now.root_translation(skeleton);
+    let rest = now.rest.as_ref().map(|(offsets, scales)| {
+        let mut offsets = offsets.clone();
+        offsets[0] = skeleton.joint(0).rest_offset;
+        (offsets, scales.clone())
+    });
     let mut posed = Posed {
         placement: c.placement,
-        pose,
-        root: skeleton.joint(0).rest_offset,
-        rest: None,
+        now,
+        root,
+        rest,
         motion: None,
         motion_name: String::new(),
         clips: std::sync::Arc::new([]),
-        // One weight per morph target: the document's, zero where it sets none.
-        weights: (0..asset.morphs.len()).map(|k| c.morphs.get(k).copied().unwrap_or(0.0)).collect(),
     };
-    if let Some(anim) = &c.anim {
-        let clip = super::retarget::anim_clip(library, scene, c, asset, anim)?;
-        let clip = clip.retargeted(skeleton, &anim.names);
-        if animated {
-            let clip_file = if anim.file.as_os_str().is_empty() { std::path::Path::new(&c.name) } else { &anim.file };
-            let splines = keyframes_as_splines(&clip, skeleton, &posed.pose, &clip_name(clip_file, &c.name))
-                .map_err(|e| FormatError::other(clip_file, e))?;
-            posed.clips = std::sync::Arc::new([splines]);
-        }
-        (posed.root, posed.pose) = clip.pose_at(skeleton, anim.time, &posed.pose);
+    if !animated {
+        return Ok(posed);
+    }
+    if let (Some(anim), Some(clip)) = (&c.anim, motion.keyframes()) {
+        let clip_file = if anim.file.as_os_str().is_empty() { std::path::Path::new(&c.name) } else { &anim.file };
+        let splines = keyframes_as_splines(clip, skeleton, motion.still(), &clip_name(clip_file, &c.name))
+            .map_err(|e| FormatError::other(clip_file, e))?;
+        posed.clips = std::sync::Arc::new([splines]);
     }
     if let Some(part) = library.part_of_source(&c.source) {
-        if let Some(playback) = &c.playback {
-            play_node_clip(&mut posed, skeleton, &part.clips, playback)
-                .map_err(|e| FormatError::other(c.source.path().unwrap_or(std::path::Path::new(&c.name)), e))?;
-        }
-        if animated {
-            // Keyframes on a part whose clips key its root under folded nodes go out in
-            // their frame, which the export writes above the root.
-            let frame = part.clips.first().map_or(glam::Mat4::IDENTITY, |k| k.root_parent);
-            let keyframes = posed.clips.iter().map(|k| marionette_rig::keyframe_splines::reframed(k.clone(), frame));
-            posed.clips = part.clips.iter().cloned().chain(keyframes).collect();
-        }
+        // Keyframes on a part whose clips key its root under folded nodes go out in
+        // their frame, which the export writes above the root.
+        let frame = part.clips.first().map_or(glam::Mat4::IDENTITY, |k| k.root_parent);
+        let keyframes = posed.clips.iter().map(|k| marionette_rig::keyframe_splines::reframed(k.clone(), frame));
+        posed.clips = part.clips.iter().cloned().chain(keyframes).collect();
     }
-    // An SMPL body stands in its clip's pose at its time, as the editor shows it.
-    if let Some(pose) = super::retarget::smpl_pose_now(library, c, skeleton)? {
-        posed.pose = pose;
-    }
-    if animated && let Some((name, frames)) = super::retarget::smpl_frames(library, c, skeleton)? {
-        (posed.motion_name, posed.motion) = (smpl_clip_name(&name), Some(smpl_motion(&frames)));
+    if let Some(name) = c.smpl.as_ref().and_then(|s| s.clip.as_ref()).filter(|_| motion.has_smpl()) {
+        let frames = crate::motion::sampled_frames(skeleton, motion.still(), &motion.smpl_only(), FPS, "export")
+            .map_err(|e| FormatError::other(std::path::Path::new(&c.name), e))?;
+        (posed.motion_name, posed.motion) = (smpl_clip_name(name), Some(smpl_motion(&frames)));
     }
     Ok(posed)
 }
 
 impl Posed {
-    /// The rest offsets and scales its clip keys, for the matrix stack.
+    /// The rest offsets and scales its clip keys, for the glTF writer (the root's is `root`).
     fn rest_override(&self) -> RestOverride<'_> {
         self.rest.as_ref().map_or_else(Default::default, |(o, s)| RestOverride { offsets: Some(o), scales: Some(s) })
-    }
-
-    /// Model space as the root's translation moves it from its rest offset.
-    fn root_shift(&self, asset: &marionette_rig::CharacterAsset) -> glam::Mat4 {
-        glam::Mat4::from_translation(self.root - asset.skeleton.joint(0).rest_offset)
     }
 
     /// The world transform of the joint `key` names (a pose key), posed.
     fn joint_world(&self, asset: &marionette_rig::CharacterAsset, key: &str) -> Option<glam::Mat4> {
         let skeleton = &asset.skeleton;
         let joint = marionette_formats::scene::joint_of_pose_key(skeleton, key)?;
-        let mut matrices = vec![glam::Mat4::IDENTITY; skeleton.len()];
-        let origin = self.placement.to_mat4() * self.root_shift(asset);
-        marionette_rig::fk::forward_kinematics_with_rest(
-            skeleton,
-            &self.pose,
-            self.rest_override(),
-            origin,
-            &mut matrices,
-        );
-        Some(matrices[joint])
+        Some(self.now.joint_to_world(skeleton, self.placement.to_mat4())[joint])
     }
-}
-
-/// A glTF clip's pose at the playback's time on `posed` (its keyed joints, root and rest).
-fn play_node_clip(
-    posed: &mut Posed,
-    skeleton: &marionette_rig::Skeleton,
-    clips: &[marionette_rig::node_clip::NodeClip],
-    playback: &marionette_formats::scene::PlaybackDoc,
-) -> Result<(), String> {
-    let find = |name: &Option<String>| clips.iter().find(|k| Some(&k.name) == name.as_ref());
-    let Some(clip) = find(&playback.clip) else { return Ok(()) };
-    let blend = find(&playback.blend_clip).map(|k| (k, playback.blend));
-    let now = pose_mix(skeleton, clip, blend, playback.time, &mut posed.pose);
-    posed.weights = marionette_rig::node_clip::weights_mix(&posed.weights, clip, blend, playback.time);
-    posed.root = now.offsets[0];
-    if clip.moves_rest() || blend.is_some_and(|(k, _)| k.moves_rest()) {
-        posed.rest = Some(rest_of(skeleton, &now));
-    }
-    Ok(())
-}
-
-/// A sampled pose's offsets (the root's left at the skeleton's, as `root` carries it) and
-/// scales.
-fn rest_of(skeleton: &marionette_rig::Skeleton, sample: &NodePose) -> (Vec<glam::Vec3>, Vec<glam::Vec3>) {
-    let mut offsets = sample.offsets.clone();
-    offsets[0] = skeleton.joint(0).rest_offset;
-    (offsets, sample.scales.clone())
 }
 
 /// An SMPL body's frames as a motion at its 30 frames per second.
 fn smpl_motion(frames: &[marionette_rig::retarget::Frame]) -> Motion {
     let mut motion = Motion::default();
     for (f, frame) in frames.iter().enumerate() {
-        motion.times.push(f as f32 / marionette_rig::smpl::CLIP_FPS);
+        motion.times.push(f as f32 / FPS);
         motion.poses.push(frame.pose.clone());
         motion.roots.push(frame.root);
     }

@@ -5,6 +5,25 @@ use std::path::{Path, PathBuf};
 
 use marionette_formats::limits::MAX_SAMPLED_FRAMES;
 
+/// A frame sequence, a frame pattern or a picture size that cannot be.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum FramesError {
+    #[error("expected --from at or before --to, found {from} and {to}")]
+    Order { from: f64, to: f64 },
+    #[error("expected --fps above 0, found {0}")]
+    Fps(f64),
+    #[error("expected --turntable above 0 seconds, found {0}")]
+    Turntable(f32),
+    #[error(
+        "{frames} frames from {from} s to {to} s at {fps} per second: more than the {MAX_SAMPLED_FRAMES} a render writes (MAX_SAMPLED_FRAMES)"
+    )]
+    TooMany { frames: f64, from: f64, to: f64, fps: f64 },
+    #[error("expected one %d or %04d in --out for the frame number, found {0}")]
+    Pattern(String),
+    #[error("{0}")]
+    Picture(String),
+}
+
 /// Frames from `from` to `to` seconds (both included where `to` falls on a frame) at `fps`
 /// frames per second; with `turntable`, the camera goes once round the scene every that
 /// many seconds.
@@ -20,24 +39,20 @@ impl FrameSequence {
     /// Each frame's time: `from + k / fps` up to `to` (a hair of rounding allowed, so that
     /// 0 to 1 at 10 fps is 11 frames). Refused when the times are not finite and in order,
     /// or there would be more than [`MAX_SAMPLED_FRAMES`].
-    pub fn times(&self) -> Result<Vec<f32>, String> {
+    pub fn times(&self) -> Result<Vec<f32>, FramesError> {
         let (from, to, fps) = (f64::from(self.from), f64::from(self.to), f64::from(self.fps));
         if !(from.is_finite() && to.is_finite() && from <= to) {
-            return Err(format!("expected --from at or before --to, found {from} and {to}"));
+            return Err(FramesError::Order { from, to });
         }
         if !(fps.is_finite() && fps > 0.0) {
-            return Err(format!("expected --fps above 0, found {fps}"));
+            return Err(FramesError::Fps(fps));
         }
         if let Some(seconds) = self.turntable.filter(|s| !(s.is_finite() && *s > 0.0)) {
-            return Err(format!("expected --turntable above 0 seconds, found {seconds}"));
+            return Err(FramesError::Turntable(seconds));
         }
         let last = ((to - from) * fps + 1e-6).floor();
         if last + 1.0 > MAX_SAMPLED_FRAMES as f64 {
-            return Err(format!(
-                "{} frames from {from} s to {to} s at {fps} per second: more than the {MAX_SAMPLED_FRAMES} a \
-                 render writes (MAX_SAMPLED_FRAMES)",
-                last + 1.0
-            ));
+            return Err(FramesError::TooMany { frames: last + 1.0, from, to, fps });
         }
         Ok((0..=last as usize).map(|k| (from + k as f64 / fps) as f32).collect())
     }
@@ -51,22 +66,22 @@ impl FrameSequence {
 
 /// The path of frame `n` from `pattern`: its one `%d` or `%0Nd` (N digits, zero-padded)
 /// replaced by `n`. Refused without exactly one.
-pub fn frame_path(pattern: &Path, n: usize) -> Result<PathBuf, String> {
+pub fn frame_path(pattern: &Path, n: usize) -> Result<PathBuf, FramesError> {
     let (start, width, tail) = pattern_parts(pattern)?;
     Ok(PathBuf::from(format!("{start}{n:0width$}{tail}")))
 }
 
 /// The file a whole sequence shares (its COCO file): the pattern with `all` for the frame
 /// number and `extension` for its own (`f_%04d.png`, `json` → `f_all.json`).
-pub fn sequence_path(pattern: &Path, extension: &str) -> Result<PathBuf, String> {
+pub fn sequence_path(pattern: &Path, extension: &str) -> Result<PathBuf, FramesError> {
     let (start, _, tail) = pattern_parts(pattern)?;
     Ok(PathBuf::from(format!("{start}all{tail}")).with_extension(extension))
 }
 
 /// A pattern's text before its `%d` (or `%04d`), the number's width, and the text after.
-fn pattern_parts(pattern: &Path) -> Result<(String, usize, String), String> {
+fn pattern_parts(pattern: &Path) -> Result<(String, usize, String), FramesError> {
     let text = pattern.to_string_lossy();
-    let expected = || format!("expected one %d or %04d in --out for the frame number, found {text}");
+    let expected = || FramesError::Pattern(text.to_string());
     let (start, rest) = text.split_once('%').ok_or_else(expected)?;
     let digits_end = rest.find('d').ok_or_else(expected)?;
     let width = &rest[..digits_end];
@@ -92,13 +107,13 @@ impl PictureRequest {
     pub fn resolved(
         self,
         shot: &marionette_formats::scene::ShotDoc,
-    ) -> Result<marionette_formats::scene::ShotDoc, String> {
+    ) -> Result<marionette_formats::scene::ShotDoc, FramesError> {
         let picture = marionette_formats::scene::ShotDoc {
             width: self.width.unwrap_or(shot.width),
             height: self.height.unwrap_or(shot.height),
             samples: self.samples.unwrap_or(shot.samples),
         };
-        picture.validate().map(|()| picture)
+        picture.validate().map(|()| picture).map_err(FramesError::Picture)
     }
 }
 
@@ -135,11 +150,11 @@ mod tests {
         assert_eq!(sequence_path(Path::new("out/f_%04d.png"), "json").unwrap(), Path::new("out/f_all.json"));
         for bad in ["frame.png", "f_%x.png", "f_%04d_%d.png", "f_%4d.png"] {
             let e = frame_path(Path::new(bad), 0).unwrap_err();
-            assert!(e.contains("expected one %d or %04d"), "{bad}: {e}");
+            assert!(e.to_string().contains("expected one %d or %04d"), "{bad}: {e}");
         }
         let backwards = FrameSequence { from: 2.0, to: 1.0, fps: 10.0, turntable: None };
-        assert!(backwards.times().unwrap_err().contains("--from at or before --to"));
+        assert!(backwards.times().unwrap_err().to_string().contains("--from at or before --to"));
         let endless = FrameSequence { from: 0.0, to: 1e30, fps: 10.0, turntable: None };
-        assert!(endless.times().unwrap_err().contains("MAX_SAMPLED_FRAMES"));
+        assert!(endless.times().unwrap_err().to_string().contains("MAX_SAMPLED_FRAMES"));
     }
 }

@@ -20,6 +20,51 @@ use marionette_rig::JointRotation;
 
 use super::AssetLibrary;
 
+/// A spec's field that cannot be: its path in the spec (`camera.fov`) and what was expected.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[error("{at}: {expected}")]
+pub struct SpecError {
+    pub at: String,
+    pub expected: String,
+}
+
+impl SpecError {
+    fn at(at: impl Into<String>, expected: String) -> Self {
+        Self { at: at.into(), expected }
+    }
+}
+
+/// What stops a data set: a shard that cannot be, a picture's scene, its files.
+#[derive(Debug, thiserror::Error)]
+pub enum GenerateError {
+    #[error("--shard: expected I/N with 0 ≤ I < N, found {0:?}")]
+    Shard(String),
+    #[error("{name}: expected a whole number, found {value:?}")]
+    Variable { name: &'static str, value: String },
+    #[error("SLURM_ARRAY_TASK_ID is set without SLURM_ARRAY_TASK_COUNT")]
+    NoSlurmCount,
+    #[error("SLURM_ARRAY_TASK_ID {id} (from {first}) is not one of {count} tasks")]
+    SlurmTask { id: usize, first: usize, count: usize },
+    #[error("JOB_COMPLETION_INDEX is set: give the job's completions with --shards N")]
+    NoShards,
+    #[error("JOB_COMPLETION_INDEX {index} is not below --shards {count}")]
+    CompletionIndex { index: usize, count: usize },
+    #[error("picture {k}: {message}")]
+    Picture { k: u64, message: String },
+    #[error(transparent)]
+    Format(#[from] FormatError),
+    #[error("{}: {source}", path.display())]
+    Io { path: PathBuf, source: std::io::Error },
+    #[error("{}: {source}", path.display())]
+    Json { path: PathBuf, source: serde_json::Error },
+    #[error("{}: {source} (was it generated with data?)", path.display())]
+    NoData { path: PathBuf, source: std::io::Error },
+    #[error("{}: no manifest-*.jsonl: nothing generated here", .0.display())]
+    NoManifest(PathBuf),
+    #[error(transparent)]
+    Write(#[from] super::annotate::write::WriteError),
+}
+
 /// The most characters a picture may hold (annotation ids are numbered within it).
 pub const MAX_PER_PICTURE: usize = 100;
 
@@ -126,24 +171,24 @@ impl Draw {
     }
 
     /// Refused when not finite or empty (a uniform range backwards, a negative spread).
-    fn check(&self, at: &str) -> Result<(), String> {
+    fn check(&self, at: &str) -> Result<(), SpecError> {
         let numbers = match *self {
             Draw::Fixed(v) => vec![v],
             Draw::Uniform(a, b) => {
                 if a > b {
-                    return Err(format!("{at}: an empty distribution: Uniform({a}, {b}) runs backwards"));
+                    return Err(SpecError::at(at, format!("an empty distribution: Uniform({a}, {b}) runs backwards")));
                 }
                 vec![a, b]
             }
             Draw::Normal { mean, sd } => {
                 if sd < 0.0 {
-                    return Err(format!("{at}: expected a spread of 0 or more, found sd: {sd}"));
+                    return Err(SpecError::at(at, format!("expected a spread of 0 or more, found sd: {sd}")));
                 }
                 vec![mean, sd]
             }
         };
         match numbers.iter().find(|v| !v.is_finite()) {
-            Some(v) => Err(format!("{at}: expected a finite number, found {v}")),
+            Some(v) => Err(SpecError::at(at, format!("expected a finite number, found {v}"))),
             None => Ok(()),
         }
     }
@@ -272,10 +317,15 @@ impl Spec {
     /// Every field: sizes within what a picture may be, distributions not empty, weights
     /// positive, the characters that may be asked for fitting in the area `spacing` apart,
     /// presets known, files there. The error names the field (`camera.fov`).
-    pub fn check(&self) -> Result<(), String> {
-        ShotDoc { width: self.width, height: self.height, samples: 1 }.validate()?;
+    pub fn check(&self) -> Result<(), SpecError> {
+        ShotDoc { width: self.width, height: self.height, samples: 1 }.validate().map_err(|e| {
+            match e.split_once(": ") {
+                Some((at, expected)) => SpecError::at(at, expected.to_owned()),
+                None => SpecError::at("shot", e),
+            }
+        })?;
         if self.count == 0 || self.count > MAX_PICTURES {
-            return Err(format!("count: expected 1 to {MAX_PICTURES} pictures, found {}", self.count));
+            return Err(SpecError::at("count", format!("expected 1 to {MAX_PICTURES} pictures, found {}", self.count)));
         }
         weights("characters", self.characters.iter().map(|c| c.weight))?;
         for (k, c) in self.characters.iter().enumerate() {
@@ -296,19 +346,25 @@ impl Spec {
         }
         let (least, most) = self.per_picture;
         if least > most || most == 0 || most > MAX_PER_PICTURE {
-            return Err(format!(
-                "per_picture: expected (least, most) with least ≤ most and 1 ≤ most ≤ {MAX_PER_PICTURE}, found \
+            return Err(SpecError::at(
+                "per_picture",
+                format!(
+                    "expected (least, most) with least ≤ most and 1 ≤ most ≤ {MAX_PER_PICTURE}, found \
                  ({least}, {most})"
+                ),
             ));
         }
         positive("area", self.area)?;
         positive("spacing", self.spacing)?;
         let fits = places(self.area, self.spacing);
         if most > fits {
-            return Err(format!(
-                "spacing: {most} characters {} m apart do not fit in a square of {} m (at most {fits}); widen \
+            return Err(SpecError::at(
+                "spacing",
+                format!(
+                    "{most} characters {} m apart do not fit in a square of {} m (at most {fits}); widen \
                  `area`, narrow `spacing` or ask for fewer in `per_picture`",
-                self.spacing, self.area
+                    self.spacing, self.area
+                ),
             ));
         }
         self.facing.check("facing")?;
@@ -320,20 +376,29 @@ impl Spec {
         camera.fov.check("camera.fov")?;
         let (low, high) = camera.fov.bounds();
         if low <= 0.0 || high >= 180.0 {
-            return Err(format!("camera.fov: expected degrees above 0 and below 180, found {low} to {high}"));
+            return Err(SpecError::at(
+                "camera.fov",
+                format!("expected degrees above 0 and below 180, found {low} to {high}"),
+            ));
         }
         if camera.distance.bounds().0 <= 0.0 {
-            return Err(format!("camera.distance: expected metres above 0, found {:?}", camera.distance));
+            return Err(SpecError::at(
+                "camera.distance",
+                format!("expected metres above 0, found {:?}", camera.distance),
+            ));
         }
         if !camera.look_at.is_finite() {
-            return Err(format!("camera.look_at: expected a finite number, found {}", camera.look_at));
+            return Err(SpecError::at("camera.look_at", format!("expected a finite number, found {}", camera.look_at)));
         }
         if self.lights.presets.is_empty() {
-            return Err("lights.presets: an empty distribution: name at least one preset".into());
+            return Err(SpecError::at("lights.presets", "an empty distribution: name at least one preset".into()));
         }
         for (k, name) in self.lights.presets.iter().enumerate() {
             if preset_named(name).is_none() {
-                return Err(format!("lights.presets[{k}]: expected default, studio, overcast or dusk, found {name:?}"));
+                return Err(SpecError::at(
+                    format!("lights.presets[{k}]"),
+                    format!("expected default, studio, overcast or dusk, found {name:?}"),
+                ));
             }
         }
         for (name, draw) in [("sun_azimuth", self.lights.sun_azimuth), ("sun_elevation", self.lights.sun_elevation)] {
@@ -351,14 +416,14 @@ impl Spec {
                 }
                 Background::Gradient { top, bottom } => {
                     if top.iter().chain(bottom).any(|v| !v.is_finite()) {
-                        return Err(format!("{at}: expected finite colours"));
+                        return Err(SpecError::at(at, "expected finite colours".into()));
                     }
                 }
                 Background::Images(folder) => {
                     if image_files(folder).is_empty() {
-                        return Err(format!(
-                            "{at}: an empty distribution: no PNG or JPEG pictures in {}",
-                            folder.display()
+                        return Err(SpecError::at(
+                            at,
+                            format!("an empty distribution: no PNG or JPEG pictures in {}", folder.display()),
                         ));
                     }
                 }
@@ -380,25 +445,29 @@ impl Spec {
     }
 }
 
-fn positive(at: &str, v: f32) -> Result<(), String> {
-    if v.is_finite() && v > 0.0 { Ok(()) } else { Err(format!("{at}: expected a number above 0, found {v}")) }
+fn positive(at: &str, v: f32) -> Result<(), SpecError> {
+    if v.is_finite() && v > 0.0 {
+        Ok(())
+    } else {
+        Err(SpecError::at(at, format!("expected a number above 0, found {v}")))
+    }
 }
 
-fn exists(at: &str, path: &Path) -> Result<(), String> {
-    if path.exists() { Ok(()) } else { Err(format!("{at}: {}: no such file or folder", path.display())) }
+fn exists(at: &str, path: &Path) -> Result<(), SpecError> {
+    if path.exists() { Ok(()) } else { Err(SpecError::at(at, format!("{}: no such file or folder", path.display()))) }
 }
 
 /// Weights to draw by: at least one, each finite and 0 or more, not all 0.
-fn weights(at: &str, weights: impl Iterator<Item = f32>) -> Result<(), String> {
+fn weights(at: &str, weights: impl Iterator<Item = f32>) -> Result<(), SpecError> {
     let weights: Vec<f32> = weights.collect();
     if weights.is_empty() {
-        return Err(format!("{at}: an empty distribution: list at least one"));
+        return Err(SpecError::at(at, "an empty distribution: list at least one".into()));
     }
     if let Some(w) = weights.iter().find(|w| !(w.is_finite() && **w >= 0.0)) {
-        return Err(format!("{at}: expected weights of 0 or more, found {w}"));
+        return Err(SpecError::at(at, format!("expected weights of 0 or more, found {w}")));
     }
     if weights.iter().all(|&w| w == 0.0) {
-        return Err(format!("{at}: an empty distribution: every weight is 0"));
+        return Err(SpecError::at(at, "an empty distribution: every weight is 0".into()));
     }
     Ok(())
 }
@@ -493,7 +562,7 @@ impl Rng {
 /// The scene of picture `k`: its characters drawn, posed and stood on the floor `spacing`
 /// apart in the area; the camera looking at their centre; the lights and background drawn;
 /// the picture's size. Also the background picture to put behind it, if one was drawn.
-pub fn scene_of(spec: &Spec, library: &mut AssetLibrary, k: u64) -> Result<(SceneDoc, Option<PathBuf>), String> {
+pub fn scene_of(spec: &Spec, library: &mut AssetLibrary, k: u64) -> Result<(SceneDoc, Option<PathBuf>), GenerateError> {
     let mut rng = Rng::of_picture(spec.seed, k);
     let (least, most) = spec.per_picture;
     let n = least + rng.below(most - least + 1);
@@ -552,7 +621,7 @@ pub fn scene_of(spec: &Spec, library: &mut AssetLibrary, k: u64) -> Result<(Scen
         shot: ShotDoc { width: spec.width, height: spec.height, samples: 1 },
         ..SceneDoc::default()
     };
-    scene.validate().map_err(|e| format!("picture {k}: {e}"))?;
+    scene.validate().map_err(|message| GenerateError::Picture { k, message })?;
     Ok((scene, backdrop))
 }
 
@@ -587,7 +656,7 @@ fn character(
     rng: &mut Rng,
     time: f32,
     name: String,
-) -> Result<CharacterDoc, String> {
+) -> Result<CharacterDoc, GenerateError> {
     Ok(match who {
         Who::Puppet => {
             let mut c = CharacterDoc::new(SourceDoc::Embedded("puppet".into()), name);
@@ -610,7 +679,7 @@ fn character(
         }
         Who::File { path, anim } => {
             let source = SourceDoc::File(path.clone());
-            let asset = library.load(&source).map_err(|e| e.to_string())?;
+            let asset = library.load(&source)?;
             let mut c = CharacterDoc { name, ..library.new_character_doc(source.clone(), &asset) };
             if let Some(file) = anim {
                 c.anim = Some(marionette_formats::scene::AnimDoc::of(file.clone()));
@@ -630,12 +699,7 @@ fn character(
             let clip = (!clips.is_empty())
                 .then(|| clips[rng.below(clips.len())].file_name().map(|n| n.to_string_lossy().into_owned()))
                 .flatten();
-            let smpl = SmplDoc {
-                betas: (0..10).map(|_| betas.draw(rng)).collect(),
-                time: time * marionette_rig::smpl::CLIP_FPS,
-                clip,
-                ..SmplDoc::default()
-            };
+            let smpl = SmplDoc { betas: (0..10).map(|_| betas.draw(rng)).collect(), time, clip, ..SmplDoc::default() };
             CharacterDoc { smpl: Some(smpl), ..CharacterDoc::new(SourceDoc::File(folder.clone()), name) }
         }
     })
@@ -644,9 +708,9 @@ fn character(
 /// Moves `c` so that its skin, posed, is centred over `spot` (the middle of its box seen
 /// from above: a clip that has carried the body away from its origin is brought back) and
 /// its lowest point touches the floor.
-fn stand_at(library: &mut AssetLibrary, c: &mut CharacterDoc, spot: Vec3) -> Result<(), String> {
+fn stand_at(library: &mut AssetLibrary, c: &mut CharacterDoc, spot: Vec3) -> Result<(), GenerateError> {
     let alone = SceneDoc { characters: vec![c.clone()], ..SceneDoc::default() };
-    let (positions, _) = super::export::scene_mesh_from(library, &alone).map_err(|e| e.to_string())?;
+    let (positions, _) = super::export::scene_mesh_from(library, &alone)?;
     let (lo, hi) = super::layout::union(positions.iter().map(|&p| (p, p)));
     if lo.is_finite() && hi.is_finite() {
         let middle = (lo + hi) / 2.0;
@@ -666,8 +730,8 @@ impl Shard {
     pub const WHOLE: Shard = Shard { index: 0, count: 1 };
 
     /// `I/N` (I from 0).
-    pub fn parse(text: &str) -> Result<Shard, String> {
-        let bad = || format!("--shard: expected I/N with 0 ≤ I < N, found {text:?}");
+    pub fn parse(text: &str) -> Result<Shard, GenerateError> {
+        let bad = || GenerateError::Shard(text.to_owned());
         let (i, n) = text.split_once('/').ok_or_else(bad)?;
         let (index, count) = (i.trim().parse().map_err(|_| bad())?, n.trim().parse().map_err(|_| bad())?);
         if count == 0 || index >= count {
@@ -684,26 +748,25 @@ impl Shard {
         flag: Option<&str>,
         shards: Option<usize>,
         env: impl Fn(&str) -> Option<String>,
-    ) -> Result<Shard, String> {
+    ) -> Result<Shard, GenerateError> {
         if let Some(text) = flag {
             return Shard::parse(text);
         }
-        let number = |name: &str| -> Result<Option<usize>, String> {
+        let number = |name: &'static str| -> Result<Option<usize>, GenerateError> {
             env(name)
-                .map(|v| v.trim().parse::<usize>().map_err(|_| format!("{name}: expected a whole number, found {v:?}")))
+                .map(|v| v.trim().parse::<usize>().map_err(|_| GenerateError::Variable { name, value: v.clone() }))
                 .transpose()
         };
         if let Some(id) = number("SLURM_ARRAY_TASK_ID")? {
-            let count =
-                number("SLURM_ARRAY_TASK_COUNT")?.ok_or("SLURM_ARRAY_TASK_ID is set without SLURM_ARRAY_TASK_COUNT")?;
+            let count = number("SLURM_ARRAY_TASK_COUNT")?.ok_or(GenerateError::NoSlurmCount)?;
             let first = number("SLURM_ARRAY_TASK_MIN")?.unwrap_or(0);
             return Shard::parse(&format!("{}/{count}", id.wrapping_sub(first)))
-                .map_err(|_| format!("SLURM_ARRAY_TASK_ID {id} (from {first}) is not one of {count} tasks"));
+                .map_err(|_| GenerateError::SlurmTask { id, first, count });
         }
         if let Some(index) = number("JOB_COMPLETION_INDEX")? {
-            let count = shards.ok_or("JOB_COMPLETION_INDEX is set: give the job's completions with --shards N")?;
+            let count = shards.ok_or(GenerateError::NoShards)?;
             return Shard::parse(&format!("{index}/{count}"))
-                .map_err(|_| format!("JOB_COMPLETION_INDEX {index} is not below --shards {count}"));
+                .map_err(|_| GenerateError::CompletionIndex { index, count });
         }
         Ok(Shard::WHOLE)
     }
@@ -756,10 +819,10 @@ pub fn manifest_lines(dir: &Path) -> Vec<ManifestLine> {
 
 /// The manifest line of picture `k`: the files in `dir` named `STEM.*` (its picture, data and
 /// scene), with their digests.
-pub fn manifest_line(dir: &Path, k: usize) -> Result<ManifestLine, String> {
+pub fn manifest_line(dir: &Path, k: usize) -> Result<ManifestLine, GenerateError> {
     let stem = picture_stem(k);
     let mut names: Vec<String> = std::fs::read_dir(dir)
-        .map_err(|e| format!("{}: {e}", dir.display()))?
+        .map_err(|source| GenerateError::Io { path: dir.to_owned(), source })?
         .flatten()
         .filter_map(|e| e.file_name().to_str().map(str::to_string))
         .filter(|n| n.strip_prefix(&stem).is_some_and(|rest| rest.starts_with('.')) && !n.contains(".tmp"))
@@ -767,22 +830,22 @@ pub fn manifest_line(dir: &Path, k: usize) -> Result<ManifestLine, String> {
     names.sort();
     let files = names
         .into_iter()
-        .map(|n| Ok((sha256_of(&dir.join(&n)).map_err(|e| format!("{}: {e}", dir.join(&n).display()))?, n)))
-        .map(|r: Result<(String, String), String>| r.map(|(d, n)| (n, d)))
-        .collect::<Result<Vec<_>, String>>()?;
+        .map(|n| {
+            let path = dir.join(&n);
+            sha256_of(&path).map(|digest| (n, digest)).map_err(|source| GenerateError::Io { path, source })
+        })
+        .collect::<Result<Vec<_>, GenerateError>>()?;
     Ok(ManifestLine { picture: k, scene: format!("{stem}.scene.ron"), files })
 }
 
 /// Appends a line to a manifest, whole (one write of the line and its newline, synced).
-pub fn append_manifest(path: &Path, line: &ManifestLine) -> Result<(), String> {
+pub fn append_manifest(path: &Path, line: &ManifestLine) -> Result<(), GenerateError> {
     use std::io::Write;
-    let text = serde_json::to_string(line).map_err(|e| e.to_string())? + "\n";
-    let mut file = std::fs::OpenOptions::new()
-        .create(true)
-        .append(true)
-        .open(path)
-        .map_err(|e| format!("{}: {e}", path.display()))?;
-    file.write_all(text.as_bytes()).and_then(|()| file.sync_data()).map_err(|e| format!("{}: {e}", path.display()))
+    let json = |source| GenerateError::Json { path: path.to_owned(), source };
+    let text = serde_json::to_string(line).map_err(json)? + "\n";
+    let io = |source| GenerateError::Io { path: path.to_owned(), source };
+    let mut file = std::fs::OpenOptions::new().create(true).append(true).open(path).map_err(io)?;
+    file.write_all(text.as_bytes()).and_then(|()| file.sync_data()).map_err(io)
 }
 
 /// A file's SHA-256, in hex.
@@ -795,20 +858,20 @@ pub fn sha256_of(path: &Path) -> std::io::Result<String> {
 /// Joins the COCO files of every picture the manifests in `dir` list into `dir/coco.json`
 /// (images and annotations in picture order, ids as each picture numbered them). Returns
 /// the number of pictures joined.
-pub fn merge(dir: &Path) -> Result<usize, String> {
+pub fn merge(dir: &Path) -> Result<usize, GenerateError> {
     let mut lines = manifest_lines(dir);
     if lines.is_empty() {
-        return Err(format!("{}: no manifest-*.jsonl: nothing generated here", dir.display()));
+        return Err(GenerateError::NoManifest(dir.to_owned()));
     }
     lines.sort_by_key(|l| l.picture);
     lines.dedup_by_key(|l| l.picture);
     let (mut images, mut annotations) = (Vec::new(), Vec::new());
     for line in &lines {
         let path = dir.join(format!("{}.json", picture_stem(line.picture)));
-        let text = std::fs::read_to_string(&path)
-            .map_err(|e| format!("{}: {e} (was it generated with data?)", path.display()))?;
+        let text =
+            std::fs::read_to_string(&path).map_err(|source| GenerateError::NoData { path: path.clone(), source })?;
         let mut coco: serde_json::Value =
-            serde_json::from_str(&text).map_err(|e| format!("{}: {e}", path.display()))?;
+            serde_json::from_str(&text).map_err(|source| GenerateError::Json { path: path.clone(), source })?;
         images.extend(coco["images"].as_array_mut().map(std::mem::take).unwrap_or_default());
         annotations.extend(coco["annotations"].as_array_mut().map(std::mem::take).unwrap_or_default());
     }
@@ -878,8 +941,8 @@ mod tests {
         assert_eq!(Shard::from_environment(None, None, slurm).unwrap(), Shard { index: 3, count: 4 });
         let kube = |k: &str| (k == "JOB_COMPLETION_INDEX").then(|| "2".to_string());
         assert_eq!(Shard::from_environment(None, Some(4), kube).unwrap(), Shard { index: 2, count: 4 });
-        assert!(Shard::from_environment(None, None, kube).unwrap_err().contains("--shards"));
-        assert!(Shard::from_environment(None, Some(2), kube).unwrap_err().contains("not below"));
+        assert!(Shard::from_environment(None, None, kube).unwrap_err().to_string().contains("--shards"));
+        assert!(Shard::from_environment(None, Some(2), kube).unwrap_err().to_string().contains("not below"));
         for bad in ["4/4", "1", "a/2", "0/0"] {
             assert!(Shard::parse(bad).is_err(), "{bad}");
         }
@@ -911,6 +974,6 @@ mod tests {
         let e = spec(&base.replacen("seed: 1", "sead: 1", 1)).unwrap_err();
         assert!(e.starts_with("spec.ron:"), "syntax errors carry their line: {e}");
         let empty = base.replacen("presets: [\"default\", \"studio\", \"overcast\", \"dusk\"]", "presets: []", 1);
-        assert!(spec(&empty).unwrap_err().contains("lights.presets: an empty distribution"));
+        assert!(spec(&empty).unwrap_err().to_string().contains("lights.presets: an empty distribution"));
     }
 }

@@ -12,6 +12,7 @@ pub mod frames;
 pub mod generate;
 pub mod layout;
 pub mod library;
+pub mod motion;
 pub mod options;
 pub mod picture;
 pub mod posing;

@@ -21,7 +21,19 @@ pub struct AssetLibrary {
     parts: HashMap<PathBuf, Vec<LoadedPart>>,
     humanoids: HashMap<SourceDoc, Arc<marionette_rig::humanoid::HumanoidMap>>,
     /// Motions carried from one character onto another, by what they were worked out from.
-    pub(crate) retargetings: HashMap<String, Arc<crate::retarget::Retargeting>>,
+    pub(crate) retargetings: HashMap<String, Arc<Retargeting>>,
+}
+
+/// A retargeted clip and what retargeting did ([`crate::retarget::retarget`]).
+pub struct Retargeting {
+    pub clip: marionette_rig::anim::Clip,
+    pub report: marionette_rig::retarget::Retargeted,
+    /// Target leg length over the source's.
+    pub leg_ratio: f32,
+    /// The source's frames as sampled.
+    pub source_frames: Vec<marionette_rig::retarget::Frame>,
+    /// The floors (model space) of the source's motion and of the target.
+    pub floors: (f32, f32),
 }
 
 /// One part of a glTF or FBX file, loaded: its asset, its clips and its morph weights.
@@ -70,7 +82,8 @@ impl AssetLibrary {
         let map = match self.humanoids.get(source) {
             Some(map) => map.clone(),
             None => {
-                let map = Arc::new(crate::retarget::humanoid_map(&asset, &Default::default()));
+                // Found from the skeleton alone (none assigned by hand).
+                let map = Arc::new(marionette_rig::humanoid::of_asset(&asset).map(|d| d.map).unwrap_or_default());
                 self.humanoids.insert(source.clone(), map.clone());
                 map
             }

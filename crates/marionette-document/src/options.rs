@@ -12,12 +12,35 @@
 
 use glam::{Mat4, Vec3};
 
-use marionette_formats::scene::{AnimDoc, PlaybackDoc, SceneDoc, pose_key};
+use marionette_formats::scene::{AnimDoc, Clocked, PlaybackDoc, SceneDoc, pose_key};
 use marionette_rig::dqs::SkinningMethod;
+use marionette_rig::playback::Clock;
 
 use crate::AssetLibrary;
-use crate::posing::{IkSpec, PoseSpec, TwoBoneSpec, apply_ik_specs, apply_pose_specs, describe_ik, find_clip};
-use crate::posing::{LookAtSpec, apply_look_at_specs, apply_two_bone_specs, describe_look_at, describe_two_bone};
+use marionette_formats::FormatError;
+
+/// An option that cannot be carried out: it names what no character has, or what it
+/// needs cannot be read.
+#[derive(Debug, thiserror::Error)]
+pub enum OptionsError {
+    #[error(transparent)]
+    Format(#[from] FormatError),
+    #[error(transparent)]
+    Pose(#[from] crate::posing::PoseSpecError),
+    #[error("--retarget: no character has a humanoid map (two legs, two arms) to take the motion")]
+    NoHumanoid,
+    #[error("{}: its {channels} channels fit no character (3 for the root, then 3 per joint, or joints by name)", file.display())]
+    ClipFitsNone { file: std::path::PathBuf, channels: usize },
+    #[error("{file}: no clip `{spec}` (its clips: {clips})")]
+    NoSuchClip { file: String, spec: String, clips: String },
+    #[error("no file has a clip `{spec}` ({files})")]
+    NoFileHasClip { spec: String, files: String },
+    #[error("--preset {preset}: no character has a humanoid map (hips, two legs)")]
+    NoHumanoidForPreset { preset: String },
+    #[error("{option}: no character has a joint named or numbered `{joint}` ({known})")]
+    UnknownJoint { option: &'static str, joint: String, known: String },
+}
+use crate::posing::{IkSpec, LookAtSpec, PoseSpec, TwoBoneSpec, apply_pose_specs, find_clip, solve_constraints};
 
 /// The posing specs of the command line, applied to every character that has the joint
 /// (or, for the hands, mapped fingers) in this order.
@@ -73,7 +96,7 @@ pub fn apply_options(
     doc: &mut SceneDoc,
     options: &PoseOptions,
     library: &mut AssetLibrary,
-) -> Result<Vec<String>, String> {
+) -> Result<Vec<String>, OptionsError> {
     let mut notes = Vec::new();
     if let Some(method) = options.skinning {
         doc.characters.iter_mut().for_each(|c| c.skinning = method);
@@ -104,7 +127,7 @@ fn put_clip_on_fitting_characters(
     anim: &AnimDoc,
     library: &mut AssetLibrary,
     notes: &mut Vec<String>,
-) -> Result<(), String> {
+) -> Result<(), OptionsError> {
     if let Some(settings) = &anim.retarget {
         let scene = doc.clone();
         // The source, found once (when a character can take its motion).
@@ -117,21 +140,21 @@ fn put_clip_on_fitting_characters(
             }
             if source.is_none() {
                 let found = crate::retarget::motion_source_doc(library, &scene, &settings.from);
-                source = Some(found.map_err(|e| e.to_string())?);
+                source = Some(found?);
             }
             let from = source.as_ref().expect("found above");
-            let done = crate::retarget::retarget(library, from, c, &asset, settings).map_err(|e| e.to_string())?;
+            let done = crate::retarget::retarget(library, from, c, &asset, settings)?;
             notes.push(crate::retarget::describe(&done, &from.name, &c.name, &asset.skeleton));
             c.anim = Some(anim.clone());
             c.playback = None;
             fitted += 1;
         }
         return match fitted {
-            0 => Err("--retarget: no character has a humanoid map (two legs, two arms) to take the motion".into()),
+            0 => Err(OptionsError::NoHumanoid),
             _ => Ok(()),
         };
     }
-    let clip = library.keyframe_clip(&anim.file).map_err(|e| e.to_string())?;
+    let clip = library.keyframe_clip(&anim.file)?;
     let mut fitted = 0;
     for c in &mut doc.characters {
         let fits = |a: &marionette_rig::CharacterAsset| match clip.joint_names.is_empty() {
@@ -145,11 +168,7 @@ fn put_clip_on_fitting_characters(
         }
     }
     match fitted {
-        0 => Err(format!(
-            "{}: its {} channels fit no character (3 for the root, then 3 per joint, or joints by name)",
-            anim.file.display(),
-            clip.channels.len()
-        )),
+        0 => Err(OptionsError::ClipFitsNone { file: anim.file.clone(), channels: clip.channels.len() }),
         _ => Ok(()),
     }
 }
@@ -157,7 +176,7 @@ fn put_clip_on_fitting_characters(
 /// Plays the file's own clip `spec` (name, or index as `info` numbers them) on every
 /// character it moves. Fails on a file that has clips but none `spec` names, or when no
 /// character's file has it, listing the clips there are.
-fn play_own_clip(doc: &mut SceneDoc, spec: &str, library: &mut AssetLibrary) -> Result<(), String> {
+fn play_own_clip(doc: &mut SceneDoc, spec: &str, library: &mut AssetLibrary) -> Result<(), OptionsError> {
     // Each file once, in order: its clips as `info` lists them, and whether `spec` found one.
     let mut files: Vec<(String, Vec<String>, bool)> = Vec::new();
     for c in &mut doc.characters {
@@ -180,13 +199,13 @@ fn play_own_clip(doc: &mut SceneDoc, spec: &str, library: &mut AssetLibrary) -> 
         }
     }
     if let Some((file, clips, _)) = files.iter().find(|(_, clips, found)| !found && !clips.is_empty()) {
-        return Err(format!("{file}: no clip `{spec}` (its clips: {})", clips.join(", ")));
+        return Err(OptionsError::NoSuchClip { file: file.clone(), spec: spec.to_owned(), clips: clips.join(", ") });
     }
     if !files.iter().any(|f| f.2) {
         let listed: Vec<String> = files.iter().map(|f| format!("{}: none", f.0)).collect();
         let files =
             if listed.is_empty() { "no character comes from a glTF or FBX file".into() } else { listed.join("; ") };
-        return Err(format!("no file has a clip `{spec}` ({files})"));
+        return Err(OptionsError::NoFileHasClip { spec: spec.to_owned(), files });
     }
     Ok(())
 }
@@ -194,28 +213,23 @@ fn play_own_clip(doc: &mut SceneDoc, spec: &str, library: &mut AssetLibrary) -> 
 /// Every clip of the document paused where it is.
 fn pause_clips(doc: &mut SceneDoc) {
     for c in &mut doc.characters {
-        c.anim.iter_mut().for_each(|a| a.playing = false);
-        c.smpl.iter_mut().for_each(|s| s.playing = false);
-        c.playback.iter_mut().for_each(|p| p.playing = false);
+        for_each_clock(c, |clock| clock.set_clock(Clock { playing: false, ..clock.clock() }));
     }
 }
 
 /// Every clip of the document (keyframes, SMPL, a file's own) paused at `t` seconds.
 pub fn pause_clips_at(doc: &mut SceneDoc, t: f32) {
     for c in &mut doc.characters {
-        if let Some(anim) = &mut c.anim {
-            anim.time = t;
-            anim.playing = false;
-        }
-        if let Some(smpl) = c.smpl.as_mut().filter(|s| s.clip.is_some()) {
-            smpl.time = t * marionette_rig::smpl::CLIP_FPS;
-            smpl.playing = false;
-        }
-        if let Some(playback) = c.playback.as_mut().filter(|p| p.clip.is_some()) {
-            playback.time = t;
-            playback.playing = false;
-        }
+        for_each_clock(c, |clock| clock.pause_at(t));
     }
+}
+
+/// `f` on the clock of each motion `c` plays (its keyframed clip; its SMPL and own clips
+/// where one is chosen).
+fn for_each_clock(c: &mut marionette_formats::scene::CharacterDoc, mut f: impl FnMut(&mut dyn Clocked)) {
+    c.anim.iter_mut().for_each(|a| f(a));
+    c.smpl.iter_mut().filter(|s| s.clip.is_some()).for_each(|s| f(s));
+    c.playback.iter_mut().filter(|p| p.clip.is_some()).for_each(|p| f(p));
 }
 
 /// `--pose` then `--ik` on every character that has the joints, on top of its pose now;
@@ -224,7 +238,7 @@ fn pose_characters(
     doc: &mut SceneDoc,
     options: &PoseOptions,
     library: &mut AssetLibrary,
-) -> Result<Vec<String>, String> {
+) -> Result<Vec<String>, OptionsError> {
     let scene = doc.clone();
     let mut notes = Vec::new();
     let mut used = vec![
@@ -266,8 +280,7 @@ fn pose_characters(
             .chain(options.specs.two_bone.iter().map(|p| &p.joint))
             .chain(options.specs.look_at.iter().map(|p| &p.joint));
         names.zip(&mut used).filter(|(j, _)| has(j)).for_each(|(_, u)| *u = true);
-        let (mut pose, root_shift) =
-            crate::export::still_pose(library, &scene, c, &asset).map_err(|e| e.to_string())?;
+        let (mut pose, root_shift) = crate::export::still_pose(library, &scene, c, &asset)?;
         // The humanoid map, once, for the body pose, the hands and the look-at.
         let map = if options.specs.hands.is_empty() && look_at.is_empty() && options.specs.preset.is_none() {
             Default::default()
@@ -284,19 +297,13 @@ fn pose_characters(
                 None => notes.push(format!("{}: no humanoid map (hips, two legs); {} skipped", c.name, spec.name)),
             }
         }
-        apply_pose_specs(skeleton, &mut pose, &poses).map_err(|e| e.to_string())?;
+        apply_pose_specs(skeleton, &mut pose, &poses)?;
         let hands = crate::posing::apply_hand_specs(skeleton, &map, &mut pose, &options.specs.hands);
         notes.extend(hands.into_iter().map(|n| format!("{}: {n}", c.name)));
         let placement = c.placement.to_mat4() * Mat4::from_translation(root_shift);
-        for report in apply_ik_specs(skeleton, &mut pose, placement, &ik).map_err(|e| e.to_string())? {
-            notes.push(format!("{}: {}", c.name, describe_ik(skeleton, &report)));
-        }
-        for report in apply_two_bone_specs(skeleton, &mut pose, placement, &two_bone).map_err(|e| e.to_string())? {
-            notes.push(format!("{}: {}", c.name, describe_two_bone(skeleton, &report)));
-        }
-        for report in apply_look_at_specs(skeleton, &map, &mut pose, placement, &look_at).map_err(|e| e.to_string())? {
-            notes.push(format!("{}: {}", c.name, describe_look_at(skeleton, &report)));
-        }
+        let goals = (&ik[..], &two_bone[..], &look_at[..]);
+        let reports = solve_constraints(skeleton, &map, &mut pose, placement, goals)?;
+        notes.extend(reports.lines(skeleton, &c.name));
         let placement = match options.specs.preset.is_some() {
             true => crate::posing::stood_on_floor(&asset, &pose, placement),
             false => placement,
@@ -318,11 +325,11 @@ fn pose_characters(
     let specs = specs.chain(options.specs.two_bone.iter().map(|p| ("--two-bone", &p.joint)));
     let specs = specs.chain(options.specs.look_at.iter().map(|p| ("--look-at", &p.joint)));
     if let (Some(spec), false) = (&options.specs.preset, preset_used) {
-        return Err(format!("--preset {}: no character has a humanoid map (hips, two legs)", spec.name));
+        return Err(OptionsError::NoHumanoidForPreset { preset: spec.name.clone() });
     }
     if let Some((option, joint)) = specs.zip(&used).find(|(_, u)| !**u).map(|(s, _)| s) {
         let known = joints_seen.join("; ");
-        return Err(format!("{option}: no character has a joint named or numbered `{joint}` ({known})"));
+        return Err(OptionsError::UnknownJoint { option, joint: joint.clone(), known });
     }
     Ok(notes)
 }
@@ -340,10 +347,13 @@ fn bake_clips(c: &mut marionette_formats::scene::CharacterDoc) {
 
 /// A file's characters (each where its file puts it) posed by `options` as a still, as
 /// `export FILE --out F.obj` writes them: every vertex and triangle, in file order.
-pub fn posed_file(path: &std::path::Path, options: &PoseOptions) -> Result<(Vec<glam::Vec3>, Vec<[u32; 3]>), String> {
+pub fn posed_file(
+    path: &std::path::Path,
+    options: &PoseOptions,
+) -> Result<(Vec<glam::Vec3>, Vec<[u32; 3]>), OptionsError> {
     let mut library = AssetLibrary::default();
-    let mut doc = crate::scenes::file_doc(&mut library, path).map_err(|e| e.to_string())?;
+    let mut doc = crate::scenes::file_doc(&mut library, path)?;
     let options = PoseOptions { still: true, ..options.clone() };
     apply_options(&mut doc, &options, &mut library)?;
-    crate::export::scene_mesh_from(&mut library, &doc).map_err(|e| e.to_string())
+    Ok(crate::export::scene_mesh_from(&mut library, &doc)?)
 }

@@ -86,10 +86,18 @@ pub fn reference_picture(picture: &DynamicImage, fill: bool, w: u32, h: u32) -> 
     out
 }
 
-pub fn over_background(drawn: RgbaImage, background: &BackgroundDoc) -> Result<DynamicImage, String> {
+/// The reference picture behind a scene could not be read.
+#[derive(Debug, thiserror::Error)]
+#[error("{}: {source}", path.display())]
+pub struct BackgroundError {
+    pub path: std::path::PathBuf,
+    pub source: image::ImageError,
+}
+
+pub fn over_background(drawn: RgbaImage, background: &BackgroundDoc) -> Result<DynamicImage, BackgroundError> {
     Ok(match background {
         BackgroundDoc::Image { path, fill } => {
-            let behind = image::open(path).map_err(|e| format!("{}: {e}", path.display()))?;
+            let behind = image::open(path).map_err(|source| BackgroundError { path: path.clone(), source })?;
             let behind = reference_picture(&behind, *fill, drawn.width(), drawn.height());
             composite(drawn, |x, y| behind.get_pixel(x, y).0.map(|c| c as f32 / 255.0))
         }

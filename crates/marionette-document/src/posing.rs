@@ -5,7 +5,6 @@ use glam::{Mat4, Vec3};
 
 use marionette_rig::dqs::SkinningMethod;
 use marionette_rig::fk::{RestOverride, posed_palette_with_rest};
-use marionette_rig::lbs::skin;
 use marionette_rig::node_clip::NodeClip;
 use marionette_rig::{CharacterAsset, JointRotation, Skeleton};
 
@@ -104,21 +103,11 @@ pub fn posed_positions_with_rest(
 ) -> Vec<Vec3> {
     let mut out = vec![Vec3::ZERO; asset.vertex_count()];
     let (skeleton, binds, weights) = (&asset.skeleton, &asset.bind_world_to_joint, &asset.skin.weights);
-    match method {
-        SkinningMethod::Linear => {
-            let palette = posed_palette_with_rest(skeleton, binds, pose, rest, placement);
-            skin(&asset.skin.bind_positions, weights, &palette, &mut out);
-        }
-        SkinningMethod::DualQuaternion => {
-            // A dual quaternion holds no scale: skin in model space, then place, as the
-            // editor does (its placement is the character's transform).
-            let palette = posed_palette_with_rest(skeleton, binds, pose, rest, Mat4::IDENTITY);
-            let mut dq = Vec::new();
-            marionette_rig::dqs::dual_quaternion_palette(&palette, &mut dq);
-            marionette_rig::dqs::skin_dq(&asset.skin.bind_positions, weights, &dq, &mut out);
-            out.iter_mut().for_each(|p| *p = placement.transform_point3(*p));
-        }
-    }
+    // Skinned in model space, then placed, as the editor does (its placement is the
+    // character's transform; a dual quaternion holds no scale).
+    let palette = posed_palette_with_rest(skeleton, binds, pose, rest, Mat4::IDENTITY);
+    marionette_rig::dqs::skin_by(method, &asset.skin.bind_positions, weights, &palette, &mut out);
+    out.iter_mut().for_each(|p| *p = placement.transform_point3(*p));
     out
 }
 
@@ -475,6 +464,43 @@ pub fn apply_look_at_specs(
     placement: Mat4,
     specs: &[LookAtSpec],
 ) -> Result<Vec<marionette_rig::look_at::LookAtReport>, PoseSpecError> {
+    let goals = look_at_goals(skeleton, map, specs)?;
+    Ok(goals.iter().map(|g| g.solve(skeleton, pose, placement)).collect())
+}
+
+/// A look-at worked out for a skeleton: the joints it turns (the head last), the head's
+/// face in its own frame, the target.
+#[derive(Debug, Clone)]
+struct LookAtGoal {
+    joints: Vec<usize>,
+    face: Vec3,
+    target: Vec3,
+}
+
+impl LookAtGoal {
+    fn solve(&self, skeleton: &Skeleton, pose: &mut [JointRotation], placement: Mat4) -> LookAtReport {
+        let (joints, face) = (&self.joints, self.face);
+        marionette_rig::look_at::solve_look_at(skeleton, pose, placement, joints, face, &LOOK_AT_SHARES, self.target)
+    }
+
+    /// The angle between the face and the target in `world` (degrees).
+    fn off_degrees(&self, world: &[Mat4]) -> f32 {
+        let head = world[*self.joints.last().expect("a look-at turns its joint")];
+        let now = marionette_rig::ik::rotation_of(head) * self.face;
+        now.angle_between(self.target - head.w_axis.truncate()).to_degrees()
+    }
+}
+
+use marionette_rig::look_at::LookAtReport;
+
+/// The look-at goals of `specs`: the face is where the character faces at rest (square to
+/// its hips' line, from the humanoid map `map`; else +z); a joint the map calls the head
+/// spreads the turn over the chest and neck.
+fn look_at_goals(
+    skeleton: &Skeleton,
+    map: &marionette_rig::humanoid::HumanoidMap,
+    specs: &[LookAtSpec],
+) -> Result<Vec<LookAtGoal>, PoseSpecError> {
     use marionette_rig::humanoid::HumanBone;
     let mut rest = vec![Mat4::IDENTITY; skeleton.len()];
     marionette_rig::fk::forward_kinematics(skeleton, &skeleton.initial_pose(), Mat4::IDENTITY, &mut rest);
@@ -491,24 +517,121 @@ pub fn apply_look_at_specs(
                 joint: s.joint.clone(),
                 known: joint_list(skeleton),
             })?;
-            let rotation = marionette_rig::ik::rotation_of(rest[joint]);
-            let face = rotation.inverse() * facing;
+            let face = marionette_rig::ik::rotation_of(rest[joint]).inverse() * facing;
             let spread = [HumanBone::Chest, HumanBone::Neck].map(|b| map.get(&b).copied());
             let joints = match spread {
                 [Some(chest), Some(neck)] if map.get(&HumanBone::Head) == Some(&joint) => vec![chest, neck, joint],
                 _ => vec![joint],
             };
-            Ok(marionette_rig::look_at::solve_look_at(
-                skeleton,
-                pose,
-                placement,
-                &joints,
-                face,
-                &LOOK_AT_SHARES,
-                s.target,
-            ))
+            Ok(LookAtGoal { joints, face, target: s.target })
         })
         .collect()
+}
+
+/// What the solving still edits reported, each measured on the pose they leave.
+#[derive(Debug, Clone, Default)]
+pub struct SolveReports {
+    pub ik: Vec<marionette_rig::ik::IkReport>,
+    pub two_bone: Vec<marionette_rig::two_bone::TwoBoneReport>,
+    pub look_at: Vec<LookAtReport>,
+}
+
+impl SolveReports {
+    /// Every report as the command line prints it, named by `who`.
+    pub fn lines(&self, skeleton: &Skeleton, who: &str) -> Vec<String> {
+        let ik = self.ik.iter().map(|r| describe_ik(skeleton, r));
+        let two_bone = self.two_bone.iter().map(|r| describe_two_bone(skeleton, r));
+        let look_at = self.look_at.iter().map(|r| describe_look_at(skeleton, r));
+        ik.chain(two_bone).chain(look_at).map(|l| format!("{who}: {l}")).collect()
+    }
+}
+
+/// Rounds of solving at most before the constraints are taken as they stand.
+pub const CONSTRAINT_ROUNDS: usize = 4;
+
+/// The solving still edits — IK, two-bone, look-at — on top of `pose`, for a character
+/// placed by `placement`, composed so that each holds on the pose they leave together:
+/// IK first, then the two-bone and look-at goals parents before children (by the depth of
+/// the highest joint each turns: a look-at that turns the chest before the arm's
+/// two-bone), all again while one that held no longer does (at most
+/// [`CONSTRAINT_ROUNDS`]). Every report is measured on the final pose.
+pub fn solve_constraints(
+    skeleton: &Skeleton,
+    map: &marionette_rig::humanoid::HumanoidMap,
+    pose: &mut [JointRotation],
+    placement: Mat4,
+    (ik, two_bone, look_at): (&[IkSpec], &[TwoBoneSpec], &[LookAtSpec]),
+) -> Result<SolveReports, PoseSpecError> {
+    let looks = look_at_goals(skeleton, map, look_at)?;
+    let depth = |mut j: usize| {
+        let mut d = 0;
+        while let Some(p) = skeleton.parent(j) {
+            (j, d) = (p, d + 1);
+        }
+        d
+    };
+    // Two-bone goals as `Ok(k)`, look-ats as `Err(k)`, by the depth of their highest joint.
+    let mut order: Vec<(usize, Result<usize, usize>)> = Vec::new();
+    for (k, s) in two_bone.iter().enumerate() {
+        let top = skeleton.resolve(&s.joint).and_then(|e| skeleton.parent(e)).and_then(|m| skeleton.parent(m));
+        order.push((top.map_or(0, depth), Ok(k)));
+    }
+    order.extend(looks.iter().enumerate().map(|(k, g)| (depth(g.joints[0]), Err(k))));
+    order.sort_by_key(|(d, _)| *d);
+    let mut reports = SolveReports::default();
+    for _ in 0..CONSTRAINT_ROUNDS {
+        reports.ik = apply_ik_specs(skeleton, pose, placement, ik)?;
+        reports.two_bone.clear();
+        let mut twos = vec![None; two_bone.len()];
+        let mut lookings = vec![None; looks.len()];
+        for (_, goal) in &order {
+            match *goal {
+                Ok(k) => twos[k] = apply_two_bone_specs(skeleton, pose, placement, &two_bone[k..=k])?.pop(),
+                Err(k) => lookings[k] = Some(looks[k].solve(skeleton, pose, placement)),
+            }
+        }
+        reports.two_bone = twos.into_iter().flatten().collect();
+        reports.look_at = lookings.into_iter().flatten().collect();
+        let solved = (reports.ik.clone(), reports.two_bone.clone(), reports.look_at.clone());
+        let targets = (ik.iter().map(|s| s.target).collect(), two_bone.iter().map(|s| s.target).collect());
+        measure(skeleton, pose, placement, targets, &looks, &mut reports);
+        let held = |was: bool, is: bool| !was || is;
+        let still_hold = solved.0.iter().zip(&reports.ik).all(|(a, b)| held(a.reached, b.reached))
+            && solved.1.iter().zip(&reports.two_bone).all(|(a, b)| held(a.reached, b.reached))
+            && solved.2.iter().zip(&reports.look_at).all(|(a, b)| b.off_degrees <= a.off_degrees.max(LOOK_AT_HOLDS));
+        if still_hold {
+            break;
+        }
+    }
+    Ok(reports)
+}
+
+/// A look-at holds within this angle (degrees).
+pub const LOOK_AT_HOLDS: f32 = 0.1;
+
+/// The reports' distances and angles (and whether each is reached) measured on `pose`.
+fn measure(
+    skeleton: &Skeleton,
+    pose: &[JointRotation],
+    placement: Mat4,
+    (ik, two_bone): (Vec<Vec3>, Vec<Vec3>),
+    looks: &[LookAtGoal],
+    r: &mut SolveReports,
+) {
+    let mut world = vec![Mat4::IDENTITY; skeleton.len()];
+    marionette_rig::fk::forward_kinematics(skeleton, pose, placement, &mut world);
+    let at = |j: usize| world[j].w_axis.truncate();
+    for (report, target) in r.ik.iter_mut().zip(ik) {
+        report.distance = at(report.end).distance(target);
+        report.reached = report.distance <= IK_TOLERANCE;
+    }
+    for (report, target) in r.two_bone.iter_mut().zip(two_bone) {
+        report.distance = at(report.chain[2]).distance(target);
+        report.reached = report.distance <= IK_TOLERANCE;
+    }
+    for (report, goal) in r.look_at.iter_mut().zip(looks) {
+        report.off_degrees = goal.off_degrees(&world);
+    }
 }
 
 /// One line about a look-at.

@@ -11,23 +11,15 @@ use marionette_formats::scene::{
 };
 use marionette_rig::anim::Clip;
 use marionette_rig::humanoid::{HumanBone, HumanoidMap};
-use marionette_rig::retarget::{Frame, Humanoid, Retargeted, Retargeter};
+use marionette_rig::retarget::{Frame, Humanoid, Retargeter};
 use marionette_rig::{CharacterAsset, JointRotation};
+
+use crate::motion::CharacterMotion;
 
 /// Frames a second at which motion is sampled for retargeting (the SMPL clips' rate).
 pub const FPS: f32 = marionette_rig::smpl::CLIP_FPS;
 
-/// A retargeted clip and what retargeting did.
-pub struct Retargeting {
-    pub clip: Clip,
-    pub report: Retargeted,
-    /// Target leg length over the source's.
-    pub leg_ratio: f32,
-    /// The source's frames as sampled.
-    pub source_frames: Vec<Frame>,
-    /// The floors (model space) of the source's motion and of the target.
-    pub floors: (f32, f32),
-}
+pub use crate::library::Retargeting;
 
 /// A character's humanoid map: found from its skeleton, with the document's bones
 /// assigned by hand over it (an empty or unknown key takes the bone off).
@@ -106,125 +98,33 @@ pub fn soles(asset: &CharacterAsset, map: &HumanoidMap) -> Vec<marionette_rig::r
     out
 }
 
-/// A character's own motion as frames at [`FPS`] over the clip's length: its keyframed
-/// clip, else its glTF clip, else its SMPL clip (stood upright when it asks). None when it
-/// has no motion of its own.
+/// A character's own motion as frames at [`FPS`] over its clips' range, as the motion
+/// service poses it ([`crate::motion`]): its SMPL clip, its keyframed clip, its glTF clip.
+/// None when it has no motion of its own; refused for a motion that is itself retargeted.
 pub fn motion_frames(
     library: &mut super::AssetLibrary,
     c: &CharacterDoc,
     asset: &CharacterAsset,
 ) -> Result<Option<Vec<Frame>>, FormatError> {
-    let skeleton = &asset.skeleton;
-    let (base, _) = super::scenes::pose_from_doc(asset, c);
-    let named =
-        |path: &Path| FormatError::other(path, "expected a clip of its own to retarget, found a retargeted one");
-    if let Some(anim) = &c.anim {
-        let clip = match (&anim.keys, &anim.retarget) {
-            (Some(keys), _) => keys.clone(),
-            (None, Some(_)) => return Err(named(Path::new(&c.name))),
-            (None, None) => (*library.keyframe_clip(&anim.file)?).clone(),
-        };
-        let clip = clip.retargeted(skeleton, &anim.names);
-        let frames = sample_times(clip.range, &c.name)?
-            .map(|t| {
-                let (root, pose) = clip.pose_at(skeleton, t, &base);
-                Frame { root, pose }
-            })
-            .collect();
-        return Ok(Some(frames));
-    }
-    if let (Some(part), Some(playback)) = (library.part_of_source(&c.source), &c.playback) {
-        let find = |name: &Option<String>| part.clips.iter().find(|k| Some(&k.name) == name.as_ref());
-        if let Some(clip) = find(&playback.clip) {
-            let blend = find(&playback.blend_clip).map(|k| (k, playback.blend));
-            let frames = sample_times((0.0, clip.duration()), &c.name)?
-                .map(|t| {
-                    let mut pose = base.clone();
-                    let now = marionette_rig::node_clip::pose_mix(skeleton, clip, blend, t, &mut pose);
-                    Frame { root: now.offsets[0], pose }
-                })
-                .collect();
-            return Ok(Some(frames));
+    let keyframes = match c.anim.as_ref().map(|anim| (&anim.keys, &anim.retarget, &anim.file)) {
+        None => None,
+        Some((Some(keys), _, _)) => Some(keys.clone()),
+        Some((None, Some(_), _)) => {
+            return Err(FormatError::other(
+                Path::new(&c.name),
+                "expected a clip of its own to retarget, found a retargeted one",
+            ));
         }
+        Some((None, None, file)) => Some((*library.keyframe_clip(file)?).clone()),
+    };
+    let (motion, _) = CharacterMotion::of(library, c, asset, keyframes)?;
+    let playing = motion.playing();
+    if playing.is_empty() {
+        return Ok(None);
     }
-    Ok(smpl_frames(library, c, skeleton)?.map(|(_, frames)| frames))
-}
-
-/// An SMPL body's playing clip as the editor plays it, every frame from the start (with
-/// its blend clip, stood upright when it asks, clamped to the joints' limits) at its own
-/// root, and the clip's file name; `None` when the body plays no clip of its folder.
-pub fn smpl_frames(
-    library: &mut super::AssetLibrary,
-    c: &CharacterDoc,
-    skeleton: &marionette_rig::Skeleton,
-) -> Result<Option<(String, Vec<Frame>)>, FormatError> {
-    let Some((name, clip, blend)) = smpl_clips(library, c)? else { return Ok(None) };
-    let smpl = c.smpl.as_ref().expect("a body with a clip");
-    let root = skeleton.joint(0).rest_offset;
-    let mut sampler = marionette_rig::smpl::BlendSampler::default();
-    let frames = (0..clip.frame_count())
-        .map(|f| {
-            let pose = smpl_pose(&mut sampler, (&clip, blend.as_deref()), smpl, skeleton, f as f32, false);
-            Frame { root, pose }
-        })
-        .collect();
-    Ok(Some((name, frames)))
-}
-
-/// An SMPL body's pose at its document's time (looping as it says), as the editor shows it
-/// paused there; `None` when the body plays no clip of its folder.
-pub fn smpl_pose_now(
-    library: &mut super::AssetLibrary,
-    c: &CharacterDoc,
-    skeleton: &marionette_rig::Skeleton,
-) -> Result<Option<Vec<JointRotation>>, FormatError> {
-    let Some((_, clip, blend)) = smpl_clips(library, c)? else { return Ok(None) };
-    let smpl = c.smpl.as_ref().expect("a body with a clip");
-    let mut sampler = marionette_rig::smpl::BlendSampler::default();
-    Ok(Some(smpl_pose(&mut sampler, (&clip, blend.as_deref()), smpl, skeleton, smpl.time, smpl.looping)))
-}
-
-/// The playing clip of an SMPL body's document and its blend clip, found in its folder.
-type SmplClips =
-    (String, std::sync::Arc<marionette_rig::smpl::Clip>, Option<std::sync::Arc<marionette_rig::smpl::Clip>>);
-
-fn smpl_clips(library: &mut super::AssetLibrary, c: &CharacterDoc) -> Result<Option<SmplClips>, FormatError> {
-    let (Some(smpl), SourceDoc::File(dir)) = (&c.smpl, &c.source) else { return Ok(None) };
-    let Some(name) = &smpl.clip else { return Ok(None) };
-    let set = library.smpl(dir)?;
-    let find = |wanted: &String| set.clips.iter().find(|(n, _)| n == wanted).map(|(_, k)| k.clone());
-    let Some(clip) = find(name) else { return Ok(None) };
-    Ok(Some((name.clone(), clip, smpl.blend_clip.as_ref().and_then(find))))
-}
-
-/// The playback pose at `time_frames`, clamped to the joints' limits as the editor's
-/// matrix stack clamps it.
-fn smpl_pose(
-    sampler: &mut marionette_rig::smpl::BlendSampler,
-    (clip, blend): (&marionette_rig::smpl::Clip, Option<&marionette_rig::smpl::Clip>),
-    smpl: &marionette_formats::scene::SmplDoc,
-    skeleton: &marionette_rig::Skeleton,
-    time_frames: f32,
-    looping: bool,
-) -> Vec<JointRotation> {
-    let blend = blend.map(|k| (k, smpl.blend));
-    let rotations = sampler.playback_pose(clip, blend, time_frames, looping, smpl.upright);
-    rotations.iter().enumerate().map(|(j, r)| r.clamped(&skeleton.joint(j).limits)).collect()
-}
-
-/// The times of frames at [`FPS`] from the start of `range` to its end (at least one);
-/// refused, naming `what`, when there would be more than
-/// [`MAX_SAMPLED_FRAMES`](marionette_formats::limits::MAX_SAMPLED_FRAMES).
-fn sample_times((start, end): (f32, f32), what: &str) -> Result<impl Iterator<Item = f32>, FormatError> {
-    let most = marionette_formats::limits::MAX_SAMPLED_FRAMES;
-    let n = ((end - start).max(0.0) * FPS).round();
-    if n.is_nan() || n >= most as f32 {
-        return Err(FormatError::other(
-            Path::new(what),
-            format!("expected a clip of at most {most} frames at {FPS} a second to retarget, found {end} − {start} s"),
-        ));
-    }
-    Ok((0..=n as usize).map(move |f| start + f as f32 / FPS))
+    let frames = crate::motion::sampled_frames(&asset.skeleton, motion.still(), &playing, FPS, "retarget")
+        .map_err(|e| FormatError::other(Path::new(&c.name), e))?;
+    Ok(Some(frames))
 }
 
 /// The document of the character a file brings, playing the clip `clip` names (see

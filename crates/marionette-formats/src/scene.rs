@@ -204,8 +204,14 @@ pub struct SmplDoc {
     pub betas: Vec<f32>,
     /// Clip file name in the SMPL folder, if one plays.
     pub clip: Option<String>,
-    /// Playback time in frames.
+    /// Playback time in seconds (the clip's frames are [`marionette_rig::smpl::CLIP_FPS`]
+    /// a second apart); written as `seconds`.
+    #[serde(rename = "seconds")]
     pub time: f32,
+    /// The time in frames, as files written before `seconds` keep it (`time`); read only,
+    /// turned into `time` when the scene is read.
+    #[serde(rename = "time", skip_serializing, deserialize_with = "some_number")]
+    pub legacy_frames: Option<f32>,
     pub playing: bool,
     pub speed: f32,
     pub looping: bool,
@@ -216,6 +222,48 @@ pub struct SmplDoc {
     /// clips carry a global rotation from a z-up capture).
     pub upright: bool,
 }
+
+/// A number read as present (a field that was a plain number before it was optional).
+fn some_number<'de, D: serde::Deserializer<'de>>(d: D) -> Result<Option<f32>, D::Error> {
+    f32::deserialize(d).map(Some)
+}
+
+impl SmplDoc {
+    /// Takes a legacy time in frames into `time` (seconds).
+    fn read_legacy_frames(&mut self) {
+        if let Some(frames) = self.legacy_frames.take() {
+            self.time = frames / marionette_rig::smpl::CLIP_FPS;
+        }
+    }
+}
+
+/// The playback state of a motion document — SMPL playback, a keyframed clip, a source's
+/// own clips — as the one clock every kind of motion runs on (seconds).
+pub trait Clocked {
+    /// Its clock: time in seconds, playing, speed, looping.
+    fn clock(&self) -> marionette_rig::playback::Clock;
+    /// Stores the clock's time and whether it plays (speed and looping are the document's).
+    fn set_clock(&mut self, clock: marionette_rig::playback::Clock);
+    /// Paused at `t` seconds.
+    fn pause_at(&mut self, t: f32) {
+        self.set_clock(marionette_rig::playback::Clock { time: t, playing: false, ..self.clock() });
+    }
+}
+
+/// The motion documents keep the clock's four fields under the same names.
+macro_rules! clocked {
+    ($($doc:ty),*) => {$(
+        impl Clocked for $doc {
+            fn clock(&self) -> marionette_rig::playback::Clock {
+                marionette_rig::playback::Clock { time: self.time, playing: self.playing, speed: self.speed, looping: self.looping }
+            }
+            fn set_clock(&mut self, clock: marionette_rig::playback::Clock) {
+                (self.time, self.playing) = (clock.time, clock.playing);
+            }
+        }
+    )*};
+}
+clocked!(SmplDoc, AnimDoc, PlaybackDoc);
 
 /// A character's stable id within a scene: saved in scene files, kept by undo and redo;
 /// selections, pins and the history name characters by it.
@@ -514,6 +562,7 @@ impl Default for SmplDoc {
             betas: Vec::new(),
             clip: None,
             time: 0.0,
+            legacy_frames: None,
             playing: false,
             speed: 1.0,
             looping: true,
@@ -551,9 +600,10 @@ fn joint_of_indexed_key(skeleton: &Skeleton, key: &str) -> Option<usize> {
 /// (`characters[1].placement.scale`).
 pub fn parse_scene(reader: impl BufRead, path: &Path) -> Result<SceneDoc, FormatError> {
     let text = super::error::read_text(reader, path)?;
-    let doc: SceneDoc = ron::from_str(&text)
+    let mut doc: SceneDoc = ron::from_str(&text)
         .map_err(|e| FormatError::syntax_at(path, e.span.start.line.max(1), e.span.start.col.max(1), e.code))?;
     doc.validate().map_err(|e| FormatError::other(path, e))?;
+    doc.characters.iter_mut().filter_map(|c| c.smpl.as_mut()).for_each(SmplDoc::read_legacy_frames);
     Ok(doc)
 }
 
@@ -588,7 +638,8 @@ impl SceneDoc {
             }
             if let Some(smpl) = &c.smpl {
                 finite(&at("smpl.betas"), &smpl.betas)?;
-                finite(&at("smpl.time"), &[smpl.time])?;
+                finite(&at("smpl.seconds"), &[smpl.time])?;
+                finite(&at("smpl.time"), &smpl.legacy_frames.into_iter().collect::<Vec<_>>())?;
                 finite(&at("smpl.speed"), &[smpl.speed])?;
                 blend_weight(&at("smpl.blend"), smpl.blend)?;
             }

@@ -46,6 +46,24 @@ pub fn has_scale(m: &Mat4) -> bool {
 }
 
 /// Each palette matrix as a dual quaternion (into a caller's buffer: no allocation once
+/// Skins `bind_positions` by the model-space `palette` as `method` does: linear blend, or
+/// dual quaternions (a palette without scale).
+pub fn skin_by(
+    method: super::skinning::SkinningMethod,
+    bind_positions: &[Vec3],
+    weights: &SkinWeights,
+    palette: &[Mat4],
+    out: &mut [Vec3],
+) {
+    if method.is_linear() {
+        crate::lbs::skin(bind_positions, weights, palette, out);
+    } else {
+        let mut dq = Vec::new();
+        dual_quaternion_palette(palette, &mut dq);
+        skin_dq(bind_positions, weights, &dq, out);
+    }
+}
+
 /// it has grown).
 pub fn dual_quaternion_palette(palette: &[Mat4], out: &mut Vec<DualQuat>) {
     out.clear();

@@ -20,8 +20,14 @@ impl Span {
     /// A clip of `frames` frames, timed in frames: it stops on its last frame and loops
     /// through the step from its last frame back to its first.
     pub fn frames(frames: usize) -> Self {
+        Self::sampled(frames, 1.0)
+    }
+
+    /// A clip of `frames` frames `fps` a second, timed in seconds: it stops on its last
+    /// frame and loops through the step from its last frame back to its first.
+    pub fn sampled(frames: usize, fps: f32) -> Self {
         let n = frames as f32;
-        Self { start: 0.0, end: (n - 1.0).max(0.0), period: n }
+        Self { start: 0.0, end: (n - 1.0).max(0.0) / fps, period: n / fps }
     }
 }
 

@@ -12,7 +12,7 @@ use crate::editor::scene_doc::document::{HumanoidMapOf, SceneCharacter};
 use crate::editor::state::camera::OrbitCamera;
 use crate::formats::scene::DisplayDoc;
 use crate::scene::smpl::SmplCharacter;
-use crate::scene::{Character, CharacterView, JointScratch, SkinScratch};
+use crate::scene::{Character, CharacterSkinning, CharacterView, JointScratch, SkinScratch};
 
 /// What a data picture is made from.
 pub struct DataFrame {
@@ -45,7 +45,7 @@ impl DataFrame {
         first_id: u64,
     ) -> Result<(serde_json::Value, Vec<serde_json::Value>), String> {
         let passes = self.passes();
-        annotate::write::passes(picture, &self.camera, &passes, &self.figures)?;
+        annotate::write::passes(picture, &self.camera, &passes, &self.figures).map_err(|e| e.to_string())?;
         let file_name = picture.file_name().map_or_else(String::new, |n| n.to_string_lossy().into_owned());
         let image = annotate::coco::image_json(image_id, &file_name, &self.camera);
         Ok((image, annotate::coco::annotations(&self.camera, &passes, &self.figures, image_id, first_id)))
@@ -58,6 +58,7 @@ impl DataFrame {
             &annotate::write::beside(picture, "json"),
             &annotate::coco::file(vec![image], annotations),
         )
+        .map_err(|e| e.to_string())
     }
 }
 
@@ -74,6 +75,7 @@ pub struct DataScene<'w, 's> {
             &'static JointScratch,
             &'static GlobalTransform,
             &'static CharacterView,
+            &'static CharacterSkinning,
             Option<&'static HumanoidMapOf>,
             Has<SmplCharacter>,
         ),
@@ -87,15 +89,16 @@ impl DataScene<'_, '_> {
     /// order of their scene ids (from 1), so a sequence keeps each one's number.
     pub fn frame(&self, width: u32, height: u32) -> Result<DataFrame, String> {
         let orbit = self.cameras.iter().next().ok_or("the render has no camera")?;
-        let camera = Pinhole::of(orbit, width, height)?;
+        let camera = Pinhole::of(orbit, width, height).map_err(|e| e.to_string())?;
         let mut characters: Vec<_> = self.characters.iter().collect();
         characters.sort_by_key(|c| c.0.id);
         let figures = characters
             .into_iter()
             .enumerate()
             .filter(|(_, c)| c.5.0.visible && c.5.0.display != DisplayDoc::Skeleton)
-            .map(|(k, (scene, character, skin, joints, place, _, map, smpl))| {
-                figure(k as u16 + 1, &scene.name, character, skin, joints, place.to_matrix(), map.map(|m| &m.0), smpl)
+            .map(|(k, (scene, character, skin, joints, place, _, method, map, smpl))| {
+                let drawn = Drawn { character, skin, joints, method: method.0 };
+                figure(k as u16 + 1, &scene.name, drawn, place.to_matrix(), map.map(|m| &m.0), smpl)
             })
             .collect();
         let floor = self.floors.iter().find(|(_, v)| **v != Visibility::Hidden).map(|(t, _)| floor_corners(t));
@@ -103,15 +106,21 @@ impl DataScene<'_, '_> {
     }
 }
 
-/// One character as a figure: its skinned vertices (as drawn) and joints in the world, its
-/// vertices' body parts and its keypoints.
-#[allow(clippy::too_many_arguments)]
+/// A character as the picture draws it: its asset, its skin (empty when the GPU skins it),
+/// its joints and its skinning method.
+struct Drawn<'a> {
+    character: &'a Character,
+    skin: &'a SkinScratch,
+    joints: &'a JointScratch,
+    method: crate::rig::dqs::SkinningMethod,
+}
+
+/// One character as a figure: its skinned vertices (as drawn, by its own method) and
+/// joints in the world, its vertices' body parts and its keypoints.
 fn figure(
     instance: u16,
     name: &str,
-    character: &Character,
-    skin: &SkinScratch,
-    joints: &JointScratch,
+    Drawn { character, skin, joints, method }: Drawn,
     world: Mat4,
     map: Option<&crate::rig::humanoid::HumanoidMap>,
     smpl: bool,
@@ -120,11 +129,11 @@ fn figure(
     let model = if skin.positions.len() == asset.vertex_count() {
         skin.positions.to_vec()
     } else {
-        // Skinned on the GPU: the same linear blend here.
+        // Skinned on the GPU: the same method here.
         let palette: Vec<Mat4> =
             joints.matrices.iter().zip(&asset.bind_world_to_joint).map(|(m, bind)| *m * *bind).collect();
         let mut out = vec![Vec3::ZERO; asset.vertex_count()];
-        crate::rig::skinning::skin_positions(&asset.skin.bind_positions, &asset.skin.weights, &palette, &mut out);
+        crate::rig::dqs::skin_by(method, &asset.skin.bind_positions, &asset.skin.weights, &palette, &mut out);
         out
     };
     let positions: Vec<Vec3> = model.iter().map(|&p| world.transform_point3(p)).collect();

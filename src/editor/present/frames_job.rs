@@ -1,16 +1,18 @@
-//! "Render frames…" in the editor: the scene as it stands is saved aside and rendered by
-//! `marionette render --from A --to B --fps N` in a process of its own, so the editor stays
-//! responsive; its progress lines feed a progress bar, Cancel stops it.
+//! "Render frames…" in the editor: the scene as it stands is saved aside and rendered on a
+//! thread of its own by the same render as `marionette render --from A --to B --fps N`
+//! (an offscreen app of its own), so the editor stays responsive; each frame written moves
+//! the progress bar, Cancel stops it.
 
-use std::io::BufRead;
 use std::path::PathBuf;
-use std::process::{Child, Command, Stdio};
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, Mutex};
 
 use bevy::prelude::*;
 
-use crate::editor::state::Messages;
-use crate::formats::scene::SceneDoc;
+use crate::document::frames::{FrameSequence, PictureRequest, Pictures};
+use crate::editor::present::render::{OnWritten, Rendering, render_with};
+use crate::editor::state::{Messages, StartupEdits};
+use crate::formats::scene::{SceneDoc, ShotDoc};
 
 /// What the panel asks for.
 #[derive(Debug, Clone, PartialEq)]
@@ -40,68 +42,83 @@ impl Default for FramesRequest {
     }
 }
 
-/// The render under way (if any): its process, frames done of all, and the last lines it
-/// wrote (its error, if it fails).
+/// The render under way (if any): the thread rendering it, frames done of all, whether it
+/// was asked to stop, and the scene file it renders.
 #[derive(Resource, Default)]
 pub struct FramesJob {
     pub request: FramesRequest,
-    child: Option<Child>,
+    worker: Option<std::thread::JoinHandle<Result<(Vec<String>, ShotDoc), String>>>,
     scene: Option<PathBuf>,
-    progress: Arc<Mutex<(usize, usize, Vec<String>)>>,
+    progress: Arc<Mutex<(usize, usize)>>,
+    cancelled: Arc<AtomicBool>,
 }
 
 impl FramesJob {
     pub fn running(&self) -> bool {
-        self.child.is_some()
+        self.worker.is_some()
     }
 
     /// Frames done and all of them (0 of 0 before the first is known).
     pub fn progress(&self) -> (usize, usize) {
-        self.progress.lock().map(|p| (p.0, p.1)).unwrap_or((0, 0))
+        self.progress.lock().map(|p| *p).unwrap_or((0, 0))
     }
 
-    /// Saves `doc` aside and starts rendering it; says why not when it cannot.
+    /// Saves `doc` aside and starts rendering it on a thread of its own, through the same
+    /// render as `marionette render --from A --to B --fps N`; says why not when it cannot.
     pub fn start(&mut self, doc: &SceneDoc) -> Result<(), String> {
         if self.running() {
             return Err("frames are being rendered already".into());
         }
         let r = self.request.clone();
+        let sequence = FrameSequence { from: r.from, to: r.to, fps: r.fps, turntable: r.turntable };
+        let count = sequence.times().map_err(|e| e.to_string())?.len();
         if let Some(dir) = std::path::Path::new(&r.pattern).parent().filter(|d| !d.as_os_str().is_empty()) {
             std::fs::create_dir_all(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
         }
         let scene = std::env::temp_dir().join(format!("marionette-frames-{}.ron", std::process::id()));
         crate::document::scenes::write_scene(&scene, doc).map_err(|e| e.to_string())?;
-        let exe = std::env::current_exe().map_err(|e| format!("cannot find the marionette program: {e}"))?;
-        let mut command = Command::new(exe);
-        command.arg("render").arg(&scene).args(["--from", &r.from.to_string(), "--to", &r.to.to_string()]);
-        command.args(["--fps", &r.fps.to_string(), "--out", &r.pattern]);
-        if let Some(seconds) = r.turntable {
-            command.args(["--turntable", &seconds.to_string()]);
-        }
-        if r.with_data {
-            command.arg("--data");
-        }
-        let mut child = command
-            .stdout(Stdio::null())
-            .stderr(Stdio::piped())
-            .spawn()
+        let (progress, cancelled) = (Arc::new(Mutex::new((0, count))), Arc::new(AtomicBool::new(false)));
+        let (done, stop) = (progress.clone(), cancelled.clone());
+        let on_written: OnWritten = Box::new(move |index| {
+            if let Ok(mut p) = done.lock() {
+                p.0 = p.0.max(index + 1);
+            }
+            if stop.load(Ordering::Relaxed) { Err("cancelled".into()) } else { Ok(()) }
+        });
+        let rendering = Rendering {
+            paths: vec![scene.clone()],
+            edits: StartupEdits::default(),
+            out: PathBuf::from(&r.pattern),
+            picture: PictureRequest::default(),
+            pictures: Pictures::Sequence(sequence),
+            data: r.with_data,
+        };
+        let worker = std::thread::Builder::new()
+            .name("frames".into())
+            .spawn(move || render_with(rendering, Some(on_written)))
             .map_err(|e| format!("cannot start the render: {e}"))?;
-        let progress = Arc::new(Mutex::new((0, 0, Vec::new())));
-        if let Some(stderr) = child.stderr.take() {
-            let shared = progress.clone();
-            std::thread::spawn(move || read_progress(stderr, &shared));
-        }
-        (self.child, self.scene, self.progress) = (Some(child), Some(scene), progress);
+        (self.worker, self.scene, self.progress, self.cancelled) = (Some(worker), Some(scene), progress, cancelled);
         Ok(())
     }
 
-    /// Stops the render under way.
+    /// Stops the render under way (after the frame being written) and waits for it.
     pub fn cancel(&mut self) {
-        if let Some(mut child) = self.child.take() {
-            let _ = child.kill();
-            let _ = child.wait();
+        self.cancelled.store(true, Ordering::Relaxed);
+        if let Some(worker) = self.worker.take() {
+            let _ = worker.join();
         }
         self.clean_up();
+    }
+
+    /// How the render ended, once it has: `None` while it runs (or when none was started).
+    pub fn finished(&mut self) -> Option<Result<(), String>> {
+        if !self.worker.as_ref().is_some_and(std::thread::JoinHandle::is_finished) {
+            return None;
+        }
+        let worker = self.worker.take()?;
+        self.clean_up();
+        let ended = worker.join().unwrap_or_else(|_| Err("the render stopped unexpectedly".into()));
+        Some(ended.map(|_| ()))
     }
 
     fn clean_up(&mut self) {
@@ -111,38 +128,15 @@ impl FramesJob {
     }
 }
 
-/// Reads `progress: k/n` lines into `shared`, keeping the last few other lines.
-fn read_progress(stderr: impl std::io::Read, shared: &Mutex<(usize, usize, Vec<String>)>) {
-    for line in std::io::BufReader::new(stderr).lines().map_while(Result::ok) {
-        let Ok(mut p) = shared.lock() else { return };
-        match line.strip_prefix("progress: ").and_then(|s| s.split_once('/')) {
-            Some((k, n)) => (p.0, p.1) = (k.trim().parse().unwrap_or(p.0), n.trim().parse().unwrap_or(p.1)),
-            // Bevy's own log lines are not the render's word.
-            None if line.contains(" INFO ") || line.contains(" WARN ") => {}
-            None => {
-                p.2.push(line);
-                let excess = p.2.len().saturating_sub(4);
-                p.2.drain(..excess);
-            }
-        }
-    }
-}
-
-/// Says when the render under way ends, and how (reads the process; writes `FramesJob`,
-/// `Messages`).
+/// Says when the render under way ends, and how (writes `FramesJob`, `Messages`).
 pub fn finish_frames_job(mut job: ResMut<FramesJob>, mut messages: ResMut<Messages>) {
-    let Some(child) = job.child.as_mut() else { return };
-    let Ok(Some(status)) = child.try_wait() else { return };
-    job.child = None;
-    job.clean_up();
+    let Some(ended) = job.finished() else { return };
     let (done, _) = job.progress();
     let pattern = job.request.pattern.clone();
-    if status.success() {
-        messages.push(format!("wrote {done} frames as {pattern}"));
-    } else {
-        let said = job.progress.lock().map(|p| p.2.join(" ")).unwrap_or_default();
-        messages.push(format!("the frames were not rendered: {said}"));
-    }
+    messages.push(match ended {
+        Ok(()) => format!("wrote {done} frames as {pattern}"),
+        Err(e) => format!("the frames were not rendered: {e}"),
+    });
 }
 
 impl Drop for FramesJob {

@@ -13,7 +13,6 @@ use crate::editor::present::readiness::{CaptureGate, UpdateCaptureGate};
 use crate::editor::present::screenshot::ScreenshotRequest;
 use crate::scene::keyframes::ClipPlayer;
 use crate::scene::node_clips::NodeClipPlayer;
-use crate::scene::playhead::Playhead;
 use crate::scene::smpl::SmplCharacter;
 
 /// The longest the editor may sleep, as a timed job of another room asked this frame (the
@@ -68,10 +67,10 @@ pub fn busy_with(
     frames: Option<&FramesJob>,
     screenshot: Option<&ScreenshotRequest>,
 ) -> Option<&'static str> {
-    fn playing<P: Playhead>(players: &Query<&P>) -> bool {
-        players.iter().any(|p| p.clock().playing && p.span().is_some())
-    }
-    if playing(keyframes) || playing(bodies) || playing(node_clips) {
+    let playing = keyframes.iter().any(|p| p.state.playing)
+        || bodies.iter().any(|b| b.state.playing && b.clip().is_some())
+        || node_clips.iter().any(|p| p.state.playing && p.clip().is_some());
+    if playing {
         Some("playing")
     } else if gate.is_some_and(|g| !g.is_ready() && g.failed.is_none()) {
         Some("preparing")

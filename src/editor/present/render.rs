@@ -23,7 +23,7 @@ use crate::editor::present::view::ViewPlugin;
 use crate::editor::scene_doc::document::Library;
 use crate::editor::state::camera::OrbitCamera;
 use crate::editor::state::{Messages, StartupEdits, StartupPaths};
-use crate::formats::scene::{BackgroundDoc, BindingDoc, SceneDoc, ShotDoc, SourceDoc};
+use crate::formats::scene::{BackgroundDoc, BindingDoc, Clocked, SceneDoc, ShotDoc, SourceDoc};
 use crate::formats::scene::{MotionSourceDoc, RetargetDoc};
 use crate::scene::{RigCorePlugin, SkinningPlugin};
 
@@ -132,24 +132,49 @@ enum FrameAt {
 /// Returns the notes and the picture's size, or what went wrong.
 pub fn render(
     paths: Vec<PathBuf>,
-    mut edits: StartupEdits,
+    edits: StartupEdits,
     out: PathBuf,
     picture: PictureRequest,
     pictures: Pictures,
     data: bool,
 ) -> Result<(Vec<String>, ShotDoc), String> {
+    render_with(Rendering { paths, edits, out, picture, pictures, data }, None)
+}
+
+/// What [`render`] is asked for.
+pub struct Rendering {
+    pub paths: Vec<PathBuf>,
+    pub edits: StartupEdits,
+    pub out: PathBuf,
+    pub picture: PictureRequest,
+    pub pictures: Pictures,
+    pub data: bool,
+}
+
+/// [`render`], calling `on_written` with each picture's index once its files are written
+/// (where given; else each picture's progress is said on standard error). The render stops
+/// at the first call that fails, with its error.
+pub fn render_with(
+    Rendering { paths, mut edits, out, picture, pictures, data }: Rendering,
+    on_written: Option<OnWritten>,
+) -> Result<(Vec<String>, ShotDoc), String> {
     let data = match (data, pictures) {
         (false, _) => None,
         (true, Pictures::PoseSheet) => return Err("--data: a contact sheet of poses carries no data".into()),
-        (true, Pictures::Sequence(_)) => Some(CocoSoFar { path: sequence_path(&out, "json")?, ..default() }),
+        (true, Pictures::Sequence(_)) => {
+            Some(CocoSoFar { path: sequence_path(&out, "json").map_err(|e| e.to_string())?, ..default() })
+        }
         (true, Pictures::Still) => Some(CocoSoFar { path: annotate::write::beside(&out, "json"), ..default() }),
     };
     let (library, shot, poses) = preload(&paths, &edits)?;
     let cells = std::env::temp_dir().join(format!("marionette-sheet-{}", std::process::id()));
     let (frames, sequence): (Vec<(FrameAt, PathBuf)>, _) = match pictures {
         Pictures::Sequence(sequence) => {
-            let times = sequence.times()?;
-            let paths = (0..times.len()).map(|n| frame_path(&out, n)).collect::<Result<Vec<_>, _>>()?;
+            let times = sequence.times().map_err(|e| e.to_string())?;
+            let paths = (0..times.len())
+                .map(|n| frame_path(&out, n))
+                .collect::<Result<Vec<_>, _>>()
+                .map_err(|e| e.to_string())?;
             edits.time = times.first().copied();
             (times.into_iter().map(FrameAt::Time).zip(paths).collect(), Some(sequence))
         }
@@ -168,14 +193,14 @@ pub fn render(
             (poses.iter().enumerate().map(|(k, name)| (FrameAt::Pose(name.clone()), at(k))).collect(), None)
         }
     };
-    let picture = picture.resolved(&shot)?;
+    let picture = picture.resolved(&shot).map_err(|e| e.to_string())?;
     for out in frames.iter().map(|f| &f.1).chain([&out]) {
         crate::formats::error::refuse_overwriting_input(out).map_err(|e| e.to_string())?;
     }
     let cell_files: Vec<PathBuf> = frames.iter().map(|f| f.1.clone()).collect();
     let frames = frames.into_iter().enumerate().map(|(k, (at, out))| Frame::new(at, out, k)).collect();
     let setup =
-        JobSetup { paths, library, edits, picture, frames, sequence, data, coco_per_picture: false, on_written: None };
+        JobSetup { paths, library, edits, picture, frames, sequence, data, coco_per_picture: false, on_written };
     let done = run_job(setup);
     let done = match (pictures, done) {
         (Pictures::PoseSheet, Ok(messages)) => contact_sheet(&cell_files, &out).map(|()| messages),
@@ -239,7 +264,7 @@ fn run_job(setup: JobSetup) -> Result<Vec<String>, String> {
     let JobSetup { paths, library, edits, picture, frames, sequence, data, coco_per_picture, on_written } = setup;
     let (width, height) = (picture.width, picture.height);
     let mut app = App::new();
-    app.add_plugins(crate::editor::windowless_plugins())
+    app.add_plugins(crate::editor::cores::windowless_plugins())
         .add_plugins(ScheduleRunnerPlugin::run_loop(Duration::from_millis(2)))
         .insert_resource(ClearColor(stage::SKY))
         .insert_resource(crate::editor::state::camera::FramingAspect(width as f32 / height as f32))
@@ -413,7 +438,9 @@ fn capture_when_ready(
                     return Ok(Some((image, annotations)));
                 }
                 let coco = annotate::coco::file(vec![image], annotations);
-                annotate::write::json(&annotate::write::beside(&out, "json"), &coco).map(|()| None)
+                annotate::write::json(&annotate::write::beside(&out, "json"), &coco)
+                    .map(|()| None)
+                    .map_err(|e| e.to_string())
             });
             if let Ok(mut written) = written.lock() {
                 written.push((index, result));
@@ -453,7 +480,7 @@ fn finish(job: &mut RenderJob) -> Result<(), String> {
             for (k, annotation) in c.annotations.iter_mut().enumerate() {
                 annotation["id"] = serde_json::json!(k + 1);
             }
-            annotate::write::json(&c.path, &annotate::coco::file(c.images, c.annotations))
+            annotate::write::json(&c.path, &annotate::coco::file(c.images, c.annotations)).map_err(|e| e.to_string())
         }
         None => Ok(()),
     }
@@ -499,7 +526,8 @@ fn save_picture(
     out: &std::path::Path,
 ) -> Result<(), String> {
     let rendered = image.clone().try_into_dynamic().map_err(|e| format!("unreadable capture: {e}"))?.to_rgba8();
-    let mut picture = picture::over_background(picture::downsampled(&rendered, samples), background)?;
+    let mut picture =
+        picture::over_background(picture::downsampled(&rendered, samples), background).map_err(|e| e.to_string())?;
     if let Some(path) = backdrop {
         let behind = image::open(path).map_err(|e| format!("{}: {e}", path.display()))?;
         picture = picture::over_picture(picture, &behind);
@@ -537,15 +565,9 @@ fn next_frame(
     }
     let first_yaw = *job.first_yaw.get_or_insert_with(|| cameras.iter().next().map_or(0.0, |c| c.0.yaw));
     let FrameAt::Time(t) = job.frames[job.next].at else { return };
-    for mut player in &mut keyframes {
-        (player.state.time, player.state.playing) = (t, false);
-    }
-    for mut body in smpl.iter_mut().filter(|b| b.state.clip.is_some()) {
-        (body.state.time, body.state.playing) = (t * crate::rig::smpl::CLIP_FPS, false);
-    }
-    for mut player in node_clips.iter_mut().filter(|p| p.state.clip.is_some()) {
-        (player.state.time, player.state.playing) = (t, false);
-    }
+    keyframes.iter_mut().for_each(|mut p| p.state.pause_at(t));
+    smpl.iter_mut().filter(|b| b.state.clip.is_some()).for_each(|mut b| b.state.pause_at(t));
+    node_clips.iter_mut().filter(|p| p.state.clip.is_some()).for_each(|mut p| p.state.pause_at(t));
     if let Some(sequence) = job.sequence.filter(|s| s.turntable.is_some()) {
         cameras.iter_mut().for_each(|mut c| c.0.yaw = first_yaw + sequence.turn_at(t));
     }

@@ -193,7 +193,8 @@ fn apply_startup_options(
     let layout: Option<Vec<_>> = scene_path(paths)
         .is_none()
         .then(|| doc.characters.iter_mut().map(|c| std::mem::take(&mut c.placement)).collect());
-    let notes = crate::document::options::apply_options(doc, &edits.pose_options(), library)?;
+    let notes =
+        crate::document::options::apply_options(doc, &edits.pose_options(), library).map_err(|e| e.to_string())?;
     for (c, placed) in doc.characters.iter_mut().zip(layout.iter().flatten()) {
         c.placement = crate::formats::scene::PlacementDoc::from_mat4(placed.to_mat4() * c.placement.to_mat4());
     }

@@ -183,7 +183,7 @@ impl Plugin for InspectorPlugin {
 }
 
 /// Points the scene path box (what Save writes) at the scene the editor was opened on.
-fn save_to_the_opened_scene(paths: Option<Res<super::StartupPaths>>, mut state: ResMut<InspectorState>) {
+fn save_to_the_opened_scene(paths: Option<Res<super::state::StartupPaths>>, mut state: ResMut<InspectorState>) {
     let (Some(paths), Ok(cwd)) = (paths, std::env::current_dir()) else { return };
     state.scene_path = crate::document::scenes::initial_save_path(&paths.0, &cwd).display().to_string();
 }

@@ -131,7 +131,7 @@ fn add_crowd(state: &InspectorState, panels: &mut Panels) {
     };
     let crowd = match crowd {
         Ok(doc) => doc,
-        Err(e) => return panels.messages.push(e),
+        Err(e) => return panels.messages.push(e.to_string()),
     };
     let right = panels.scene.characters.iter().map(|c| c.placement.translation.x).fold(f32::NEG_INFINITY, f32::max);
     let width = crowd.characters.iter().map(|c| c.placement.translation.x).fold(0.0f32, |m, x| m.max(x.abs()));

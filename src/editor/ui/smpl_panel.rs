@@ -49,8 +49,8 @@ fn playback_rows(ui: &mut egui::Ui, body: &SmplCharacter, names: &[&str], state:
         ui.checkbox(&mut state.looping, "loop");
         ui.checkbox(&mut state.upright, "upright");
     });
-    let last = body.clip_frames().saturating_sub(1) as f32;
-    ui.add(slider(&mut state.time, 0.0..=last).text("frame").max_decimals(1));
+    let last = body.clip().map_or(0.0, |k| crate::document::motion::smpl_span(k).end);
+    ui.add(slider(&mut state.time, 0.0..=last).text("time (s)").max_decimals(2));
     ui.add(slider(&mut state.speed, 0.1..=3.0).text("speed"));
     clip_choice(ui, "blend with", names, &mut state.blend_clip);
     if state.blend_clip.is_some() {

@@ -5,6 +5,11 @@
 use glam::{Mat4, Vec3};
 use marionette_formats::scene::CameraDoc;
 
+/// Data pictures are of a perspective camera only.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, thiserror::Error)]
+#[error("--data: the scene's camera is orthographic; data pictures need a perspective camera")]
+pub struct Orthographic;
+
 /// The renderer's near plane (Bevy's perspective default), metres.
 pub const NEAR: f32 = 0.1;
 /// The farthest distance the data passes keep, metres.
@@ -23,9 +28,9 @@ pub struct Pinhole {
 impl Pinhole {
     /// The camera `doc` over a picture of `width` × `height`: its vertical field of view
     /// spans the picture's height. An orthographic camera has no pinhole model.
-    pub fn of(doc: &CameraDoc, width: u32, height: u32) -> Result<Self, String> {
+    pub fn of(doc: &CameraDoc, width: u32, height: u32) -> Result<Self, Orthographic> {
         if doc.ortho.is_some() {
-            return Err("--data: the scene's camera is orthographic; data pictures need a perspective camera".into());
+            return Err(Orthographic);
         }
         // The renderer's camera looks along its -z with y up; OpenCV's along +z with y down.
         let camera_to_world = Mat4::from_rotation_translation(doc.rotation(), doc.eye());

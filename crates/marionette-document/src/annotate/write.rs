@@ -13,6 +13,19 @@ use image::{ImageBuffer, Luma, Rgb, RgbImage};
 use super::raster::FLOOR;
 use super::{Figure, Passes, Pinhole, openpose};
 
+/// A data picture or JSON file that could not be written.
+#[derive(Debug, thiserror::Error)]
+pub enum WriteError {
+    #[error("{}: {source}", path.display())]
+    Image { path: PathBuf, source: image::ImageError },
+    #[error("{}: {source}", path.display())]
+    Exr { path: PathBuf, source: exr::error::Error },
+    #[error("{}: {source}", path.display())]
+    Io { path: PathBuf, source: std::io::Error },
+    #[error("{0}")]
+    Json(#[from] serde_json::Error),
+}
+
 /// The file beside `picture` with `suffix` in place of its extension (`shot.png`,
 /// `depth.exr` → `shot.depth.exr`).
 pub fn beside(picture: &Path, suffix: &str) -> PathBuf {
@@ -21,7 +34,7 @@ pub fn beside(picture: &Path, suffix: &str) -> PathBuf {
 }
 
 /// Writes every pass and OpenPose's files beside `picture`.
-pub fn passes(picture: &Path, camera: &Pinhole, passes: &Passes, figures: &[Figure]) -> Result<(), String> {
+pub fn passes(picture: &Path, camera: &Pinhole, passes: &Passes, figures: &[Figure]) -> Result<(), WriteError> {
     depth_exr(&beside(picture, "depth.exr"), passes)?;
     let (w, h) = (passes.width, passes.height);
     let millimetres = ImageBuffer::<Luma<u16>, _>::from_fn(w, h, |x, y| {
@@ -51,27 +64,29 @@ pub fn passes(picture: &Path, camera: &Pinhole, passes: &Passes, figures: &[Figu
 }
 
 /// Writes `value` as JSON.
-pub fn json(path: &Path, value: &serde_json::Value) -> Result<(), String> {
-    let text = serde_json::to_string(value).map_err(|e| e.to_string())?;
-    std::fs::write(path, text).map_err(|e| format!("{}: {e}", path.display()))
+pub fn json(path: &Path, value: &serde_json::Value) -> Result<(), WriteError> {
+    let text = serde_json::to_string(value)?;
+    std::fs::write(path, text).map_err(|source| WriteError::Io { path: path.to_owned(), source })
 }
 
-fn save<P, C>(image: &ImageBuffer<P, C>, path: &Path) -> Result<(), String>
+fn save<P, C>(image: &ImageBuffer<P, C>, path: &Path) -> Result<(), WriteError>
 where
     P: image::Pixel + image::PixelWithColorType,
     [P::Subpixel]: image::EncodableLayout,
     C: std::ops::Deref<Target = [P::Subpixel]>,
 {
-    image.save_with_format(path, image::ImageFormat::Png).map_err(|e| format!("{}: {e}", path.display()))
+    image
+        .save_with_format(path, image::ImageFormat::Png)
+        .map_err(|source| WriteError::Image { path: path.to_owned(), source })
 }
 
 /// The depth pass as a one-channel (`Z`) 32-bit float OpenEXR file.
-fn depth_exr(path: &Path, passes: &Passes) -> Result<(), String> {
+fn depth_exr(path: &Path, passes: &Passes) -> Result<(), WriteError> {
     use exr::prelude::*;
     let width = passes.width as usize;
     let channels = SpecificChannels::build()
         .with_channel("Z")
         .with_pixel_fn(|at: Vec2<usize>| (passes.depth[at.y() * width + at.x()],));
     let image = Image::from_channels((width, passes.height as usize), channels);
-    image.write().to_file(path).map_err(|e| format!("{}: {e}", path.display()))
+    image.write().to_file(path).map_err(|source| WriteError::Exr { path: path.to_owned(), source })
 }
