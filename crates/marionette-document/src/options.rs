@@ -300,14 +300,16 @@ fn pose_characters(
         apply_pose_specs(skeleton, &mut pose, &poses)?;
         let hands = crate::posing::apply_hand_specs(skeleton, &map, &mut pose, &options.specs.hands);
         notes.extend(hands.into_iter().map(|n| format!("{}: {n}", c.name)));
+        // A body pose stands on the floor before the goals are solved: they are where the
+        // written pose reaches.
         let placement = c.placement.to_mat4() * Mat4::from_translation(root_shift);
-        let goals = (&ik[..], &two_bone[..], &look_at[..]);
-        let reports = solve_constraints(skeleton, &map, &mut pose, placement, goals)?;
-        notes.extend(reports.lines(skeleton, &c.name));
         let placement = match options.specs.preset.is_some() {
             true => crate::posing::stood_on_floor(&asset, &pose, placement),
             false => placement,
         };
+        let goals = (&ik[..], &two_bone[..], &look_at[..]);
+        let reports = solve_constraints(skeleton, &map, &mut pose, placement, goals)?;
+        notes.extend(reports.lines(skeleton, &c.name));
         let initial = skeleton.initial_pose();
         c.pose =
             (0..skeleton.len()).filter(|&j| pose[j] != initial[j]).map(|j| (pose_key(skeleton, j), pose[j])).collect();
