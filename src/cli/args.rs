@@ -18,20 +18,7 @@ pub struct Cli {
 #[derive(clap::Subcommand)]
 pub enum Command {
     /// Open the editor on characters (`Model1.skel` finds `Model1.obj` and `Model1.attach`).
-    Edit {
-        /// Character files; none opens the default scene.
-        paths: Vec<PathBuf>,
-        #[command(flatten)]
-        clip: ClipArgs,
-        /// `--pose`, `--hand`, `--ik`, `--two-bone`, `--look-at` (the scene opens with
-        /// unsaved changes).
-        #[command(flatten)]
-        pose: PoseArgs,
-        /// Open the newest recovery file (what autosave or a crash left in
-        /// `$XDG_STATE_HOME/marionette/recovery`).
-        #[arg(long, conflicts_with = "paths")]
-        recover: bool,
-    },
+    Edit(EditArgs),
     /// Print what a character file loads as: joints, vertices, triangles, weight checks.
     Info { path: PathBuf },
     /// Write the posed, skinned mesh as OBJ: one `v` per source vertex in source order,
@@ -42,28 +29,7 @@ pub enum Command {
     /// bone, or smoothly to the nearest few.
     Bind(BindArgs),
     /// Render a scene (.ron) or characters offscreen to a PNG, without a window.
-    Render {
-        /// A scene file or character files; none renders the default scene.
-        paths: Vec<PathBuf>,
-        #[arg(long)]
-        out: PathBuf,
-        #[command(flatten)]
-        shot: ShotArgs,
-        #[command(flatten)]
-        pose: PoseArgs,
-        /// Skin every character by linear blend (`lbs`) or dual quaternion (`dq`) skinning
-        /// (default: as the scene file says).
-        #[arg(long, value_enum)]
-        skinning: Option<Skinning>,
-        /// Scale every character to the first one's height (as they stand, feet on the
-        /// floor); characters named on the command line then stand side by side.
-        #[arg(long)]
-        match_height: bool,
-        #[command(flatten)]
-        clip: ClipArgs,
-        #[command(flatten)]
-        frames: FrameArgs,
-    },
+    Render(RenderArgs),
     /// The SMPL exercise: writes frame000.obj, frame001.obj, ... into --out.
     ///
     /// Tasks: 1 the shapes β0, β1, β2 (unskinned); 2 L_Elbow moved +0.2 in y, absolute
@@ -81,32 +47,7 @@ pub enum Command {
     Smpl(SmplArgs),
     /// A crowd of animated characters headless through the app and the render world:
     /// frame time (p50/p95) by phase, mesh data handed on, and the skinning kernel's speed.
-    Bench {
-        /// How many characters (SMPL bodies from the data folder, else puppets).
-        #[arg(long, default_value_t = 64, value_parser = clap::value_parser!(u32).range(1..=4096))]
-        characters: u32,
-        /// Frames measured (after warming up).
-        #[arg(long, default_value_t = 300, value_parser = clap::value_parser!(u32).range(1..=100_000))]
-        frames: u32,
-        /// The course data folder (with its `smpl`) or an SMPL folder itself; defaults to
-        /// MARIONETTE_DATA. A folder without an SMPL body is refused.
-        #[arg(long, conflicts_with = "puppets")]
-        data: Option<PathBuf>,
-        /// A crowd of the project's puppets instead of SMPL bodies.
-        #[arg(long)]
-        puppets: bool,
-        /// Print one JSON object instead of the table.
-        #[arg(long)]
-        json: bool,
-        /// Skin the crowd with the GPU skinning compute shader instead of on the CPU.
-        #[arg(long)]
-        gpu: bool,
-        /// Leave the picture undrawn while measuring (the camera off; extraction and upload
-        /// go on): the frame's CPU work as on a machine whose GPU draws, without llvmpipe
-        /// rasterising on the same cores between frames.
-        #[arg(long)]
-        no_draw: bool,
-    },
+    Bench(BenchArgs),
     /// Render a data set: pictures (and their data) of scenes drawn from a spec, each
     /// picture's depending only on the spec's seed and its number; sharded over machines,
     /// resumable. `generate --example` prints a spec to start from.
@@ -439,4 +380,75 @@ impl PoseArgs {
             look_at: self.look_at.clone(),
         }
     }
+}
+
+/// What `edit` is given.
+#[derive(clap::Args)]
+pub struct EditArgs {
+    /// Character files; none opens the default scene.
+    pub paths: Vec<PathBuf>,
+    #[command(flatten)]
+    pub clip: ClipArgs,
+    /// `--pose`, `--hand`, `--ik`, `--two-bone`, `--look-at` (the scene opens with
+    /// unsaved changes).
+    #[command(flatten)]
+    pub pose: PoseArgs,
+    /// Open the newest recovery file (what autosave or a crash left in
+    /// `$XDG_STATE_HOME/marionette/recovery`).
+    #[arg(long, conflicts_with = "paths")]
+    pub recover: bool,
+}
+
+/// What `render` is given.
+#[derive(clap::Args)]
+pub struct RenderArgs {
+    /// A scene file or character files; none renders the default scene.
+    pub paths: Vec<PathBuf>,
+    #[arg(long)]
+    pub out: PathBuf,
+    #[command(flatten)]
+    pub shot: ShotArgs,
+    #[command(flatten)]
+    pub pose: PoseArgs,
+    /// Skin every character by linear blend (`lbs`) or dual quaternion (`dq`) skinning
+    /// (default: as the scene file says).
+    #[arg(long, value_enum)]
+    pub skinning: Option<Skinning>,
+    /// Scale every character to the first one's height (as they stand, feet on the
+    /// floor); characters named on the command line then stand side by side.
+    #[arg(long)]
+    pub match_height: bool,
+    #[command(flatten)]
+    pub clip: ClipArgs,
+    #[command(flatten)]
+    pub frames: FrameArgs,
+}
+
+/// What `bench` is given.
+#[derive(clap::Args)]
+pub struct BenchArgs {
+    /// How many characters (SMPL bodies from the data folder, else puppets).
+    #[arg(long, default_value_t = 64, value_parser = clap::value_parser!(u32).range(1..=4096))]
+    pub characters: u32,
+    /// Frames measured (after warming up).
+    #[arg(long, default_value_t = 300, value_parser = clap::value_parser!(u32).range(1..=100_000))]
+    pub frames: u32,
+    /// The course data folder (with its `smpl`) or an SMPL folder itself; defaults to
+    /// MARIONETTE_DATA. A folder without an SMPL body is refused.
+    #[arg(long, conflicts_with = "puppets")]
+    pub data: Option<PathBuf>,
+    /// A crowd of the project's puppets instead of SMPL bodies.
+    #[arg(long)]
+    pub puppets: bool,
+    /// Print one JSON object instead of the table.
+    #[arg(long)]
+    pub json: bool,
+    /// Skin the crowd with the GPU skinning compute shader instead of on the CPU.
+    #[arg(long)]
+    pub gpu: bool,
+    /// Leave the picture undrawn while measuring (the camera off; extraction and upload
+    /// go on): the frame's CPU work as on a machine whose GPU draws, without llvmpipe
+    /// rasterising on the same cores between frames.
+    #[arg(long)]
+    pub no_draw: bool,
 }

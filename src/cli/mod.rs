@@ -1,7 +1,8 @@
-//! Each command's body but the editor's (`edit`, `render`, `bench` run the app): `export`,
-//! `info`, `bind`, `smpl` and `gen-assets` on the document layer, and the command line's
-//! words ([`args`]). No Bevy; `main.rs` parses and dispatches.
+//! Each command's body: `export`, `info`, `bind`, `smpl` and `gen-assets` on the document
+//! layer; `edit`, `render` and `bench`, which run the app ([`app`]); `generate`'s plan and
+//! run; and the command line's words ([`args`]). `main.rs` parses and dispatches.
 
+pub mod app;
 pub mod args;
 pub mod bind;
 pub mod export;

@@ -172,8 +172,8 @@ pub fn task_frames(model: &SmplModel, data_dir: &Path, task: u32) -> Result<Vec<
 
 /// Frame `f` of an SMPL clip as the motion service plays it (not stood upright).
 fn clip_frame(skeleton: &Skeleton, clip: &Clip, f: usize) -> Vec<Quat> {
-    use crate::document::motion::{Clock, Playing, SmplMotion, pose_at};
-    let clock = Clock { time: f as f32 / crate::rig::smpl::CLIP_FPS, playing: false, speed: 1.0, looping: false };
+    use crate::document::motion::{Clock, Playing, SmplMotion, pose_at, smpl_frame_time};
+    let clock = Clock { time: smpl_frame_time(f), playing: false, speed: 1.0, looping: false };
     let smpl = SmplMotion { clip, blend: None, upright: false };
     let playing = Playing { smpl: Some((smpl, clock)), ..Playing::default() };
     let still = skeleton.initial_pose();

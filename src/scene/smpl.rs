@@ -12,8 +12,6 @@ use crate::formats::scene::SmplDoc;
 use crate::rig::smpl::{Clip, SmplModel};
 use crate::scene::{Character, PoseDirty};
 
-pub use crate::rig::smpl::CLIP_FPS;
-
 /// An SMPL body: the model and the clips of its folder, and its live state, the scene
 /// file's own `SmplDoc` (β, clips by file name, time, playback, blend).
 #[derive(Component, Clone)]

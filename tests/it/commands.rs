@@ -17,13 +17,13 @@ struct Options(&'static [&'static str]);
 impl Options {
     /// `render`'s startup options for these words (parsed as `edit` parses them).
     fn startup(&self, paths: &[PathBuf]) -> StartupEdits {
-        use marionette::cli::args::{Cli, Command};
+        use marionette::cli::args::{Cli, Command, RenderArgs};
         let mut args: Vec<String> = vec!["marionette".into(), "render".into()];
         args.extend(paths.iter().map(|p| p.display().to_string()));
         args.extend(["--out".into(), "unused.png".into()]);
         args.extend(self.0.iter().map(|s| s.to_string()));
         let cli = <Cli as clap::Parser>::try_parse_from(&args).unwrap();
-        let Some(Command::Render { pose, skinning, clip, .. }) = cli.command else { unreachable!() };
+        let Some(Command::Render(RenderArgs { pose, skinning, clip, .. })) = cli.command else { unreachable!() };
         StartupEdits {
             pose: pose.specs(),
             skinning: skinning.map(Into::into),

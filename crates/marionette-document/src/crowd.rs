@@ -44,7 +44,7 @@ pub fn smpl_crowd(dir: &Path, n: usize) -> Result<SceneDoc, NoClips> {
             let state = SmplDoc {
                 betas: (0..10).map(|k| (((i * 7 + k * 3) % 11) as f32 - 5.0) * 0.3).collect(),
                 clip: Some(clips[i % clips.len()].clone()),
-                time: (i * 13 % 60) as f32 / marionette_rig::smpl::CLIP_FPS,
+                time: crate::motion::smpl_frame_time(i * 13 % 60),
                 playing: true,
                 blend_clip: (i % 3 == 0).then(|| clips[(i + 1) % clips.len()].clone()),
                 blend: if i % 3 == 0 { 0.5 } else { 0.0 },

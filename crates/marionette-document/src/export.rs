@@ -244,7 +244,7 @@ impl Posed {
 fn smpl_motion(frames: &[marionette_rig::retarget::Frame]) -> Motion {
     let mut motion = Motion::default();
     for (f, frame) in frames.iter().enumerate() {
-        motion.times.push(f as f32 / FPS);
+        motion.times.push(crate::motion::smpl_frame_time(f));
         motion.poses.push(frame.pose.clone());
         motion.roots.push(frame.root);
     }

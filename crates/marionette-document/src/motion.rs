@@ -86,6 +86,11 @@ impl Playing<'_> {
     }
 }
 
+/// The time of an SMPL clip's frame `f` (seconds).
+pub fn smpl_frame_time(f: usize) -> f32 {
+    f as f32 / CLIP_FPS
+}
+
 /// An SMPL clip's frame (fractional) at `seconds`: a time within 1e-4 of a frame's
 /// stands on that frame, so a frame's time in seconds samples the frame itself.
 pub fn smpl_frame_at(seconds: f32) -> f32 {
