@@ -263,8 +263,13 @@ struct JobSetup {
 fn run_job(setup: JobSetup) -> Result<Vec<String>, String> {
     let JobSetup { paths, library, edits, picture, frames, sequence, data, coco_per_picture, on_written } = setup;
     let (width, height) = (picture.width, picture.height);
+    // A render in a process that logs already (the editor's frames) logs through its log.
+    let plugins = match bevy::log::tracing::dispatcher::has_been_set() {
+        true => crate::editor::cores::windowless_plugins().disable::<bevy::log::LogPlugin>(),
+        false => crate::editor::cores::windowless_plugins(),
+    };
     let mut app = App::new();
-    app.add_plugins(crate::editor::cores::windowless_plugins())
+    app.add_plugins(plugins)
         .add_plugins(ScheduleRunnerPlugin::run_loop(Duration::from_millis(2)))
         .insert_resource(ClearColor(stage::SKY))
         .insert_resource(crate::editor::state::camera::FramingAspect(width as f32 / height as f32))
