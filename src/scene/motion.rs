@@ -85,8 +85,11 @@ fn pose_from_motion(
             node_clips: node_clips.as_deref().and_then(NodeClipPlayer::motion),
         };
         let skeleton = &character.asset.skeleton;
-        let still: Vec<_> =
-            character.joints.iter().map(|&e| poses.get(e).map_or(Default::default(), |p| p.0)).collect();
+        // SMPL playback sets every joint: the joints' poses are not read under it.
+        let still: Vec<_> = match playing.smpl {
+            Some(_) => skeleton.initial_pose(),
+            None => character.joints.iter().map(|&e| poses.get(e).map_or(Default::default(), |p| p.0)).collect(),
+        };
         let weights = morphs.as_ref().map_or(Vec::new(), |m| m.weights.clone());
         let now = pose_at(skeleton, &still, &weights, &playing);
         for (&entity, rotation) in character.joints.iter().zip(now.rotations) {
