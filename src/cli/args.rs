@@ -331,9 +331,27 @@ pub struct GenerateArgs {
     /// Print a commented example spec (built-in puppets only) and exit.
     #[arg(long, conflicts_with_all = ["spec", "merge"])]
     pub example: bool,
-    /// Join the COCO files of every picture a data set's folder holds into DIR/coco.json.
+    /// Join the COCO files of every picture a data set's folder holds (loose or in its
+    /// tars) into DIR/coco.json.
     #[arg(long, value_name = "DIR", conflicts_with = "spec")]
     pub merge: Option<PathBuf>,
+    /// How the set is written: `folder` (each picture's files in --out) or `webdataset`
+    /// (tars of --shard-size pictures, `set-IIIIII-SSSSSS.tar` for the run's shard I, each
+    /// picture's files under its key: `000042.png`, `000042.json`, …).
+    #[arg(long, value_enum, default_value_t = SetFormat::Folder)]
+    pub format: SetFormat,
+    /// Pictures a WebDataset tar holds (the last of a shard may hold fewer).
+    #[arg(long, value_name = "N", default_value_t = 1000, value_parser = clap::value_parser!(u32).range(1..=1_000_000))]
+    pub shard_size: u32,
+}
+
+/// How `generate` writes a set.
+#[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
+pub enum SetFormat {
+    /// Each picture's files in the folder.
+    Folder,
+    /// WebDataset tars.
+    Webdataset,
 }
 
 /// The posing options every command takes, applied to every character that has the joint

@@ -7,10 +7,11 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result, anyhow};
 
-use crate::cli::args::GenerateArgs;
+use crate::cli::args::{GenerateArgs, SetFormat};
 use crate::document::AssetLibrary;
 use crate::document::generate::{self, ManifestLine, Shard, Spec, picture_stem, scene_of};
 use crate::document::scenes::{read_scene, write_scene};
+use crate::document::webdataset::TarSet;
 use crate::formats::scene::{SceneDoc, ShotDoc};
 
 /// What the app renders for a shard.
@@ -25,6 +26,8 @@ pub struct Plan {
     pub finished: usize,
     /// The files every scene names, loaded.
     pub library: AssetLibrary,
+    /// With `--format webdataset`: the run's tars.
+    pub tars: Option<TarSet>,
 }
 
 impl Plan {
@@ -87,7 +90,18 @@ pub fn plan(args: &GenerateArgs) -> Result<Option<Plan>> {
         return Ok(None);
     }
     std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
-    let done = generate::finished_pictures(dir);
+    let tars = (args.format == SetFormat::Webdataset).then(|| TarSet {
+        dir: dir.clone(),
+        shard,
+        size: args.shard_size as usize,
+        count: spec.count,
+    });
+    let mut done = generate::finished_pictures(dir);
+    if let Some(tars) = &tars {
+        // A run stopped between a tar's last picture and the tar finishes it now.
+        tars.pack_finished(&done).map_err(anyhow::Error::msg)?;
+        done.extend(tars.packed());
+    }
     let mut pictures = Vec::new();
     let mut finished = 0;
     for k in shard.pictures(spec.count) {
@@ -105,11 +119,13 @@ pub fn plan(args: &GenerateArgs) -> Result<Option<Plan>> {
         }
         pictures.push((k, scene, backdrop));
     }
-    Ok(Some(Plan { dir: dir.clone(), spec, shard, pictures, finished, library }))
+    Ok(Some(Plan { dir: dir.clone(), spec, shard, pictures, finished, library, tars }))
 }
 
 /// `generate`: the plan's pictures rendered in one app, each recorded in the shard's
-/// manifest as its files are written, a progress bar with pictures a second and the time left.
+/// manifest as its files are written (and with `--format webdataset` packed into its tar
+/// once the tar's pictures are all there), a progress bar with pictures a second and the
+/// time left.
 pub fn run(args: &GenerateArgs) -> Result<()> {
     use crate::editor::present::render::{ScenePicture, render_scenes};
     let Some(mut plan) = plan(args)? else { return Ok(()) };
@@ -139,8 +155,13 @@ pub fn run(args: &GenerateArgs) -> Result<()> {
             .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
     );
     let recorder = bar.clone();
+    let mut finished = generate::finished_pictures(&plan.dir);
     let on_written = Box::new(move |index: usize| {
         plan.record(numbers[index])?;
+        if let Some(tars) = &plan.tars {
+            finished.insert(numbers[index]);
+            tars.pack_finished(&finished).map_err(|e| e.to_string())?;
+        }
         recorder.inc(1);
         Ok(())
     });

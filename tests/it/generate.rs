@@ -149,3 +149,67 @@ fn spec_errors_stop_generate_before_rendering() {
         assert!(!out.exists(), "{words}: nothing written");
     }
 }
+
+/// Digests of the tars in `dir`, by name.
+fn tars(dir: &Path) -> BTreeMap<String, String> {
+    std::fs::read_dir(dir)
+        .unwrap()
+        .flatten()
+        .map(|e| e.file_name().to_string_lossy().into_owned())
+        .filter(|n| n.ends_with(".tar"))
+        .map(|n| (n.clone(), marionette::document::generate::sha256_of(&dir.join(&n)).unwrap()))
+        .collect()
+}
+
+/// Streams the tars of `set` with the Python `webdataset` package against `folder`
+/// (scripts/check_webdataset.py); what it printed.
+fn stream(set: &Path, folder: &Path) -> String {
+    let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("scripts/check_webdataset.py");
+    let output = Command::new("python3")
+        .arg(script)
+        .arg(set)
+        .arg(folder)
+        .output()
+        .expect("python3 with webdataset (scripts/ensure-tools.sh installs it)");
+    let said = String::from_utf8_lossy(&output.stdout).into_owned();
+    assert!(output.status.success(), "{said}{}", String::from_utf8_lossy(&output.stderr));
+    said
+}
+
+/// `--format webdataset`: tars of `--shard-size` pictures that the `webdataset` package
+/// streams as the folder form's files, byte for byte; a tar lost and the run started again
+/// comes back the same; split over two shards, the same samples; `--merge` reads the tars.
+#[test]
+fn a_webdataset_set_streams_as_the_folder_form_and_comes_back_the_same() {
+    let dir = scratch("webdataset");
+    let spec = small_spec(&dir, 8);
+    let folder = dir.join("folder");
+    generate(&spec, &folder, &[], &[]);
+    let set = dir.join("set");
+    let webdataset = ["--format", "webdataset", "--shard-size", "3"];
+    generate(&spec, &set, &webdataset, &[]);
+    let written = tars(&set);
+    let names: Vec<&str> = written.keys().map(String::as_str).collect();
+    assert_eq!(names, ["set-000000-000000.tar", "set-000000-000001.tar", "set-000000-000002.tar"]);
+    assert!(files(&set).is_empty(), "no loose picture files left: {:?}", files(&set));
+    assert_eq!(stream(&set, &folder).trim(), "8 samples");
+
+    // The last tar lost (a run killed before it was written whole), then the run again.
+    std::fs::remove_file(set.join("set-000000-000002.tar")).unwrap();
+    let again = generate(&spec, &set, &webdataset, &[]);
+    assert!(again.contains("6 already there, 2 to render"), "{again}");
+    assert_eq!(tars(&set), written, "the same tars, byte for byte");
+
+    let split = dir.join("split");
+    generate(&spec, &split, &[&webdataset[..], &["--shard", "0/2"]].concat(), &[]);
+    generate(&spec, &split, &[&webdataset[..], &["--shard", "1/2"]].concat(), &[]);
+    assert_eq!(tars(&split).len(), 4, "two tars a shard: {:?}", tars(&split));
+    assert_eq!(stream(&split, &folder).trim(), "8 samples");
+
+    let output =
+        Command::new(env!("CARGO_BIN_EXE_marionette")).args(["generate", "--merge"]).arg(&set).output().unwrap();
+    assert!(output.status.success(), "{}", String::from_utf8_lossy(&output.stderr));
+    let coco: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(set.join("coco.json")).unwrap()).unwrap();
+    assert_eq!(coco["images"].as_array().unwrap().len(), 8);
+}

@@ -867,11 +867,12 @@ pub fn merge(dir: &Path) -> Result<usize, GenerateError> {
     lines.dedup_by_key(|l| l.picture);
     let (mut images, mut annotations) = (Vec::new(), Vec::new());
     for line in &lines {
-        let path = dir.join(format!("{}.json", picture_stem(line.picture)));
-        let text =
-            std::fs::read_to_string(&path).map_err(|source| GenerateError::NoData { path: path.clone(), source })?;
+        let name = format!("{}.json", picture_stem(line.picture));
+        let path = dir.join(&name);
+        let text = super::webdataset::read_member(dir, &name)?
+            .ok_or_else(|| GenerateError::NoData { path: path.clone(), source: std::io::ErrorKind::NotFound.into() })?;
         let mut coco: serde_json::Value =
-            serde_json::from_str(&text).map_err(|source| GenerateError::Json { path: path.clone(), source })?;
+            serde_json::from_slice(&text).map_err(|source| GenerateError::Json { path: path.clone(), source })?;
         images.extend(coco["images"].as_array_mut().map(std::mem::take).unwrap_or_default());
         annotations.extend(coco["annotations"].as_array_mut().map(std::mem::take).unwrap_or_default());
     }

@@ -18,5 +18,6 @@ pub mod picture;
 pub mod posing;
 pub mod retarget;
 pub mod scenes;
+pub mod webdataset;
 
 pub use library::{AssetLibrary, LoadedPart, SmplSet, own_motion, rebind};

@@ -1,0 +1,123 @@
+//! A data set as WebDataset shards: a run's pictures, `size` at a time, each group packed
+//! into one tar `set-IIIIII-SSSSSS.tar` (the run's shard I, its S-th tar) once every picture
+//! of it is written whole, its files under the picture's key as the WebDataset convention
+//! has it (`000042.png`, `000042.depth.exr`, `000042.json`, `000042.scene.ron`, …).
+//!
+//! A tar is written through a temporary file and renamed, its members in name order with
+//! no time, owner or mode of the machine's, so the same pictures give the same bytes; the
+//! pictures' loose files go once their tar is there. A run stopped and started again finds
+//! the tars written whole and the pictures written loose, and renders only the others.
+
+use std::collections::BTreeSet;
+use std::io::Write;
+use std::path::{Path, PathBuf};
+
+use crate::generate::{GenerateError, Shard, manifest_line};
+
+/// A run's tars: the folder, the shard it renders, the pictures a tar and the set's count.
+#[derive(Debug, Clone, PartialEq)]
+pub struct TarSet {
+    pub dir: PathBuf,
+    pub shard: Shard,
+    pub size: usize,
+    pub count: usize,
+}
+
+impl TarSet {
+    /// Each tar of the run and the pictures it holds: the shard's pictures, `size` at a time.
+    pub fn tars(&self) -> Vec<(PathBuf, Vec<usize>)> {
+        let pictures: Vec<usize> = self.shard.pictures(self.count).collect();
+        let name = |s: usize| self.dir.join(format!("set-{:06}-{s:06}.tar", self.shard.index));
+        pictures.chunks(self.size.max(1)).enumerate().map(|(s, group)| (name(s), group.to_vec())).collect()
+    }
+
+    /// The pictures the tars already written hold.
+    pub fn packed(&self) -> BTreeSet<usize> {
+        self.tars().into_iter().filter(|(tar, _)| tar.is_file()).flat_map(|(_, group)| group).collect()
+    }
+
+    /// Packs every tar not written yet whose pictures are all `finished` (written whole,
+    /// loose in the folder), then removes their loose files. Returns how many it wrote.
+    pub fn pack_finished(&self, finished: &BTreeSet<usize>) -> Result<usize, GenerateError> {
+        let mut written = 0;
+        for (tar, group) in self.tars() {
+            if tar.is_file() || !group.iter().all(|k| finished.contains(k)) {
+                continue;
+            }
+            let files = group
+                .iter()
+                .map(|&k| Ok(manifest_line(&self.dir, k)?.files.into_iter().map(|(name, _)| name)))
+                .collect::<Result<Vec<_>, GenerateError>>()?;
+            let mut names: Vec<String> = files.into_iter().flatten().collect();
+            names.sort();
+            write_tar(&self.dir, &names, &tar)?;
+            for name in &names {
+                let path = self.dir.join(name);
+                std::fs::remove_file(&path).map_err(|source| GenerateError::Io { path, source })?;
+            }
+            written += 1;
+        }
+        Ok(written)
+    }
+}
+
+/// Writes the files `names` of `dir` into the tar `path`, whole: through a temporary file,
+/// synced, then renamed.
+fn write_tar(dir: &Path, names: &[String], path: &Path) -> Result<(), GenerateError> {
+    let io = |path: &Path| {
+        let path = path.to_owned();
+        move |source| GenerateError::Io { path, source }
+    };
+    let temporary = path.with_extension("tar.tmp");
+    let file = std::fs::File::create(&temporary).map_err(io(&temporary))?;
+    let mut builder = tar::Builder::new(std::io::BufWriter::new(file));
+    for name in names {
+        let member = dir.join(name);
+        let bytes = std::fs::read(&member).map_err(io(&member))?;
+        let mut header = tar::Header::new_gnu();
+        header.set_path(name).map_err(io(&member))?;
+        header.set_size(bytes.len() as u64);
+        header.set_mode(0o644);
+        header.set_mtime(0);
+        header.set_uid(0);
+        header.set_gid(0);
+        header.set_entry_type(tar::EntryType::Regular);
+        header.set_cksum();
+        builder.append(&header, bytes.as_slice()).map_err(io(&temporary))?;
+    }
+    let mut out = builder.into_inner().map_err(io(&temporary))?;
+    out.flush().map_err(io(&temporary))?;
+    let file = out.into_inner().map_err(|e| GenerateError::Io { path: temporary.clone(), source: e.into_error() })?;
+    file.sync_all().map_err(io(&temporary))?;
+    std::fs::rename(&temporary, path).map_err(io(path))
+}
+
+/// The file `name` of a data set's folder: loose there, else a member of one of its tars.
+pub fn read_member(dir: &Path, name: &str) -> Result<Option<Vec<u8>>, GenerateError> {
+    let loose = dir.join(name);
+    if loose.is_file() {
+        return std::fs::read(&loose).map(Some).map_err(|source| GenerateError::Io { path: loose, source });
+    }
+    let mut tars: Vec<PathBuf> = std::fs::read_dir(dir)
+        .map_err(|source| GenerateError::Io { path: dir.to_owned(), source })?
+        .flatten()
+        .map(|e| e.path())
+        .filter(|p| {
+            p.file_name().and_then(|n| n.to_str()).is_some_and(|n| n.starts_with("set-") && n.ends_with(".tar"))
+        })
+        .collect();
+    tars.sort();
+    for tar in tars {
+        let io = |source| GenerateError::Io { path: tar.clone(), source };
+        let mut archive = tar::Archive::new(std::fs::File::open(&tar).map_err(io)?);
+        for entry in archive.entries().map_err(io)? {
+            let mut entry = entry.map_err(io)?;
+            if entry.path().map_err(io)?.to_str() == Some(name) {
+                let mut bytes = Vec::new();
+                std::io::Read::read_to_end(&mut entry, &mut bytes).map_err(io)?;
+                return Ok(Some(bytes));
+            }
+        }
+    }
+    Ok(None)
+}
