@@ -325,6 +325,9 @@ pub struct GenerateArgs {
     /// How many pictures, in place of the spec's count.
     #[arg(long)]
     pub count: Option<usize>,
+    /// The seed every picture is drawn from, in place of the spec's.
+    #[arg(long)]
+    pub seed: Option<u64>,
     /// Print each picture's scene instead of rendering.
     #[arg(long)]
     pub dry_run: bool,

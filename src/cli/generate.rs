@@ -73,6 +73,9 @@ pub fn plan(args: &GenerateArgs) -> Result<Option<Plan>> {
         return Err(anyhow!("generate: expected SPEC and --out DIR"));
     };
     let mut spec = generate::read_spec(spec_path)?;
+    if let Some(seed) = args.seed {
+        spec.seed = seed;
+    }
     if let Some(count) = args.count {
         spec.count = count;
         spec.check().map_err(|e| anyhow!("--count: {e}"))?;

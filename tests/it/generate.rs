@@ -213,3 +213,29 @@ fn a_webdataset_set_streams_as_the_folder_form_and_comes_back_the_same() {
         serde_json::from_str(&std::fs::read_to_string(set.join("coco.json")).unwrap()).unwrap();
     assert_eq!(coco["images"].as_array().unwrap().len(), 8);
 }
+
+/// `--seed S` draws every picture from S in place of the spec's seed: the same as a spec
+/// that says S, another picture than the spec's own seed gives.
+#[test]
+fn seed_overrides_the_specs_seed() {
+    let dir = scratch("seed");
+    let spec = small_spec(&dir, 1);
+    let text = std::fs::read_to_string(&spec).unwrap();
+    assert!(text.contains("seed: 1,"), "the example's seed");
+    let reseeded = dir.join("reseeded.ron");
+    std::fs::write(&reseeded, text.replacen("seed: 1,", "seed: 7,", 1)).unwrap();
+    let scenes = |spec: &Path, extra: &[&str]| {
+        let output = Command::new(env!("CARGO_BIN_EXE_marionette"))
+            .arg("generate")
+            .arg(spec)
+            .args(["--out", dir.join("unused").to_str().unwrap(), "--dry-run"])
+            .args(extra)
+            .output()
+            .unwrap();
+        assert!(output.status.success(), "{}", String::from_utf8_lossy(&output.stderr));
+        String::from_utf8_lossy(&output.stdout).into_owned()
+    };
+    let by_flag = scenes(&spec, &["--seed", "7"]);
+    assert_eq!(by_flag, scenes(&reseeded, &[]), "--seed 7 is the spec's seed: 7");
+    assert_ne!(by_flag, scenes(&spec, &[]), "another seed, another picture");
+}
