@@ -52,9 +52,10 @@ pub fn render(args: RenderArgs) -> Result<()> {
         still: false,
     };
     let (sequence, pictures) = (frames.sequence(), frames.pictures());
-    let (notes, picture) =
-        crate::editor::present::render::render(paths, edits, out.clone(), shot.picture(), pictures, shot.data)
-            .map_err(anyhow::Error::msg)?;
+    use crate::editor::present::render::{Rendering, render_with};
+    let (picture, data, controlnet) = (shot.picture(), shot.data, shot.controlnet);
+    let rendering = Rendering { paths, edits, out: out.clone(), picture, pictures, data, controlnet };
+    let (notes, picture) = render_with(rendering, None).map_err(anyhow::Error::msg)?;
     for n in notes {
         eprintln!("note: {n}");
     }

@@ -127,6 +127,12 @@ pub struct ShotArgs {
     /// camera (one for a whole frame sequence).
     #[arg(long)]
     pub data: bool,
+    /// Write the maps ControlNet reads beside the picture: `shot.cn-openpose.png` (drawn as
+    /// the OpenPose annotator draws) and `.json` (18 points, the canvas size),
+    /// `shot.cn-depth.png` (relative inverse depth, near white) and `shot.cn-normal.png`
+    /// (Normal 1.1: red left, green up, blue toward the viewer).
+    #[arg(long)]
+    pub controlnet: bool,
 }
 
 fn parse_view(s: &str) -> Result<crate::formats::scene::ViewName, String> {

@@ -354,3 +354,95 @@ fn the_openpose_drawing_has_controlnets_colours_and_limbs() {
     assert!(limbs >= 10, "{limbs} limbs in their colour at 60 %");
     assert_eq!(drawing.get_pixel(0, 0).0, [0, 0, 0], "on black");
 }
+
+/// `render --controlnet` at `width` × `height` of `characters` (RON) into `dir/shot.png`,
+/// with `--data` for the metric passes to hold the maps to.
+fn render_controlnet(dir: &Path, characters: &[String], width: u32, height: u32) {
+    let scene = dir.join("scene.ron");
+    std::fs::write(&scene, format!("(characters: [{}], {})", characters.join(", "), camera_ron())).unwrap();
+    let out = dir.join("shot.png");
+    let output = Command::new(env!("CARGO_BIN_EXE_marionette"))
+        .args(["render", scene.to_str().unwrap(), "--out", out.to_str().unwrap(), "--data", "--controlnet"])
+        .args(["--width", &width.to_string(), "--height", &height.to_string()])
+        .output()
+        .unwrap();
+    assert!(output.status.success(), "{}", String::from_utf8_lossy(&output.stderr));
+}
+
+/// The OpenPose map is the annotator's own drawing of the same points (its `draw_bodypose`
+/// taken from the `controlnet_aux` wheel, scripts/check_controlnet_openpose.py): one and
+/// three people, 512×512 and 640×480.
+#[test]
+fn the_controlnet_openpose_map_is_the_annotators_drawing() {
+    let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("scripts/check_controlnet_openpose.py");
+    let three = [puppet("a", -0.9, 0.4), puppet("b", 0.0, 0.0), puppet("c", 0.9, -0.5)];
+    for (people, (w, h)) in [(&three[1..2], (512, 512)), (&three[..], (640, 480)), (&three[..], (512, 512))] {
+        let dir = scratch(&format!("controlnet-openpose-{}-{w}x{h}", people.len()));
+        render_controlnet(&dir, people, w, h);
+        let output = Command::new("python3")
+            .arg(&script)
+            .arg(dir.join("shot.png"))
+            .output()
+            .expect("python3 with numpy and opencv (scripts/ensure-tools.sh installs them)");
+        let said = String::from_utf8_lossy(&output.stdout);
+        assert!(output.status.success(), "{said}{}", String::from_utf8_lossy(&output.stderr));
+        assert!(said.contains(&format!("{} people", people.len())), "{said}");
+        eprintln!("{said}");
+    }
+}
+
+/// The depth map is relative inverse depth: 255 at the nearest shown point, 0 where nothing
+/// is, never darker for a nearer pixel; the normal map is the camera-frame normals with x
+/// turned to the viewer's left (a surface facing left is red), nothing facing the viewer;
+/// the 18-point JSON carries the canvas.
+#[test]
+fn the_controlnet_depth_and_normal_maps_follow_its_conventions() {
+    let dir = scratch("controlnet-maps");
+    render_controlnet(&dir, &[puppet("a", -0.4, 0.9), puppet("b", 0.5, -0.9)], W, H);
+    let depth = read_depth(&dir.join("shot.depth.exr"));
+    let map = image::open(dir.join("shot.cn-depth.png")).unwrap().to_luma8();
+    let values: Vec<u8> = map.pixels().map(|p| p.0[0]).collect();
+    let mut shown: Vec<(f32, u8)> =
+        depth.iter().zip(&values).filter(|(d, _)| d.is_finite()).map(|(&d, &v)| (d, v)).collect();
+    assert!(depth.iter().zip(&values).all(|(d, &v)| d.is_finite() || v == 0), "nothing is black");
+    shown.sort_by(|a, b| a.0.total_cmp(&b.0));
+    assert_eq!(shown[0].1, 255, "the nearest shown point is white");
+    assert!(shown.windows(2).all(|p| p[0].1 >= p[1].1), "farther is never brighter");
+    assert!(shown.iter().all(|&(_, v)| v >= 1), "what is shown is not black");
+
+    let camera_frame = image::open(dir.join("shot.normal.png")).unwrap().to_rgb8();
+    let controlnet = image::open(dir.join("shot.cn-normal.png")).unwrap().to_rgb8();
+    let (mut left, mut right) = (0, 0);
+    for (i, (ours, theirs)) in camera_frame.pixels().zip(controlnet.pixels()).enumerate() {
+        if !depth[i].is_finite() {
+            assert_eq!(theirs.0, [128, 128, 255], "nothing faces the viewer");
+            continue;
+        }
+        let [x, y, z] = ours.0.map(i32::from);
+        let [r, g, b] = theirs.0.map(i32::from);
+        assert!(
+            (r - (255 - x)).abs() <= 1 && g == y && b == z,
+            "pixel {i}: camera {:?}, ControlNet {:?}",
+            ours.0,
+            theirs.0
+        );
+        // Facing the viewer's left (x < 0 in the camera frame): red above the middle.
+        if x < 100 {
+            assert!(r > 155, "a surface facing left is red: {:?}", theirs.0);
+            left += 1;
+        } else if x > 155 {
+            right += 1;
+        }
+    }
+    assert!(left > 50 && right > 50, "surfaces facing both ways: {left} left, {right} right");
+
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("shot.cn-openpose.json")).unwrap()).unwrap();
+    assert_eq!(
+        (json["canvas_width"].as_u64(), json["canvas_height"].as_u64()),
+        (Some(u64::from(W)), Some(u64::from(H)))
+    );
+    let people = json["people"].as_array().unwrap();
+    assert_eq!(people.len(), 2);
+    assert!(people.iter().all(|p| p["pose_keypoints_2d"].as_array().unwrap().len() == 54), "18 points a person");
+}

@@ -51,6 +51,11 @@ impl DataFrame {
         Ok((image, annotate::coco::annotations(&self.camera, &passes, &self.figures, image_id, first_id)))
     }
 
+    /// Writes the maps ControlNet reads beside `picture`.
+    pub fn write_controlnet_beside(&self, picture: &std::path::Path) -> Result<(), String> {
+        annotate::write::controlnet(picture, &self.camera, &self.passes(), &self.figures).map_err(|e| e.to_string())
+    }
+
     /// Writes the passes and a COCO file of this one picture beside `picture`.
     pub fn write_all_beside(&self, picture: &std::path::Path) -> Result<(), String> {
         let (image, annotations) = self.write_beside(picture, 1, 1)?;

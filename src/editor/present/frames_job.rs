@@ -92,6 +92,7 @@ impl FramesJob {
             picture: PictureRequest::default(),
             pictures: Pictures::Sequence(sequence),
             data: r.with_data,
+            controlnet: false,
         };
         let worker = std::thread::Builder::new()
             .name("frames".into())

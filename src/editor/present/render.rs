@@ -65,6 +65,8 @@ struct RenderJob {
     /// `--data`: the COCO file's path and its images and annotations so far (the passes
     /// are written beside each picture as it is saved).
     data: Option<CocoSoFar>,
+    /// Write the maps ControlNet reads beside each picture.
+    controlnet: bool,
     /// The saved picture's width and height.
     size: (u32, u32),
     /// Each picture's data carries a COCO file of its own (a data set's), not a share of one
@@ -138,7 +140,7 @@ pub fn render(
     pictures: Pictures,
     data: bool,
 ) -> Result<(Vec<String>, ShotDoc), String> {
-    render_with(Rendering { paths, edits, out, picture, pictures, data }, None)
+    render_with(Rendering { paths, edits, out, picture, pictures, data, controlnet: false }, None)
 }
 
 /// What [`render`] is asked for.
@@ -149,13 +151,15 @@ pub struct Rendering {
     pub picture: PictureRequest,
     pub pictures: Pictures,
     pub data: bool,
+    /// `--controlnet`: the maps ControlNet reads beside each picture.
+    pub controlnet: bool,
 }
 
 /// [`render`], calling `on_written` with each picture's index once its files are written
 /// (where given; else each picture's progress is said on standard error). The render stops
 /// at the first call that fails, with its error.
 pub fn render_with(
-    Rendering { paths, mut edits, out, picture, pictures, data }: Rendering,
+    Rendering { paths, mut edits, out, picture, pictures, data, controlnet }: Rendering,
     on_written: Option<OnWritten>,
 ) -> Result<(Vec<String>, ShotDoc), String> {
     let data = match (data, pictures) {
@@ -199,8 +203,18 @@ pub fn render_with(
     }
     let cell_files: Vec<PathBuf> = frames.iter().map(|f| f.1.clone()).collect();
     let frames = frames.into_iter().enumerate().map(|(k, (at, out))| Frame::new(at, out, k)).collect();
-    let setup =
-        JobSetup { paths, library, edits, picture, frames, sequence, data, coco_per_picture: false, on_written };
+    let setup = JobSetup {
+        paths,
+        library,
+        edits,
+        picture,
+        frames,
+        sequence,
+        data,
+        controlnet,
+        coco_per_picture: false,
+        on_written,
+    };
     let done = run_job(setup);
     let done = match (pictures, done) {
         (Pictures::PoseSheet, Ok(messages)) => contact_sheet(&cell_files, &out).map(|()| messages),
@@ -237,6 +251,7 @@ pub fn render_scenes(
         frames,
         sequence: None,
         data: data.then(CocoSoFar::default),
+        controlnet: false,
         coco_per_picture: true,
         on_written: Some(on_written),
     };
@@ -253,6 +268,7 @@ struct JobSetup {
     sequence: Option<FrameSequence>,
     /// With data: the COCO file all pictures share, as it fills.
     data: Option<CocoSoFar>,
+    controlnet: bool,
     /// Each picture's data has a COCO file of its own instead.
     coco_per_picture: bool,
     on_written: Option<OnWritten>,
@@ -261,7 +277,8 @@ struct JobSetup {
 /// Builds the render's app, runs it until every picture is written or it fails, and
 /// returns the notes or what went wrong.
 fn run_job(setup: JobSetup) -> Result<Vec<String>, String> {
-    let JobSetup { paths, library, edits, picture, frames, sequence, data, coco_per_picture, on_written } = setup;
+    let JobSetup { paths, library, edits, picture, frames, sequence, data, controlnet, coco_per_picture, on_written } =
+        setup;
     let (width, height) = (picture.width, picture.height);
     // A render in a process that logs already (the editor's frames) logs through its log.
     let plugins = match bevy::log::tracing::dispatcher::has_been_set() {
@@ -301,6 +318,7 @@ fn run_job(setup: JobSetup) -> Result<Vec<String>, String> {
         done: None,
         outcome: outcome.clone(),
         data,
+        controlnet,
         size: (width, height),
         coco_per_picture,
         on_written,
@@ -423,7 +441,8 @@ fn capture_when_ready(
     let (out, ids, backdrop) = (frame_now.out.clone(), frame_now.ids, frame_now.backdrop.clone());
     let (samples, background, coco_per_picture) = (job.samples, stage.background.clone(), job.coco_per_picture);
     // What the data pictures show is taken now, with the frame the capture draws.
-    let mut frame = match job.data.is_some().then(|| scene.frame(job.size.0, job.size.1)).transpose() {
+    let (data, controlnet) = (job.data.is_some(), job.controlnet);
+    let mut frame = match (data || controlnet).then(|| scene.frame(job.size.0, job.size.1)).transpose() {
         Ok(frame) => frame,
         Err(e) => {
             job.done = Some(Err(e));
@@ -438,6 +457,12 @@ fn capture_when_ready(
         std::thread::spawn(move || {
             let result = save_picture(&image, samples, &background, backdrop.as_deref(), &out).and_then(|()| {
                 let Some(frame) = frame else { return Ok(None) };
+                if controlnet {
+                    frame.write_controlnet_beside(&out)?;
+                }
+                if !data {
+                    return Ok(None);
+                }
                 let (image, annotations) = frame.write_beside(&out, ids.0, ids.1)?;
                 if !coco_per_picture {
                     return Ok(Some((image, annotations)));

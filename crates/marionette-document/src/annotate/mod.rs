@@ -6,6 +6,7 @@
 
 pub mod camera;
 pub mod coco;
+pub mod controlnet;
 pub mod openpose;
 pub mod raster;
 pub mod write;

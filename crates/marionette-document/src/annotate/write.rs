@@ -63,6 +63,18 @@ pub fn passes(picture: &Path, camera: &Pinhole, passes: &Passes, figures: &[Figu
     json(&beside(picture, "openpose.json"), &openpose::json(camera, passes, figures))
 }
 
+/// Writes the maps ControlNet reads beside `picture` ([`super::controlnet`]):
+/// `shot.cn-openpose.png` and `.json`, `shot.cn-depth.png`, `shot.cn-normal.png`.
+pub fn controlnet(picture: &Path, camera: &Pinhole, passes: &Passes, figures: &[Figure]) -> Result<(), WriteError> {
+    use super::controlnet::{bodies, inverse_depth, normal_map, openpose_drawing, openpose_json};
+    let people = bodies(camera, passes, figures);
+    let (w, h) = (passes.width, passes.height);
+    save(&openpose_drawing(w, h, &people), &beside(picture, "cn-openpose.png"))?;
+    json(&beside(picture, "cn-openpose.json"), &openpose_json(w, h, &people))?;
+    save(&inverse_depth(passes), &beside(picture, "cn-depth.png"))?;
+    save(&normal_map(passes), &beside(picture, "cn-normal.png"))
+}
+
 /// Writes `value` as JSON.
 pub fn json(path: &Path, value: &serde_json::Value) -> Result<(), WriteError> {
     let text = serde_json::to_string(value)?;
