@@ -12,10 +12,10 @@ if ! command -v cargo > /dev/null; then
   echo "ensure-tools: cargo not found: install Rust 1.95 or later (https://rustup.rs), then run this again" >&2
   exit 1
 fi
-# The tests' independent references (numpy, pycocotools, pillow, webdataset, opencv),
-# installed when missing.
-if ! python3 -c "import numpy, pycocotools, PIL, webdataset, cv2" 2> /dev/null; then
-  packages=(numpy pycocotools pillow webdataset "opencv-python-headless<4.11")
+# The tests' independent references (numpy, pycocotools, pillow, webdataset, opencv,
+# matplotlib), installed when missing.
+if ! python3 -c "import numpy, pycocotools, PIL, webdataset, cv2, matplotlib" 2> /dev/null; then
+  packages=(numpy pycocotools pillow webdataset "opencv-python-headless<4.11" matplotlib)
   python3 -m pip install --quiet "${packages[@]}" \
     || python3 -m pip install --quiet --break-system-packages "${packages[@]}" \
     || echo "ensure-tools: could not install ${packages[*]} for python3; the data-picture and data-set tests need them" >&2

@@ -370,8 +370,9 @@ fn render_controlnet(dir: &Path, characters: &[String], width: u32, height: u32)
 }
 
 /// The OpenPose map is the annotator's own drawing of the same points (its `draw_bodypose`
-/// taken from the `controlnet_aux` wheel, scripts/check_controlnet_openpose.py): one and
-/// three people, 512×512 and 640×480.
+/// and `draw_handpose` taken from the `controlnet_aux` wheel,
+/// scripts/check_controlnet_openpose.py): one and three people, 512×512 and 640×480, and a
+/// figure with both hands.
 #[test]
 fn the_controlnet_openpose_map_is_the_annotators_drawing() {
     let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("scripts/check_controlnet_openpose.py");
@@ -389,6 +390,21 @@ fn the_controlnet_openpose_map_is_the_annotators_drawing() {
         assert!(said.contains(&format!("{} people", people.len())), "{said}");
         eprintln!("{said}");
     }
+    // Hands where the fingers are mapped: a Mixamo rig waving, one hand open, one pointing.
+    let dir = scratch("controlnet-openpose-hands");
+    let out = dir.join("shot.png");
+    let mixamo = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/rigs/mixamo.glb");
+    let output = Command::new(env!("CARGO_BIN_EXE_marionette"))
+        .args(["render", mixamo.to_str().unwrap(), "--out", out.to_str().unwrap(), "--controlnet"])
+        .args(["--preset", "wave", "--hand", "left=open", "--hand", "right=point", "--width", "640", "--height", "480"])
+        .output()
+        .unwrap();
+    assert!(output.status.success(), "{}", String::from_utf8_lossy(&output.stderr));
+    let output = Command::new("python3").arg(&script).arg(&out).output().unwrap();
+    let said = String::from_utf8_lossy(&output.stdout);
+    assert!(output.status.success(), "{said}{}", String::from_utf8_lossy(&output.stderr));
+    assert!(said.contains("1 people (2 hands)"), "{said}");
+    eprintln!("{said}");
 }
 
 /// The depth map is relative inverse depth: 255 at the nearest shown point, 0 where nothing

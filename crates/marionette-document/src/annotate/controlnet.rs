@@ -14,28 +14,88 @@
 use image::{GrayImage, Luma, Rgb, RgbImage};
 use serde_json::{Value, json};
 
-use super::openpose::{BODY_18, COLOURS, LIMBS};
+use super::openpose::{BODY_18, COLOURS, HAND_EDGES, LIMBS};
 use super::{Figure, Passes, Pinhole, seen};
 
 /// A person's 18 points in pixels, where the picture shows them.
 pub type Body18 = [Option<(f32, f32)>; 18];
 
-/// Each person's 18 points: those in the picture (seen or hidden by something in front).
-pub fn bodies(camera: &Pinhole, passes: &Passes, figures: &[Figure]) -> Vec<Body18> {
+/// A hand's 21 points in pixels, (0, 0) where the picture does not show one (as the
+/// detector gives them).
+pub type Hand21 = [(f32, f32); 21];
+
+/// A person as the annotator draws them: body, left hand, right hand.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Person {
+    pub body: Body18,
+    /// Left, then right; none where the rig's fingers are not mapped.
+    pub hands: [Option<Hand21>; 2],
+}
+
+/// Each person's points: those in the picture (seen or hidden by something in front).
+pub fn people(camera: &Pinhole, passes: &Passes, figures: &[Figure]) -> Vec<Person> {
     let point = |figure: &Figure, name: &str| {
         let (x, y, v) = seen(camera, passes, figure.instance, figure.points.get(name)?);
         (v > 0).then_some((x, y))
     };
-    figures.iter().filter(|f| f.is_person()).map(|f| BODY_18.map(|name| point(f, name))).collect()
+    let hand = |figure: &Figure, side: &str| {
+        let names: [String; 21] = std::array::from_fn(|k| format!("{side}_hand_{k}"));
+        let all = names.iter().all(|n| figure.points.contains_key(n));
+        all.then(|| names.map(|n| point(figure, &n).unwrap_or((0.0, 0.0))))
+    };
+    let person =
+        |f: &Figure| Person { body: BODY_18.map(|name| point(f, name)), hands: [hand(f, "left"), hand(f, "right")] };
+    figures.iter().filter(|f| f.is_person()).map(person).collect()
 }
 
-/// The annotator's drawing of `people` on a black canvas of `width` × `height`.
-pub fn openpose_drawing(width: u32, height: u32, people: &[Body18]) -> RgbImage {
+/// The annotator's drawing of `people` (`draw_poses`: each person's body, left hand, right
+/// hand) on a black canvas of `width` × `height`.
+pub fn openpose_drawing(width: u32, height: u32, people: &[Person]) -> RgbImage {
     let mut canvas = RgbImage::new(width, height);
-    for body in people {
-        draw_body(&mut canvas, body);
+    for person in people {
+        draw_body(&mut canvas, &person.body);
+        person.hands.iter().flatten().for_each(|hand| draw_hand(&mut canvas, hand));
     }
     canvas
+}
+
+/// `draw_handpose`: each bone a line 2 pixels thick in its colour round the hue circle,
+/// then each point a blue filled circle of radius 4; points at the picture's edge (0) are
+/// left out.
+fn draw_hand(canvas: &mut RgbImage, hand: &Hand21) {
+    const EPS: i32 = 0;
+    let (w, h) = (canvas.width() as f32, canvas.height() as f32);
+    // The annotator works on points divided by the canvas size and multiplies them back.
+    let pixel =
+        |(x, y): (f32, f32)| ((f64::from(x / w) * f64::from(w)) as i32, (f64::from(y / h) * f64::from(h)) as i32);
+    for (k, [a, b]) in HAND_EDGES.iter().enumerate() {
+        let ((x1, y1), (x2, y2)) = (pixel(hand[*a]), pixel(hand[*b]));
+        if x1 > EPS && y1 > EPS && x2 > EPS && y2 > EPS {
+            thick_line2(canvas, (x1, y1), (x2, y2), hue(k as f64 / HAND_EDGES.len() as f64));
+        }
+    }
+    for &point in hand {
+        let (x, y) = pixel(point);
+        if x > EPS && y > EPS {
+            fill_circle(canvas, (x, y), 4, [0, 0, 255]);
+        }
+    }
+}
+
+/// matplotlib's `hsv_to_rgb([h, 1, 1]) * 255` as OpenCV rounds a colour (ties to even).
+fn hue(h: f64) -> [u8; 3] {
+    let i = (h * 6.0).floor();
+    let f = h * 6.0 - i;
+    let (q, t) = (1.0 - f, f);
+    let rgb = match i as i64 % 6 {
+        0 => [1.0, t, 0.0],
+        1 => [q, 1.0, 0.0],
+        2 => [0.0, 1.0, t],
+        3 => [0.0, q, 1.0],
+        4 => [t, 0.0, 1.0],
+        _ => [1.0, 0.0, q],
+    };
+    rgb.map(|c: f64| (c * 255.0).round_ties_even().clamp(0.0, 255.0) as u8)
 }
 
 /// `draw_bodypose` for one person: its limbs, then its points.
@@ -136,35 +196,51 @@ fn line8(canvas: &mut RgbImage, mut p1: (i64, i64), mut p2: (i64, i64), colour: 
     }
 }
 
-/// `cv::fillConvexPoly` with 8-connected edges and no fractional bits: the outline, then
-/// each row between the two edges walked down from the topmost point.
+/// `cv::fillConvexPoly` of pixel points, 8-connected edges.
 fn fill_convex_poly(canvas: &mut RgbImage, v: &[(i32, i32)], colour: [u8; 3]) {
-    const SHIFT: u32 = 16;
-    const ONE: i64 = 1 << SHIFT;
+    let v: Vec<(i64, i64)> = v.iter().map(|&(x, y)| (i64::from(x), i64::from(y))).collect();
+    fill_convex_poly_fixed(canvas, &v, colour, 0);
+}
+
+/// OpenCV's fixed point: 16 fractional bits.
+const XY_SHIFT: u32 = 16;
+const XY_ONE: i64 = 1 << XY_SHIFT;
+
+/// OpenCV's `FillConvexPoly` (8-connected) of points with `shift` fractional bits: the
+/// outline, then each row between the two edges walked down from the topmost point.
+fn fill_convex_poly_fixed(canvas: &mut RgbImage, v: &[(i64, i64)], colour: [u8; 3], shift: u32) {
     let n = v.len();
     if n == 0 {
         return;
     }
-    let v: Vec<(i64, i64)> = v.iter().map(|&(x, y)| (i64::from(x), i64::from(y))).collect();
+    let delta = (1i64 << shift) >> 1;
+    let up = |p: (i64, i64)| (p.0 << (XY_SHIFT - shift), p.1 << (XY_SHIFT - shift));
     let (mut xmin, mut xmax, mut ymin, mut ymax, mut imin) = (v[0].0, v[0].0, v[0].1, v[0].1, 0);
-    let mut p0 = v[n - 1];
+    let mut p0 = up(v[n - 1]);
     for (i, &p) in v.iter().enumerate() {
         if p.1 < ymin {
             (ymin, imin) = (p.1, i);
         }
         (ymax, xmax, xmin) = (ymax.max(p.1), xmax.max(p.0), xmin.min(p.0));
-        line8(canvas, p0, p, colour);
+        let p = up(p);
+        if shift == 0 {
+            line8(canvas, (p0.0 >> XY_SHIFT, p0.1 >> XY_SHIFT), (p.0 >> XY_SHIFT, p.1 >> XY_SHIFT), colour);
+        } else {
+            line_fixed(canvas, p0, p, colour);
+        }
         p0 = p;
     }
+    let (xmin, xmax, ymin, ymax) =
+        ((xmin + delta) >> shift, (xmax + delta) >> shift, (ymin + delta) >> shift, (ymax + delta) >> shift);
     let (w, h) = (i64::from(canvas.width()), i64::from(canvas.height()));
     if n < 3 || xmax < 0 || ymax < 0 || xmin >= w || ymin >= h {
         return;
     }
     let ymax = ymax.min(h - 1);
-    let half = ONE >> 1;
+    let half = XY_ONE >> 1;
     // Each edge: the index of its lower end, its direction round the polygon, x (16
     // fractional bits), its step a row, the row it ends on.
-    let mut edges = [(imin, 1usize, -ONE, 0i64, ymin), (imin, n - 1, -ONE, 0i64, ymin)];
+    let mut edges = [(imin, 1usize, -XY_ONE, 0i64, ymin), (imin, n - 1, -XY_ONE, 0i64, ymin)];
     let mut remaining = n as i64;
     let mut y = ymin;
     loop {
@@ -179,9 +255,9 @@ fn fill_convex_poly(canvas: &mut RgbImage, v: &[(i32, i32)], colour: [u8; 3]) {
                 if remaining < 0 {
                     break;
                 }
-                let ty = v[idx].1;
+                let ty = (v[idx].1 + delta) >> shift;
                 if ty > y {
-                    let (xs, xe) = (v[idx0].0 << SHIFT, v[idx].0 << SHIFT);
+                    let (xs, xe) = (v[idx0].0 << (XY_SHIFT - shift), v[idx].0 << (XY_SHIFT - shift));
                     *edge = (idx, di, xs, ((xe - xs) * 2 + (ty - y)) / (2 * (ty - y)), ty);
                     break;
                 }
@@ -194,7 +270,7 @@ fn fill_convex_poly(canvas: &mut RgbImage, v: &[(i32, i32)], colour: [u8; 3]) {
         }
         if y >= 0 {
             let (left, right) = if edges[0].2 > edges[1].2 { (1, 0) } else { (0, 1) };
-            let (x1, x2) = ((edges[left].2 + half) >> SHIFT, (edges[right].2 + half) >> SHIFT);
+            let (x1, x2) = ((edges[left].2 + half) >> XY_SHIFT, (edges[right].2 + half) >> XY_SHIFT);
             if x2 >= 0 && x1 < w {
                 hline(canvas, y, x1, x2, colour);
             }
@@ -205,6 +281,84 @@ fn fill_convex_poly(canvas: &mut RgbImage, v: &[(i32, i32)], colour: [u8; 3]) {
         if y > ymax {
             break;
         }
+    }
+}
+
+/// OpenCV's `Line2`: a line between fixed-point ends, one pixel a step along its longer
+/// axis.
+fn line_fixed(canvas: &mut RgbImage, mut p1: (i64, i64), mut p2: (i64, i64), colour: [u8; 3]) {
+    let (w, h) = (i64::from(canvas.width()), i64::from(canvas.height()));
+    let mut put = |x: i64, y: i64| {
+        if (0..w).contains(&x) && (0..h).contains(&y) {
+            canvas.put_pixel(x as u32, y as u32, Rgb(colour));
+        }
+    };
+    let (dx, dy) = (p2.0 - p1.0, p2.1 - p1.1);
+    let (ax, ay) = (dx.abs(), dy.abs());
+    let (x_step, y_step, mut count);
+    if ax > ay {
+        if dx < 0 {
+            std::mem::swap(&mut p1, &mut p2);
+        }
+        let dy = if dx < 0 { -dy } else { dy };
+        (x_step, y_step) = (XY_ONE, (dy << XY_SHIFT) / (ax | 1));
+        count = (p2.0 - p1.0) >> XY_SHIFT;
+    } else {
+        if dy < 0 {
+            std::mem::swap(&mut p1, &mut p2);
+        }
+        let dx = if dy < 0 { -dx } else { dx };
+        (x_step, y_step) = ((dx << XY_SHIFT) / (ay | 1), XY_ONE);
+        count = (p2.1 - p1.1) >> XY_SHIFT;
+    }
+    let half = XY_ONE >> 1;
+    let (mut x, mut y) = (p1.0 + half, p1.1 + half);
+    put((p2.0 + half) >> XY_SHIFT, (p2.1 + half) >> XY_SHIFT);
+    if ax > ay {
+        x >>= XY_SHIFT;
+        while count >= 0 {
+            put(x, y >> XY_SHIFT);
+            x += 1;
+            y += y_step;
+            count -= 1;
+        }
+    } else {
+        y >>= XY_SHIFT;
+        while count >= 0 {
+            put(x >> XY_SHIFT, y);
+            x += x_step;
+            y += 1;
+            count -= 1;
+        }
+    }
+}
+
+/// `cv::line(…, thickness = 2)`: OpenCV's `ThickLine`, a quadrilateral a pixel either side
+/// of the line with a round cap of radius 1 at each end.
+fn thick_line2(canvas: &mut RgbImage, p0: (i32, i32), p1: (i32, i32), colour: [u8; 3]) {
+    let (p0, p1) = (
+        (i64::from(p0.0) << XY_SHIFT, i64::from(p0.1) << XY_SHIFT),
+        (i64::from(p1.0) << XY_SHIFT, i64::from(p1.1) << XY_SHIFT),
+    );
+    let inverse = 1.0 / XY_ONE as f64;
+    let (dx, dy) = ((p0.0 - p1.0) as f64 * inverse, (p1.1 - p0.1) as f64 * inverse);
+    let r = dx * dx + dy * dy;
+    let thickness = 2i64 << (XY_SHIFT - 1);
+    if r.abs() > f64::EPSILON {
+        let r = thickness as f64 / r.sqrt();
+        let dp = ((dy * r).round_ties_even() as i64, (dx * r).round_ties_even() as i64);
+        let quad = [
+            (p0.0 + dp.0, p0.1 + dp.1),
+            (p0.0 - dp.0, p0.1 - dp.1),
+            (p1.0 - dp.0, p1.1 - dp.1),
+            (p1.0 + dp.0, p1.1 + dp.1),
+        ];
+        fill_convex_poly_fixed(canvas, &quad, colour, XY_SHIFT);
+    }
+    let radius = ((thickness + (XY_ONE >> 1)) >> XY_SHIFT) as i32;
+    for p in [p0, p1] {
+        let centre = (((p.0 + (XY_ONE >> 1)) >> XY_SHIFT) as i32, ((p.1 + (XY_ONE >> 1)) >> XY_SHIFT) as i32);
+        fill_circle(canvas, centre, radius, colour);
     }
 }
 
@@ -229,14 +383,24 @@ fn fill_circle(canvas: &mut RgbImage, center: (i32, i32), radius: i32, colour: [
 }
 
 /// The OpenPose JSON ControlNet front ends import: each person's 18 points as
-/// `pose_keypoints_2d` (x, y, confidence 1; 0, 0, 0 where not in the picture), with the
-/// canvas size.
-pub fn openpose_json(width: u32, height: u32, people: &[Body18]) -> Value {
+/// `pose_keypoints_2d` (x, y, confidence 1; 0, 0, 0 where not in the picture), the hands'
+/// 21 as `hand_left_keypoints_2d` and `hand_right_keypoints_2d` (empty without mapped
+/// fingers), with the canvas size.
+pub fn openpose_json(width: u32, height: u32, people: &[Person]) -> Value {
+    let hand = |hand: &Option<Hand21>| -> Vec<f32> {
+        let point = |&(x, y): &(f32, f32)| if (x, y) == (0.0, 0.0) { [0.0; 3] } else { [x, y, 1.0] };
+        hand.as_ref().map_or_else(Vec::new, |h| h.iter().flat_map(point).collect())
+    };
     let people: Vec<Value> = people
         .iter()
-        .map(|body| {
-            let points: Vec<f32> = body.iter().flat_map(|p| p.map_or([0.0, 0.0, 0.0], |(x, y)| [x, y, 1.0])).collect();
-            json!({ "pose_keypoints_2d": points })
+        .map(|person| {
+            let points: Vec<f32> =
+                person.body.iter().flat_map(|p| p.map_or([0.0, 0.0, 0.0], |(x, y)| [x, y, 1.0])).collect();
+            json!({
+                "pose_keypoints_2d": points,
+                "hand_left_keypoints_2d": hand(&person.hands[0]),
+                "hand_right_keypoints_2d": hand(&person.hands[1]),
+            })
         })
         .collect();
     json!({ "people": people, "canvas_width": width, "canvas_height": height })

@@ -103,7 +103,7 @@ pub const COLOURS: [[u8; 3]; 18] = [
 ];
 
 /// The hand's bones over its 21 points.
-const HAND_EDGES: [[usize; 2]; 20] = [
+pub const HAND_EDGES: [[usize; 2]; 20] = [
     [0, 1],
     [1, 2],
     [2, 3],

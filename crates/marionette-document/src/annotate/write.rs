@@ -66,8 +66,8 @@ pub fn passes(picture: &Path, camera: &Pinhole, passes: &Passes, figures: &[Figu
 /// Writes the maps ControlNet reads beside `picture` ([`super::controlnet`]):
 /// `shot.cn-openpose.png` and `.json`, `shot.cn-depth.png`, `shot.cn-normal.png`.
 pub fn controlnet(picture: &Path, camera: &Pinhole, passes: &Passes, figures: &[Figure]) -> Result<(), WriteError> {
-    use super::controlnet::{bodies, inverse_depth, normal_map, openpose_drawing, openpose_json};
-    let people = bodies(camera, passes, figures);
+    use super::controlnet::{inverse_depth, normal_map, openpose_drawing, openpose_json, people};
+    let people = people(camera, passes, figures);
     let (w, h) = (passes.width, passes.height);
     save(&openpose_drawing(w, h, &people), &beside(picture, "cn-openpose.png"))?;
     json(&beside(picture, "cn-openpose.json"), &openpose_json(w, h, &people))?;
