@@ -130,7 +130,7 @@ pub fn plan(args: &GenerateArgs) -> Result<Option<Plan>> {
 /// once the tar's pictures are all there), a progress bar with pictures a second and the
 /// time left.
 pub fn run(args: &GenerateArgs) -> Result<()> {
-    use crate::editor::present::render::{ScenePicture, render_scenes};
+    use crate::editor::present::render::{Beside, ScenePicture, render_scenes};
     let Some(mut plan) = plan(args)? else { return Ok(()) };
     let (todo, finished, shard) = (plan.pictures.len(), plan.finished, plan.shard);
     eprintln!(
@@ -151,7 +151,8 @@ pub fn run(args: &GenerateArgs) -> Result<()> {
         .collect();
     let first_scene = plan.scene_file(numbers[0]);
     let library = std::mem::take(&mut plan.library);
-    let (picture, data) = (plan.picture(), plan.spec.data);
+    let picture = plan.picture();
+    let beside = Beside { data: plan.spec.data, controlnet: plan.spec.controlnet };
     let bar = indicatif::ProgressBar::new(todo as u64);
     bar.set_style(
         indicatif::ProgressStyle::with_template("{bar:40} {pos}/{len} pictures, {per_sec}, {elapsed} (left {eta})")
@@ -168,7 +169,8 @@ pub fn run(args: &GenerateArgs) -> Result<()> {
         recorder.inc(1);
         Ok(())
     });
-    let notes = render_scenes(first_scene, library, pictures, picture, data, on_written).map_err(anyhow::Error::msg)?;
+    let notes =
+        render_scenes(first_scene, library, pictures, picture, beside, on_written).map_err(anyhow::Error::msg)?;
     bar.finish();
     for n in notes {
         eprintln!("note: {n}");

@@ -239,3 +239,20 @@ fn seed_overrides_the_specs_seed() {
     assert_eq!(by_flag, scenes(&reseeded, &[]), "--seed 7 is the spec's seed: 7");
     assert_ne!(by_flag, scenes(&spec, &[]), "another seed, another picture");
 }
+
+/// `controlnet: true` in a spec writes the maps ControlNet reads beside each picture, as
+/// `render --controlnet` does.
+#[test]
+fn a_spec_asks_for_the_controlnet_maps() {
+    let dir = scratch("generate-controlnet");
+    let spec = small_spec(&dir, 2);
+    let text = std::fs::read_to_string(&spec).unwrap().replacen("controlnet: false", "controlnet: true", 1);
+    std::fs::write(&spec, text).unwrap();
+    let out = dir.join("set");
+    generate(&spec, &out, &[], &[]);
+    for stem in ["000000", "000001"] {
+        for tail in ["cn-openpose.png", "cn-openpose.json", "cn-depth.png", "cn-normal.png", "json"] {
+            assert!(out.join(format!("{stem}.{tail}")).is_file(), "{stem}.{tail}");
+        }
+    }
+}

@@ -89,6 +89,9 @@ pub struct Spec {
     /// Write each picture's data (depth, normals, masks, keypoints, COCO) beside it.
     #[serde(default)]
     pub data: bool,
+    /// Write the maps ControlNet reads beside each picture (`render --controlnet`'s).
+    #[serde(default)]
+    pub controlnet: bool,
     /// Who may stand in a picture, each drawn with its weight.
     pub characters: Vec<Choice<Who>>,
     /// How many characters a picture holds, at least and at most.

@@ -226,16 +226,24 @@ pub fn render_with(
     done.map(|messages| (messages, picture))
 }
 
+/// What a data set's pictures carry beside them: their data (each with its own COCO file),
+/// the maps ControlNet reads.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct Beside {
+    pub data: bool,
+    pub controlnet: bool,
+}
+
 /// Renders a data set's pictures, each its own scene, in one app: `first_scene` (the file
 /// of the first picture's scene) opens it; every picture after loads its scene in place of
-/// the last. Each picture's data (with `data`) carries its own COCO file; `on_written` is
-/// called with a picture's index once its files are written. Returns the notes.
+/// the last, with what `beside` asks written beside it; `on_written` is called with a
+/// picture's index once its files are written. Returns the notes.
 pub fn render_scenes(
     first_scene: PathBuf,
     library: AssetLibrary,
     pictures: Vec<ScenePicture>,
     picture: ShotDoc,
-    data: bool,
+    beside: Beside,
     on_written: OnWritten,
 ) -> Result<Vec<String>, String> {
     let frames = pictures
@@ -250,8 +258,8 @@ pub fn render_scenes(
         picture,
         frames,
         sequence: None,
-        data: data.then(CocoSoFar::default),
-        controlnet: false,
+        data: beside.data.then(CocoSoFar::default),
+        controlnet: beside.controlnet,
         coco_per_picture: true,
         on_written: Some(on_written),
     };
