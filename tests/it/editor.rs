@@ -624,7 +624,15 @@ fn the_editor_renders_frames_in_its_own_process() {
         ..SceneDoc::default()
     };
     let pattern = dir.join("f_%02d.png").display().to_string();
-    let request = FramesRequest { from: 0.0, to: 0.25, fps: 4.0, turntable: None, pattern, with_data: false };
+    let request = FramesRequest {
+        from: 0.0,
+        to: 0.25,
+        fps: 4.0,
+        turntable: None,
+        pattern,
+        with_data: false,
+        with_controlnet: true,
+    };
     let mut job = FramesJob::default();
     job.request = request;
     job.start(&doc).unwrap();
@@ -642,6 +650,8 @@ fn the_editor_renders_frames_in_its_own_process() {
     for n in 0..2 {
         let picture = image::open(dir.join(format!("f_{n:02}.png"))).unwrap();
         assert_eq!((picture.width(), picture.height()), (64, 48));
+        let openpose = image::open(dir.join(format!("f_{n:02}.cn-openpose.png"))).unwrap();
+        assert_eq!((openpose.width(), openpose.height()), (64, 48), "the ControlNet maps asked for");
     }
     assert!(!job.running());
 }

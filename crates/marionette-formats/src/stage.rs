@@ -457,7 +457,11 @@ pub const MAX_PICTURE_SIDE: u32 = 8192;
 pub const MAX_SAMPLES: u32 = 4;
 
 /// Common picture sizes, by name.
-pub const RESOLUTION_PRESETS: [(&str, u32, u32); 6] = [
+pub const RESOLUTION_PRESETS: [(&str, u32, u32); 10] = [
+    ("ControlNet 512×512", 512, 512),
+    ("ControlNet 512×768", 512, 768),
+    ("ControlNet 768×512", 768, 512),
+    ("ControlNet 1024×1024", 1024, 1024),
     ("HD 720p", 1280, 720),
     ("Full HD 1080p", 1920, 1080),
     ("4K UHD", 3840, 2160),

@@ -26,6 +26,8 @@ pub struct FramesRequest {
     pub pattern: String,
     /// Write each frame's data pictures and one COCO file (`render --data`).
     pub with_data: bool,
+    /// Write each frame's ControlNet maps (`render --controlnet`).
+    pub with_controlnet: bool,
 }
 
 impl Default for FramesRequest {
@@ -38,6 +40,7 @@ impl Default for FramesRequest {
             turntable: None,
             pattern: format!("{cwd}/frames/frame_%04d.png"),
             with_data: false,
+            with_controlnet: false,
         }
     }
 }
@@ -92,7 +95,7 @@ impl FramesJob {
             picture: PictureRequest::default(),
             pictures: Pictures::Sequence(sequence),
             data: r.with_data,
-            controlnet: false,
+            controlnet: r.with_controlnet,
         };
         let worker = std::thread::Builder::new()
             .name("frames".into())

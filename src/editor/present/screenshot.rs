@@ -20,6 +20,8 @@ pub struct ScreenshotRequest {
     pub with_panels: bool,
     /// Write the data pictures beside it (the panels are then left out).
     pub with_data: bool,
+    /// Write the maps ControlNet reads beside it (the panels are then left out).
+    pub with_controlnet: bool,
     /// Frames left before the capture (the panels are hidden meanwhile).
     countdown: Option<u8>,
 }
@@ -28,7 +30,8 @@ impl Default for ScreenshotRequest {
     fn default() -> Self {
         let dir =
             std::env::current_dir().map(|d| d.join("screenshots")).unwrap_or_else(|_| PathBuf::from("screenshots"));
-        Self { dir_text: dir.display().to_string(), with_panels: false, with_data: false, countdown: None }
+        let dir_text = dir.display().to_string();
+        Self { dir_text, with_panels: false, with_data: false, with_controlnet: false, countdown: None }
     }
 }
 
@@ -46,7 +49,7 @@ impl ScreenshotRequest {
     /// Whether the panels are in the picture: asked for, and no data pictures (whose
     /// camera is the whole window's).
     fn panels_shown(&self) -> bool {
-        self.with_panels && !self.with_data
+        self.with_panels && !self.with_data && !self.with_controlnet
     }
 
     /// Whether the panels are hidden this frame (for a screenshot without them).
@@ -116,7 +119,8 @@ fn take_requested_screenshot(
     let path = dir.join(format!("marionette_{}.png", timestamp(now)));
     // The data pictures' frame is taken now, with the frame the capture draws.
     let size = windows.iter().next().map(|w| (w.physical_width(), w.physical_height()));
-    let frame = match (request.with_data, size) {
+    let (data, controlnet) = (request.with_data, request.with_controlnet);
+    let frame = match (data || controlnet, size) {
         (true, Some((w, h))) => match scene.frame(w, h) {
             Ok(frame) => Some(frame),
             Err(e) => {
@@ -128,8 +132,14 @@ fn take_requested_screenshot(
     };
     commands.spawn(Screenshot::primary_window()).observe(
         move |captured: On<ScreenshotCaptured>, mut messages: ResMut<Messages>| {
-            let saved = save_png(&captured.image, &path)
-                .and_then(|()| frame.as_ref().map_or(Ok(()), |frame| frame.write_all_beside(&path)));
+            let saved = save_png(&captured.image, &path).and_then(|()| match frame.as_ref() {
+                Some(frame) if data && controlnet => {
+                    frame.write_all_beside(&path).and_then(|()| frame.write_controlnet_beside(&path))
+                }
+                Some(frame) if controlnet => frame.write_controlnet_beside(&path),
+                Some(frame) => frame.write_all_beside(&path),
+                None => Ok(()),
+            });
             match saved {
                 Ok(()) if frame.is_some() => {
                     messages.push(format!("saved screenshot {} with its data", path.display()))

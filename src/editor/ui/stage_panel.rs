@@ -85,6 +85,8 @@ fn frames_rows(ui: &mut egui::Ui, panels: &mut Panels) {
         .on_hover_text("one %04d for the frame number");
     ui.checkbox(&mut r.with_data, "with data")
         .on_hover_text("each frame's depth, normals, masks and OpenPose files, and one COCO file for all");
+    ui.checkbox(&mut r.with_controlnet, "ControlNet maps")
+        .on_hover_text("each frame's OpenPose drawing and JSON, depth and normals as ControlNet reads them");
     if ui.button("Render frames…").clicked()
         && let Err(e) = job.start(&panels.scene.capture())
     {
