@@ -108,6 +108,10 @@ pub struct ShotArgs {
     /// Height in pixels.
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..=MAX_PICTURE_SIDE))]
     pub height: Option<u32>,
+    /// Width and height at once, `WxH` (`512x768`; ControlNet's sizes are multiples of 64),
+    /// in place of --width and --height.
+    #[arg(long, value_name = "WxH", value_parser = parse_size, conflicts_with_all = ["width", "height"])]
+    pub size: Option<(u32, u32)>,
     /// Supersampling: each pixel the mean of N×N rendered ones (1 to 4; edges are
     /// multisampled either way).
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..=4))]
@@ -135,6 +139,14 @@ pub struct ShotArgs {
     pub controlnet: bool,
 }
 
+/// `WxH`: two whole numbers of pixels, each 1 to [`MAX_PICTURE_SIDE`].
+fn parse_size(s: &str) -> Result<(u32, u32), String> {
+    let expected = || format!("expected WxH (512x768), each 1 to {MAX_PICTURE_SIDE}, found {s:?}");
+    let (w, h) = s.split_once(['x', 'X', '×']).ok_or_else(expected)?;
+    let side = |t: &str| t.trim().parse::<u32>().ok().filter(|&v| v >= 1 && i64::from(v) <= MAX_PICTURE_SIDE);
+    Ok((side(w).ok_or_else(expected)?, side(h).ok_or_else(expected)?))
+}
+
 fn parse_view(s: &str) -> Result<crate::formats::scene::ViewName, String> {
     s.parse()
 }
@@ -142,7 +154,8 @@ fn parse_view(s: &str) -> Result<crate::formats::scene::ViewName, String> {
 impl ShotArgs {
     /// The size and samples asked for (each none: the scene's).
     pub fn picture(&self) -> crate::document::frames::PictureRequest {
-        crate::document::frames::PictureRequest { width: self.width, height: self.height, samples: self.samples }
+        let (width, height) = self.size.map_or((self.width, self.height), |(w, h)| (Some(w), Some(h)));
+        crate::document::frames::PictureRequest { width, height, samples: self.samples }
     }
 }
 

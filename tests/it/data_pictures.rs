@@ -462,3 +462,46 @@ fn the_controlnet_depth_and_normal_maps_follow_its_conventions() {
     assert_eq!(people.len(), 2);
     assert!(people.iter().all(|p| p["pose_keypoints_2d"].as_array().unwrap().len() == 54), "18 points a person");
 }
+
+/// The ControlNet normal map agrees with the depth it came from: normals worked out from
+/// the metric depth by finite differences (the pixels back-projected through the scene's
+/// camera), put in Normal 1.1's frame, lie within 15° (median) of the decoded map over the
+/// characters.
+#[test]
+fn the_controlnet_normals_agree_with_the_depth_they_came_from() {
+    let dir = scratch("controlnet-normals-depth");
+    render_controlnet(&dir, &[puppet("a", -0.4, 0.9), puppet("b", 0.5, -0.9)], W, H);
+    let depth = read_depth(&dir.join("shot.depth.exr"));
+    let mask = image::open(dir.join("shot.mask.png")).unwrap().to_luma16();
+    let map = image::open(dir.join("shot.cn-normal.png")).unwrap().to_rgb8();
+    let (_, _, f) = camera();
+    let (cx, cy) = (f64::from(W) / 2.0, f64::from(H) / 2.0);
+    // A pixel's point in OpenCV's camera frame (x right, y down, z forward).
+    let at = |u: u32, v: u32| {
+        let d = f64::from(depth[(v * W + u) as usize]);
+        DVec3::new((f64::from(u) + 0.5 - cx) / f * d, (f64::from(v) + 0.5 - cy) / f * d, d)
+    };
+    let mut angles = Vec::new();
+    for v in 1..H - 1 {
+        for u in 1..W - 1 {
+            let id = mask.get_pixel(u, v).0[0];
+            let around = [(u - 1, v), (u + 1, v), (u, v - 1), (u, v + 1)];
+            if id == 0 || around.iter().any(|&(a, b)| mask.get_pixel(a, b).0[0] != id) {
+                continue;
+            }
+            let n = (at(u + 1, v) - at(u - 1, v)).cross(at(u, v + 1) - at(u, v - 1));
+            if n.length() < 1e-12 {
+                continue;
+            }
+            let n = if n.dot(at(u, v)) > 0.0 { -n.normalize() } else { n.normalize() };
+            // Normal 1.1: left, up, towards the viewer.
+            let wanted = DVec3::new(-n.x, -n.y, -n.z);
+            let got = DVec3::from(map.get_pixel(u, v).0.map(|c| f64::from(c) / 255.0 * 2.0 - 1.0));
+            angles.push(wanted.angle_between(got).to_degrees());
+        }
+    }
+    angles.sort_by(f64::total_cmp);
+    let median = angles[angles.len() / 2];
+    eprintln!("{} pixels: median {median:.2}°", angles.len());
+    assert!(angles.len() > 500 && median <= 15.0, "{} pixels, median {median}°", angles.len());
+}
