@@ -872,7 +872,7 @@ pub fn merge(dir: &Path) -> Result<usize, GenerateError> {
     for line in &lines {
         let name = format!("{}.json", picture_stem(line.picture));
         let path = dir.join(&name);
-        let text = super::webdataset::read_member(dir, &name)?
+        let text = read_set_file(dir, &name)?
             .ok_or_else(|| GenerateError::NoData { path: path.clone(), source: std::io::ErrorKind::NotFound.into() })?;
         let mut coco: serde_json::Value =
             serde_json::from_slice(&text).map_err(|source| GenerateError::Json { path: path.clone(), source })?;
@@ -881,6 +881,37 @@ pub fn merge(dir: &Path) -> Result<usize, GenerateError> {
     }
     super::annotate::write::json(&dir.join("coco.json"), &super::annotate::coco::file(images, annotations))?;
     Ok(lines.len())
+}
+
+/// The file `name` of a data set's folder: loose there, else a member of one of its
+/// WebDataset tars (`set-*.tar`, see [`crate::webdataset`]).
+pub fn read_set_file(dir: &Path, name: &str) -> Result<Option<Vec<u8>>, GenerateError> {
+    let loose = dir.join(name);
+    if loose.is_file() {
+        return std::fs::read(&loose).map(Some).map_err(|source| GenerateError::Io { path: loose, source });
+    }
+    let mut tars: Vec<PathBuf> = std::fs::read_dir(dir)
+        .map_err(|source| GenerateError::Io { path: dir.to_owned(), source })?
+        .flatten()
+        .map(|e| e.path())
+        .filter(|p| {
+            p.file_name().and_then(|n| n.to_str()).is_some_and(|n| n.starts_with("set-") && n.ends_with(".tar"))
+        })
+        .collect();
+    tars.sort();
+    for tar in tars {
+        let io = |source| GenerateError::Io { path: tar.clone(), source };
+        let mut archive = tar::Archive::new(std::fs::File::open(&tar).map_err(io)?);
+        for entry in archive.entries().map_err(io)? {
+            let mut entry = entry.map_err(io)?;
+            if entry.path().map_err(io)?.to_str() == Some(name) {
+                let mut bytes = Vec::new();
+                std::io::Read::read_to_end(&mut entry, &mut bytes).map_err(io)?;
+                return Ok(Some(bytes));
+            }
+        }
+    }
+    Ok(None)
 }
 
 /// The COCO ids picture `k` uses: its image's, and its first annotation's.

@@ -91,33 +91,3 @@ fn write_tar(dir: &Path, names: &[String], path: &Path) -> Result<(), GenerateEr
     file.sync_all().map_err(io(&temporary))?;
     std::fs::rename(&temporary, path).map_err(io(path))
 }
-
-/// The file `name` of a data set's folder: loose there, else a member of one of its tars.
-pub fn read_member(dir: &Path, name: &str) -> Result<Option<Vec<u8>>, GenerateError> {
-    let loose = dir.join(name);
-    if loose.is_file() {
-        return std::fs::read(&loose).map(Some).map_err(|source| GenerateError::Io { path: loose, source });
-    }
-    let mut tars: Vec<PathBuf> = std::fs::read_dir(dir)
-        .map_err(|source| GenerateError::Io { path: dir.to_owned(), source })?
-        .flatten()
-        .map(|e| e.path())
-        .filter(|p| {
-            p.file_name().and_then(|n| n.to_str()).is_some_and(|n| n.starts_with("set-") && n.ends_with(".tar"))
-        })
-        .collect();
-    tars.sort();
-    for tar in tars {
-        let io = |source| GenerateError::Io { path: tar.clone(), source };
-        let mut archive = tar::Archive::new(std::fs::File::open(&tar).map_err(io)?);
-        for entry in archive.entries().map_err(io)? {
-            let mut entry = entry.map_err(io)?;
-            if entry.path().map_err(io)?.to_str() == Some(name) {
-                let mut bytes = Vec::new();
-                std::io::Read::read_to_end(&mut entry, &mut bytes).map_err(io)?;
-                return Ok(Some(bytes));
-            }
-        }
-    }
-    Ok(None)
-}
