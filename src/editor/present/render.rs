@@ -27,7 +27,8 @@ use crate::formats::scene::{BackgroundDoc, BindingDoc, Clocked, SceneDoc, ShotDo
 use crate::formats::scene::{MotionSourceDoc, RetargetDoc};
 use crate::scene::{RigCorePlugin, SkinningPlugin};
 
-/// Seconds after which the render gives up, saying what was still pending.
+/// Seconds a picture may wait to be ready (from the start, or from the last picture
+/// captured) before the render gives up, saying what was still pending.
 const GIVE_UP_SECONDS: u64 = 300;
 
 /// The render in progress: for each frame it waits for [`CaptureGate`] (every pipeline
@@ -401,8 +402,8 @@ fn preload(paths: &[PathBuf], edits: &StartupEdits) -> Result<(AssetLibrary, Sho
     Ok((library, shot, poses))
 }
 
-/// Once the gate opens, captures the target once, saves it and exits; gives up after
-/// [`GIVE_UP_SECONDS`] or when a pipeline failed, saying what was pending.
+/// Once the gate opens, captures the target once, saves it and exits; gives up when a
+/// picture waits [`GIVE_UP_SECONDS`] or a pipeline failed, saying what was pending.
 fn capture_when_ready(
     mut commands: Commands,
     mut job: ResMut<RenderJob>,
@@ -423,7 +424,8 @@ fn capture_when_ready(
         job.done = Some(Err(format!("cannot render: {failed}")));
         return;
     }
-    if job.started.elapsed().as_secs() > GIVE_UP_SECONDS {
+    let waiting_since = job.captures.map_or(job.started, |(_, last, _)| last);
+    if waiting_since.elapsed().as_secs() > GIVE_UP_SECONDS {
         let pending = gate.last_reason.clone().unwrap_or_else(|| "nothing reported".into());
         job.done = Some(Err(format!("the render was not ready within {GIVE_UP_SECONDS} s; still pending: {pending}")));
         return;
