@@ -130,7 +130,8 @@ pub fn plan(args: &GenerateArgs) -> Result<Option<Plan>> {
 /// once the tar's pictures are all there), a progress bar with pictures a second and the
 /// time left.
 pub fn run(args: &GenerateArgs) -> Result<()> {
-    use crate::editor::present::render::{Beside, ScenePicture, render_scenes};
+    use crate::editor::present::data::Beside;
+    use crate::editor::present::render::{ScenePicture, render_scenes};
     let Some(mut plan) = plan(args)? else { return Ok(()) };
     let (todo, finished, shard) = (plan.pictures.len(), plan.finished, plan.shard);
     eprintln!(
@@ -164,7 +165,7 @@ pub fn run(args: &GenerateArgs) -> Result<()> {
         plan.record(numbers[index])?;
         if let Some(tars) = &plan.tars {
             finished.insert(numbers[index]);
-            tars.pack_finished(&finished).map_err(|e| e.to_string())?;
+            tars.pack_tar_of(numbers[index], &finished).map_err(|e| e.to_string())?;
         }
         recorder.inc(1);
         Ok(())

@@ -36,35 +36,45 @@ impl DataFrame {
         annotate::rasterize(&self.camera, &surfaces)
     }
 
-    /// Writes the passes beside `picture`; returns its COCO image (`image_id`) and
-    /// annotations (ids from `first_id`).
+    /// Writes beside `picture` what `beside` asks, from one rasterisation of the frame: the
+    /// ControlNet maps, and the data passes (then its COCO image, `ids.0`, and annotations,
+    /// ids from `ids.1`, are returned).
     pub fn write_beside(
         &self,
         picture: &std::path::Path,
-        image_id: u64,
-        first_id: u64,
-    ) -> Result<(serde_json::Value, Vec<serde_json::Value>), String> {
+        ids: (u64, u64),
+        beside: Beside,
+    ) -> Result<Option<(serde_json::Value, Vec<serde_json::Value>)>, String> {
         let passes = self.passes();
+        if beside.controlnet {
+            annotate::write::controlnet(picture, &self.camera, &passes, &self.figures).map_err(|e| e.to_string())?;
+        }
+        if !beside.data {
+            return Ok(None);
+        }
         annotate::write::passes(picture, &self.camera, &passes, &self.figures).map_err(|e| e.to_string())?;
         let file_name = picture.file_name().map_or_else(String::new, |n| n.to_string_lossy().into_owned());
-        let image = annotate::coco::image_json(image_id, &file_name, &self.camera);
-        Ok((image, annotate::coco::annotations(&self.camera, &passes, &self.figures, image_id, first_id)))
+        let image = annotate::coco::image_json(ids.0, &file_name, &self.camera);
+        Ok(Some((image, annotate::coco::annotations(&self.camera, &passes, &self.figures, ids.0, ids.1))))
     }
 
-    /// Writes the maps ControlNet reads beside `picture`.
-    pub fn write_controlnet_beside(&self, picture: &std::path::Path) -> Result<(), String> {
-        annotate::write::controlnet(picture, &self.camera, &self.passes(), &self.figures).map_err(|e| e.to_string())
-    }
-
-    /// Writes the passes and a COCO file of this one picture beside `picture`.
-    pub fn write_all_beside(&self, picture: &std::path::Path) -> Result<(), String> {
-        let (image, annotations) = self.write_beside(picture, 1, 1)?;
+    /// [`Self::write_beside`], with the data's COCO file of this one picture.
+    pub fn write_all_beside(&self, picture: &std::path::Path, beside: Beside) -> Result<(), String> {
+        let Some((image, annotations)) = self.write_beside(picture, (1, 1), beside)? else { return Ok(()) };
         annotate::write::json(
             &annotate::write::beside(picture, "json"),
             &annotate::coco::file(vec![image], annotations),
         )
         .map_err(|e| e.to_string())
     }
+}
+
+/// What a picture carries beside it: its data (depth, normals, masks, keypoints, COCO), the
+/// maps ControlNet reads.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct Beside {
+    pub data: bool,
+    pub controlnet: bool,
 }
 
 /// The ECS's view of what a data picture shows.

@@ -16,7 +16,7 @@ use crate::document::annotate;
 use crate::document::frames::{FrameSequence, PictureRequest, Pictures, frame_path, sequence_path};
 use crate::document::picture;
 use crate::document::scenes::{read_scene, scene_path};
-use crate::editor::present::data::DataScene;
+use crate::editor::present::data::{Beside, DataScene};
 use crate::editor::present::readiness::CaptureGate;
 use crate::editor::present::stage;
 use crate::editor::present::view::ViewPlugin;
@@ -225,14 +225,6 @@ pub fn render_with(
         let _ = std::fs::remove_dir_all(&cells);
     }
     done.map(|messages| (messages, picture))
-}
-
-/// What a data set's pictures carry beside them: their data (each with its own COCO file),
-/// the maps ControlNet reads.
-#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
-pub struct Beside {
-    pub data: bool,
-    pub controlnet: bool,
 }
 
 /// Renders a data set's pictures, each its own scene, in one app: `first_scene` (the file
@@ -467,13 +459,9 @@ fn capture_when_ready(
         std::thread::spawn(move || {
             let result = save_picture(&image, samples, &background, backdrop.as_deref(), &out).and_then(|()| {
                 let Some(frame) = frame else { return Ok(None) };
-                if controlnet {
-                    frame.write_controlnet_beside(&out)?;
-                }
-                if !data {
+                let Some((image, annotations)) = frame.write_beside(&out, ids, Beside { data, controlnet })? else {
                     return Ok(None);
-                }
-                let (image, annotations) = frame.write_beside(&out, ids.0, ids.1)?;
+                };
                 if !coco_per_picture {
                     return Ok(Some((image, annotations)));
                 }

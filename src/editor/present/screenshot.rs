@@ -132,14 +132,9 @@ fn take_requested_screenshot(
     };
     commands.spawn(Screenshot::primary_window()).observe(
         move |captured: On<ScreenshotCaptured>, mut messages: ResMut<Messages>| {
-            let saved = save_png(&captured.image, &path).and_then(|()| match frame.as_ref() {
-                Some(frame) if data && controlnet => {
-                    frame.write_all_beside(&path).and_then(|()| frame.write_controlnet_beside(&path))
-                }
-                Some(frame) if controlnet => frame.write_controlnet_beside(&path),
-                Some(frame) => frame.write_all_beside(&path),
-                None => Ok(()),
-            });
+            let beside = crate::editor::present::data::Beside { data, controlnet };
+            let saved = save_png(&captured.image, &path)
+                .and_then(|()| frame.as_ref().map_or(Ok(()), |frame| frame.write_all_beside(&path, beside)));
             match saved {
                 Ok(()) if frame.is_some() => {
                     messages.push(format!("saved screenshot {} with its data", path.display()))
