@@ -372,7 +372,8 @@ fn render_controlnet(dir: &Path, characters: &[String], width: u32, height: u32)
 /// The OpenPose map is the annotator's own drawing of the same points (its `draw_bodypose`
 /// and `draw_handpose` taken from the `controlnet_aux` wheel,
 /// scripts/check_controlnet_openpose.py): one and three people, 512×512 and 640×480, and a
-/// figure with both hands.
+/// figure with both hands. Its JSON, read back by the annotator's JSON reader
+/// (`decode_json_as_poses`), draws the same picture.
 #[test]
 fn the_controlnet_openpose_map_is_the_annotators_drawing() {
     let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("scripts/check_controlnet_openpose.py");
