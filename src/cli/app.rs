@@ -52,8 +52,10 @@ pub fn render(args: RenderArgs) -> Result<()> {
         still: false,
     };
     let (sequence, pictures) = (frames.sequence(), frames.pictures());
+    use crate::document::annotate::controlnet::ControlNet;
     use crate::editor::present::render::{Rendering, render_with};
-    let (picture, data, controlnet) = (shot.picture(), shot.data, shot.controlnet);
+    let controlnet = shot.controlnet.then_some(ControlNet { canny: shot.canny });
+    let (picture, data) = (shot.picture(), shot.data);
     let rendering = Rendering { paths, edits, out: out.clone(), picture, pictures, data, controlnet };
     let (notes, picture) = render_with(rendering, None).map_err(anyhow::Error::msg)?;
     for n in notes {

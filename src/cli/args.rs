@@ -137,6 +137,10 @@ pub struct ShotArgs {
     /// (Normal 1.1: red left, green up, blue toward the viewer).
     #[arg(long)]
     pub controlnet: bool,
+    /// With --controlnet, also `shot.cn-canny.png`: the picture's edges as ControlNet's canny
+    /// preprocessor (`cv2.Canny`) finds them, at thresholds LOW,HIGH (default 100,200).
+    #[arg(long, value_name = "LOW,HIGH", num_args = 0..=1, default_missing_value = "100,200", requires = "controlnet")]
+    pub canny: Option<crate::document::annotate::canny::Canny>,
 }
 
 /// `WxH`: two whole numbers of pixels, each 1 to [`MAX_PICTURE_SIDE`].

@@ -130,6 +130,7 @@ pub fn plan(args: &GenerateArgs) -> Result<Option<Plan>> {
 /// once the tar's pictures are all there), a progress bar with pictures a second and the
 /// time left.
 pub fn run(args: &GenerateArgs) -> Result<()> {
+    use crate::document::annotate::controlnet::ControlNet;
     use crate::editor::present::data::Beside;
     use crate::editor::present::render::{ScenePicture, render_scenes};
     let Some(mut plan) = plan(args)? else { return Ok(()) };
@@ -153,7 +154,8 @@ pub fn run(args: &GenerateArgs) -> Result<()> {
     let first_scene = plan.scene_file(numbers[0]);
     let library = std::mem::take(&mut plan.library);
     let picture = plan.picture();
-    let beside = Beside { data: plan.spec.data, controlnet: plan.spec.controlnet };
+    let controlnet = plan.spec.controlnet.then_some(ControlNet { canny: plan.spec.canny });
+    let beside = Beside { data: plan.spec.data, controlnet };
     let bar = indicatif::ProgressBar::new(todo as u64);
     bar.set_style(
         indicatif::ProgressStyle::with_template("{bar:40} {pos}/{len} pictures, {per_sec}, {elapsed} (left {eta})")

@@ -356,14 +356,15 @@ fn the_openpose_drawing_has_controlnets_colours_and_limbs() {
 }
 
 /// `render --controlnet` at `width` × `height` of `characters` (RON) into `dir/shot.png`,
-/// with `--data` for the metric passes to hold the maps to.
-fn render_controlnet(dir: &Path, characters: &[String], width: u32, height: u32) {
+/// with `--data` for the metric passes to hold the maps to, and `extra` arguments.
+fn render_controlnet(dir: &Path, characters: &[String], width: u32, height: u32, extra: &[&str]) {
     let scene = dir.join("scene.ron");
     std::fs::write(&scene, format!("(characters: [{}], {})", characters.join(", "), camera_ron())).unwrap();
     let out = dir.join("shot.png");
     let output = Command::new(env!("CARGO_BIN_EXE_marionette"))
         .args(["render", scene.to_str().unwrap(), "--out", out.to_str().unwrap(), "--data", "--controlnet"])
         .args(["--width", &width.to_string(), "--height", &height.to_string()])
+        .args(extra)
         .output()
         .unwrap();
     assert!(output.status.success(), "{}", String::from_utf8_lossy(&output.stderr));
@@ -380,7 +381,7 @@ fn the_controlnet_openpose_map_is_the_annotators_drawing() {
     let three = [puppet("a", -0.9, 0.4), puppet("b", 0.0, 0.0), puppet("c", 0.9, -0.5)];
     for (people, (w, h)) in [(&three[1..2], (512, 512)), (&three[..], (640, 480)), (&three[..], (512, 512))] {
         let dir = scratch(&format!("controlnet-openpose-{}-{w}x{h}", people.len()));
-        render_controlnet(&dir, people, w, h);
+        render_controlnet(&dir, people, w, h, &[]);
         let output = Command::new("python3")
             .arg(&script)
             .arg(dir.join("shot.png"))
@@ -408,6 +409,21 @@ fn the_controlnet_openpose_map_is_the_annotators_drawing() {
     eprintln!("{said}");
 }
 
+/// `dir/shot.cn-canny.png` is, pixel for pixel, `cv2.Canny` of the picture at `low`, `high`
+/// (scripts/check_controlnet_canny.py).
+fn the_canny_edges_are_opencvs(dir: &Path, low: &str, high: &str) {
+    let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("scripts/check_controlnet_canny.py");
+    let output = Command::new("python3")
+        .arg(&script)
+        .arg(dir.join("shot.png"))
+        .args([low, high])
+        .output()
+        .expect("python3 with numpy and opencv (scripts/ensure-tools.sh installs them)");
+    let said = String::from_utf8_lossy(&output.stdout);
+    assert!(output.status.success(), "{said}{}", String::from_utf8_lossy(&output.stderr));
+    eprintln!("{said}");
+}
+
 /// The depth map is relative inverse depth: 255 at the nearest shown point, 0 where nothing
 /// is, never darker for a nearer pixel; the normal map is the camera-frame normals with x
 /// turned to the viewer's left (a surface facing left is red), nothing facing the viewer;
@@ -415,7 +431,8 @@ fn the_controlnet_openpose_map_is_the_annotators_drawing() {
 #[test]
 fn the_controlnet_depth_and_normal_maps_follow_its_conventions() {
     let dir = scratch("controlnet-maps");
-    render_controlnet(&dir, &[puppet("a", -0.4, 0.9), puppet("b", 0.5, -0.9)], W, H);
+    render_controlnet(&dir, &[puppet("a", -0.4, 0.9), puppet("b", 0.5, -0.9)], W, H, &["--canny"]);
+    the_canny_edges_are_opencvs(&dir, "100", "200");
     let depth = read_depth(&dir.join("shot.depth.exr"));
     let map = image::open(dir.join("shot.cn-depth.png")).unwrap().to_luma8();
     let values: Vec<u8> = map.pixels().map(|p| p.0[0]).collect();
@@ -471,7 +488,8 @@ fn the_controlnet_depth_and_normal_maps_follow_its_conventions() {
 #[test]
 fn the_controlnet_normals_agree_with_the_depth_they_came_from() {
     let dir = scratch("controlnet-normals-depth");
-    render_controlnet(&dir, &[puppet("a", -0.4, 0.9), puppet("b", 0.5, -0.9)], W, H);
+    render_controlnet(&dir, &[puppet("a", -0.4, 0.9), puppet("b", 0.5, -0.9)], W, H, &["--canny", "50,150"]);
+    the_canny_edges_are_opencvs(&dir, "50", "150");
     let depth = read_depth(&dir.join("shot.depth.exr"));
     let mask = image::open(dir.join("shot.mask.png")).unwrap().to_luma16();
     let map = image::open(dir.join("shot.cn-normal.png")).unwrap().to_rgb8();

@@ -614,6 +614,8 @@ fn the_fast_viewport_is_fast_only_while_the_view_is_worked() {
 /// counted, the scene set aside removed.
 #[test]
 fn the_editor_renders_frames_in_its_own_process() {
+    use marionette::document::annotate::canny::Canny;
+    use marionette::editor::present::data::ControlNetChoice;
     use marionette::editor::present::frames_job::{FramesJob, FramesRequest};
     use marionette::formats::scene::{CharacterDoc, SceneDoc, ShotDoc, SourceDoc};
     let dir = scratch("frames-in-process");
@@ -631,7 +633,7 @@ fn the_editor_renders_frames_in_its_own_process() {
         turntable: None,
         pattern,
         with_data: false,
-        with_controlnet: true,
+        controlnet: ControlNetChoice { on: true, canny: true, thresholds: Canny { low: 50.0, high: 150.0 } },
     };
     let mut job = FramesJob::default();
     job.request = request;
@@ -652,6 +654,8 @@ fn the_editor_renders_frames_in_its_own_process() {
         assert_eq!((picture.width(), picture.height()), (64, 48));
         let openpose = image::open(dir.join(format!("f_{n:02}.cn-openpose.png"))).unwrap();
         assert_eq!((openpose.width(), openpose.height()), (64, 48), "the ControlNet maps asked for");
+        let canny = image::open(dir.join(format!("f_{n:02}.cn-canny.png"))).unwrap();
+        assert_eq!((canny.width(), canny.height()), (64, 48), "the canny edges asked for");
     }
     assert!(!job.running());
 }

@@ -132,6 +132,10 @@ fn spec_errors_stop_generate_before_rendering() {
         ),
         (text.replacen("per_picture: (1, 3)", "per_picture: (1, 30)", 1), "do not fit"),
         (text.replacen("width: 96", "width: 90000", 1), "width"),
+        (
+            text.replacen("canny: None", "canny: Some((low: 100, high: 200))", 1),
+            "canny: the canny edges are a ControlNet map",
+        ),
         (text.replacen("count: 4", "count: 4,\n    colour: 3", 1), "spec.ron:"),
     ];
     for (bad, words) in cases {
@@ -246,12 +250,16 @@ fn seed_overrides_the_specs_seed() {
 fn a_spec_asks_for_the_controlnet_maps() {
     let dir = scratch("generate-controlnet");
     let spec = small_spec(&dir, 2);
-    let text = std::fs::read_to_string(&spec).unwrap().replacen("controlnet: false", "controlnet: true", 1);
+    let text = std::fs::read_to_string(&spec).unwrap().replacen("controlnet: false", "controlnet: true", 1).replacen(
+        "canny: None",
+        "canny: Some((low: 100, high: 200))",
+        1,
+    );
     std::fs::write(&spec, text).unwrap();
     let out = dir.join("set");
     generate(&spec, &out, &[], &[]);
     for stem in ["000000", "000001"] {
-        for tail in ["cn-openpose.png", "cn-openpose.json", "cn-depth.png", "cn-normal.png", "json"] {
+        for tail in ["cn-openpose.png", "cn-openpose.json", "cn-depth.png", "cn-normal.png", "cn-canny.png", "json"] {
             assert!(out.join(format!("{stem}.{tail}")).is_file(), "{stem}.{tail}");
         }
     }

@@ -92,6 +92,10 @@ pub struct Spec {
     /// Write the maps ControlNet reads beside each picture (`render --controlnet`'s).
     #[serde(default)]
     pub controlnet: bool,
+    /// With `controlnet`, also the picture's canny edges at these thresholds
+    /// (`render --canny`'s).
+    #[serde(default)]
+    pub canny: Option<crate::annotate::canny::Canny>,
     /// Who may stand in a picture, each drawn with its weight.
     pub characters: Vec<Choice<Who>>,
     /// How many characters a picture holds, at least and at most.
@@ -327,6 +331,9 @@ impl Spec {
                 None => SpecError::at("shot", e),
             }
         })?;
+        if self.canny.is_some() && !self.controlnet {
+            return Err(SpecError::at("canny", "the canny edges are a ControlNet map: set controlnet: true".into()));
+        }
         if self.count == 0 || self.count > MAX_PICTURES {
             return Err(SpecError::at("count", format!("expected 1 to {MAX_PICTURES} pictures, found {}", self.count)));
         }

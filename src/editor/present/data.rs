@@ -46,8 +46,9 @@ impl DataFrame {
         beside: Beside,
     ) -> Result<Option<(serde_json::Value, Vec<serde_json::Value>)>, String> {
         let passes = self.passes();
-        if beside.controlnet {
-            annotate::write::controlnet(picture, &self.camera, &passes, &self.figures).map_err(|e| e.to_string())?;
+        if let Some(maps) = beside.controlnet {
+            annotate::write::controlnet(picture, &self.camera, &passes, &self.figures, maps)
+                .map_err(|e| e.to_string())?;
         }
         if !beside.data {
             return Ok(None);
@@ -71,10 +72,26 @@ impl DataFrame {
 
 /// What a picture carries beside it: its data (depth, normals, masks, keypoints, COCO), the
 /// maps ControlNet reads.
-#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
 pub struct Beside {
     pub data: bool,
-    pub controlnet: bool,
+    pub controlnet: Option<annotate::controlnet::ControlNet>,
+}
+
+/// The ControlNet maps a panel asks for: whether, and whether with the canny edges at
+/// thresholds kept while they are off.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct ControlNetChoice {
+    pub on: bool,
+    pub canny: bool,
+    pub thresholds: annotate::canny::Canny,
+}
+
+impl ControlNetChoice {
+    /// The maps to write, if any.
+    pub fn maps(&self) -> Option<annotate::controlnet::ControlNet> {
+        self.on.then_some(annotate::controlnet::ControlNet { canny: self.canny.then_some(self.thresholds) })
+    }
 }
 
 /// The ECS's view of what a data picture shows.

@@ -10,6 +10,7 @@ use std::sync::{Arc, Mutex};
 use bevy::prelude::*;
 
 use crate::document::frames::{FrameSequence, PictureRequest, Pictures};
+use crate::editor::present::data::ControlNetChoice;
 use crate::editor::present::render::{OnWritten, Rendering, render_with};
 use crate::editor::state::{Messages, StartupEdits};
 use crate::formats::scene::{SceneDoc, ShotDoc};
@@ -27,7 +28,7 @@ pub struct FramesRequest {
     /// Write each frame's data pictures and one COCO file (`render --data`).
     pub with_data: bool,
     /// Write each frame's ControlNet maps (`render --controlnet`).
-    pub with_controlnet: bool,
+    pub controlnet: ControlNetChoice,
 }
 
 impl Default for FramesRequest {
@@ -40,7 +41,7 @@ impl Default for FramesRequest {
             turntable: None,
             pattern: format!("{cwd}/frames/frame_%04d.png"),
             with_data: false,
-            with_controlnet: false,
+            controlnet: ControlNetChoice::default(),
         }
     }
 }
@@ -95,7 +96,7 @@ impl FramesJob {
             picture: PictureRequest::default(),
             pictures: Pictures::Sequence(sequence),
             data: r.with_data,
-            controlnet: r.with_controlnet,
+            controlnet: r.controlnet.maps(),
         };
         let worker = std::thread::Builder::new()
             .name("frames".into())

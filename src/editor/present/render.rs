@@ -13,6 +13,7 @@ use bevy::render::view::screenshot::{Screenshot, ScreenshotCaptured};
 
 use crate::document::AssetLibrary;
 use crate::document::annotate;
+use crate::document::annotate::controlnet::ControlNet;
 use crate::document::frames::{FrameSequence, PictureRequest, Pictures, frame_path, sequence_path};
 use crate::document::picture;
 use crate::document::scenes::{read_scene, scene_path};
@@ -67,7 +68,7 @@ struct RenderJob {
     /// are written beside each picture as it is saved).
     data: Option<CocoSoFar>,
     /// Write the maps ControlNet reads beside each picture.
-    controlnet: bool,
+    controlnet: Option<ControlNet>,
     /// The saved picture's width and height.
     size: (u32, u32),
     /// Each picture's data carries a COCO file of its own (a data set's), not a share of one
@@ -141,7 +142,7 @@ pub fn render(
     pictures: Pictures,
     data: bool,
 ) -> Result<(Vec<String>, ShotDoc), String> {
-    render_with(Rendering { paths, edits, out, picture, pictures, data, controlnet: false }, None)
+    render_with(Rendering { paths, edits, out, picture, pictures, data, controlnet: None }, None)
 }
 
 /// What [`render`] is asked for.
@@ -153,7 +154,7 @@ pub struct Rendering {
     pub pictures: Pictures,
     pub data: bool,
     /// `--controlnet`: the maps ControlNet reads beside each picture.
-    pub controlnet: bool,
+    pub controlnet: Option<ControlNet>,
 }
 
 /// [`render`], calling `on_written` with each picture's index once its files are written
@@ -269,7 +270,7 @@ struct JobSetup {
     sequence: Option<FrameSequence>,
     /// With data: the COCO file all pictures share, as it fills.
     data: Option<CocoSoFar>,
-    controlnet: bool,
+    controlnet: Option<ControlNet>,
     /// Each picture's data has a COCO file of its own instead.
     coco_per_picture: bool,
     on_written: Option<OnWritten>,
@@ -444,7 +445,7 @@ fn capture_when_ready(
     let (samples, background, coco_per_picture) = (job.samples, stage.background.clone(), job.coco_per_picture);
     // What the data pictures show is taken now, with the frame the capture draws.
     let (data, controlnet) = (job.data.is_some(), job.controlnet);
-    let mut frame = match (data || controlnet).then(|| scene.frame(job.size.0, job.size.1)).transpose() {
+    let mut frame = match (data || controlnet.is_some()).then(|| scene.frame(job.size.0, job.size.1)).transpose() {
         Ok(frame) => frame,
         Err(e) => {
             job.done = Some(Err(e));

@@ -8,7 +8,7 @@ use bevy::render::view::screenshot::{Screenshot, ScreenshotCaptured};
 
 use bevy::window::PrimaryWindow;
 
-use crate::editor::present::data::DataScene;
+use crate::editor::present::data::{ControlNetChoice, DataScene};
 use crate::editor::present::readiness::CaptureGate;
 use crate::editor::state::Messages;
 
@@ -21,7 +21,7 @@ pub struct ScreenshotRequest {
     /// Write the data pictures beside it (the panels are then left out).
     pub with_data: bool,
     /// Write the maps ControlNet reads beside it (the panels are then left out).
-    pub with_controlnet: bool,
+    pub controlnet: ControlNetChoice,
     /// Frames left before the capture (the panels are hidden meanwhile).
     countdown: Option<u8>,
 }
@@ -31,7 +31,13 @@ impl Default for ScreenshotRequest {
         let dir =
             std::env::current_dir().map(|d| d.join("screenshots")).unwrap_or_else(|_| PathBuf::from("screenshots"));
         let dir_text = dir.display().to_string();
-        Self { dir_text, with_panels: false, with_data: false, with_controlnet: false, countdown: None }
+        Self {
+            dir_text,
+            with_panels: false,
+            with_data: false,
+            controlnet: ControlNetChoice::default(),
+            countdown: None,
+        }
     }
 }
 
@@ -49,7 +55,7 @@ impl ScreenshotRequest {
     /// Whether the panels are in the picture: asked for, and no data pictures (whose
     /// camera is the whole window's).
     fn panels_shown(&self) -> bool {
-        self.with_panels && !self.with_data && !self.with_controlnet
+        self.with_panels && !self.with_data && !self.controlnet.on
     }
 
     /// Whether the panels are hidden this frame (for a screenshot without them).
@@ -119,8 +125,8 @@ fn take_requested_screenshot(
     let path = dir.join(format!("marionette_{}.png", timestamp(now)));
     // The data pictures' frame is taken now, with the frame the capture draws.
     let size = windows.iter().next().map(|w| (w.physical_width(), w.physical_height()));
-    let (data, controlnet) = (request.with_data, request.with_controlnet);
-    let frame = match (data || controlnet, size) {
+    let (data, controlnet) = (request.with_data, request.controlnet.maps());
+    let frame = match (data || controlnet.is_some(), size) {
         (true, Some((w, h))) => match scene.frame(w, h) {
             Ok(frame) => Some(frame),
             Err(e) => {

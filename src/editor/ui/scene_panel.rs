@@ -370,7 +370,9 @@ fn screenshot_rows(ui: &mut egui::Ui, state: &mut InspectorState, shot: &mut Scr
     ui.checkbox(&mut shot.with_data, "with data").on_hover_text(
         "beside the picture: depth, normals, instance and body-part masks, OpenPose drawing and JSON, COCO keypoints with the camera",
     );
-    ui.checkbox(&mut shot.with_controlnet, "ControlNet maps").on_hover_text(
+    super::stage_panel::controlnet_choice(
+        ui,
+        &mut shot.controlnet,
         "beside the picture: the OpenPose drawing as ControlNet's annotator draws it and its 18-point JSON, relative inverse depth, Normal 1.1 normals",
     );
     if ui.button("Save screenshot (F12)").clicked() {

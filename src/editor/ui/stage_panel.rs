@@ -3,6 +3,7 @@
 //! picture `render` takes (size presets, samples, the viewport's frame guide).
 
 use crate::editor::edits::kinds;
+use crate::editor::present::data::ControlNetChoice;
 use bevy_egui::egui;
 
 use super::{InspectorState, Panels};
@@ -85,13 +86,34 @@ fn frames_rows(ui: &mut egui::Ui, panels: &mut Panels) {
         .on_hover_text("one %04d for the frame number");
     ui.checkbox(&mut r.with_data, "with data")
         .on_hover_text("each frame's depth, normals, masks and OpenPose files, and one COCO file for all");
-    ui.checkbox(&mut r.with_controlnet, "ControlNet maps")
-        .on_hover_text("each frame's OpenPose drawing and JSON, depth and normals as ControlNet reads them");
+    controlnet_choice(
+        ui,
+        &mut r.controlnet,
+        "each frame's OpenPose drawing and JSON, depth and normals as ControlNet reads them",
+    );
     if ui.button("Render frames…").clicked()
         && let Err(e) = job.start(&panels.scene.capture())
     {
         panels.messages.push(e);
     }
+}
+
+/// The "ControlNet maps" box, and under it while on, the canny edges with their two
+/// thresholds (`--canny LOW,HIGH`).
+pub fn controlnet_choice(ui: &mut egui::Ui, choice: &mut ControlNetChoice, what: &str) {
+    ui.checkbox(&mut choice.on, "ControlNet maps").on_hover_text(what);
+    if !choice.on {
+        return;
+    }
+    ui.horizontal(|ui| {
+        ui.checkbox(&mut choice.canny, "canny edges")
+            .on_hover_text("the picture's edges as ControlNet's canny preprocessor finds them (cv2.Canny)");
+        if choice.canny {
+            let t = &mut choice.thresholds;
+            ui.add(egui::DragValue::new(&mut t.low).range(0.0..=1020.0).prefix("low "));
+            ui.add(egui::DragValue::new(&mut t.high).range(0.0..=1020.0).prefix("high "));
+        }
+    });
 }
 
 /// An sRGB colour picker.

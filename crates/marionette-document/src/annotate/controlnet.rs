@@ -14,8 +14,16 @@
 use image::{GrayImage, Luma, Rgb, RgbImage};
 use serde_json::{Value, json};
 
+use super::canny::Canny;
 use super::openpose::{BODY_18, COLOURS, HAND_EDGES, LIMBS};
 use super::{Figure, Passes, Pinhole, seen};
+
+/// Which of the maps to write: the OpenPose drawing and JSON, depth and normals always,
+/// the picture's canny edges where asked.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct ControlNet {
+    pub canny: Option<Canny>,
+}
 
 /// A person's 18 points in pixels, where the picture shows them.
 pub type Body18 = [Option<(f32, f32)>; 18];

@@ -5,6 +5,7 @@
 //! the camera ([`coco`], [`openpose`]); [`write`] puts the files on disk.
 
 pub mod camera;
+pub mod canny;
 pub mod coco;
 pub mod controlnet;
 pub mod openpose;

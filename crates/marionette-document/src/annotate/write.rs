@@ -10,6 +10,7 @@ use std::path::{Path, PathBuf};
 
 use image::{ImageBuffer, Luma, Rgb, RgbImage};
 
+use super::controlnet::ControlNet;
 use super::raster::FLOOR;
 use super::{Figure, Passes, Pinhole, openpose};
 
@@ -64,15 +65,25 @@ pub fn passes(picture: &Path, camera: &Pinhole, passes: &Passes, figures: &[Figu
 }
 
 /// Writes the maps ControlNet reads beside `picture` ([`super::controlnet`]):
-/// `shot.cn-openpose.png` and `.json`, `shot.cn-depth.png`, `shot.cn-normal.png`.
-pub fn controlnet(picture: &Path, camera: &Pinhole, passes: &Passes, figures: &[Figure]) -> Result<(), WriteError> {
+/// `shot.cn-openpose.png` and `.json`, `shot.cn-depth.png`, `shot.cn-normal.png`, and with
+/// `maps.canny` the edges of the picture written at `picture`, `shot.cn-canny.png` ([`super::canny`]).
+pub fn controlnet(
+    picture: &Path,
+    camera: &Pinhole,
+    passes: &Passes,
+    figures: &[Figure],
+    maps: ControlNet,
+) -> Result<(), WriteError> {
     use super::controlnet::{inverse_depth, normal_map, openpose_drawing, openpose_json, people};
     let people = people(camera, passes, figures);
     let (w, h) = (passes.width, passes.height);
     save(&openpose_drawing(w, h, &people), &beside(picture, "cn-openpose.png"))?;
     json(&beside(picture, "cn-openpose.json"), &openpose_json(w, h, &people))?;
     save(&inverse_depth(passes), &beside(picture, "cn-depth.png"))?;
-    save(&normal_map(passes), &beside(picture, "cn-normal.png"))
+    save(&normal_map(passes), &beside(picture, "cn-normal.png"))?;
+    let Some(canny) = maps.canny else { return Ok(()) };
+    let shown = image::open(picture).map_err(|source| WriteError::Image { path: picture.to_owned(), source })?;
+    save(&super::canny::edges(&shown.to_rgb8(), canny), &beside(picture, "cn-canny.png"))
 }
 
 /// Writes `value` as JSON.
