@@ -12,7 +12,7 @@
 //!
 //! Plugins (one per capability): [`present::view::ViewPlugin`] (stage, scene, edits and
 //! history, drawing; also used headless), [`InteractionPlugin`] (camera input, picking, IK
-//! drag, gizmo, shortcuts), [`ui::InspectorPlugin`], [`present::screenshot::ScreenshotPlugin`].
+//! drag, gizmo, shortcuts), [`ui::InspectorPlugin`], [`present::screenshot::ScreenshotPlugin`], [`ui::conditioning::ConditioningOverlayPlugin`].
 
 pub mod bench;
 pub mod cores;
@@ -108,6 +108,7 @@ pub fn run(paths: Vec<PathBuf>, edits: StartupEdits, library: crate::document::A
             ui::recent::RecentFilesPlugin,
             ui::unsaved::UnsavedWorkPlugin,
             present::screenshot::ScreenshotPlugin,
+            ui::conditioning::ConditioningOverlayPlugin,
             present::redraw::RedrawPlugin,
             present::fast_viewport::FastViewportPlugin,
         ))

@@ -659,3 +659,63 @@ fn the_editor_renders_frames_in_its_own_process() {
     }
     assert!(!job.running());
 }
+
+/// The ControlNet map over the view is worked out only when what it shows changes: once
+/// when switched on, not again while nothing moves (no frame asked for either), again for
+/// a pose edit, another map, the camera moved; switched off, never.
+#[test]
+fn the_controlnet_overlay_is_worked_out_only_on_change() {
+    use bevy::prelude::*;
+    use bevy::window::{PrimaryWindow, RequestRedraw};
+    use marionette::editor::edits::commands::Edit;
+    use marionette::editor::edits::kinds;
+    use marionette::editor::interact::pointer::ViewportArea;
+    use marionette::editor::state::camera::OrbitCamera;
+    use marionette::editor::ui::conditioning::{ConditioningMap, ConditioningOverlay, work_out_the_overlay_on_change};
+    use marionette::formats::scene::CharacterId;
+
+    #[derive(Resource, Default)]
+    struct Asked(usize);
+    fn count(mut asked: ResMut<Asked>, mut redraws: MessageReader<RequestRedraw>) {
+        asked.0 += redraws.read().count();
+    }
+    let mut app = crate::edits::scene_app();
+    app.add_message::<RequestRedraw>()
+        .init_resource::<Asked>()
+        .init_resource::<ConditioningOverlay>()
+        .insert_resource(ViewportArea(Some(Rect::new(0.0, 0.0, 320.0, 240.0))))
+        .add_systems(First, count)
+        .add_systems(PostUpdate, work_out_the_overlay_on_change.after(marionette::scene::MarionetteSystems::Draw));
+    app.world_mut().spawn((Window::default(), PrimaryWindow));
+    let orbit = app.world_mut().spawn(OrbitCamera::default()).id();
+    crate::edits::open_puppets(&mut app, &[Some(1), Some(2)]);
+    let drawn = |app: &App| app.world().resource::<ConditioningOverlay>().drawn;
+    // Times worked out and frames asked for over `n` updates.
+    let over = |app: &mut App, n: usize| {
+        let before = (drawn(app), app.world().resource::<Asked>().0);
+        (0..n).for_each(|_| app.update());
+        app.update(); // the last update's ask is counted at the start of the next
+        (drawn(app) - before.0, app.world().resource::<Asked>().0 - before.1)
+    };
+    assert_eq!(over(&mut app, 5), (0, 0), "off: never worked out");
+
+    app.world_mut().resource_mut::<ConditioningOverlay>().map = Some(ConditioningMap::OpenPose);
+    assert_eq!(over(&mut app, 1), (1, 1), "switched on: once, and a frame to show it");
+    assert_eq!(over(&mut app, 10), (0, 0), "nothing moves: not again, no frame asked for");
+
+    let elbow = crate::edits::joint(&app, 1, "l_elbow");
+    let turn = marionette::rig::JointRotation::euler_xyz(0.0, 0.0, 70f32.to_radians());
+    let pose = Edit::from(kinds::Pose { character: CharacterId(1), joints: vec![(elbow, turn)] });
+    app.world_mut().resource_mut::<marionette::editor::edits::commands::EditQueue>().push(pose);
+    assert_eq!(over(&mut app, 1), (1, 1), "a pose edit: once more");
+    assert_eq!(over(&mut app, 5), (0, 0));
+
+    app.world_mut().resource_mut::<ConditioningOverlay>().map = Some(ConditioningMap::Depth);
+    assert_eq!(over(&mut app, 3).0, 1, "another map: once");
+    app.world_mut().get_mut::<OrbitCamera>(orbit).unwrap().0.yaw += 10.0;
+    assert_eq!(over(&mut app, 3).0, 1, "the camera moved: once");
+
+    app.world_mut().resource_mut::<ConditioningOverlay>().map = None;
+    assert_eq!(over(&mut app, 5), (0, 0), "switched off: never");
+    assert_eq!(app.world().resource::<ConditioningOverlay>().texture(), None);
+}

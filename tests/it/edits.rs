@@ -32,7 +32,7 @@ pub fn capture_scene(reader: SceneReader, mut out: ResMut<Captured>) {
 }
 
 /// Opens a scene of puppets with these ids.
-fn open_puppets(app: &mut App, ids: &[Option<u64>]) {
+pub fn open_puppets(app: &mut App, ids: &[Option<u64>]) {
     let one = doc_with(SourceDoc::Embedded("puppet".into()), &[]).characters[0].clone();
     let characters = ids.iter().map(|&id| CharacterDoc { id: id.map(CharacterId), ..one.clone() }).collect();
     let doc = SceneDoc { characters, ..SceneDoc::default() };

@@ -120,8 +120,17 @@ impl DataScene<'_, '_> {
     /// The frame now, for a picture of `width` × `height`. Characters are numbered in the
     /// order of their scene ids (from 1), so a sequence keeps each one's number.
     pub fn frame(&self, width: u32, height: u32) -> Result<DataFrame, String> {
+        Ok(self.frame_through(self.camera(width, height)?))
+    }
+
+    /// The scene's camera over a picture of `width` × `height`.
+    pub fn camera(&self, width: u32, height: u32) -> Result<Pinhole, String> {
         let orbit = self.cameras.iter().next().ok_or("the render has no camera")?;
-        let camera = Pinhole::of(orbit, width, height).map_err(|e| e.to_string())?;
+        Pinhole::of(orbit, width, height).map_err(|e| e.to_string())
+    }
+
+    /// The frame now, seen through `camera`.
+    pub fn frame_through(&self, camera: Pinhole) -> DataFrame {
         let mut characters: Vec<_> = self.characters.iter().collect();
         characters.sort_by_key(|c| c.0.id);
         let figures = characters
@@ -134,7 +143,7 @@ impl DataScene<'_, '_> {
             })
             .collect();
         let floor = self.floors.iter().find(|(_, v)| **v != Visibility::Hidden).map(|(t, _)| floor_corners(t));
-        Ok(DataFrame { camera, figures, floor })
+        DataFrame { camera, figures, floor }
     }
 }
 

@@ -4,6 +4,7 @@
 
 pub mod attach_panel;
 pub mod clip_panel;
+pub mod conditioning;
 pub mod dialogs;
 pub mod joint_panel;
 pub mod keyframe_panel;
@@ -117,6 +118,8 @@ pub struct Panels<'w, 's> {
     pub fast_viewport: Option<ResMut<'w, crate::editor::present::fast_viewport::FastViewport>>,
     /// Symmetry and the limb handles.
     pub posing: PosingTools<'w>,
+    /// The ControlNet map over the view (none in an app without it).
+    pub conditioning: Option<ResMut<'w, crate::editor::ui::conditioning::ConditioningOverlay>>,
 }
 
 /// The body poses' thumbnails, drawn for one character with one humanoid map.
@@ -233,6 +236,12 @@ fn inspector_ui(
     if state.frame_guide {
         frame_guide(&ctx, central, &panels.scene.shot.0);
     }
+    if let Some(texture) = panels.conditioning.as_ref().and_then(|c| c.texture()) {
+        let frame = crate::editor::ui::conditioning::frame_rect(central, &panels.scene.shot.0);
+        let painter = ctx.layer_painter(egui::LayerId::new(egui::Order::Background, "conditioning".into()));
+        let whole = egui::Rect::from_min_max(egui::pos2(0.0, 0.0), egui::pos2(1.0, 1.0));
+        painter.image(texture, frame, whole, egui::Color32::WHITE);
+    }
     hovered_joint_tooltip(&ctx, &panels, &overlays.hovered);
     if let Some(text) =
         state.active_dof.as_ref().or(overlays.gizmo.readout.as_ref()).or(overlays.moving.readout.as_ref())
@@ -300,13 +309,7 @@ fn frame_time_readout(
 /// The shot's frame in the viewport: what `render` takes at the shot's aspect (the
 /// viewport's height or width, centred), the rest dimmed.
 fn frame_guide(ctx: &egui::Context, viewport: egui::Rect, shot: &crate::formats::scene::ShotDoc) {
-    let aspect = shot.width as f32 / shot.height.max(1) as f32;
-    let size = if viewport.width() / viewport.height().max(1.0) > aspect {
-        egui::vec2(viewport.height() * aspect, viewport.height())
-    } else {
-        egui::vec2(viewport.width(), viewport.width() / aspect)
-    };
-    let frame = egui::Rect::from_center_size(viewport.center(), size);
+    let frame = crate::editor::ui::conditioning::frame_rect(viewport, shot);
     let painter = ctx.layer_painter(egui::LayerId::new(egui::Order::Background, "frame guide".into()));
     let dim = egui::Color32::from_black_alpha(110);
     for outside in [

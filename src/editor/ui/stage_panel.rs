@@ -30,6 +30,7 @@ pub fn stage_panel(ui: &mut egui::Ui, state: &mut InspectorState, panels: &mut P
     let mut shot = panels.scene.shot.0;
     egui::CollapsingHeader::new("Shot").show(ui, |ui| {
         shot_rows(ui, state, &mut shot);
+        conditioning_rows(ui, panels);
         frames_rows(ui, panels);
     });
     if shot != panels.scene.shot.0 {
@@ -48,6 +49,24 @@ fn fast_viewport_rows(ui: &mut egui::Ui, panels: &mut Panels) {
     });
     if (enabled, scale) != (fast.enabled, fast.scale) {
         (fast.enabled, fast.scale) = (enabled, scale);
+    }
+}
+
+/// The ControlNet map drawn over the view inside the frame guide: off, or one of them.
+fn conditioning_rows(ui: &mut egui::Ui, panels: &mut Panels) {
+    use crate::editor::ui::conditioning::ConditioningMap;
+    let Some(overlay) = panels.conditioning.as_deref_mut() else { return };
+    let mut map = overlay.map;
+    ui.label("ControlNet map over the view")
+        .on_hover_text("drawn as render --controlnet writes it, inside the frame guide, as the figures are posed");
+    ui.horizontal(|ui| {
+        ui.selectable_value(&mut map, None, "off");
+        for m in ConditioningMap::ALL {
+            ui.selectable_value(&mut map, Some(m), m.label());
+        }
+    });
+    if map != overlay.map {
+        overlay.map = map;
     }
 }
 
