@@ -264,3 +264,29 @@ fn a_spec_asks_for_the_controlnet_maps() {
         }
     }
 }
+
+/// A set's pictures are drawn without waiting frames of their own once the renderer is
+/// settled (each checked drawn whole, else drawn again): every one equals, byte for byte,
+/// `render` of the scene file written beside it, which waits for the renderer to settle.
+#[test]
+fn a_generated_picture_is_its_scene_rendered_alone() {
+    let dir = scratch("generate-alone");
+    let spec = small_spec(&dir, 5);
+    let out = dir.join("set");
+    let said = generate(&spec, &out, &[], &[]);
+    eprintln!("{said}");
+    for k in 0..5 {
+        let stem = format!("{k:06}");
+        let alone = dir.join(format!("{stem}.alone.png"));
+        let output = Command::new(env!("CARGO_BIN_EXE_marionette"))
+            .arg("render")
+            .arg(out.join(format!("{stem}.scene.ron")))
+            .arg("--out")
+            .arg(&alone)
+            .output()
+            .unwrap();
+        assert!(output.status.success(), "{}", String::from_utf8_lossy(&output.stderr));
+        let generated = std::fs::read(out.join(format!("{stem}.png"))).unwrap();
+        assert!(generated == std::fs::read(&alone).unwrap(), "picture {stem} differs from its scene rendered alone");
+    }
+}

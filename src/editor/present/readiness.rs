@@ -4,6 +4,13 @@
 //! its current pose, for [`READY_FRAMES`] rendered frames in a row. The CLI render, F12
 //! and the test pictures capture only then. (Fast GPUs used to pass "two frames agree"
 //! while the PBR and shadow pipelines were still compiling in the background.)
+//!
+//! Once settled, a picture that only changes what is drawn is captured without waiting
+//! frames of its own: a new pose in the frame that first draws it, a new scene of the same
+//! kinds of meshes and materials in the frame after. The render world says of every frame
+//! whether it drew all it was given (each main-world frame's meshes and targets, by
+//! [`WantedAssets`]'s generation, every pipeline compiled: [`DrawnFrames`]), and such a
+//! capture of a frame that did not is taken again.
 
 use std::sync::{Arc, Mutex};
 
@@ -26,6 +33,8 @@ pub const READY_FRAMES: u32 = 3;
 pub struct GpuStatus {
     /// Render-world frames seen so far.
     pub frame: u64,
+    /// The main world's frame (its [`WantedAssets`] generation) the last one drew.
+    pub generation: u64,
     /// Pipelines queued or compiling.
     pub pipelines_waiting: usize,
     /// Pipelines whose shaders failed (they will never draw).
@@ -36,18 +45,33 @@ pub struct GpuStatus {
     pub images_missing: usize,
 }
 
-/// The assets the main world draws, for the render world to look for.
-#[derive(Debug, Clone, Default)]
-struct WantedAssets {
+/// The assets a main-world frame draws, for the render world to look for when it draws
+/// that frame (extracted with it); `generation` counts the main world's frames.
+#[derive(Resource, Debug, Clone, Default)]
+pub struct WantedAssets {
+    pub generation: u64,
     meshes: Vec<AssetId<Mesh>>,
     images: Vec<AssetId<Image>>,
 }
 
-/// Shared between the main and the render world.
+/// How many frames' outcomes the render world keeps (more than captures wait for).
+const DRAWN_KEPT: usize = 64;
+
+/// Shared between the main and the render world: the last frame's status, and whether
+/// each recent generation was drawn whole.
 #[derive(Resource, Clone, Default)]
-struct GpuStatusChannel {
-    wanted: Arc<Mutex<WantedAssets>>,
+pub struct DrawnFrames {
     status: Arc<Mutex<GpuStatus>>,
+    drawn: Arc<Mutex<std::collections::VecDeque<(u64, bool)>>>,
+}
+
+impl DrawnFrames {
+    /// Whether the frame of `generation` was drawn with every mesh and target on the GPU
+    /// and no pipeline compiling; none while it is not drawn yet (or forgotten).
+    pub fn drawn_whole(&self, generation: u64) -> Option<bool> {
+        let drawn = self.drawn.lock().ok()?;
+        drawn.iter().find(|(g, _)| *g == generation).map(|&(_, whole)| whole)
+    }
 }
 
 /// Whether a capture may happen now.
@@ -90,14 +114,18 @@ pub fn readiness(gpu: &GpuStatus, characters_unskinned: usize, scene_pending: bo
 pub struct CaptureGate {
     ready_frames: u32,
     last_frame: u64,
-    /// Everything the frames need is on the GPU and was drawn: a new picture (a new pose,
-    /// a turned camera) needs only its own frame, and that frame is ready as soon as the
-    /// main world has skinned it.
-    settled: bool,
+    /// Everything the frames need was on the GPU and drawn before this picture was set up:
+    /// it needs only this many ready frames of its own (none: [`READY_FRAMES`]).
+    settled: Option<u32>,
     /// The last reason not to capture (for a time-out's message).
     pub last_reason: Option<String>,
     /// Set when the frame can never be ready.
     pub failed: Option<String>,
+    /// The main world's frame now, and the one the render world last drew.
+    generations: (u64, u64),
+    /// The first main-world frame that draws what the picture shows (render frames of
+    /// earlier ones do not count towards its capture).
+    since: u64,
 }
 
 impl CaptureGate {
@@ -106,14 +134,15 @@ impl CaptureGate {
     pub fn observe(&mut self, frame: u64, readiness: Readiness) {
         match readiness {
             Readiness::Ready => {
-                if frame != self.last_frame || self.settled {
+                let drew_it = frame != self.last_frame && self.generations.1 >= self.since;
+                if drew_it || self.settled.is_some() {
                     self.ready_frames += 1;
                 }
                 self.last_reason = None;
             }
             Readiness::Waiting(reason) => {
                 self.ready_frames = 0;
-                self.settled = false;
+                self.settled = None;
                 self.last_reason = Some(reason);
             }
             Readiness::Failed(reason) => {
@@ -128,21 +157,45 @@ impl CaptureGate {
     /// library: its edits land in a later frame), and only frames after the change count.
     pub fn restart(&mut self) {
         self.ready_frames = 0;
-        self.settled = false;
+        self.settled = None;
+        self.since = self.generations.0 + 1;
+    }
+
+    /// The main world's frame now and the one the render world last drew.
+    pub fn note_generations(&mut self, now: u64, drawn: u64) {
+        self.generations = (now, drawn);
     }
 
     /// The next picture of a sequence is set up (clips at a new time, the camera turned)
     /// after a capture: once the gate was ready, its first ready frame may be captured
     /// (its pose is skinned in the frame it is drawn in).
     pub fn next_picture(&mut self) {
-        self.settled = self.is_ready();
+        self.settle(1);
+    }
+
+    /// The next picture is a new scene of the kinds of meshes and materials drawn already:
+    /// once the gate was ready, it may be captured in the frame after the one that first
+    /// draws it (the renderer takes up new entities' materials and shadows in their first
+    /// frame).
+    pub fn next_scene(&mut self) {
+        self.settle(2);
+    }
+
+    fn settle(&mut self, frames: u32) {
+        self.settled = self.is_ready().then_some(frames);
         self.ready_frames = 0;
+        self.since = self.generations.0 + 1;
+    }
+
+    /// Whether a capture now is of a picture set up after the gate was ready (and so must
+    /// be checked against [`DrawnFrames`] once drawn).
+    pub fn is_speculative(&self) -> bool {
+        self.settled.is_some()
     }
 
     /// Whether enough ready frames passed in a row.
     pub fn is_ready(&self) -> bool {
-        let needed = if self.settled { 1 } else { READY_FRAMES };
-        self.ready_frames >= needed && self.failed.is_none()
+        self.ready_frames >= self.settled.unwrap_or(READY_FRAMES) && self.failed.is_none()
     }
 }
 
@@ -155,20 +208,25 @@ pub struct ReadinessPlugin;
 
 impl Plugin for ReadinessPlugin {
     fn build(&self, app: &mut App) {
-        let channel = GpuStatusChannel::default();
+        let channel = DrawnFrames::default();
         app.insert_resource(channel.clone())
             .init_resource::<CaptureGate>()
+            .init_resource::<WantedAssets>()
             .add_systems(Last, (publish_wanted_assets, update_capture_gate).chain().in_set(UpdateCaptureGate));
         if let Some(render_app) = app.get_sub_app_mut(RenderApp) {
-            render_app.insert_resource(channel).add_systems(Render, report_gpu_status.in_set(RenderSystems::Cleanup));
+            render_app
+                .insert_resource(channel)
+                .init_resource::<WantedAssets>()
+                .add_systems(bevy::render::ExtractSchedule, extract_wanted_assets)
+                .add_systems(Render, report_gpu_status.in_set(RenderSystems::Cleanup));
         }
     }
 }
 
-/// Lists the meshes drawn and the cameras' target images (reads `Mesh3d`, `RenderTarget`;
-/// writes the channel).
-fn publish_wanted_assets(channel: Res<GpuStatusChannel>, meshes: Query<&Mesh3d>, targets: Query<&RenderTarget>) {
-    let Ok(mut wanted) = channel.wanted.lock() else { return };
+/// Lists the meshes drawn and the cameras' target images, a generation later (reads
+/// `Mesh3d`, `RenderTarget`; writes `WantedAssets`).
+fn publish_wanted_assets(mut wanted: ResMut<WantedAssets>, meshes: Query<&Mesh3d>, targets: Query<&RenderTarget>) {
+    wanted.generation += 1;
     // The same buffers every frame: no allocation once they are large enough.
     wanted.meshes.clear();
     wanted.meshes.extend(meshes.iter().map(|m| m.id()));
@@ -176,10 +234,16 @@ fn publish_wanted_assets(channel: Res<GpuStatusChannel>, meshes: Query<&Mesh3d>,
     wanted.images.extend(targets.iter().filter_map(|t| t.as_image().map(Handle::id)));
 }
 
+/// The main world's list, with the frame the render world is about to draw.
+fn extract_wanted_assets(mut wanted: ResMut<WantedAssets>, main: bevy::render::Extract<Res<WantedAssets>>) {
+    wanted.clone_from(&main);
+}
+
 /// Feeds this frame's readiness to the gate (reads the channel, `PoseDirty`,
 /// `PendingScene`; writes `CaptureGate`).
 fn update_capture_gate(
-    channel: Res<GpuStatusChannel>,
+    channel: Res<DrawnFrames>,
+    wanted: Res<WantedAssets>,
     dirty: Query<&PoseDirty>,
     pending: Option<Res<PendingScene>>,
     mut gate: ResMut<CaptureGate>,
@@ -187,13 +251,15 @@ fn update_capture_gate(
     let gpu = channel.status.lock().map(|s| s.clone()).unwrap_or_default();
     let unskinned = dirty.iter().filter(|d| **d != PoseDirty::default()).count();
     let scene_pending = pending.is_some_and(|p| p.doc.is_some());
+    gate.note_generations(wanted.generation, gpu.generation);
     gate.observe(gpu.frame, readiness(&gpu, unskinned, scene_pending));
 }
 
 /// After the render world's frame: counts pipelines waiting or failed and the wanted
 /// assets not prepared (reads `PipelineCache`, render assets; writes the channel).
 fn report_gpu_status(
-    channel: Res<GpuStatusChannel>,
+    channel: Res<DrawnFrames>,
+    wanted: Res<WantedAssets>,
     cache: Res<PipelineCache>,
     meshes: Res<RenderAssets<RenderMesh>>,
     images: Res<RenderAssets<GpuImage>>,
@@ -209,16 +275,19 @@ fn report_gpu_status(
             _ => None,
         })
         .collect::<Vec<_>>();
-    let (meshes_missing, images_missing) = match channel.wanted.lock() {
-        Ok(wanted) => (
-            wanted.meshes.iter().filter(|&&id| meshes.get(id).is_none()).count(),
-            wanted.images.iter().filter(|&&id| images.get(id).is_none()).count(),
-        ),
-        Err(_) => (0, 0),
-    };
+    let meshes_missing = wanted.meshes.iter().filter(|&&id| meshes.get(id).is_none()).count();
+    let images_missing = wanted.images.iter().filter(|&&id| images.get(id).is_none()).count();
+    let whole = waiting.is_empty() && pipelines_failed.is_empty() && meshes_missing == 0 && images_missing == 0;
+    if let Ok(mut drawn) = channel.drawn.lock() {
+        if drawn.len() == DRAWN_KEPT {
+            drawn.pop_front();
+        }
+        drawn.push_back((wanted.generation, whole));
+    }
     let Ok(mut status) = channel.status.lock() else { return };
     *status = GpuStatus {
         frame: status.frame + 1,
+        generation: wanted.generation,
         pipelines_waiting: waiting.len(),
         pipelines_failed,
         meshes_missing,

@@ -18,7 +18,7 @@ use crate::document::frames::{FrameSequence, PictureRequest, Pictures, frame_pat
 use crate::document::picture;
 use crate::document::scenes::{read_scene, scene_path};
 use crate::editor::present::data::{Beside, DataScene};
-use crate::editor::present::readiness::CaptureGate;
+use crate::editor::present::readiness::{CaptureGate, DrawnFrames, WantedAssets};
 use crate::editor::present::stage;
 use crate::editor::present::view::ViewPlugin;
 use crate::editor::scene_doc::document::Library;
@@ -43,7 +43,11 @@ struct RenderJob {
     set_up: bool,
     /// Rendered pixels a side of each saved one.
     samples: u32,
-    /// The picture being set up or captured next (all are captured once it is their count).
+    /// The pictures in the order they are drawn: each once, and again at the end where its
+    /// capture was of a frame not drawn whole.
+    queue: Vec<usize>,
+    /// The place in `queue` of the picture being set up or captured next (all are captured
+    /// once it is the queue's length).
     next: usize,
     sequence: Option<FrameSequence>,
     /// The camera's yaw at the first frame (a turntable turns from it).
@@ -305,6 +309,7 @@ fn run_job(setup: JobSetup) -> Result<Vec<String>, String> {
     };
     let outcome = Arc::new(Mutex::new((None, Vec::new())));
     app.insert_resource(RenderJob {
+        queue: drawing_order(&frames),
         frames,
         set_up: false,
         samples: picture.samples,
@@ -396,11 +401,15 @@ fn preload(paths: &[PathBuf], edits: &StartupEdits) -> Result<(AssetLibrary, Sho
 }
 
 /// Once the gate opens, captures the target once, saves it and exits; gives up when a
-/// picture waits [`GIVE_UP_SECONDS`] or a pipeline failed, saying what was pending.
+/// picture waits [`GIVE_UP_SECONDS`] or a pipeline failed, saying what was pending. A
+/// capture of a frame the GPU did not draw whole is thrown away and its picture drawn
+/// again after the others.
+#[allow(clippy::too_many_arguments)]
 fn capture_when_ready(
     mut commands: Commands,
     mut job: ResMut<RenderJob>,
     gate: Res<CaptureGate>,
+    wanted: Res<WantedAssets>,
     messages: Res<Messages>,
     stage: Res<crate::editor::state::StageSettings>,
     scene: DataScene,
@@ -428,7 +437,7 @@ fn capture_when_ready(
         job.done = Some(Err(e));
         return;
     }
-    if job.next == job.frames.len() {
+    if job.next == job.queue.len() {
         if job.in_flight == 0 {
             job.done = Some(finish(&mut job));
         }
@@ -440,7 +449,8 @@ fn capture_when_ready(
     if !job.set_up || !gate.is_ready() || job.in_flight >= MAX_IN_FLIGHT {
         return;
     }
-    let (index, frame_now) = (job.next, &job.frames[job.next]);
+    let index = job.queue[job.next];
+    let frame_now = &job.frames[index];
     let (out, ids, backdrop) = (frame_now.out.clone(), frame_now.ids, frame_now.backdrop.clone());
     let (samples, background, coco_per_picture) = (job.samples, stage.background.clone(), job.coco_per_picture);
     // What the data pictures show is taken now, with the frame the capture draws.
@@ -452,8 +462,18 @@ fn capture_when_ready(
             return;
         }
     };
-    let written = job.written.clone();
-    commands.spawn(Screenshot::image(job.target.clone())).observe(move |captured: On<ScreenshotCaptured>| {
+    let (written, generation, speculative) = (job.written.clone(), wanted.generation, gate.is_speculative());
+    let on_captured = move |captured: On<ScreenshotCaptured>,
+                            drawn: Res<DrawnFrames>,
+                            mut job: ResMut<RenderJob>,
+                            mut gate: ResMut<CaptureGate>| {
+        if speculative && drawn.drawn_whole(generation) != Some(true) {
+            // Drawn before all of it was on the GPU: again, once everything is.
+            job.queue.push(index);
+            job.in_flight -= 1;
+            gate.restart();
+            return;
+        }
         // Encoded and written on a thread of its own while the next pictures are drawn.
         let (image, out, frame, written) = (captured.image.clone(), out.clone(), frame.take(), written.clone());
         let (backdrop, background) = (backdrop.clone(), background.clone());
@@ -475,7 +495,8 @@ fn capture_when_ready(
                 written.push((index, result));
             }
         });
-    });
+    };
+    commands.spawn(Screenshot::image(job.target.clone())).observe(on_captured);
     // This frame is the one captured: the next picture is set up from the next frame on.
     job.in_flight += 1;
     let now = std::time::Instant::now();
@@ -589,11 +610,11 @@ fn next_frame(
     mut node_clips: Query<&mut crate::scene::node_clips::NodeClipPlayer>,
     mut cameras: Query<&mut OrbitCamera>,
 ) {
-    if job.set_up || job.next == 0 || job.next == job.frames.len() {
+    if job.set_up || job.next == 0 || job.next == job.queue.len() {
         return;
     }
     let first_yaw = *job.first_yaw.get_or_insert_with(|| cameras.iter().next().map_or(0.0, |c| c.0.yaw));
-    let FrameAt::Time(t) = job.frames[job.next].at else { return };
+    let FrameAt::Time(t) = job.frames[job.queue[job.next]].at else { return };
     keyframes.iter_mut().for_each(|mut p| p.state.pause_at(t));
     smpl.iter_mut().filter(|b| b.state.clip.is_some()).for_each(|mut b| b.state.pause_at(t));
     node_clips.iter_mut().filter(|p| p.state.clip.is_some()).for_each(|mut p| p.state.pause_at(t));
@@ -611,15 +632,45 @@ fn scene_frame(
     mut gate: ResMut<CaptureGate>,
     mut pending: ResMut<crate::editor::scene_doc::document::PendingScene>,
 ) {
-    if job.set_up || job.done.is_some() || job.next == job.frames.len() {
+    if job.set_up || job.done.is_some() || job.next == job.queue.len() {
         return;
     }
-    let FrameAt::Scene(doc) = &job.frames[job.next].at else { return };
+    let FrameAt::Scene(doc) = &job.frames[job.queue[job.next]].at else { return };
     if job.next > 0 {
+        let lit_alike = match &job.frames[job.queue[job.next - 1]].at {
+            FrameAt::Scene(last) => light_setup(&last.stage) == light_setup(&doc.stage) && doc.stage.lamps.is_empty(),
+            _ => false,
+        };
         *pending = crate::editor::scene_doc::document::PendingScene { frame: false, doc: Some((**doc).clone()) };
-        gate.restart();
+        if lit_alike { gate.next_scene() } else { gate.restart() }
     }
     job.set_up = true;
+}
+
+/// The order to draw `frames` in: the first (the scene the app opens with) first; a data
+/// set's scenes then grouped by how they are lit, those lit like the first first, so that
+/// the renderer settles once a group (the pictures do not depend on the order).
+fn drawing_order(frames: &[Frame]) -> Vec<usize> {
+    let lights = |k: usize| match &frames[k].at {
+        FrameAt::Scene(doc) => Some(light_setup(&doc.stage)),
+        _ => None,
+    };
+    let mut order: Vec<usize> = (0..frames.len()).collect();
+    if let Some(first) = lights(0).filter(|_| frames.len() > 2) {
+        order[1..].sort_by_cached_key(|&k| {
+            let lit = lights(k);
+            (lit.as_ref() != Some(&first), lit)
+        });
+    }
+    order
+}
+
+/// What of a stage has the renderer set up its lights' views and passes anew when it
+/// changes: shadows at all, and each lamp's kind and whether it casts shadows. A scene
+/// without lamps lit alike to the last is drawn as it should be from its second frame;
+/// another waits for the renderer to settle (a new lamp's views take frames of their own).
+fn light_setup(stage: &crate::formats::scene::StageDoc) -> (bool, Vec<(bool, bool)>) {
+    (stage.shadows, stage.lamps.iter().map(|l| (l.spot.is_some(), l.shadows)).collect())
 }
 
 /// Sets up the frame to render: a pose frame puts the pose on every character that has its
@@ -639,11 +690,11 @@ fn pose_frame(
     mut edits: ResMut<crate::editor::edits::edit::EditQueue>,
     mut assets: ResMut<crate::editor::scene_doc::document::Library>,
 ) {
-    if job.set_up || job.done.is_some() || job.next == job.frames.len() {
+    if job.set_up || job.done.is_some() || job.next == job.queue.len() {
         return;
     }
     job.set_up = true;
-    let FrameAt::Pose(name) = &job.frames[job.next].at else { return };
+    let FrameAt::Pose(name) = &job.frames[job.queue[job.next]].at else { return };
     let kept = library.0.get(name);
     let joints: Vec<_> = kept.iter().flat_map(|pose| pose.joints.iter().map(|(k, r)| (k.clone(), *r))).collect();
     let rig = kept.and_then(|pose| pose.rig.as_ref()).and_then(|rig| assets.rig(rig).ok());
