@@ -216,3 +216,96 @@ fn a_character_in_mid_stride_maps_as_at_rest() {
         named(&puppet.skeleton, &detect(&puppet.skeleton).unwrap())
     );
 }
+
+/// A BVH hierarchy in CMU's shape (a pelvis-side joint at the hips' centre, `OFFSET 0 0 0`,
+/// whose bone runs to the hip socket, then the thigh), with these names for the hip joint,
+/// the thigh, the shin, the foot and the toes of each side (`{s}` is `L`/`R`, `{side}`
+/// `Left`/`Right`, `{l}` `l`/`r`).
+fn cmu_shaped(names: [&str; 5]) -> Skeleton {
+    let leg = |s: &str, side: &str, l: &str, x: f32| {
+        let name = |n: &str| n.replace("{s}", s).replace("{side}", side).replace("{l}", l);
+        format!(
+            "JOINT {}\n{{\nOFFSET 0 0 0\nCHANNELS 3 Zrotation Yrotation Xrotation\n\
+             JOINT {}\n{{\nOFFSET {x} -1.9 0.8\nCHANNELS 3 Zrotation Yrotation Xrotation\n\
+             JOINT {}\n{{\nOFFSET {x2} -7.5 0\nCHANNELS 3 Zrotation Yrotation Xrotation\n\
+             JOINT {}\n{{\nOFFSET 0 -7.2 0\nCHANNELS 3 Zrotation Yrotation Xrotation\n\
+             JOINT {}\n{{\nOFFSET 0 -0.4 2.2\nCHANNELS 3 Zrotation Yrotation Xrotation\n\
+             End Site\n{{\nOFFSET 0 0 0.8\n}}\n}}\n}}\n}}\n}}\n}}\n",
+            name(names[0]),
+            name(names[1]),
+            name(names[2]),
+            name(names[3]),
+            name(names[4]),
+            x2 = x * 0.5,
+        )
+    };
+    let arm = |side: &str, x: f32| {
+        format!(
+            "JOINT {side}Shoulder\n{{\nOFFSET {} 1.5 0\nCHANNELS 3 Zrotation Yrotation Xrotation\n\
+             JOINT {side}Arm\n{{\nOFFSET {} 0 0\nCHANNELS 3 Zrotation Yrotation Xrotation\n\
+             JOINT {side}ForeArm\n{{\nOFFSET {} 0 0\nCHANNELS 3 Zrotation Yrotation Xrotation\n\
+             JOINT {side}Hand\n{{\nOFFSET {} 0 0\nCHANNELS 3 Zrotation Yrotation Xrotation\n\
+             End Site\n{{\nOFFSET {} 0 0\n}}\n}}\n}}\n}}\n}}\n",
+            x * 1.5,
+            x * 3.0,
+            x * 5.0,
+            x * 4.5,
+            x * 1.5
+        )
+    };
+    let text = format!(
+        "HIERARCHY\nROOT Hips\n{{\nOFFSET 0 0 0\nCHANNELS 6 Xposition Yposition Zposition Zrotation Yrotation Xrotation\n\
+         {}{}\
+         JOINT LowerBack\n{{\nOFFSET 0 2.0 -0.1\nCHANNELS 3 Zrotation Yrotation Xrotation\n\
+         JOINT Spine\n{{\nOFFSET 0 2.0 0\nCHANNELS 3 Zrotation Yrotation Xrotation\n\
+         JOINT Spine1\n{{\nOFFSET 0 2.0 0\nCHANNELS 3 Zrotation Yrotation Xrotation\n\
+         {}{}\
+         JOINT Neck\n{{\nOFFSET 0 2.0 0\nCHANNELS 3 Zrotation Yrotation Xrotation\n\
+         JOINT Head\n{{\nOFFSET 0 1.5 0\nCHANNELS 3 Zrotation Yrotation Xrotation\n\
+         End Site\n{{\nOFFSET 0 1.8 0\n}}\n}}\n}}\n}}\n}}\n}}\n}}\n\
+         MOTION\nFrames: 1\nFrame Time: 0.0083333\n{}\n",
+        leg("L", "Left", "l", 1.6),
+        leg("R", "Right", "r", -1.6),
+        arm("Left", 1.0),
+        arm("Right", -1.0),
+        vec!["0"; 6 + 3 * 23].join(" ")
+    );
+    let file = marionette::formats::bvh::parse_bvh(std::io::Cursor::new(text), std::path::Path::new("cmu.bvh"));
+    file.expect("the fixture reads").skeleton
+}
+
+/// CMU's legs: the joint at the hips' centre whose bone runs to the hip socket
+/// (`LHipJoint`, `lhipjoint`) is never the upper leg; the thigh below it is, whatever it is
+/// called (`LeftHip`, `LeftUpLeg`, `lfemur`).
+#[test]
+fn cmu_legs_map_the_thigh_not_the_pelvis_side_joint() {
+    for (names, thigh, shin) in [
+        (["{s}HipJoint", "{side}Hip", "{side}Knee", "{side}Ankle", "{side}Toe"], "Hip", "Knee"),
+        (["{s}HipJoint", "{side}UpLeg", "{side}Leg", "{side}Foot", "{side}ToeBase"], "UpLeg", "Leg"),
+        (["{l}hipjoint", "{l}femur", "{l}tibia", "{l}foot", "{l}toes"], "femur", "tibia"),
+    ] {
+        let skeleton = cmu_shaped(names);
+        let (left_thigh, right_thigh) = if thigh == "femur" {
+            ("lfemur".to_string(), "rfemur".to_string())
+        } else {
+            (format!("Left{thigh}"), format!("Right{thigh}"))
+        };
+        let (left_shin, right_shin) = if shin == "tibia" {
+            ("ltibia".to_string(), "rtibia".to_string())
+        } else {
+            (format!("Left{shin}"), format!("Right{shin}"))
+        };
+        expect(
+            &skeleton,
+            &[
+                (Hips, "Hips"),
+                (LeftUpperLeg, &left_thigh),
+                (LeftLowerLeg, &left_shin),
+                (RightUpperLeg, &right_thigh),
+                (RightLowerLeg, &right_shin),
+                (LeftUpperArm, "LeftArm"),
+                (LeftHand, "LeftHand"),
+            ],
+        );
+    }
+}

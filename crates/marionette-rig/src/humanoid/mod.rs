@@ -477,7 +477,8 @@ fn named_leg(tree: &Tree, says: &[NameSays], hips: usize, foot: usize, side: Sid
     let upper_at = above
         .iter()
         .position(|&j| role(j) == Some(Role::UpperLeg))
-        .or_else(|| above.iter().position(|&j| role(j) == Some(Role::SidedHip)))?;
+        // The sided hip nearest the knee (one above it runs to the hip socket).
+        .or_else(|| above.iter().rposition(|&j| role(j) == Some(Role::SidedHip)))?;
     Some((above[upper_at], path[lower_at]))
 }
 

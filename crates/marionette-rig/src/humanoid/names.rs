@@ -318,6 +318,7 @@ pub fn words(name: &str) -> Vec<String> {
             split.push(w);
         }
     }
-    // `hipjoint` (CMU's ASF names) is a hip joint.
-    split.into_iter().flat_map(|w| if w == "hipjoint" { vec!["hip".into(), "joint".into()] } else { vec![w] }).collect()
+    // `hipjoint` (CMU's `LHipJoint`, its ASF's `lhipjoint`) is the pelvis-side bone from the
+    // hips' centre to the hip socket: a sided pelvis, never the upper leg.
+    split.into_iter().map(|w| if w == "hipjoint" { "pelvis".into() } else { w }).collect()
 }
