@@ -553,6 +553,17 @@ fn the_skin_phases_ideal_uses_only_the_cores_it_has_tasks_for() {
     assert!((ideal_skin_ms(1, 2 * chunk, 500.0, 8) - (2 * chunk) as f64 / 1e6).abs() < 1e-9);
 }
 
+/// The frames an app asked for (`RequestRedraw`), counted at the start of each update.
+#[derive(bevy::prelude::Resource, Default)]
+struct Asked(usize);
+
+fn count(
+    mut asked: bevy::prelude::ResMut<Asked>,
+    mut redraws: bevy::prelude::MessageReader<bevy::window::RequestRedraw>,
+) {
+    asked.0 += redraws.read().count();
+}
+
 /// The editor draws on change: with nothing playing it asks for no frame; a playing clip
 /// asks for one every frame while it plays, and none once paused (the window's own events,
 /// input among them, wake Bevy's reactive loop without asking).
@@ -563,11 +574,6 @@ fn the_editor_asks_for_frames_only_while_something_moves() {
     use marionette::editor::present::redraw::{DrawMode, RedrawPlugin};
     use marionette::scene::keyframes::ClipPlayer;
 
-    #[derive(Resource, Default)]
-    struct Asked(usize);
-    fn count(mut asked: ResMut<Asked>, mut redraws: MessageReader<RequestRedraw>) {
-        asked.0 += redraws.read().count();
-    }
     let mut app = App::new();
     app.add_plugins(MinimalPlugins)
         .add_message::<RequestRedraw>()
@@ -674,11 +680,6 @@ fn the_controlnet_overlay_is_worked_out_only_on_change() {
     use marionette::editor::ui::conditioning::{ConditioningMap, ConditioningOverlay, work_out_the_overlay_on_change};
     use marionette::formats::scene::CharacterId;
 
-    #[derive(Resource, Default)]
-    struct Asked(usize);
-    fn count(mut asked: ResMut<Asked>, mut redraws: MessageReader<RequestRedraw>) {
-        asked.0 += redraws.read().count();
-    }
     let mut app = crate::edits::scene_app();
     app.add_message::<RequestRedraw>()
         .init_resource::<Asked>()
