@@ -9,7 +9,7 @@ use std::hash::{Hash, Hasher};
 
 use bevy::prelude::*;
 use bevy::window::{PrimaryWindow, RequestRedraw};
-use bevy_egui::{EguiContexts, egui};
+use bevy_egui::egui;
 
 use crate::document::annotate::controlnet::{inverse_depth, normal_map, openpose_drawing, people};
 use crate::editor::interact::pointer::ViewportArea;
@@ -47,9 +47,10 @@ pub struct ConditioningOverlay {
     /// A digest of what the map was last worked out from.
     digest: Option<u64>,
     /// The map worked out, not yet handed to egui.
-    pending: Option<egui::ColorImage>,
-    /// egui's texture of the map.
-    texture: Option<egui::TextureHandle>,
+    pending: Option<Image>,
+    /// The map's picture, and egui's name for it while the toggle is on.
+    image: Handle<Image>,
+    shown: Option<egui::TextureId>,
     /// How many times the map has been worked out (each a change of what it shows).
     pub drawn: u64,
 }
@@ -57,7 +58,7 @@ pub struct ConditioningOverlay {
 impl ConditioningOverlay {
     /// The texture to draw inside the frame guide, while the toggle is on.
     pub fn texture(&self) -> Option<egui::TextureId> {
-        self.map.and(self.texture.as_ref()).map(egui::TextureHandle::id)
+        self.map.and(self.shown)
     }
 }
 
@@ -99,7 +100,7 @@ pub fn work_out_the_overlay_on_change(
 ) {
     let Some(map) = overlay.map else {
         if overlay.digest.is_some() {
-            (overlay.digest, overlay.texture) = (None, None);
+            (overlay.digest, overlay.shown) = (None, None);
         }
         return;
     };
@@ -135,38 +136,36 @@ pub fn work_out_the_overlay_on_change(
     redraw.write(RequestRedraw);
 }
 
-/// Gives egui the map worked out this frame (its texture changed in place).
-fn hand_the_overlay_to_egui(mut overlay: ResMut<ConditioningOverlay>, mut contexts: EguiContexts) {
+/// Puts the map worked out this frame in its image (one image, changed in place) and
+/// names it to egui.
+fn hand_the_overlay_to_egui(
+    mut overlay: ResMut<ConditioningOverlay>,
+    mut images: ResMut<Assets<Image>>,
+    mut textures: ResMut<bevy_egui::EguiUserTextures>,
+) {
     let Some(image) = overlay.pending.take() else { return };
-    let Ok(ctx) = contexts.ctx_mut() else { return };
-    match overlay.texture.as_mut() {
-        Some(texture) => texture.set(image, egui::TextureOptions::NEAREST),
-        None => overlay.texture = Some(ctx.load_texture("conditioning overlay", image, egui::TextureOptions::NEAREST)),
+    if overlay.image == Handle::default() {
+        overlay.image = images.add(image);
+    } else if images.insert(overlay.image.id(), image).is_err() {
+        return;
     }
+    overlay.shown = Some(textures.add_image(bevy_egui::EguiTextureHandle::Weak(overlay.image.id())));
 }
 
 /// The map as a picture to lay over the view: the OpenPose drawing with its black left out,
-/// depth and normals a little see-through.
-fn map_image(map: ConditioningMap, data: &crate::editor::present::data::DataFrame) -> egui::ColorImage {
+/// depth and normals a little see-through (sRGB, alpha not premultiplied).
+fn map_image(map: ConditioningMap, data: &crate::editor::present::data::DataFrame) -> Image {
+    use bevy::render::render_resource::{Extent3d, TextureDimension, TextureFormat};
     let passes = data.passes();
-    let (w, h) = (passes.width as usize, passes.height as usize);
-    let rgba: Vec<egui::Color32> = match map {
+    let rgba: Vec<[u8; 4]> = match map {
         ConditioningMap::OpenPose => {
             let drawing = openpose_drawing(passes.width, passes.height, &people(&data.camera, &passes, &data.figures));
-            let see_black = |[r, g, b]: [u8; 3]| {
-                let alpha = if [r, g, b] == [0; 3] { 0 } else { 255 };
-                egui::Color32::from_rgba_unmultiplied(r, g, b, alpha)
-            };
-            drawing.pixels().map(|p| see_black(p.0)).collect()
+            drawing.pixels().map(|p| [p.0[0], p.0[1], p.0[2], if p.0 == [0; 3] { 0 } else { 255 }]).collect()
         }
-        ConditioningMap::Depth => inverse_depth(&passes)
-            .pixels()
-            .map(|p| egui::Color32::from_rgba_unmultiplied(p.0[0], p.0[0], p.0[0], 230))
-            .collect(),
-        ConditioningMap::Normal => normal_map(&passes)
-            .pixels()
-            .map(|p| egui::Color32::from_rgba_unmultiplied(p.0[0], p.0[1], p.0[2], 230))
-            .collect(),
+        ConditioningMap::Depth => inverse_depth(&passes).pixels().map(|p| [p.0[0], p.0[0], p.0[0], 230]).collect(),
+        ConditioningMap::Normal => normal_map(&passes).pixels().map(|p| [p.0[0], p.0[1], p.0[2], 230]).collect(),
     };
-    egui::ColorImage::new([w, h], rgba)
+    let size = Extent3d { width: passes.width, height: passes.height, depth_or_array_layers: 1 };
+    let usage = bevy::asset::RenderAssetUsages::RENDER_WORLD;
+    Image::new(size, TextureDimension::D2, rgba.concat(), TextureFormat::Rgba8UnormSrgb, usage)
 }

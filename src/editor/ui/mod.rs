@@ -229,18 +229,18 @@ fn inspector_ui(
         let whole = egui::Rect::from_min_max(egui::pos2(0.0, 0.0), egui::pos2(1.0, 1.0));
         ui.painter().image(texture, central, whole, egui::Color32::WHITE);
     }
+    // The ControlNet map over the view (and over the fast view), in the frame guide.
+    if let Some(texture) = panels.conditioning.as_ref().and_then(|c| c.texture()) {
+        let frame = crate::editor::ui::conditioning::frame_rect(central, &panels.scene.shot.0);
+        let whole = egui::Rect::from_min_max(egui::pos2(0.0, 0.0), egui::pos2(1.0, 1.0));
+        ui.painter().image(texture, frame, whole, egui::Color32::WHITE);
+    }
     dialogs::show(&ctx, &mut state, &mut panels, &mut shot);
     let mode = overlays.draw_mode.as_deref().copied().unwrap_or_default();
     let fast_scale = fast.and(panels.fast_viewport.as_ref().map(|s| s.scale));
     frame_time_readout(&ctx, central, &overlays.diagnostics, mode, fast_scale);
     if state.frame_guide {
         frame_guide(&ctx, central, &panels.scene.shot.0);
-    }
-    if let Some(texture) = panels.conditioning.as_ref().and_then(|c| c.texture()) {
-        let frame = crate::editor::ui::conditioning::frame_rect(central, &panels.scene.shot.0);
-        let painter = ctx.layer_painter(egui::LayerId::new(egui::Order::Background, "conditioning".into()));
-        let whole = egui::Rect::from_min_max(egui::pos2(0.0, 0.0), egui::pos2(1.0, 1.0));
-        painter.image(texture, frame, whole, egui::Color32::WHITE);
     }
     hovered_joint_tooltip(&ctx, &panels, &overlays.hovered);
     if let Some(text) =
