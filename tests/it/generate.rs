@@ -136,6 +136,11 @@ fn spec_errors_stop_generate_before_rendering() {
             text.replacen("canny: None", "canny: Some((low: 100, high: 200))", 1),
             "canny: the canny edges are a ControlNet map",
         ),
+        (
+            text.replacen("canny: None,", "canny: None,\n    poses: Some((body: [\"fly\"])),", 1),
+            "poses.body[0]: expected one of",
+        ),
+        (text.replacen("canny: None,", "canny: None,\n    poses: Some((hands: [\"claw\"])),", 1), "poses.hands[0]"),
         (text.replacen("count: 4", "count: 4,\n    colour: 3", 1), "spec.ron:"),
     ];
     for (bad, words) in cases {
@@ -288,5 +293,43 @@ fn a_generated_picture_is_its_scene_rendered_alone() {
         assert!(output.status.success(), "{}", String::from_utf8_lossy(&output.stderr));
         let generated = std::fs::read(out.join(format!("{stem}.png"))).unwrap();
         assert!(generated == std::fs::read(&alone).unwrap(), "picture {stem} differs from its scene rendered alone");
+    }
+}
+
+/// `poses:` puts a drawn built-in body pose on every humanoid: the puppets of a spec asking
+/// for `sit-chair` have their thighs turned a quarter turn (level) and their knees a
+/// quarter turn back (shins down); `t-pose` leaves the legs straight.
+#[test]
+fn a_spec_poses_its_characters_with_the_body_poses_it_draws() {
+    let dir = scratch("generate-poses");
+    let spec = small_spec(&dir, 1);
+    let text = std::fs::read_to_string(&spec).unwrap();
+    let legs = |body: &str| {
+        let posed = dir.join(format!("{body}.ron"));
+        let asked = format!("canny: None,\n    poses: Some((body: [\"{body}\"], hands: [\"fist\"])),");
+        let text = text.replacen("canny: None,", &asked, 1).replacen("per_picture: (1, 3)", "per_picture: (3, 3)", 1);
+        std::fs::write(&posed, text).unwrap();
+        let output = Command::new(env!("CARGO_BIN_EXE_marionette"))
+            .arg("generate")
+            .arg(&posed)
+            .args(["--out", dir.join("unused").to_str().unwrap(), "--dry-run"])
+            .output()
+            .unwrap();
+        assert!(output.status.success(), "{}", String::from_utf8_lossy(&output.stderr));
+        let scene = dir.join(format!("{body}.scene.ron"));
+        std::fs::write(&scene, String::from_utf8_lossy(&output.stdout).replacen("// picture 0", "", 1)).unwrap();
+        let doc = marionette::document::scenes::read_scene(&scene).unwrap();
+        assert_eq!(doc.characters.len(), 3);
+        let turn = |c: &marionette::formats::scene::CharacterDoc, joint: &str| {
+            c.pose.get(joint).map_or(0.0, |r| r.to_quat().angle_between(bevy::math::Quat::IDENTITY).to_degrees())
+        };
+        let legs = ["l_hip", "r_hip", "l_knee", "r_knee"];
+        doc.characters.iter().map(|c| legs.map(|j| (j, turn(c, j)))).collect::<Vec<_>>()
+    };
+    for (joint, angle) in legs("sit-chair").into_iter().flatten() {
+        assert!((angle - 90.0).abs() < 5.0, "sit-chair: {joint} turned {angle:.1}°");
+    }
+    for (joint, angle) in legs("t-pose").into_iter().flatten() {
+        assert!(angle < 10.0, "t-pose: {joint} turned {angle:.1}°");
     }
 }

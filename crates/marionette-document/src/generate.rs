@@ -116,6 +116,75 @@ pub struct Spec {
     /// Behind the characters, each drawn with its weight (none: the sky).
     #[serde(default)]
     pub backgrounds: Vec<Choice<Background>>,
+    /// Built-in body poses and hand presets put on each humanoid, drawn for each (none:
+    /// the characters as they come).
+    #[serde(default)]
+    pub poses: Option<PosesSpec>,
+}
+
+/// The body poses and hand presets a spec draws from for each humanoid: the body pose is put
+/// over its clip's pose at the drawn time (the clip then stops), mirrored for a share of
+/// them, and each hand takes one of `hands`.
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+pub struct PosesSpec {
+    /// Names of the built-in body poses (`sit-chair`, `wave`, …); none: all of them.
+    #[serde(default)]
+    pub body: Vec<String>,
+    /// The share of characters whose body pose is mirrored, 0 to 1.
+    #[serde(default)]
+    pub mirrored: f32,
+    /// Hand presets (`fist`, `open`, `point`, …) each hand is drawn from; none: hands as
+    /// they are.
+    #[serde(default)]
+    pub hands: Vec<String>,
+}
+
+impl PosesSpec {
+    /// Names known and the share within 0 to 1; the error names the field.
+    fn check(&self) -> Result<(), SpecError> {
+        for (k, name) in self.body.iter().enumerate() {
+            if marionette_rig::body_poses::body_pose(name).is_none() {
+                let names: Vec<&str> = marionette_rig::body_poses::POSES.iter().map(|p| p.name).collect();
+                return Err(SpecError::at(
+                    format!("poses.body[{k}]"),
+                    format!("expected one of {}, found {name:?}", names.join(", ")),
+                ));
+            }
+        }
+        for (k, name) in self.hands.iter().enumerate() {
+            if marionette_rig::hands::preset(name).is_none() {
+                let names: Vec<&str> = marionette_rig::hands::PRESETS.iter().map(|p| p.0).collect();
+                return Err(SpecError::at(
+                    format!("poses.hands[{k}]"),
+                    format!("expected one of {}, found {name:?}", names.join(", ")),
+                ));
+            }
+        }
+        if !(0.0..=1.0).contains(&self.mirrored) {
+            return Err(SpecError::at(
+                "poses.mirrored",
+                format!("expected a share from 0 to 1, found {}", self.mirrored),
+            ));
+        }
+        Ok(())
+    }
+
+    /// The body pose and the hands for one character, drawn (the same number of draws
+    /// whatever is drawn).
+    fn draw(&self, rng: &mut Rng) -> (crate::posing::BodyPoseSpec, Vec<crate::posing::HandSpec>) {
+        let names: Vec<&str> = match self.body.is_empty() {
+            true => marionette_rig::body_poses::POSES.iter().map(|p| p.name).collect(),
+            false => self.body.iter().map(String::as_str).collect(),
+        };
+        let name = names[rng.below(names.len())].to_string();
+        let mirrored = rng.unit() < self.mirrored;
+        let hands = [true, false].map(|left| (left, rng.below(self.hands.len().max(1))));
+        let hands = match self.hands.is_empty() {
+            true => Vec::new(),
+            false => hands.map(|(left, k)| crate::posing::HandSpec { left, preset: self.hands[k].clone() }).to_vec(),
+        };
+        (crate::posing::BodyPoseSpec { name, mirrored }, hands)
+    }
 }
 
 fn default_width() -> u32 {
@@ -331,6 +400,9 @@ impl Spec {
                 None => SpecError::at("shot", e),
             }
         })?;
+        if let Some(poses) = &self.poses {
+            poses.check()?;
+        }
         if self.canny.is_some() && !self.controlnet {
             return Err(SpecError::at("canny", "the canny edges are a ControlNet map: set controlnet: true".into()));
         }
@@ -585,6 +657,10 @@ pub fn scene_of(spec: &Spec, library: &mut AssetLibrary, k: u64) -> Result<(Scen
         let mut c = character(who, library, &mut rng, time, format!("person {}", i + 1))?;
         c.id = Some(marionette_formats::scene::CharacterId(i as u64 + 1));
         c.placement = PlacementDoc::new(at, yaw, 1.0);
+        if let Some(poses) = &spec.poses {
+            let (body, hands) = poses.draw(&mut rng);
+            c = posed_by_presets(library, c, body, hands).map_err(|message| GenerateError::Picture { k, message })?;
+        }
         stand_at(library, &mut c, at)?;
         characters.push(c);
     }
@@ -713,6 +789,21 @@ fn character(
             CharacterDoc { smpl: Some(smpl), ..CharacterDoc::new(SourceDoc::File(folder.clone()), name) }
         }
     })
+}
+
+/// `c` in the body pose `body` with the hands `hands`, through the options every command
+/// poses with (over its pose at its clip's time; the clip then stops).
+fn posed_by_presets(
+    library: &mut AssetLibrary,
+    c: CharacterDoc,
+    body: crate::posing::BodyPoseSpec,
+    hands: Vec<crate::posing::HandSpec>,
+) -> Result<CharacterDoc, String> {
+    let mut alone = SceneDoc { characters: vec![c], ..SceneDoc::default() };
+    let specs = crate::options::PoseSpecs { preset: Some(body), hands, ..Default::default() };
+    let options = crate::options::PoseOptions { specs, ..Default::default() };
+    crate::options::apply_options(&mut alone, &options, library).map_err(|e| e.to_string())?;
+    Ok(alone.characters.remove(0))
 }
 
 /// Moves `c` so that its skin, posed, is centred over `spot` (the middle of its box seen
