@@ -141,6 +141,14 @@ fn spec_errors_stop_generate_before_rendering() {
             "poses.body[0]: expected one of",
         ),
         (text.replacen("canny: None,", "canny: None,\n    poses: Some((hands: [\"claw\"])),", 1), "poses.hands[0]"),
+        (
+            text.replacen(
+                "canny: None,",
+                "canny: None,\n    tint: Some((Uniform(1.0, 0.0), Fixed(1.0), Fixed(1.0))),",
+                1,
+            ),
+            "tint.0: an empty distribution",
+        ),
         (text.replacen("count: 4", "count: 4,\n    colour: 3", 1), "spec.ron:"),
     ];
     for (bad, words) in cases {
@@ -332,4 +340,26 @@ fn a_spec_poses_its_characters_with_the_body_poses_it_draws() {
     for (joint, angle) in legs("t-pose").into_iter().flatten() {
         assert!(angle < 10.0, "t-pose: {joint} turned {angle:.1}°");
     }
+}
+
+/// `tint:` draws each character's colour: fixed channels give every character that tint.
+#[test]
+fn a_spec_draws_each_characters_tint() {
+    let dir = scratch("generate-tint");
+    let spec = small_spec(&dir, 1);
+    let asked = "canny: None,\n    tint: Some((Fixed(0.25), Fixed(0.5), Uniform(0.75, 0.75))),";
+    let text = std::fs::read_to_string(&spec).unwrap().replacen("canny: None,", asked, 1);
+    std::fs::write(&spec, text.replacen("per_picture: (1, 3)", "per_picture: (3, 3)", 1)).unwrap();
+    let output = Command::new(env!("CARGO_BIN_EXE_marionette"))
+        .arg("generate")
+        .arg(&spec)
+        .args(["--out", dir.join("unused").to_str().unwrap(), "--dry-run"])
+        .output()
+        .unwrap();
+    assert!(output.status.success(), "{}", String::from_utf8_lossy(&output.stderr));
+    let scene = dir.join("picture.scene.ron");
+    std::fs::write(&scene, String::from_utf8_lossy(&output.stdout).replacen("// picture 0", "", 1)).unwrap();
+    let doc = marionette::document::scenes::read_scene(&scene).unwrap();
+    assert_eq!(doc.characters.len(), 3);
+    assert!(doc.characters.iter().all(|c| c.view.tint == [0.25, 0.5, 0.75]), "{:?}", doc.characters[0].view.tint);
 }

@@ -120,6 +120,10 @@ pub struct Spec {
     /// the characters as they come).
     #[serde(default)]
     pub poses: Option<PosesSpec>,
+    /// Each character's colour (the tint its materials are multiplied by), each channel
+    /// drawn (none: the character's own).
+    #[serde(default)]
+    pub tint: Option<(Draw, Draw, Draw)>,
 }
 
 /// The body poses and hand presets a spec draws from for each humanoid: the body pose is put
@@ -403,6 +407,11 @@ impl Spec {
         if let Some(poses) = &self.poses {
             poses.check()?;
         }
+        if let Some((r, g, b)) = &self.tint {
+            r.check("tint.0")?;
+            g.check("tint.1")?;
+            b.check("tint.2")?;
+        }
         if self.canny.is_some() && !self.controlnet {
             return Err(SpecError::at("canny", "the canny edges are a ControlNet map: set controlnet: true".into()));
         }
@@ -660,6 +669,9 @@ pub fn scene_of(spec: &Spec, library: &mut AssetLibrary, k: u64) -> Result<(Scen
         if let Some(poses) = &spec.poses {
             let (body, hands) = poses.draw(&mut rng);
             c = posed_by_presets(library, c, body, hands).map_err(|message| GenerateError::Picture { k, message })?;
+        }
+        if let Some((r, g, b)) = &spec.tint {
+            c.view.tint = [r, g, b].map(|d| d.draw(&mut rng).clamp(0.0, 1.0));
         }
         stand_at(library, &mut c, at)?;
         characters.push(c);
