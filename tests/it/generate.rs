@@ -304,30 +304,35 @@ fn a_generated_picture_is_its_scene_rendered_alone() {
     }
 }
 
+/// The first picture's scene of the small spec in `dir` with `asked` added to it and three
+/// characters a picture, as `--dry-run` prints it (`name` tells the files apart).
+fn first_scene_with(dir: &Path, name: &str, asked: &str) -> marionette::formats::scene::SceneDoc {
+    let spec = dir.join(format!("{name}.ron"));
+    let text = std::fs::read_to_string(small_spec(dir, 1)).unwrap();
+    let text = text.replacen("canny: None,", &format!("canny: None,\n    {asked}"), 1);
+    std::fs::write(&spec, text.replacen("per_picture: (1, 3)", "per_picture: (3, 3)", 1)).unwrap();
+    let output = Command::new(env!("CARGO_BIN_EXE_marionette"))
+        .arg("generate")
+        .arg(&spec)
+        .args(["--out", dir.join("unused").to_str().unwrap(), "--dry-run"])
+        .output()
+        .unwrap();
+    assert!(output.status.success(), "{}", String::from_utf8_lossy(&output.stderr));
+    let scene = dir.join(format!("{name}.scene.ron"));
+    std::fs::write(&scene, String::from_utf8_lossy(&output.stdout).replacen("// picture 0", "", 1)).unwrap();
+    let doc = marionette::document::scenes::read_scene(&scene).unwrap();
+    assert_eq!(doc.characters.len(), 3);
+    doc
+}
+
 /// `poses:` puts a drawn built-in body pose on every humanoid: the puppets of a spec asking
 /// for `sit-chair` have their thighs turned a quarter turn (level) and their knees a
 /// quarter turn back (shins down); `t-pose` leaves the legs straight.
 #[test]
 fn a_spec_poses_its_characters_with_the_body_poses_it_draws() {
     let dir = scratch("generate-poses");
-    let spec = small_spec(&dir, 1);
-    let text = std::fs::read_to_string(&spec).unwrap();
     let legs = |body: &str| {
-        let posed = dir.join(format!("{body}.ron"));
-        let asked = format!("canny: None,\n    poses: Some((body: [\"{body}\"], hands: [\"fist\"])),");
-        let text = text.replacen("canny: None,", &asked, 1).replacen("per_picture: (1, 3)", "per_picture: (3, 3)", 1);
-        std::fs::write(&posed, text).unwrap();
-        let output = Command::new(env!("CARGO_BIN_EXE_marionette"))
-            .arg("generate")
-            .arg(&posed)
-            .args(["--out", dir.join("unused").to_str().unwrap(), "--dry-run"])
-            .output()
-            .unwrap();
-        assert!(output.status.success(), "{}", String::from_utf8_lossy(&output.stderr));
-        let scene = dir.join(format!("{body}.scene.ron"));
-        std::fs::write(&scene, String::from_utf8_lossy(&output.stdout).replacen("// picture 0", "", 1)).unwrap();
-        let doc = marionette::document::scenes::read_scene(&scene).unwrap();
-        assert_eq!(doc.characters.len(), 3);
+        let doc = first_scene_with(&dir, body, &format!("poses: Some((body: [\"{body}\"], hands: [\"fist\"])),"));
         let turn = |c: &marionette::formats::scene::CharacterDoc, joint: &str| {
             c.pose.get(joint).map_or(0.0, |r| r.to_quat().angle_between(bevy::math::Quat::IDENTITY).to_degrees())
         };
@@ -346,20 +351,6 @@ fn a_spec_poses_its_characters_with_the_body_poses_it_draws() {
 #[test]
 fn a_spec_draws_each_characters_tint() {
     let dir = scratch("generate-tint");
-    let spec = small_spec(&dir, 1);
-    let asked = "canny: None,\n    tint: Some((Fixed(0.25), Fixed(0.5), Uniform(0.75, 0.75))),";
-    let text = std::fs::read_to_string(&spec).unwrap().replacen("canny: None,", asked, 1);
-    std::fs::write(&spec, text.replacen("per_picture: (1, 3)", "per_picture: (3, 3)", 1)).unwrap();
-    let output = Command::new(env!("CARGO_BIN_EXE_marionette"))
-        .arg("generate")
-        .arg(&spec)
-        .args(["--out", dir.join("unused").to_str().unwrap(), "--dry-run"])
-        .output()
-        .unwrap();
-    assert!(output.status.success(), "{}", String::from_utf8_lossy(&output.stderr));
-    let scene = dir.join("picture.scene.ron");
-    std::fs::write(&scene, String::from_utf8_lossy(&output.stdout).replacen("// picture 0", "", 1)).unwrap();
-    let doc = marionette::document::scenes::read_scene(&scene).unwrap();
-    assert_eq!(doc.characters.len(), 3);
+    let doc = first_scene_with(&dir, "tint", "tint: Some((Fixed(0.25), Fixed(0.5), Uniform(0.75, 0.75))),");
     assert!(doc.characters.iter().all(|c| c.view.tint == [0.25, 0.5, 0.75]), "{:?}", doc.characters[0].view.tint);
 }
