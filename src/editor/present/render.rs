@@ -656,7 +656,7 @@ fn drawing_order(frames: &[Frame]) -> Vec<usize> {
         _ => None,
     };
     let mut order: Vec<usize> = (0..frames.len()).collect();
-    if let Some(first) = lights(0).filter(|_| frames.len() > 2) {
+    if let Some(first) = frames.first().and_then(|_| lights(0)) {
         order[1..].sort_by_cached_key(|&k| {
             let lit = lights(k);
             (lit.as_ref() != Some(&first), lit)
