@@ -141,6 +141,18 @@ impl SpecFile {
             .fold(0.0, f64::max)
     }
 
+    /// Every node's global matrix, posed by `animation` at `time` seconds (the nodes' own
+    /// transforms without one).
+    pub fn node_globals(&self, animation: Option<(usize, f64)>) -> Vec<DMat4> {
+        let nodes = self.nodes();
+        let mut trs: Vec<Trs> = nodes.iter().map(Trs::of).collect();
+        let mut weights: Vec<Option<Vec<f64>>> = vec![None; nodes.len()];
+        if let Some((a, t)) = animation {
+            self.apply(a, t, &mut trs, &mut weights);
+        }
+        self.globals(&trs)
+    }
+
     /// Every mesh node's triangle vertices, in node order (primitives in order), posed by
     /// `animation` at `time` seconds (the nodes' own transforms without one).
     pub fn posed(&self, animation: Option<(usize, f64)>) -> Vec<DVec3> {

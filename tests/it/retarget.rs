@@ -608,7 +608,7 @@ fn the_targets_limits_clamp_and_the_report_says_where() {
         .map(|f| {
             let mut pose = source.initial_pose();
             pose[elbow] = JointRotation::euler_xyz(0.0, 0.0, 0.1 + 0.4 * f as f32);
-            Frame { root: source.joint(0).rest_offset, pose }
+            Frame::posed(source.joint(0).rest_offset, pose)
         })
         .collect();
     let done = retargeter.motion(&frames, 30.0, false);

@@ -292,14 +292,13 @@ fn position_channels_below_the_root_move_the_figure() {
     let hips = bvh.skeleton.find("Hips").unwrap();
     let at = |t: f32| {
         let (root, pose) = bvh.clip.pose_at(&bvh.skeleton, t, &bvh.skeleton.initial_pose());
-        world_frames(&bvh.skeleton, root, &pose).1[hips]
+        Frame { root, pose, offsets: bvh.clip.offsets_at(&bvh.skeleton, t) }.world(&bvh.skeleton).1[hips]
     };
     let (start, end) = (at(bvh.clip.range.0 + bvh.frame_time), at(bvh.clip.range.1));
     let walked = Vec3::new(end.x - start.x, 0.0, end.z - start.z).length();
     // 100 cm over frames 2–41 of the clip (39 of its 39 steps).
     assert!((walked - 100.0).abs() < 1.0, "walked {walked} cm");
     assert!((start.y - 100.0).abs() < 0.01 && (end.y - 100.0).abs() < 0.01, "hips at {start} and {end}");
-    assert!(bvh.warnings.is_empty(), "{:?}", bvh.warnings);
 }
 
 /// Finger motion carries over where both rigs have fingers: a Mixamo-named hand's fingers
@@ -402,4 +401,123 @@ fn broken_vrm_extensions_are_refused_with_their_place() {
         let e = marionette::formats::load_character(&path).unwrap_err().to_string();
         assert!(e.contains(&format!("{name}.vrm")) && e.contains("at $.extensions") && e.contains(says), "{e}");
     }
+}
+
+/// A BVH joint as written: name, parent, OFFSET, whether it has position channels, and its
+/// rotation channels' axes outermost first.
+type BvhJoint = (&'static str, Option<usize>, [f64; 3], bool, &'static str);
+
+/// A Bandai-Namco-shaped BVH: a still `joint_Root` (placed and turned, the same in every
+/// frame) above a `Hips` whose position channels walk it away from its OFFSET, every joint
+/// with its rotation channels in the file's own order. `info` prints the file's OFFSETs, and
+/// `export --animation` writes every joint where the file defines it in every frame (its
+/// position channels in place of its OFFSET, then its rotations outermost first), within
+/// 1e-5 of the skeleton's size; `joint_Root` stays where it is.
+#[test]
+fn a_still_root_above_moving_hips_exports_as_the_file_defines_it() {
+    use glam::{DMat4, DVec3};
+    // (name, parent, OFFSET, position channels, rotation order): Hips' OFFSET is not where
+    // its channels put it.
+    let joints: [BvhJoint; 5] = [
+        ("joint_Root", None, [0.0, 0.0, 0.0], true, "ZYX"),
+        ("Hips", Some(0), [0.0, 0.0, 0.0], true, "ZYX"),
+        ("Spine", Some(1), [0.0, 20.0, 0.0], false, "ZXY"),
+        ("LeftUpLeg", Some(1), [10.0, -5.0, 0.0], false, "ZXY"),
+        ("LeftLeg", Some(3), [0.0, -45.0, 0.0], false, "ZXY"),
+    ];
+    let frames = 12;
+    let dt = 1.0 / 30.0;
+    // Each frame's channel values per joint: (position, rotations in the joint's order).
+    let values = |f: usize, j: usize| -> ([f64; 3], [f64; 3]) {
+        let t = f as f64;
+        match j {
+            0 => ([5.0, 0.0, -3.0], [0.0, 30.0, 0.0]),
+            1 => ([2.0 + 3.0 * t, 92.0 + (0.5 * t).sin(), 1.5 * t], [4.0 * t, -10.0 + t, 3.0]),
+            k => ([0.0; 3], [7.0 * (t + k as f64).sin(), 20.0 - 2.0 * t, 5.0 * k as f64 - t]),
+        }
+    };
+    let mut text = String::from("HIERARCHY\n");
+    let mut close = Vec::new();
+    for (j, (name, parent, offset, positions, order)) in joints.iter().enumerate() {
+        while close.last().is_some_and(|&open| Some(open) != *parent) {
+            close.pop();
+            text.push_str("}\n");
+        }
+        let kind = if parent.is_none() { "ROOT" } else { "JOINT" };
+        let axes: Vec<String> = order.chars().map(|a| format!("{a}rotation")).collect();
+        let channels = if *positions {
+            format!("6 Xposition Yposition Zposition {}", axes.join(" "))
+        } else {
+            format!("3 {}", axes.join(" "))
+        };
+        text.push_str(&format!(
+            "{kind} {name}\n{{\nOFFSET {} {} {}\nCHANNELS {channels}\n",
+            offset[0], offset[1], offset[2]
+        ));
+        if matches!(*name, "Spine" | "LeftLeg") {
+            text.push_str("End Site\n{\nOFFSET 0 10 0\n}\n");
+        }
+        close.push(j);
+    }
+    close.iter().for_each(|_| text.push_str("}\n"));
+    text.push_str(&format!("MOTION\nFrames: {frames}\nFrame Time: {dt}\n"));
+    for f in 0..frames {
+        let mut row = Vec::new();
+        for (j, joint) in joints.iter().enumerate() {
+            let (p, r) = values(f, j);
+            if joint.3 {
+                row.extend(p);
+            }
+            row.extend(r);
+        }
+        text.push_str(&row.iter().map(|v| format!("{v:.6}")).collect::<Vec<_>>().join(" "));
+        text.push('\n');
+    }
+    let dir = scratch("bandai-still-root");
+    let (bvh, glb) = (dir.join("still_root.bvh"), dir.join("still_root.glb"));
+    std::fs::write(&bvh, &text).unwrap();
+    let run = |args: &[&str]| {
+        let out = std::process::Command::new(env!("CARGO_BIN_EXE_marionette")).args(args).output().unwrap();
+        assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+        String::from_utf8_lossy(&out.stdout).into_owned()
+    };
+    let info = run(&["info", bvh.to_str().unwrap()]);
+    assert!(
+        info.contains("Hips")
+            && info.lines().any(|l| l.contains(" Hips ") && l.contains("offset (0.0000, 0.0000, 0.0000)")),
+        "{info}"
+    );
+    run(&["export", bvh.to_str().unwrap(), "--animation", "--out", glb.to_str().unwrap()]);
+    // The file's definition, walked here in double precision.
+    let defined = |f: usize| -> Vec<DVec3> {
+        let mut world: Vec<DMat4> = Vec::new();
+        for (j, (_, parent, offset, positions, order)) in joints.iter().enumerate() {
+            let (p, r) = values(f, j);
+            let at = DVec3::from_array(if *positions { p } else { *offset });
+            let turn = order.chars().zip(r).fold(DMat4::IDENTITY, |m, (axis, deg)| {
+                let angle = f64::to_radians(deg);
+                m * match axis {
+                    'X' => DMat4::from_rotation_x(angle),
+                    'Y' => DMat4::from_rotation_y(angle),
+                    _ => DMat4::from_rotation_z(angle),
+                }
+            });
+            let up = parent.map_or(DMat4::IDENTITY, |p| world[p]);
+            world.push(up * DMat4::from_translation(at) * turn);
+        }
+        world.iter().map(|m| m.w_axis.truncate()).collect()
+    };
+    let spec = crate::gltf_spec::SpecFile::read(&glb);
+    let node = |name: &str| spec.nodes().iter().position(|n| n["name"] == name).unwrap_or_else(|| panic!("{name}"));
+    let size = 92.0 + 45.0;
+    let mut worst = 0.0f64;
+    for f in 0..frames {
+        let globals = spec.node_globals(Some((0, f as f64 * dt)));
+        for (j, joint) in joints.iter().enumerate() {
+            let got = globals[node(joint.0)].w_axis.truncate();
+            worst = worst.max(got.distance(defined(f)[j]) / size);
+        }
+    }
+    eprintln!("worst joint off the file's definition: {worst:.2e} of the skeleton's size");
+    assert!(worst < 1e-5, "{worst}");
 }

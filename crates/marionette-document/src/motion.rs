@@ -180,6 +180,9 @@ pub fn pose_at(skeleton: &Skeleton, still: &[JointRotation], weights: &[f32], pl
     if let Some((clip, clock)) = playing.keyframes {
         let (root, rotations) = clip.pose_at_unclamped(skeleton, clock.time, &now.rotations);
         (now.root, now.rotations) = (Some(root), rotations);
+        if let Some(offsets) = clip.offsets_at(skeleton, clock.time) {
+            now.rest = Some((offsets, skeleton.joints().iter().map(|j| j.rest_scale).collect()));
+        }
     }
     if let Some((m, clock)) = playing.node_clips {
         let sample = marionette_rig::node_clip::pose_mix(skeleton, m.clip, m.blend, clock.time, &mut now.rotations);
@@ -195,8 +198,10 @@ pub fn pose_at(skeleton: &Skeleton, still: &[JointRotation], weights: &[f32], pl
 }
 
 /// The frames of `playing` (each clock from the start of its clips' range) at `fps` over
-/// that range, on `still`: the root's translation in model space and the pose, for
-/// `purpose` (what the frames are for: "retarget"). Refused when there would be more than
+/// that range, on `still`: the root's translation in model space, the pose, and the
+/// offsets of the joints a keyframed clip moves (a motion capture's joints below its root;
+/// the rest a source's own clips key is the rig's own, which retargeting leaves as it is),
+/// for `purpose` (what the frames are for: "retarget"). Refused when there would be more than
 /// [`MAX_SAMPLED_FRAMES`](marionette_formats::limits::MAX_SAMPLED_FRAMES).
 pub fn sampled_frames(
     skeleton: &Skeleton,
@@ -211,10 +216,13 @@ pub fn sampled_frames(
     if n.is_nan() || n >= most as f32 {
         return Err(TooManyFrames { purpose, most, fps, start, end });
     }
+    let moves_joints = playing.keyframes.is_some_and(|(clip, _)| !clip.offsets.is_empty());
     let frame = |f: usize| {
         let t = start + f as f32 / fps;
         let now = pose_at(skeleton, still, &[], &playing.paused_at(t));
-        marionette_rig::retarget::Frame { root: now.root_translation(skeleton), pose: now.rotations }
+        let root = now.root_translation(skeleton);
+        let offsets = now.rest.map(|(offsets, _)| offsets).filter(|_| moves_joints);
+        marionette_rig::retarget::Frame { root, pose: now.rotations, offsets }
     };
     Ok((0..=n as usize).map(frame).collect())
 }

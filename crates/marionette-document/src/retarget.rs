@@ -10,6 +10,9 @@ use marionette_formats::scene::{
     AnimDoc, CharacterDoc, MotionSourceDoc, PlaybackDoc, RetargetDoc, SceneDoc, SmplDoc, SourceDoc, is_motion_file,
 };
 use marionette_rig::anim::Clip;
+use marionette_rig::character::SkinKind;
+use marionette_rig::dqs::SkinningMethod;
+use marionette_rig::fk::RestOverride;
 use marionette_rig::humanoid::{HumanBone, HumanoidMap};
 use marionette_rig::retarget::{Frame, Humanoid, Retargeter};
 use marionette_rig::{CharacterAsset, JointRotation};
@@ -36,38 +39,40 @@ pub fn humanoid_map(asset: &CharacterAsset, assigned: &std::collections::BTreeMa
 }
 
 /// The height of a character's floor in its model space: its lowest skin vertex standing
-/// in its initial pose, or its lowest joint without a skin.
+/// in its initial pose, or its lowest joint where it has no mesh.
 pub fn floor_of(asset: &CharacterAsset) -> f32 {
     let skeleton = &asset.skeleton;
-    let initial = skeleton.initial_pose();
-    let skin = super::posing::posed_positions(asset, &initial, glam::Mat4::IDENTITY);
-    let lowest = skin.iter().map(|p| p.y).fold(f32::INFINITY, f32::min);
-    if lowest.is_finite() {
-        return lowest;
-    }
-    let (_, at) = marionette_rig::retarget::world_frames(skeleton, skeleton.joint(0).rest_offset, &initial);
-    at.iter().map(|p| p.y).fold(f32::INFINITY, f32::min)
+    lowest_point(asset, &Frame::posed(skeleton.joint(0).rest_offset, skeleton.initial_pose()))
 }
 
 /// The floor a motion stands on, in the character's model space: the lowest its skin
-/// reaches over the frames (a skeleton's bone boxes, for a BVH: its rest is only its offsets
-/// and its place is the motion's), and for a character with a mesh no higher than its own
-/// floor standing (a clip that leaves the ground throughout still stands on it).
+/// reaches over the frames (its joints, for a skeleton without a mesh: a BVH's rest is
+/// only its offsets and its place is the motion's), and for a character with a mesh no
+/// higher than its own floor standing (a clip that leaves the ground throughout still
+/// stands on it).
 pub fn motion_floor(asset: &CharacterAsset, frames: &[Frame]) -> f32 {
-    let skeleton = &asset.skeleton;
-    let lowest = frames
-        .iter()
-        .map(|f| {
-            let origin = glam::Mat4::from_translation(f.root - skeleton.joint(0).rest_offset);
-            let skin = super::posing::posed_positions(asset, &f.pose, origin);
-            skin.iter().map(|p| p.y).fold(f32::INFINITY, f32::min)
-        })
-        .fold(f32::INFINITY, f32::min);
+    let lowest = frames.iter().map(|f| lowest_point(asset, f)).fold(f32::INFINITY, f32::min);
     match asset.skin_kind {
-        marionette_rig::character::SkinKind::Mesh if lowest.is_finite() => floor_of(asset).min(lowest),
+        SkinKind::Mesh if lowest.is_finite() => floor_of(asset).min(lowest),
         _ if lowest.is_finite() => lowest,
         _ => floor_of(asset),
     }
+}
+
+/// The lowest point of a character in a frame: of its skinned mesh, or of its joints
+/// where it has none (never of the boxes drawn for its bones).
+fn lowest_point(asset: &CharacterAsset, frame: &Frame) -> f32 {
+    let skeleton = &asset.skeleton;
+    let lowest = |points: &[glam::Vec3]| points.iter().map(|p| p.y).fold(f32::INFINITY, f32::min);
+    let skin = if asset.skin_kind == SkinKind::Mesh {
+        let rest_root = frame.offsets.as_ref().map_or(skeleton.joint(0).rest_offset, |o| o[0]);
+        let origin = glam::Mat4::from_translation(frame.root - rest_root);
+        let rest = RestOverride { offsets: frame.offsets.as_deref(), scales: None };
+        lowest(&super::posing::posed_positions_with_rest(asset, &frame.pose, rest, origin, SkinningMethod::Linear))
+    } else {
+        f32::INFINITY
+    };
+    if skin.is_finite() { skin } else { lowest(&frame.world(skeleton).1) }
 }
 
 /// The points a character stands on: the lowest skin vertices (at most 4,096 a foot) that

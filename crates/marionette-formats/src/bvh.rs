@@ -14,7 +14,7 @@ use glam::{Quat, Vec3};
 
 use super::cse169::{Tokens, tokenize};
 use super::error::{FormatError, Lines, excerpt};
-use marionette_rig::anim::{Channel, Clip, Extrapolation, Key, Tangent};
+use marionette_rig::anim::{Channel, Clip, Extrapolation, Key, OffsetChannels, Tangent};
 use marionette_rig::{EulerOrder, JointRotation, MAX_JOINTS, RawJoint, Skeleton};
 
 /// A BVH file: its skeleton and its motion as a clip.
@@ -23,8 +23,6 @@ pub struct BvhFile {
     pub skeleton: Skeleton,
     pub clip: Clip,
     pub frame_time: f32,
-    /// What was read other than the file says it (a moving joint held still).
-    pub warnings: Vec<String>,
 }
 
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -156,13 +154,12 @@ pub fn parse_bvh(reader: impl BufRead, path: &Path) -> Result<BvhFile, FormatErr
         return Err(motion.error(&format!("the end of the file after {frames} frames of {columns} values")));
     }
     let names: Vec<String> = joints.iter().map(|j| j.raw.name.clone()).collect();
-    let (root_moves, warnings) = place_positioned_joints(&mut joints, &values, columns);
     give_bone_boxes(&mut joints);
     let dofs: Vec<Vec<(Dof, usize)>> = joints.iter().map(|j| j.dofs.clone()).collect();
     let skeleton =
         Skeleton::build(joints.into_iter().map(|j| j.raw).collect()).map_err(|e| FormatError::rig(path, e))?;
-    let clip = motion_clip(&skeleton, &dofs, (&values, columns), &root_moves, frame_time, names);
-    Ok(BvhFile { skeleton, clip, frame_time, warnings })
+    let clip = motion_clip(&skeleton, &dofs, (&values, columns), frame_time, names);
+    Ok(BvhFile { skeleton, clip, frame_time })
 }
 
 /// Each joint a box along the bone to its first child (a small cube at a tip), so the
@@ -263,29 +260,35 @@ impl<R: BufRead> Numbers<'_, R> {
     }
 }
 
-/// The motion as a clip: per frame, the root's position and each joint's rotation as x, y,
-/// z angles (unwrapped from frame to frame so the linear keys between them turn the short
-/// way).
+/// The motion as a clip: per frame, the root's position, each lower joint's position where
+/// it has position channels, and each joint's rotation as x, y, z angles (unwrapped from
+/// frame to frame so the linear keys between them turn the short way).
 fn motion_clip(
     skeleton: &Skeleton,
     dofs: &[Vec<(Dof, usize)>],
     (values, columns): (&[f32], usize),
-    root_moves: &[Vec3],
     frame_time: f32,
     names: Vec<String>,
 ) -> Clip {
     let frames = values.len().checked_div(columns).unwrap_or(0);
     let mut channels: Vec<Vec<Key>> = vec![Vec::new(); 3 + 3 * skeleton.len()];
+    let has_positions = |joint: &[(Dof, usize)]| joint.iter().any(|(dof, _)| matches!(dof, Dof::Position(_)));
+    let moved: Vec<usize> = (1..dofs.len()).filter(|&j| has_positions(&dofs[j])).collect();
+    let mut offsets: Vec<[Vec<Key>; 3]> = vec![Default::default(); moved.len()];
     let key = |time, value| Key { time, value, tangent_in: Tangent::Linear, tangent_out: Tangent::Linear };
     for f in 0..frames {
         let row = &values[f * columns..(f + 1) * columns];
         let time = f as f32 * frame_time;
-        let root_positioned = dofs[0].iter().any(|(dof, _)| matches!(dof, Dof::Position(_)));
-        if root_positioned || !root_moves.is_empty() {
-            let root = positioned(skeleton.joint(0).rest_offset, &dofs[0], row)
-                + root_moves.get(f).copied().unwrap_or(Vec3::ZERO);
+        if has_positions(&dofs[0]) {
+            let root = positioned(skeleton.joint(0).rest_offset, &dofs[0], row);
             for (axis, channel) in channels.iter_mut().take(3).enumerate() {
                 channel.push(key(time, root[axis]));
+            }
+        }
+        for (keys, &j) in offsets.iter_mut().zip(&moved) {
+            let at = positioned(skeleton.joint(j).rest_offset, &dofs[j], row);
+            for (axis, channel) in keys.iter_mut().enumerate() {
+                channel.push(key(time, at[axis]));
             }
         }
         for (j, joint) in dofs.iter().enumerate() {
@@ -301,10 +304,19 @@ fn motion_clip(
             }
         }
     }
-    let channels =
-        channels.into_iter().map(|keys| Channel::new(keys, Extrapolation::Constant, Extrapolation::Constant)).collect();
+    let channel = |keys| Channel::new(keys, Extrapolation::Constant, Extrapolation::Constant);
+    let offsets = moved
+        .into_iter()
+        .zip(offsets)
+        .map(|(joint, keys)| OffsetChannels { joint, channels: keys.map(channel) })
+        .collect();
     let end = frames.saturating_sub(1) as f32 * frame_time;
-    Clip { range: (0.0, end.max(frame_time)), channels, joint_names: names }
+    Clip {
+        range: (0.0, end.max(frame_time)),
+        channels: channels.into_iter().map(channel).collect(),
+        joint_names: names,
+        offsets,
+    }
 }
 
 /// `offset` with the axes its position channels give replaced by this frame's values.
@@ -325,83 +337,4 @@ fn rotation_in(dofs: &[(Dof, usize)], row: &[f32]) -> Quat {
         Dof::Rotation(axis) => q * Quat::from_axis_angle(Vec3::AXES[axis], row[column].to_radians()),
         Dof::Position(_) => q,
     })
-}
-
-/// Position channels below the root, as BVH defines them (a joint's position channels are
-/// its place in its parent's frame, in place of its offset). A joint they hold still gets
-/// that place as its offset. A joint they move, hung from the root by joints that stay
-/// still (a walk carried by `Hips` under a fixed `joint_Root`), gets its first frame's
-/// place as its offset and its movement carried by the root (returned, a world offset per
-/// frame), where nothing but that chain hangs from the root. Any other moving joint keeps
-/// its first frame's place, with a warning.
-fn place_positioned_joints(joints: &mut [Read], values: &[f32], columns: usize) -> (Vec<Vec3>, Vec<String>) {
-    let frames = values.len().checked_div(columns).unwrap_or(0);
-    let mut root_moves = Vec::new();
-    let mut warnings = Vec::new();
-    if frames == 0 {
-        return (root_moves, warnings);
-    }
-    let row = |f: usize| &values[f * columns..(f + 1) * columns];
-    // Still: within a millionth of the skeleton's largest offset (exporters round), or of a
-    // degree for a rotation.
-    let size = joints.iter().map(|j| j.raw.rest_offset.abs().max_element()).fold(1e-6f32, f32::max);
-    let still = |dofs: &[(Dof, usize)]| {
-        dofs.iter().all(|&(dof, c)| {
-            let tolerance = if matches!(dof, Dof::Position(_)) { 1e-6 * size } else { 1e-6 };
-            (0..frames).all(|f| (row(f)[c] - row(0)[c]).abs() <= tolerance.max(1e-6 * row(0)[c].abs()))
-        })
-    };
-    let mut children = vec![0usize; joints.len()];
-    for joint in joints.iter() {
-        if let Some(p) = joint.raw.parent {
-            children[p] += 1;
-        }
-    }
-    let mut held = Vec::new();
-    for j in 1..joints.len() {
-        let positions: Vec<(Dof, usize)> =
-            joints[j].dofs.iter().copied().filter(|(d, _)| matches!(d, Dof::Position(_))).collect();
-        if positions.is_empty() {
-            continue;
-        }
-        let first = positioned(joints[j].raw.rest_offset, &positions, row(0));
-        joints[j].raw.rest_offset = first;
-        if still(&positions) {
-            continue;
-        }
-        // Only the first moving joint may be carried by the root: the chain above it
-        // still and alone under the root.
-        let chain = if root_moves.is_empty() && held.is_empty() { ancestors(joints, j) } else { Vec::new() };
-        let root_turns: Vec<(Dof, usize)> =
-            joints[0].dofs.iter().copied().filter(|(d, _)| matches!(d, Dof::Rotation(_))).collect();
-        let carried = !chain.is_empty()
-            && chain.iter().all(|&a| children[a] == 1 && (a == 0 || still(&joints[a].dofs)))
-            && still(&root_turns);
-        if carried {
-            let turn = chain.iter().rev().fold(Quat::IDENTITY, |q, &a| q * rotation_in(&joints[a].dofs, row(0)));
-            root_moves = (0..frames).map(|f| turn * (positioned(first, &positions, row(f)) - first)).collect();
-        } else {
-            held.push(joints[j].raw.name.clone());
-        }
-    }
-    if !held.is_empty() {
-        let shown: Vec<&str> = held.iter().take(5).map(String::as_str).collect();
-        warnings.push(format!(
-            "{} joint(s) ({}{}) moved by position channels where the root cannot carry them: each keeps its first frame's place",
-            held.len(),
-            shown.join(", "),
-            if held.len() > shown.len() { ", …" } else { "" }
-        ));
-    }
-    (root_moves, warnings)
-}
-
-/// The joints above `j`, its parent first.
-fn ancestors(joints: &[Read], mut j: usize) -> Vec<usize> {
-    let mut out = Vec::new();
-    while let Some(p) = joints[j].raw.parent {
-        out.push(p);
-        j = p;
-    }
-    out
 }

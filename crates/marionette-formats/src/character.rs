@@ -133,7 +133,7 @@ pub fn load_character(path: &Path) -> Result<CharacterAsset, FormatError> {
         CharacterSource::Homer { json } => super::homer::load_homer(&json),
         CharacterSource::Bvh { path } => {
             let bvh = super::bvh::parse_bvh(open(&path)?, &path)?;
-            Ok(CharacterAsset::with_bone_boxes(name, bvh.skeleton, bvh.warnings))
+            Ok(CharacterAsset::with_bone_boxes(name, bvh.skeleton, Vec::new()))
         }
         CharacterSource::Parts { path } => first_part(&path),
         CharacterSource::Prop { obj } => load_prop(&obj),

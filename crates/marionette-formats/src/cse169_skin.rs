@@ -218,7 +218,7 @@ pub fn parse_anim(reader: impl BufRead, path: &Path) -> Result<Clip, FormatError
     if !tokens.at_end() {
         return Err(tokens.error("the end of the file after the animation"));
     }
-    Ok(Clip { range, channels, joint_names: Vec::new() })
+    Ok(Clip { range, channels, joint_names: Vec::new(), offsets: Vec::new() })
 }
 
 fn channel(tokens: &mut Tokens) -> Result<Channel, FormatError> {

@@ -419,6 +419,17 @@ pub struct Clip {
     /// the skeleton's own order.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub joint_names: Vec<String>,
+    /// Joints below the root moved by keys of their own (a BVH joint's position channels).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub offsets: Vec<OffsetChannels>,
+}
+
+/// A joint's place in its parent's frame over time, in place of its rest offset: x, y, z.
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct OffsetChannels {
+    /// The joint (an index into the clip's joints: its names, or the skeleton's order).
+    pub joint: usize,
+    pub channels: [Channel; 3],
 }
 
 impl Clip {
@@ -430,11 +441,15 @@ impl Clip {
         if !(start.is_finite() && end.is_finite() && (end - start).is_finite()) {
             return Err(format!("range: expected two finite times a finite length apart, found {start} and {end}"));
         }
-        for (c, channel) in self.channels.iter().enumerate() {
+        let offsets = self.offsets.iter().enumerate().flat_map(|(o, offset)| {
+            offset.channels.iter().enumerate().map(move |(axis, c)| (format!("offsets[{o}].channels[{axis}]"), c))
+        });
+        let channels = self.channels.iter().enumerate().map(|(c, channel)| (format!("channels[{c}]"), channel));
+        for (path, channel) in channels.chain(offsets) {
             if let Some(k) = channel.first_unusable_key() {
                 let key = channel.keys[k];
                 return Err(format!(
-                    "channels[{c}].keys[{k}]: expected finite numbers whose curve stays finite, found time {} and value {}",
+                    "{path}.keys[{k}]: expected finite numbers whose curve stays finite, found time {} and value {}",
                     key.time, key.value
                 ));
             }
@@ -449,13 +464,19 @@ impl Clip {
 
     /// An empty clip for `joints` joints: a channel without keys per root axis and DOF.
     pub fn empty(joints: usize) -> Self {
-        Self { range: (0.0, 1.0), channels: vec![Channel::empty(); 3 + 3 * joints], joint_names: Vec::new() }
+        Self {
+            range: (0.0, 1.0),
+            channels: vec![Channel::empty(); 3 + 3 * joints],
+            joint_names: Vec::new(),
+            offsets: Vec::new(),
+        }
     }
 
     /// This clip for `skeleton`: a clip named by joints (motion capture) has its channels
     /// moved to the skeleton's joints of the same names, or of the names `names` maps them
     /// to (target name → clip name); joints without one get no keys (they keep their
-    /// pose), and the root moves only when the skeleton's root is the clip's.
+    /// pose), and the root and the joints the clip moves move only when the skeleton's
+    /// root is the clip's (the same rig: its units).
     pub fn retargeted(&self, skeleton: &Skeleton, names: &std::collections::BTreeMap<String, String>) -> Clip {
         if self.joint_names.is_empty() {
             return self.clone();
@@ -468,10 +489,14 @@ impl Clip {
         let source = |target: &str| by_name.get(names.get(target).map_or(target, String::as_str)).copied();
         let mut clip = Clip::empty(skeleton.len());
         clip.range = self.range;
+        let same_root = source(&skeleton.joint(0).name) == Some(0);
         for (j, def) in skeleton.joints().iter().enumerate() {
             let Some(s) = source(&def.name) else { continue };
             if j == 0 && s == 0 {
                 clip.channels[..3].clone_from_slice(&self.channels[..3]);
+            }
+            if let Some(moved) = self.offsets.iter().find(|o| o.joint == s).filter(|_| same_root && j > 0) {
+                clip.offsets.push(OffsetChannels { joint: j, channels: moved.channels.clone() });
             }
             for axis in 0..3 {
                 if let Some(c) = self.channels.get(Self::joint_channel(s, axis)) {
@@ -492,6 +517,25 @@ impl Clip {
     /// leaves its number as `fallback` (and the root's offset) has it.
     pub fn pose_at(&self, skeleton: &Skeleton, t: f32, fallback: &[JointRotation]) -> (Vec3, Vec<JointRotation>) {
         self.sampled_pose(skeleton, t, fallback, true)
+    }
+
+    /// Every joint's offset in its parent's frame at `t` where the clip moves joints below
+    /// the root (the rest offsets elsewhere); none where it moves none.
+    pub fn offsets_at(&self, skeleton: &Skeleton, t: f32) -> Option<Vec<Vec3>> {
+        if self.offsets.is_empty() {
+            return None;
+        }
+        let mut offsets: Vec<Vec3> = skeleton.joints().iter().map(|j| j.rest_offset).collect();
+        let joints = offsets.len();
+        for moved in self.offsets.iter().filter(|o| o.joint < joints) {
+            let rest = offsets[moved.joint];
+            let value = |axis: usize| {
+                let c = &moved.channels[axis];
+                if c.keys.is_empty() { rest[axis] } else { c.value_at(t) }
+            };
+            offsets[moved.joint] = Vec3::new(value(0), value(1), value(2));
+        }
+        Some(offsets)
     }
 
     /// As [`pose_at`](Self::pose_at), the keyed rotations not clamped: for the ECS, whose

@@ -1,7 +1,8 @@
 //! A keyframed clip as cubic Hermite splines (glTF's CUBICSPLINE): a [`NodeClip`] keyed
 //! where the clip is keyed, with each key's own slopes on either side.
 //!
-//! The root's translation comes out exactly: between the seams of its three channels (their
+//! The root's translation (and the offsets a clip keys for joints below it) comes out
+//! exactly: between the seams of its three channels (their
 //! keys, and the keys of the repetitions their extrapolation makes) each channel is one
 //! cubic, and a cubic Hermite spline with the curve's values and slopes at both ends of a
 //! span is that cubic. A joint's rotation cannot: a cubic in Euler angles is not a cubic in
@@ -13,7 +14,7 @@
 
 use glam::{DVec3, DVec4, Mat4, Quat, Vec3};
 
-use super::anim::{Clip, Side};
+use super::anim::{Channel, Clip, Side};
 use super::node_clip::{Interpolation, JointTracks, NodeClip, Track};
 use super::pose::{DofLimits, EulerOrder, JointRotation};
 use super::skeleton::Skeleton;
@@ -34,7 +35,7 @@ struct Sample {
 }
 
 /// `clip` (over its range, times from its start) for `skeleton` as splines: the root's
-/// translation where a root channel is keyed, the rotation of every joint with a keyed
+/// translation where a root channel is keyed, each joint's the clip moves by its offsets, the rotation of every joint with a keyed
 /// channel (clamped to its limits; its unkeyed axes at `fallback`'s angles), as
 /// [`Clip::pose_at`] poses it. Refused where it would take more than `most` keys per track.
 pub fn spline_clip(
@@ -46,7 +47,13 @@ pub fn spline_clip(
 ) -> Result<NodeClip, String> {
     let mut tracks = vec![JointTracks::default(); skeleton.len()];
     if let Some(first) = tracks.first_mut() {
-        first.translation = translation_track(clip, skeleton.joint(0).rest_offset, most)?;
+        let root = [0, 1, 2].map(|c| clip.channels.get(c));
+        first.translation = translation_track(root, clip.range, skeleton.joint(0).rest_offset, most)?;
+    }
+    for moved in clip.offsets.iter().filter(|o| o.joint < skeleton.len()) {
+        let channels = [0, 1, 2].map(|c| Some(&moved.channels[c]));
+        let rest = skeleton.joint(moved.joint).rest_offset;
+        tracks[moved.joint].translation = translation_track(channels, clip.range, rest, most)?;
     }
     for (j, tracks) in tracks.iter_mut().enumerate() {
         let held = fallback.get(j).copied().unwrap_or_default().to_euler(EulerOrder::Xyz);
@@ -79,13 +86,15 @@ pub fn reframed(mut clip: NodeClip, frame: Mat4) -> NodeClip {
     clip
 }
 
-/// The channels of `indices` that have keys, and the seams of all of them (none keyed: None).
-fn seams_of(clip: &Clip, indices: std::ops::Range<usize>, most: usize) -> Result<Option<Vec<f32>>, String> {
+/// The seams of `channels` that have keys (none keyed: None).
+fn seams_of<'c>(
+    channels: impl IntoIterator<Item = Option<&'c Channel>>,
+    range: (f32, f32),
+    most: usize,
+) -> Result<Option<Vec<f32>>, String> {
     let mut seams = Vec::new();
-    for c in indices {
-        if let Some(channel) = clip.channels.get(c).filter(|c| !c.keys().is_empty()) {
-            seams.extend(channel.seams(clip.range, most)?);
-        }
+    for channel in channels.into_iter().flatten().filter(|c| !c.keys().is_empty()) {
+        seams.extend(channel.seams(range, most)?);
     }
     if seams.is_empty() {
         return Ok(None);
@@ -95,9 +104,9 @@ fn seams_of(clip: &Clip, indices: std::ops::Range<usize>, most: usize) -> Result
     Ok(Some(seams))
 }
 
-/// The value and slope of channel `c` at `t` from `side`, or `held` (still) without keys.
-fn channel_at(clip: &Clip, c: usize, t: f32, side: Side, held: f32) -> (f64, f64) {
-    match clip.channels.get(c).filter(|c| !c.keys().is_empty()) {
+/// The value and slope of `channel` at `t` from `side`, or `held` (still) without keys.
+fn channel_at(channel: Option<&Channel>, t: f32, side: Side, held: f32) -> (f64, f64) {
+    match channel.filter(|c| !c.keys().is_empty()) {
         Some(channel) => {
             let (value, slope) = channel.sided(t, side);
             (f64::from(value), f64::from(slope))
@@ -106,13 +115,19 @@ fn channel_at(clip: &Clip, c: usize, t: f32, side: Side, held: f32) -> (f64, f64
     }
 }
 
-fn translation_track(clip: &Clip, rest: Vec3, most: usize) -> Result<Option<Track<Vec3>>, String> {
-    let Some(seams) = seams_of(clip, 0..3, most)? else { return Ok(None) };
+/// A translation keyed by `channels` (x, y, z; `rest`'s value where one has no keys).
+fn translation_track(
+    channels: [Option<&Channel>; 3],
+    range: (f32, f32),
+    rest: Vec3,
+    most: usize,
+) -> Result<Option<Track<Vec3>>, String> {
+    let Some(seams) = seams_of(channels, range, most)? else { return Ok(None) };
     let sided = |t: f32, side: Side| {
-        let [x, y, z] = [0, 1, 2].map(|c| channel_at(clip, c, t, side, rest[c]));
+        let [x, y, z] = [0, 1, 2].map(|c| channel_at(channels[c], t, side, rest[c]));
         Sample { value: DVec4::new(x.0, y.0, z.0, 0.0), slope: DVec4::new(x.1, y.1, z.1, 0.0) }
     };
-    let keys = spline_keys(&seams, clip.range.0, &sided, None, most)?;
+    let keys = spline_keys(&seams, range.0, &sided, None, most)?;
     let vector = |v: DVec4| v.truncate().as_vec3();
     Ok(Some(Track { times: keys.times, values: keys.values.into_iter().map(vector).collect(), interpolation: CUBIC }))
 }
@@ -125,12 +140,14 @@ fn rotation_track(
     most: usize,
 ) -> Result<Option<Track<Quat>>, String> {
     let channels = Clip::joint_channel(joint, 0)..Clip::joint_channel(joint, 3);
-    let Some(seams) = seams_of(clip, channels.clone(), most)? else { return Ok(None) };
+    let Some(seams) = seams_of(channels.clone().map(|c| clip.channels.get(c)), clip.range, most)? else {
+        return Ok(None);
+    };
     let sided = |t: f32, side: Side| {
         let mut angles = DVec3::ZERO;
         let mut rates = DVec3::ZERO;
         for axis in 0..3 {
-            let (angle, rate) = channel_at(clip, channels.start + axis, t, side, held[axis]);
+            let (angle, rate) = channel_at(clip.channels.get(channels.start + axis), t, side, held[axis]);
             let (lo, hi) = (f64::from(limits.min[axis]), f64::from(limits.max[axis]));
             // Clamped as `DofLimits::clamp` clamps; held still at a limit.
             let clamped = angle.max(lo).min(hi);

@@ -69,12 +69,26 @@ impl Humanoid<'_> {
     }
 }
 
-/// One frame of motion: the root joint's position in model space and every joint's
-/// rotation.
+/// One frame of motion: the root joint's position in model space, every joint's rotation,
+/// and every joint's offset where the motion moves joints below the root.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Frame {
     pub root: Vec3,
     pub pose: Vec<JointRotation>,
+    /// Every joint's offset in its parent's frame; none: the rest offsets.
+    pub offsets: Option<Vec<Vec3>>,
+}
+
+impl Frame {
+    /// A frame that moves no joint below the root.
+    pub fn posed(root: Vec3, pose: Vec<JointRotation>) -> Self {
+        Self { root, pose, offsets: None }
+    }
+
+    /// Each joint's world rotation and position in this frame.
+    pub fn world(&self, skeleton: &Skeleton) -> WorldFrames {
+        world_frames_with(skeleton, self.root, &self.pose, self.offsets.as_deref())
+    }
 }
 
 /// A retargeted motion: its frames, which of them hold each foot (left, right) planted,
@@ -156,14 +170,22 @@ pub type WorldFrames = (Vec<Quat>, Vec<Vec3>);
 
 /// Each joint's world rotation and position for `pose` with the root at `root`.
 pub fn world_frames(skeleton: &Skeleton, root: Vec3, pose: &[JointRotation]) -> WorldFrames {
+    world_frames_with(skeleton, root, pose, None)
+}
+
+/// As [`world_frames`], the joints at `offsets` (one per joint) in place of their rest
+/// offsets where given.
+fn world_frames_with(skeleton: &Skeleton, root: Vec3, pose: &[JointRotation], offsets: Option<&[Vec3]>) -> WorldFrames {
     let mut rotations = vec![Quat::IDENTITY; skeleton.len()];
     for j in 0..skeleton.len() {
         let parent = skeleton.parent(j).map_or(Quat::IDENTITY, |p| rotations[p]);
         rotations[j] = (parent * pose[j].to_quat()).normalize();
     }
     let mut world = vec![Mat4::IDENTITY; skeleton.len()];
-    let origin = Mat4::from_translation(root - skeleton.joint(0).rest_offset);
-    super::fk::forward_kinematics(skeleton, pose, origin, &mut world);
+    let rest_root = offsets.map_or(skeleton.joint(0).rest_offset, |o| o[0]);
+    let origin = Mat4::from_translation(root - rest_root);
+    let rest = super::fk::RestOverride { offsets, scales: None };
+    super::fk::forward_kinematics_with_rest(skeleton, pose, rest, origin, &mut world);
     (rotations, world.iter().map(|m| m.w_axis.truncate()).collect())
 }
 
@@ -280,7 +302,7 @@ impl<'a> Retargeter<'a> {
     pub fn frame(&self, source: &Frame) -> (Frame, Vec<usize>) {
         let (pose, clamped, (s_rot, s_at)) = self.carried(source, self.target.skeleton.initial_pose(), |_| true);
         let root = self.placed_root((&s_rot, &s_at), &pose);
-        (Frame { root, pose }, clamped)
+        (Frame::posed(root, pose), clamped)
     }
 
     /// The source's pose carried onto `base` (a pose of the target): the mapped joints
@@ -294,7 +316,7 @@ impl<'a> Retargeter<'a> {
         drives: impl Fn(usize) -> bool,
     ) -> (Vec<JointRotation>, Vec<usize>, WorldFrames) {
         let (s, t) = (self.source.skeleton, self.target.skeleton);
-        let (s_rot, s_at) = world_frames(s, source.root, &source.pose);
+        let (s_rot, s_at) = source.world(s);
         let mut world = vec![Quat::IDENTITY; t.len()];
         let mut clamped = Vec::new();
         // Unmapped joints first (they hang on no mapped turn): their namesakes' turns.
@@ -339,7 +361,7 @@ impl<'a> Retargeter<'a> {
         base: &[JointRotation],
         driving: &[usize],
     ) -> Vec<(usize, JointRotation)> {
-        let frame = Frame { root: self.source.skeleton.joint(0).rest_offset, pose: source_pose.to_vec() };
+        let frame = Frame::posed(self.source.skeleton.joint(0).rest_offset, source_pose.to_vec());
         let (pose, _, _) = self.carried(&frame, base.to_vec(), |sj| driving.contains(&sj));
         (0..pose.len()).filter(|&j| pose[j] != base[j]).map(|j| (j, pose[j])).collect()
     }
@@ -402,7 +424,7 @@ impl<'a> Retargeter<'a> {
         plant: bool,
     ) -> (Vec<bool>, Vec<bool>) {
         let (s, t) = (self.source.skeleton, self.target.skeleton);
-        let s_foot: Vec<Vec3> = source.iter().map(|f| world_frames(s, f.root, &f.pose).1[sf]).collect();
+        let s_foot: Vec<Vec3> = source.iter().map(|f| f.world(s).1[sf]).collect();
         // The ankles' standing heights over their floors.
         let (s_ankle, t_ankle) =
             (self.source_rest_at[sf].y - self.source.rest_floor, self.target_rest_at[tf].y - self.target.rest_floor);
@@ -532,6 +554,6 @@ pub fn retarget_pose(
         Humanoid { skeleton: target.0, map: target.1, floor: 0.0, rest_floor: 0.0, soles: &[] },
         rest,
     )?;
-    let frame = Frame { root: source.0.joint(0).rest_offset, pose: source_pose.to_vec() };
+    let frame = Frame::posed(source.0.joint(0).rest_offset, source_pose.to_vec());
     Some(retargeter.frame(&frame).0.pose)
 }
