@@ -198,7 +198,9 @@ fn check_definitions(library: &mut AssetLibrary, doc: &CharacterDoc, failures: &
         [(LeftUpperArm, LeftLowerArm, LeftHand, 1.0), (RightUpperArm, RightLowerArm, RightHand, -1.0)]
     {
         for (from, to) in [(upper, lower), (lower, hand)] {
-            let d = direction(&p, frame, p.map[&from], p.map[&to]);
+            // An arm whose lower bone ends in no joint (6.837's) has no hand to aim it at.
+            let Some(&end) = p.map.get(&to) else { continue };
+            let d = direction(&p, frame, p.map[&from], end);
             check(format!("t-pose {from:?} from level"), elevation(d), 0.0);
             check(format!("t-pose {from:?} from straight out"), d.angle_between(Vec3::X * side).to_degrees(), 0.0);
         }

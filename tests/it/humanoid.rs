@@ -81,7 +81,8 @@ fn the_6837_models_map_by_structure_alone() {
         let skeleton =
             marionette::formats::character::load_skeleton(&data.join(format!("mit6837/Model{k}.skel"))).unwrap();
         // Numbered joints: the hips (joint2) hang from the chest (joint0), the legs from
-        // joint4 and joint8, the arms from the chest; the left side is +x.
+        // joint4 and joint8, the arms from the chest (each arm's first joint on the chest
+        // itself, its bone the clavicle); the left side is +x.
         expect(
             &skeleton,
             &[
@@ -93,13 +94,21 @@ fn the_6837_models_map_by_structure_alone() {
                 (LeftUpperLeg, "joint9"),
                 (LeftLowerLeg, "joint10"),
                 (LeftFoot, "joint11"),
-                (RightUpperArm, "joint12"),
-                (RightLowerArm, "joint13"),
-                (RightHand, "joint14"),
-                (LeftUpperArm, "joint15"),
-                (LeftLowerArm, "joint16"),
-                (LeftHand, "joint17"),
+                (RightShoulder, "joint12"),
+                (RightUpperArm, "joint13"),
+                (RightLowerArm, "joint14"),
+                (LeftShoulder, "joint15"),
+                (LeftUpperArm, "joint16"),
+                (LeftLowerArm, "joint17"),
             ],
+        );
+        // Each arm is three joints from the chest's own place: clavicle, upper arm, and the
+        // elbow, whose lower arm ends in no joint: no hand.
+        let map = detect(&skeleton).unwrap();
+        assert!(
+            !map.contains_key(&LeftHand) && !map.contains_key(&RightHand),
+            "Model{k}: {:?}",
+            named(&skeleton, &map)
         );
     }
 }
@@ -222,6 +231,13 @@ fn a_character_in_mid_stride_maps_as_at_rest() {
 /// the thigh, the shin, the foot and the toes of each side (`{s}` is `L`/`R`, `{side}`
 /// `Left`/`Right`, `{l}` `l`/`r`).
 fn cmu_shaped(names: [&str; 5]) -> Skeleton {
+    let text = cmu_text(names);
+    let file = marionette::formats::bvh::parse_bvh(std::io::Cursor::new(text), std::path::Path::new("cmu.bvh"));
+    file.expect("the fixture reads").skeleton
+}
+
+/// The text of [`cmu_shaped`]'s BVH.
+fn cmu_text(names: [&str; 5]) -> String {
     let leg = |s: &str, side: &str, l: &str, x: f32| {
         let name = |n: &str| n.replace("{s}", s).replace("{side}", side).replace("{l}", l);
         format!(
@@ -253,7 +269,7 @@ fn cmu_shaped(names: [&str; 5]) -> Skeleton {
             x * 1.5
         )
     };
-    let text = format!(
+    format!(
         "HIERARCHY\nROOT Hips\n{{\nOFFSET 0 0 0\nCHANNELS 6 Xposition Yposition Zposition Zrotation Yrotation Xrotation\n\
          {}{}\
          JOINT LowerBack\n{{\nOFFSET 0 2.0 -0.1\nCHANNELS 3 Zrotation Yrotation Xrotation\n\
@@ -269,9 +285,7 @@ fn cmu_shaped(names: [&str; 5]) -> Skeleton {
         arm("Left", 1.0),
         arm("Right", -1.0),
         vec!["0"; 6 + 3 * 23].join(" ")
-    );
-    let file = marionette::formats::bvh::parse_bvh(std::io::Cursor::new(text), std::path::Path::new("cmu.bvh"));
-    file.expect("the fixture reads").skeleton
+    )
 }
 
 /// CMU's legs: the joint at the hips' centre whose bone runs to the hip socket
@@ -307,5 +321,94 @@ fn cmu_legs_map_the_thigh_not_the_pelvis_side_joint() {
                 (LeftHand, "LeftHand"),
             ],
         );
+    }
+}
+
+/// A BVH in 6.837's shape: numbered joints, the chest the root, the hips hung below it by a
+/// joint on the chest itself, each arm a joint on the chest (its bone the clavicle), one at
+/// the shoulder and one at the elbow whose lower arm ends in no joint (zero End Sites).
+fn model1_text() -> String {
+    let chain = |joints: &[(usize, [f32; 3])], end: [f32; 3]| {
+        let mut text = String::new();
+        for (j, o) in joints {
+            text += &format!(
+                "JOINT joint{j}\n{{\nOFFSET {} {} {}\nCHANNELS 3 Zrotation Xrotation Yrotation\n",
+                o[0], o[1], o[2]
+            );
+        }
+        text += &format!("End Site\n{{\nOFFSET {} {} {}\n}}\n", end[0], end[1], end[2]);
+        text + &"}\n".repeat(joints.len())
+    };
+    let leg = |first: usize, x: f32| {
+        chain(
+            &[
+                (first, [0.0, -0.07, 0.0]),
+                (first + 1, [x, 0.0, 0.0]),
+                (first + 2, [0.0, -0.21, 0.02]),
+                (first + 3, [0.0, -0.24, -0.02]),
+            ],
+            [0.0; 3],
+        )
+    };
+    let arm = |first: usize, x: f32| {
+        chain(
+            &[(first, [0.0; 3]), (first + 1, [x * 0.1, -0.01, -0.04]), (first + 2, [x * 0.09, -0.1, -0.06])],
+            [0.0; 3],
+        )
+    };
+    format!(
+        "HIERARCHY\nROOT joint0\n{{\nOFFSET 0 0.75 0\nCHANNELS 6 Xposition Yposition Zposition Zrotation Xrotation Yrotation\n\
+         JOINT joint1\n{{\nOFFSET 0 0 0\nCHANNELS 3 Zrotation Xrotation Yrotation\n\
+         JOINT joint2\n{{\nOFFSET 0 -0.14 -0.04\nCHANNELS 3 Zrotation Xrotation Yrotation\n{}{}}}\n}}\n\
+         {}{}{}}}\nMOTION\nFrames: 1\nFrame Time: 0.1\n{}\n",
+        leg(4, -0.05),
+        leg(8, 0.05),
+        chain(&[(3, [0.0; 3])], [0.0, 0.2, 0.0]),
+        arm(12, -1.0),
+        arm(15, 1.0),
+        vec!["0"; 6 + 3 * 17].join(" ")
+    )
+}
+
+/// `info` prints the map of a three-joint arm (6.837's: clavicle, upper arm, lower arm, no
+/// hand) and of CMU's legs (the thigh below `LHipJoint`), each bone by its joint's name.
+#[test]
+fn info_prints_the_map_of_three_joint_arms_and_cmu_legs() {
+    let dir = crate::common::scratch("info-maps");
+    let cmu = cmu_text(["{s}HipJoint", "{side}UpLeg", "{side}Leg", "{side}Foot", "{side}ToeBase"]);
+    for (file, text, want, absent) in [
+        (
+            "model1.bvh",
+            model1_text(),
+            &[
+                "Hips = joint2",
+                "Chest = joint0",
+                "LeftShoulder = joint15",
+                "LeftUpperArm = joint16",
+                "LeftLowerArm = joint17",
+            ][..],
+            &["LeftHand ="][..],
+        ),
+        (
+            "cmu.bvh",
+            cmu,
+            &["LeftUpperLeg = LeftUpLeg", "LeftLowerLeg = LeftLeg", "RightUpperLeg = RightUpLeg"][..],
+            &["= LHipJoint"][..],
+        ),
+    ] {
+        let path = dir.join(file);
+        std::fs::write(&path, text).unwrap();
+        let out = std::process::Command::new(env!("CARGO_BIN_EXE_marionette"))
+            .args(["info", path.to_str().unwrap()])
+            .output()
+            .unwrap();
+        assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+        let info = String::from_utf8_lossy(&out.stdout);
+        for line in want {
+            assert!(info.lines().any(|l| l.trim_start().starts_with(line)), "{file}: no `{line}` in\n{info}");
+        }
+        for part in absent {
+            assert!(!info.contains(part), "{file}: `{part}` in\n{info}");
+        }
     }
 }

@@ -161,6 +161,17 @@ fn measure(s: &Side, source: &[Frame], t: &Side, report: &Retargeted) -> Figures
                 figures.worst_direction = (angle, format!("{bone:?}"));
             }
         }
+        // Hips hung below the chest (6.837's models): they lie from the chest as the source's.
+        let (hips, chest) = (HumanBone::Hips, HumanBone::Chest);
+        if let (Some(&tc), Some(&sc)) = (t.map.get(&chest), s.map.get(&chest))
+            && below(&t.asset.skeleton, t.map[&hips], tc)
+        {
+            let (sh, th) = (s.map[&hips], t.map[&hips]);
+            let angle = (sa[sh] - sa[sc]).angle_between(ta[th] - ta[tc]).to_degrees();
+            if angle > figures.worst_direction.0 {
+                figures.worst_direction = (angle, "Hips from the Chest".into());
+            }
+        }
         let h = HumanBone::Hips;
         let hips = ((ta[t.map[&h]].y - t.floor) / t.standing) / ((sa[s.map[&h]].y - s.floor) / s.standing);
         figures.hips_ratio = (figures.hips_ratio.0.min(hips), figures.hips_ratio.1.max(hips));

@@ -177,8 +177,8 @@ fn measure(s: &Side, source: &[Frame], t: &Side, report: &Retargeted) -> Figures
         lowest: f32::MAX,
     };
     for (k, (sf, tf)) in source.iter().zip(target).enumerate() {
-        let (_, sa) = world_frames(&s.asset.skeleton, sf.root, &sf.pose);
-        let (_, ta) = world_frames(&t.asset.skeleton, tf.root, &tf.pose);
+        let (_, sa) = sf.world(&s.asset.skeleton);
+        let (_, ta) = tf.world(&t.asset.skeleton);
         for (bone, next) in aimed {
             let (Some(&a), Some(&b), Some(&c), Some(&d)) =
                 (s.map.get(&bone), s.map.get(&next), t.map.get(&bone), t.map.get(&next))
@@ -193,6 +193,14 @@ fn measure(s: &Side, source: &[Frame], t: &Side, report: &Retargeted) -> Figures
             }
             if angle > f.worst.0 {
                 f.worst = (angle, format!("{bone:?}"));
+            }
+        }
+        // Hips hung below the chest (6.837's models) lie from the chest as the source's.
+        if t.asset.skeleton.is_below(t.map[&Hips], t.map[&Chest]) {
+            let (a, b, c, d) = (s.map[&Chest], s.map[&Hips], t.map[&Chest], t.map[&Hips]);
+            let angle = (sa[b] - sa[a]).angle_between(ta[d] - ta[c]).to_degrees();
+            if angle > f.worst.0 {
+                f.worst = (angle, "Hips from the Chest".into());
             }
         }
         let (t_hips, s_hips) = (ta[t.map[&Hips]].y - t.floor, sa[s.map[&Hips]].y - s.floor);

@@ -124,6 +124,9 @@ pub struct Retargeter<'a> {
     /// For each unmapped target joint, the source joint of the same name (a rig of the
     /// same family: fingers, spine joints between mapped ones), whose local turn it takes.
     namesakes: Vec<Option<usize>>,
+    /// Where the target's hips hang below its chest (6.837's models): the first joint from
+    /// the chest down to the hips, aimed so the hips lie from the chest as the source's do.
+    waist: Option<usize>,
     /// Target leg length over the source's.
     ratio: f32,
     source_leg: f32,
@@ -267,6 +270,7 @@ impl<'a> Retargeter<'a> {
         }
         let namesakes =
             (0..t.len()).map(|j| if bones[j].is_some() { None } else { s.find(&t.joint(j).name) }).collect();
+        let waist = waist(t, target.map).filter(|_| source.map.contains_key(&HumanBone::Chest));
         let clearances = (
             source.lowest_foot(&source_rest, &source_rest_at) - source.rest_floor,
             target.lowest_foot(&target_rest, &target_rest_at) - target.rest_floor,
@@ -276,6 +280,7 @@ impl<'a> Retargeter<'a> {
             target,
             rest,
             namesakes,
+            waist,
             source_rest,
             source_rest_at,
             target_rest_at,
@@ -346,6 +351,30 @@ impl<'a> Retargeter<'a> {
                     clamped.push(j);
                 }
                 pose[j] = held;
+            }
+            if Some(j) == self.waist
+                && let (Some(&sh), Some(&sc)) =
+                    (self.source.map.get(&HumanBone::Hips), self.source.map.get(&HumanBone::Chest))
+                && drives(sh)
+            {
+                let local = reach_in_frame(t, &pose, j, self.target.map[&HumanBone::Hips]);
+                let now = (s_at[sh] - s_at[sc]).normalize_or_zero();
+                let turned = (parent * pose[j].to_quat()).normalize();
+                // The hips on the line from the chest along the source's direction, where
+                // the waist (a child of the chest) can reach it: from the waist at `from`
+                // (the chest at 0), the farther point of that line at the hips' distance.
+                let from = parent * t.joint(j).rest_offset;
+                let along = now.dot(from);
+                let reach = (along * along - from.length_squared() + local.length_squared()).max(0.0).sqrt();
+                let goal = (now * (along + reach) - from).normalize_or_zero();
+                if goal != Vec3::ZERO && local != Vec3::ZERO {
+                    let wanted = (Quat::from_rotation_arc((turned * local).normalize(), goal) * turned).normalize();
+                    let free = pose[j].with_rotation_of((parent.inverse() * wanted).normalize());
+                    pose[j] = free.clamped(&t.joint(j).limits);
+                    if pose[j] != free {
+                        clamped.push(j);
+                    }
+                }
             }
             world[j] = (parent * pose[j].to_quat()).normalize();
         }
@@ -518,6 +547,21 @@ fn reach_in_frame(skeleton: &Skeleton, pose: &[JointRotation], j: usize, below: 
         k = p;
     }
     at
+}
+
+/// The joint that hangs `map`'s hips below its chest: the first on the way from the chest
+/// down to the hips, where the hips lie below the chest.
+fn waist(skeleton: &Skeleton, map: &HumanoidMap) -> Option<usize> {
+    let (hips, chest) = (*map.get(&HumanBone::Hips)?, *map.get(&HumanBone::Chest)?);
+    let mut j = hips;
+    while let Some(p) = skeleton.parent(j) {
+        if p == chest {
+            // Hips hung from the chest itself turn with it: no joint between to aim.
+            return (j != hips).then_some(j);
+        }
+        j = p;
+    }
+    None
 }
 
 /// `v` raised to height `y` where it lies lower.

@@ -225,18 +225,21 @@ pub fn detect_reported(skeleton: &Skeleton) -> Option<Detected> {
         (left_hand, Side::Left, [LeftShoulder, LeftUpperArm, LeftLowerArm, LeftHand]),
         (right_hand, Side::Right, [RightShoulder, RightUpperArm, RightLowerArm, RightHand]),
     ] {
-        let limb = tree.limb(chest, end);
+        let limb = tree.limb(chest, end, true);
         let (before, upper_j, lower_j, found) = match (named_arm(&tree, &says, chest, end, side), &limb) {
             (Some((c, u, l)), _) => (c, u, l, Found::Name),
             (None, Some(limb)) => (limb.before, limb.upper, limb.lower, Found::Structure),
             (None, None) => return None,
         };
-        // Found by shape, the hand is the limb's end (the leaf may be a finger's tip).
+        // Found by shape, the hand is the limb's end (the leaf may be a finger's tip); an
+        // arm of a clavicle, upper and lower arm has none.
         let hand_j = match (&limb, by_name) {
             (Some(limb), false) => limb.end,
-            _ => end,
+            _ => Some(end),
         };
-        out.put(hand, hand_j, how);
+        if let Some(hand_j) = hand_j {
+            out.put(hand, hand_j, how);
+        }
         out.put(upper, upper_j, found);
         out.put(lower, lower_j, found);
         if let Some(c) = before {
@@ -247,7 +250,7 @@ pub fn detect_reported(skeleton: &Skeleton) -> Option<Detected> {
         (left_foot, Side::Left, [LeftUpperLeg, LeftLowerLeg, LeftFoot, LeftToes]),
         (right_foot, Side::Right, [RightUpperLeg, RightLowerLeg, RightFoot, RightToes]),
     ] {
-        let limb = tree.limb(hips, end);
+        let limb = tree.limb(hips, end, false);
         let (u, l, found) = match (named_leg(&tree, &says, hips, end, side), &limb) {
             (Some((u, l)), _) => (u, l, Found::Name),
             (None, Some(limb)) => (limb.upper, limb.lower, Found::Structure),
@@ -257,7 +260,7 @@ pub fn detect_reported(skeleton: &Skeleton) -> Option<Detected> {
         out.put(lower, l, found);
         // Found by shape, the foot is the limb's end (the leaf is its toes' tip).
         let foot_j = match (&limb, by_name) {
-            (Some(limb), false) => limb.end,
+            (Some(Limb { end: Some(foot), .. }), false) => *foot,
             _ => end,
         };
         out.put(foot, foot_j, how);
@@ -268,7 +271,8 @@ pub fn detect_reported(skeleton: &Skeleton) -> Option<Detected> {
             (None, None) => {}
         }
     }
-    for (left, hand) in [(true, out.map[&LeftHand]), (false, out.map[&RightHand])] {
+    for (left, hand) in [(true, out.map.get(&LeftHand).copied()), (false, out.map.get(&RightHand).copied())] {
+        let Some(hand) = hand else { continue };
         fingers(&tree, &says, left, hand, &mut out);
         let named = (0..5).any(|f| out.map.contains_key(&HumanBone::finger(left, f, 0)));
         if !named {
@@ -644,13 +648,14 @@ fn name_side(name: &str) -> Option<bool> {
 }
 
 /// A limb from where it leaves the body to its last joint: the upper and lower bones (the
-/// two longest consecutive segments), the joint before the upper one (a shoulder) and the
-/// one after the limb's end (toes).
+/// two longest consecutive segments), the joint before the upper one (a shoulder), the
+/// limb's end (a hand, a foot; none where the lower bone is the last joint) and the one
+/// after it (toes).
 struct Limb {
     before: Option<usize>,
     upper: usize,
     lower: usize,
-    end: usize,
+    end: Option<usize>,
     after: Option<usize>,
 }
 
@@ -738,8 +743,9 @@ impl<'a> Tree<'a> {
         up
     }
 
-    /// The limb from `from` (the body joint it leaves) to the leaf `leaf`.
-    fn limb(&self, from: usize, leaf: usize) -> Option<Limb> {
+    /// The limb from `from` (the body joint it leaves) to the leaf `leaf`; an arm (`arm`)
+    /// may end in its lower bone.
+    fn limb(&self, from: usize, leaf: usize, arm: bool) -> Option<Limb> {
         // The chain's distinct places: where several joints coincide, the last of them.
         let mut chain: Vec<usize> = vec![from];
         for j in self.path(from, leaf).into_iter().filter(|&j| self.body[j] || j == leaf) {
@@ -751,6 +757,18 @@ impl<'a> Tree<'a> {
         if chain.len() < 3 {
             return None;
         }
+        // An arm of two bones from the body's own place (6.837's: a joint on the chest runs
+        // to the shoulder, the next to the elbow, the last is the elbow): the first leaves
+        // the body's middle, so it is a clavicle, and the lower arm ends in no joint.
+        if arm && chain.len() == 3 {
+            return Some(Limb {
+                before: (chain[0] != from).then_some(chain[0]),
+                upper: chain[1],
+                lower: chain[2],
+                end: None,
+                after: None,
+            });
+        }
         let length = |k: usize| self.at[chain[k + 1]].distance(self.at[chain[k]]);
         // The body joint itself is no limb bone, where the limb has joints enough.
         let first = usize::from(chain.len() >= 4);
@@ -760,7 +778,7 @@ impl<'a> Tree<'a> {
             before: (k >= 1 && chain[k - 1] != from).then(|| chain[k - 1]),
             upper: chain[k],
             lower: chain[k + 1],
-            end: chain[k + 2],
+            end: Some(chain[k + 2]),
             after: chain.get(k + 3).copied(),
         })
     }
