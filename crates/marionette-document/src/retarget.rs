@@ -77,7 +77,8 @@ fn lowest_point(asset: &CharacterAsset, frame: &Frame) -> f32 {
 
 /// The points a character stands on: the lowest skin vertices (at most 4,096 a foot) that
 /// each foot joint of its map, or a joint below it (toes), moves most, as their joints
-/// move them.
+/// move them: each in its joint's frame turned, in model units (a joint's scale, such as a
+/// Mixamo armature's 0.01, taken out).
 pub fn soles(asset: &CharacterAsset, map: &HumanoidMap) -> Vec<marionette_rig::retarget::Sole> {
     const MOST: usize = 4096;
     let (skin, skeleton) = (&asset.skin, &asset.skeleton);
@@ -95,7 +96,9 @@ pub fn soles(asset: &CharacterAsset, map: &HumanoidMap) -> Vec<marionette_rig::r
             let p = skin.bind_positions[v];
             let parts = skin.weights.of_vertex(v).iter().map(|i| {
                 let j = usize::from(i.joint);
-                (j, i.weight, asset.bind_world_to_joint[j].transform_point3(p))
+                // In the joint's frame turned but not scaled (its scale is the rig's units).
+                let (scale, _, _) = asset.bind_world_to_joint[j].inverse().to_scale_rotation_translation();
+                (j, i.weight, scale * asset.bind_world_to_joint[j].transform_point3(p))
             });
             parts.collect()
         }));
