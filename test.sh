@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
-# Runs every crate's tests, after installing the system packages the machine lacks. The
-# real-data tests run when MARIONETTE_DATA names the course data folder (relative to where
-# the command was typed); without it they are reported as ignored.
+# Runs every crate's tests, after installing the system packages the machine lacks, then
+# (without arguments) the Python package's, built into a virtual environment. The real-data
+# tests run when MARIONETTE_DATA names the course data folder (relative to where the command
+# was typed); without it they are reported as ignored (skipped, in pytest).
 set -euo pipefail
 here=$(cd "$(dirname "$0")" && pwd)
 if [ -n "${MARIONETTE_DATA:-}" ] && [ "$PWD" != "$here" ]; then
@@ -10,4 +11,7 @@ if [ -n "${MARIONETTE_DATA:-}" ] && [ "$PWD" != "$here" ]; then
 fi
 cd "$here"
 ./scripts/ensure-tools.sh
-exec cargo test "$@"
+cargo test "$@"
+if [ $# -eq 0 ]; then
+  ./scripts/python-tests.sh
+fi

@@ -99,23 +99,45 @@ pub fn scene_mesh_from(
 ) -> Result<(Vec<glam::Vec3>, Vec<[u32; 3]>), FormatError> {
     let mut positions = Vec::new();
     let mut triangles = Vec::new();
-    for (c, asset, posed) in load_posed(library, doc, false)? {
+    for posed in scene_posed(library, doc)? {
         let first = positions.len() as u32;
+        positions.extend(posed.vertices);
+        triangles.extend(posed.triangles.iter().map(|t| t.map(|v| v + first)));
+    }
+    Ok((positions, triangles))
+}
+
+/// A scene's character posed and placed in the world: its skin's vertices (in its file's
+/// order), its triangles, and each joint's transform to the world.
+#[derive(Debug, Clone)]
+pub struct PosedInWorld {
+    pub vertices: Vec<glam::Vec3>,
+    pub triangles: Vec<[u32; 3]>,
+    pub joint_to_world: Vec<glam::Mat4>,
+}
+
+/// Every character of a scene document posed (as [`scene_glb`] poses it) and placed in the
+/// world, in document order.
+pub fn scene_posed(library: &mut super::AssetLibrary, doc: &SceneDoc) -> Result<Vec<PosedInWorld>, FormatError> {
+    let mut out = Vec::new();
+    for (c, asset, posed) in load_posed(library, doc, false)? {
         let mut asset = asset;
         if posed.now.weights.iter().any(|&w| w != 0.0) {
             std::sync::Arc::make_mut(&mut asset).skin.bind_positions = asset.morphed_positions(&posed.now.weights);
         }
-        let world = posed.placement.to_mat4() * posed.now.origin(&asset.skeleton);
-        positions.extend(crate::posing::posed_positions_with_rest(
+        let placement = posed.placement.to_mat4();
+        let world = placement * posed.now.origin(&asset.skeleton);
+        let vertices = crate::posing::posed_positions_with_rest(
             &asset,
             &posed.now.rotations,
             posed.now.rest_override(),
             world,
             c.skinning,
-        ));
-        triangles.extend(asset.skin.triangles.iter().map(|t| t.map(|v| v + first)));
+        );
+        let joint_to_world = posed.now.joint_to_world(&asset.skeleton, placement);
+        out.push(PosedInWorld { vertices, triangles: asset.skin.triangles.clone(), joint_to_world });
     }
-    Ok((positions, triangles))
+    Ok(out)
 }
 
 /// A scene's character with its shaped asset and its pose.
