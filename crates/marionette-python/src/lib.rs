@@ -24,6 +24,8 @@ use marionette_formats::FormatError;
 use marionette_formats::scene::{CharacterDoc, SceneDoc, SourceDoc};
 use marionette_rig::dqs::SkinningMethod;
 
+mod render;
+
 create_exception!(marionette, Error, PyException, "What Marionette could not do, with the command line's message.");
 create_exception!(marionette, FileError, Error, "A file that cannot be read: `file:line: …`.");
 create_exception!(marionette, SpecError, Error, "A data-set spec that cannot be used: its field's path and why.");
@@ -35,12 +37,12 @@ create_exception!(
 );
 
 /// A file's error as `FileError`.
-fn file_error(e: FormatError) -> PyErr {
+pub(crate) fn file_error(e: FormatError) -> PyErr {
     FileError::new_err(e.to_string())
 }
 
 /// A posing option's error: the file's as `FileError`, the rest as `PoseError`.
-fn options_error(e: OptionsError) -> PyErr {
+pub(crate) fn options_error(e: OptionsError) -> PyErr {
     match e {
         OptionsError::Format(e) => file_error(e),
         other => PoseError::new_err(other.to_string()),
@@ -49,7 +51,7 @@ fn options_error(e: OptionsError) -> PyErr {
 
 /// A character read from a file (the first of the file's characters), or an SMPL folder.
 #[pyclass(module = "marionette", unsendable)]
-struct Character {
+pub(crate) struct Character {
     library: AssetLibrary,
     doc: CharacterDoc,
 }
@@ -180,45 +182,12 @@ impl Character {
         look_at: Option<BTreeMap<String, (f32, f32, f32)>>,
         skinning: Option<String>,
     ) -> PyResult<Pose> {
-        let specs = PoseSpecs {
-            preset: preset
-                .map(|name| parsed(&format!("{name}{}", if mirrored { ":mirrored" } else { "" })))
-                .transpose()?,
-            poses: spec_list(rotations, |(joint, (x, y, z))| format!("{joint}={x},{y},{z}"))?,
-            hands: hands
-                .unwrap_or_default()
-                .into_iter()
-                .map(|(side, name)| match side.as_str() {
-                    "left" | "right" => parsed(&format!("{side}={name}")),
-                    other => {
-                        Err(PyValueError::new_err(format!("hands: expected \"left\" or \"right\", found {other:?}")))
-                    }
-                })
-                .collect::<PyResult<_>>()?,
-            ik: Vec::new(),
-            two_bone: spec_list(two_bone, |(joint, goal)| match goal {
-                TwoBoneGoal::Target((x, y, z)) => format!("{joint}={x},{y},{z}"),
-                TwoBoneGoal::WithPole((x, y, z), (a, b, c)) => format!("{joint}={x},{y},{z}@{a},{b},{c}"),
-            })?,
-            look_at: spec_list(look_at, |(joint, (x, y, z))| format!("{joint}={x},{y},{z}"))?,
-        };
-        let skinning = match skinning.as_deref() {
-            None => None,
-            Some("lbs") => Some(SkinningMethod::Linear),
-            Some("dq") => Some(SkinningMethod::DualQuaternion),
-            Some(other) => {
-                return Err(PyValueError::new_err(format!("skinning: expected \"lbs\" or \"dq\", found {other:?}")));
-            }
-        };
-        let options = PoseOptions { specs, skinning, clip, time, still: true, ..PoseOptions::default() };
+        let options = pose_options(time, clip, (preset, mirrored), hands, rotations, two_bone, look_at, skinning)?;
+        let (doc, notes) = self.posed_doc(py, &options)?;
         let mut scene = SceneDoc::default();
-        scene.characters.push(self.doc.clone());
+        scene.characters.push(doc);
         let library = &mut self.library;
-        let (notes, posed) = py.detach(|| {
-            let notes = apply_options(&mut scene, &options, library).map_err(Failure::Options)?;
-            let posed = marionette_document::export::scene_posed(library, &scene).map_err(Failure::File)?;
-            Ok::<_, Failure>((notes, posed))
-        })?;
+        let posed = py.detach(|| marionette_document::export::scene_posed(library, &scene)).map_err(file_error)?;
         let posed = posed.into_iter().next().ok_or_else(|| Error::new_err("the character was not posed"))?;
         let matrices: Vec<f32> = posed.joint_to_world.iter().flat_map(|m| m.transpose().to_cols_array()).collect();
         let joints = posed.joint_to_world.len();
@@ -230,12 +199,45 @@ impl Character {
         })
     }
 
+    /// A copy of the character that stands in this pose (the arguments of
+    /// [`pose`](Self::pose)), for a scene: `mt.Scene([c.posed(preset="wave")])`.
+    #[pyo3(signature = (*, time=None, clip=None, preset=None, mirrored=false, hands=None, rotations=None, two_bone=None, look_at=None, skinning=None))]
+    #[allow(clippy::too_many_arguments)]
+    fn posed(
+        &mut self,
+        py: Python<'_>,
+        time: Option<f32>,
+        clip: Option<String>,
+        preset: Option<String>,
+        mirrored: bool,
+        hands: Option<BTreeMap<String, String>>,
+        rotations: Option<BTreeMap<String, (f32, f32, f32)>>,
+        two_bone: Option<BTreeMap<String, TwoBoneGoal>>,
+        look_at: Option<BTreeMap<String, (f32, f32, f32)>>,
+        skinning: Option<String>,
+    ) -> PyResult<Character> {
+        let options = pose_options(time, clip, (preset, mirrored), hands, rotations, two_bone, look_at, skinning)?;
+        let (doc, _) = self.posed_doc(py, &options)?;
+        Ok(Character { library: AssetLibrary::default(), doc })
+    }
+
     fn __repr__(&self) -> String {
         format!("<marionette.Character {:?}>", self.doc.name)
     }
 }
 
 impl Character {
+    /// Its document with `options` applied as the command line applies them (a still pose
+    /// baked in), and what they said.
+    fn posed_doc(&mut self, py: Python<'_>, options: &PoseOptions) -> PyResult<(CharacterDoc, Vec<String>)> {
+        let mut scene = SceneDoc::default();
+        scene.characters.push(self.doc.clone());
+        let library = &mut self.library;
+        let notes = py.detach(|| apply_options(&mut scene, options, library)).map_err(options_error)?;
+        let doc = scene.characters.pop().ok_or_else(|| Error::new_err("the character was not posed"))?;
+        Ok((doc, notes))
+    }
+
     fn smpl_doc(&self) -> PyResult<&marionette_formats::scene::SmplDoc> {
         self.doc.smpl.as_ref().ok_or_else(|| PoseError::new_err(format!("{}: betas: not an SMPL body", self.doc.name)))
     }
@@ -253,19 +255,46 @@ enum TwoBoneGoal {
     Target((f32, f32, f32)),
 }
 
-/// What failed while the lock was released, turned into an exception once it is held.
-enum Failure {
-    File(FormatError),
-    Options(OptionsError),
-}
-
-impl From<Failure> for PyErr {
-    fn from(f: Failure) -> Self {
-        match f {
-            Failure::File(e) => file_error(e),
-            Failure::Options(e) => options_error(e),
+/// The command line's posing options from [`Character::pose`]'s arguments, each parsed as
+/// the command line parses it.
+#[allow(clippy::too_many_arguments)]
+fn pose_options(
+    time: Option<f32>,
+    clip: Option<String>,
+    (preset, mirrored): (Option<String>, bool),
+    hands: Option<BTreeMap<String, String>>,
+    rotations: Option<BTreeMap<String, (f32, f32, f32)>>,
+    two_bone: Option<BTreeMap<String, TwoBoneGoal>>,
+    look_at: Option<BTreeMap<String, (f32, f32, f32)>>,
+    skinning: Option<String>,
+) -> PyResult<PoseOptions> {
+    let specs = PoseSpecs {
+        preset: preset.map(|name| parsed(&format!("{name}{}", if mirrored { ":mirrored" } else { "" }))).transpose()?,
+        poses: spec_list(rotations, |(joint, (x, y, z))| format!("{joint}={x},{y},{z}"))?,
+        hands: hands
+            .unwrap_or_default()
+            .into_iter()
+            .map(|(side, name)| match side.as_str() {
+                "left" | "right" => parsed(&format!("{side}={name}")),
+                other => Err(PyValueError::new_err(format!("hands: expected \"left\" or \"right\", found {other:?}"))),
+            })
+            .collect::<PyResult<_>>()?,
+        ik: Vec::new(),
+        two_bone: spec_list(two_bone, |(joint, goal)| match goal {
+            TwoBoneGoal::Target((x, y, z)) => format!("{joint}={x},{y},{z}"),
+            TwoBoneGoal::WithPole((x, y, z), (a, b, c)) => format!("{joint}={x},{y},{z}@{a},{b},{c}"),
+        })?,
+        look_at: spec_list(look_at, |(joint, (x, y, z))| format!("{joint}={x},{y},{z}"))?,
+    };
+    let skinning = match skinning.as_deref() {
+        None => None,
+        Some("lbs") => Some(SkinningMethod::Linear),
+        Some("dq") => Some(SkinningMethod::DualQuaternion),
+        Some(other) => {
+            return Err(PyValueError::new_err(format!("skinning: expected \"lbs\" or \"dq\", found {other:?}")));
         }
-    }
+    };
+    Ok(PoseOptions { specs, skinning, clip, time, still: true, ..PoseOptions::default() })
 }
 
 /// A command-line spec parsed as the command line parses it (its message on failure).
@@ -310,8 +339,13 @@ fn load(py: Python<'_>, path: PathBuf) -> PyResult<Character> {
 }
 
 #[pymodule]
-fn marionette(m: &Bound<'_, PyModule>) -> PyResult<()> {
+fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(load, m)?)?;
+    m.add_function(wrap_pyfunction!(render::render, m)?)?;
+    m.add_function(wrap_pyfunction!(render::generate_pictures, m)?)?;
+    m.add_function(wrap_pyfunction!(render::read_picture, m)?)?;
+    m.add_function(wrap_pyfunction!(render::spec_count, m)?)?;
+    m.add_class::<render::Scene>()?;
     m.add_class::<Character>()?;
     m.add_class::<Pose>()?;
     let py = m.py();

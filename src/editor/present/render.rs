@@ -80,6 +80,11 @@ struct RenderJob {
     coco_per_picture: bool,
     /// Called with a picture's index once its files are written (a data set's manifest).
     on_written: Option<OnWritten>,
+    /// The first picture shows the scene the app opened with (else each picture's scene
+    /// is opened in place of the last, the first's too).
+    opened: bool,
+    /// How the last scene set up was lit (kept from render to render).
+    last_lights: Option<LightSetup>,
 }
 
 /// What is called with a picture's index once its files are written.
@@ -264,6 +269,89 @@ pub fn render_scenes(
     run_job(setup)
 }
 
+/// A renderer kept between renders in one process (the Python package's): its app starts
+/// once, on the default scene; each render opens its pictures' scenes in place of the last
+/// and draws them, so a render after the first costs its drawn frames.
+pub struct Renderer {
+    app: App,
+    outcome: Outcome,
+    picture: ShotDoc,
+    /// Messages said before this render (each render returns its own).
+    said: usize,
+}
+
+impl Renderer {
+    /// A renderer of pictures of `picture`'s size and samples, reading files through
+    /// `library`; started (its GPU work set up) before it returns.
+    pub fn new(library: AssetLibrary, picture: ShotDoc) -> Result<Self, String> {
+        picture.validate().map_err(|e| e.to_string())?;
+        let setup = JobSetup {
+            paths: Vec::new(),
+            library,
+            edits: StartupEdits { still: true, ..default() },
+            picture,
+            frames: Vec::new(),
+            sequence: None,
+            data: None,
+            controlnet: None,
+            coco_per_picture: true,
+            // Said by the caller, not on standard error.
+            on_written: Some(Box::new(|_| Ok(()))),
+        };
+        let (mut app, outcome) = job_app(setup, false);
+        while app.plugins_state() == bevy::app::PluginsState::Adding {
+            bevy::tasks::tick_global_task_pools_on_main_thread();
+        }
+        app.finish();
+        app.cleanup();
+        let mut renderer = Self { app, outcome, picture, said: 0 };
+        renderer.run()?;
+        Ok(renderer)
+    }
+
+    /// The size and samples it draws.
+    pub fn picture(&self) -> ShotDoc {
+        self.picture
+    }
+
+    /// Draws `pictures` (each its own scene, framed from `view` where it has no camera),
+    /// each written to its file with what `beside` asks beside it; returns the notes said
+    /// meanwhile.
+    pub fn render(
+        &mut self,
+        pictures: Vec<ScenePicture>,
+        view: crate::formats::scene::CameraDoc,
+        beside: Beside,
+    ) -> Result<Vec<String>, String> {
+        let world = self.app.world_mut();
+        world.insert_resource(crate::editor::present::view::FramingView(view));
+        let mut job = world.resource_mut::<RenderJob>();
+        job.frames = pictures
+            .into_iter()
+            .map(|p| Frame { at: FrameAt::Scene(Box::new(p.scene)), out: p.out, ids: p.ids, backdrop: p.backdrop })
+            .collect();
+        job.queue = (0..job.frames.len()).collect();
+        (job.next, job.set_up, job.done, job.captures, job.failed_save) = (0, false, None, None, None);
+        job.started = std::time::Instant::now();
+        job.data = beside.data.then(CocoSoFar::default);
+        job.controlnet = beside.controlnet;
+        self.run()
+    }
+
+    /// Updates the app until its job is done: the notes said meanwhile, or what failed.
+    fn run(&mut self) -> Result<Vec<String>, String> {
+        loop {
+            self.app.update();
+            let done = self.outcome.lock().map(|mut o| (o.0.take(), std::mem::take(&mut o.1))).ok();
+            if let Some((Some(done), messages)) = done {
+                let said = messages.get(self.said..).unwrap_or_default().to_vec();
+                self.said = messages.len();
+                return done.map(|()| said);
+            }
+        }
+    }
+}
+
 /// What a render's app is made from.
 struct JobSetup {
     paths: Vec<PathBuf>,
@@ -280,21 +368,41 @@ struct JobSetup {
     on_written: Option<OnWritten>,
 }
 
+/// Where a render's result and messages are left for the caller.
+type Outcome = Arc<Mutex<(Option<Result<(), String>>, Vec<String>)>>;
+
 /// Builds the render's app, runs it until every picture is written or it fails, and
 /// returns the notes or what went wrong.
 fn run_job(setup: JobSetup) -> Result<Vec<String>, String> {
+    let (mut app, outcome) = job_app(setup, true);
+    let exit = app.run();
+    // `App::run` hands the world to the runner: the outcome comes back through `outcome`.
+    let (done, messages) = outcome.lock().map(|o| o.clone()).unwrap_or_default();
+    match (exit, done) {
+        (AppExit::Success, Some(Ok(()))) => Ok(messages),
+        (_, Some(Err(e))) => Err(e),
+        _ => Err("the render stopped before a picture was captured".to_string()),
+    }
+}
+
+/// The app of a render and where its outcome is left; `opened`: the first picture shows the
+/// scene the app opens with (else every picture's scene is opened in place of the last).
+fn job_app(setup: JobSetup, opened: bool) -> (App, Outcome) {
     let JobSetup { paths, library, edits, picture, frames, sequence, data, controlnet, coco_per_picture, on_written } =
         setup;
     let (width, height) = (picture.width, picture.height);
-    // A render in a process that logs already (the editor's frames) logs through its log.
-    let plugins = match bevy::log::tracing::dispatcher::has_been_set() {
+    // A render in a process that logs already (the editor's frames) logs through its log;
+    // a renderer kept in another program's process (Python's) does not log.
+    let plugins = match bevy::log::tracing::dispatcher::has_been_set() || !opened {
         true => crate::editor::cores::windowless_plugins().disable::<bevy::log::LogPlugin>(),
         false => crate::editor::cores::windowless_plugins(),
     };
     let mut app = App::new();
-    app.add_plugins(plugins)
-        .add_plugins(ScheduleRunnerPlugin::run_loop(Duration::from_millis(2)))
-        .insert_resource(ClearColor(stage::SKY))
+    app.add_plugins(plugins);
+    if opened {
+        app.add_plugins(ScheduleRunnerPlugin::run_loop(Duration::from_millis(2)));
+    }
+    app.insert_resource(ClearColor(stage::SKY))
         .insert_resource(crate::editor::state::camera::FramingAspect(width as f32 / height as f32))
         .insert_resource(StartupPaths(paths))
         .insert_resource(Library(library))
@@ -329,6 +437,8 @@ fn run_job(setup: JobSetup) -> Result<Vec<String>, String> {
         size: (width, height),
         coco_per_picture,
         on_written,
+        opened,
+        last_lights: None,
     });
     // The sun's shadow map sized for the picture (the editor's is for a window).
     let shadow_map = stage::shadow_map_for(width * picture.samples, height * picture.samples);
@@ -339,19 +449,12 @@ fn run_job(setup: JobSetup) -> Result<Vec<String>, String> {
     });
     app.add_systems(
         Last,
-        (capture_when_ready, next_frame, scene_frame, pose_frame)
+        (capture_when_ready, report_when_done, next_frame, scene_frame, pose_frame)
             .chain()
             .after(crate::editor::present::readiness::UpdateCaptureGate),
     )
     .add_systems(PostUpdate, clear_behind_gradient.after(stage::apply_stage_settings));
-    let exit = app.run();
-    // `App::run` hands the world to the runner: the outcome comes back through `outcome`.
-    let (done, messages) = outcome.lock().map(|o| o.clone()).unwrap_or_default();
-    match (exit, done) {
-        (AppExit::Success, Some(Ok(()))) => Ok(messages),
-        (_, Some(Err(e))) => Err(e),
-        _ => Err("the render stopped before a picture was captured".to_string()),
-    }
+    (app, outcome)
 }
 
 /// Loads everything the render will show before any window or GPU work, so that a missing
@@ -410,16 +513,10 @@ fn capture_when_ready(
     mut job: ResMut<RenderJob>,
     gate: Res<CaptureGate>,
     wanted: Res<WantedAssets>,
-    messages: Res<Messages>,
     stage: Res<crate::editor::state::StageSettings>,
     scene: DataScene,
-    mut exit: MessageWriter<AppExit>,
 ) {
-    if let Some(done) = job.done.clone() {
-        if let Ok(mut o) = job.outcome.lock() {
-            *o = (Some(done), messages.0.clone());
-        }
-        exit.write(AppExit::Success);
+    if job.done.is_some() {
         return;
     }
     if let Some(failed) = &gate.failed {
@@ -503,6 +600,16 @@ fn capture_when_ready(
     job.captures = Some(job.captures.map_or((now, now, 0), |(first, _, updates)| (first, now, updates)));
     job.next += 1;
     job.set_up = false;
+}
+
+/// Once the render is done (in the update that finished it): its result and the messages
+/// left for the caller, and the app told to exit.
+fn report_when_done(job: Res<RenderJob>, messages: Res<Messages>, mut exit: MessageWriter<AppExit>) {
+    let Some(done) = job.done.clone() else { return };
+    if let Ok(mut o) = job.outcome.lock() {
+        *o = (Some(done), messages.0.clone());
+    }
+    exit.write(AppExit::Success);
 }
 
 /// Pictures captured and not yet written at most (their pixels held in memory).
@@ -636,14 +743,16 @@ fn scene_frame(
         return;
     }
     let FrameAt::Scene(doc) = &job.frames[job.queue[job.next]].at else { return };
-    if job.next > 0 {
-        let lit_alike = match &job.frames[job.queue[job.next - 1]].at {
-            FrameAt::Scene(last) => light_setup(&last.stage) == light_setup(&doc.stage) && doc.stage.lamps.is_empty(),
-            _ => false,
-        };
-        *pending = crate::editor::scene_doc::document::PendingScene { frame: false, doc: Some((**doc).clone()) };
+    let lights = light_setup(&doc.stage);
+    if job.next > 0 || !job.opened {
+        // Lit as the last scene drawn (of this render, or of the renderer's last), its
+        // characters drawn as plain skins.
+        let lit_alike = job.last_lights.as_ref() == Some(&lights) && doc.stage.lamps.is_empty() && plainly_drawn(doc);
+        // A scene without a camera is framed as the command line frames it.
+        *pending = crate::editor::scene_doc::document::PendingScene { frame: true, doc: Some((**doc).clone()) };
         if lit_alike { gate.next_scene() } else { gate.restart() }
     }
+    job.last_lights = Some(lights);
     job.set_up = true;
 }
 
@@ -665,11 +774,25 @@ fn drawing_order(frames: &[Frame]) -> Vec<usize> {
     order
 }
 
+/// Whether every character of `doc` is drawn as a plain skin: no skeleton drawn, no weight
+/// colours, no heat map, solid (what a data set's scenes are, and what the renderer takes up
+/// in a scene's first frame: the other views add drawings and materials of later frames).
+fn plainly_drawn(doc: &SceneDoc) -> bool {
+    use crate::formats::scene::DisplayDoc;
+    doc.characters.iter().all(|c| {
+        let v = &c.view;
+        v.display == DisplayDoc::Mesh && !v.weight_colors && !v.heat_of_selected && v.opacity >= 1.0
+    })
+}
+
+/// Shadows at all, and each lamp's kind (spot) and whether it casts shadows.
+type LightSetup = (bool, Vec<(bool, bool)>);
+
 /// What of a stage has the renderer set up its lights' views and passes anew when it
 /// changes: shadows at all, and each lamp's kind and whether it casts shadows. A scene
 /// without lamps lit alike to the last is drawn as it should be from its second frame;
 /// another waits for the renderer to settle (a new lamp's views take frames of their own).
-fn light_setup(stage: &crate::formats::scene::StageDoc) -> (bool, Vec<(bool, bool)>) {
+fn light_setup(stage: &crate::formats::scene::StageDoc) -> LightSetup {
     (stage.shadows, stage.lamps.iter().map(|l| (l.spot.is_some(), l.shadows)).collect())
 }
 

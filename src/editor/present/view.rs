@@ -141,7 +141,7 @@ fn queue_startup_scene(
     notes.into_iter().for_each(|m| messages.push(m));
     if let Some(mut doc) = doc {
         changed.0 = Some(&doc) != before.as_ref() || edits.recovered;
-        if let Some(view) = startup_view(&mut doc, &edits) {
+        if let Some(view) = startup_view(&mut doc, edits.view, edits.ortho) {
             framing.0 = view;
         }
         *pending = PendingScene { frame: doc.camera.is_none(), doc: Some(doc) };
@@ -150,19 +150,23 @@ fn queue_startup_scene(
 
 /// The view and lens `--view` and `--ortho` ask for (from the scene's camera, else the
 /// three-quarter view), which the characters are then framed from: the scene's own camera
-/// is left out.
-fn startup_view(doc: &mut crate::formats::scene::SceneDoc, edits: &StartupEdits) -> Option<CameraDoc> {
-    if edits.view.is_none() && !edits.ortho {
+/// is left out. None when neither is asked for.
+pub fn startup_view(
+    doc: &mut crate::formats::scene::SceneDoc,
+    view: Option<crate::formats::scene::ViewName>,
+    ortho: bool,
+) -> Option<CameraDoc> {
+    if view.is_none() && !ortho {
         return None;
     }
-    let mut view = doc.camera.take().unwrap_or(FramingView::default().0);
-    if let Some(name) = edits.view {
-        view = view.looking_from(name);
+    let mut framing = doc.camera.take().unwrap_or(FramingView::default().0);
+    if let Some(name) = view {
+        framing = framing.looking_from(name);
     }
-    if edits.ortho && view.ortho.is_none() {
-        view = view.toggled_ortho();
+    if ortho && framing.ortho.is_none() {
+        framing = framing.toggled_ortho();
     }
-    Some(view)
+    Some(framing)
 }
 
 /// The scene the app opens with: the startup paths as a document (the default scene when

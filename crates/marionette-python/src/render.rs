@@ -1,0 +1,307 @@
+//! `mt.Scene` and `mt.render`: pictures drawn in-process by one renderer kept alive between
+//! calls (its first call pays the start, later ones their drawn frames), read back as
+//! arrays from the files `render --data` writes, so each equals the binary's.
+
+use std::cell::RefCell;
+use std::mem::ManuallyDrop;
+use std::path::{Path, PathBuf};
+
+use numpy::IntoPyArray;
+use numpy::ndarray::{Array2, Array3};
+use pyo3::exceptions::PyValueError;
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+
+use marionette::document::AssetLibrary;
+use marionette::document::annotate::controlnet::ControlNet;
+use marionette::document::options::{PoseOptions, apply_options};
+use marionette::editor::present::data::Beside;
+use marionette::editor::present::render::{Renderer, ScenePicture};
+use marionette::editor::present::view::{FramingView, startup_view};
+use marionette::formats::scene::{BackgroundDoc, PlacementDoc, SceneDoc, ShotDoc, ViewName};
+
+use super::{Character, Error, SpecError, file_error, options_error};
+
+/// A scene to render: a scene file's, or characters placed.
+#[pyclass(module = "marionette", frozen)]
+pub struct Scene {
+    doc: SceneDoc,
+}
+
+#[pymethods]
+impl Scene {
+    /// The characters as loaded (their betas), each at its placement's `(x, y, z)` (the
+    /// origin without one).
+    #[new]
+    #[pyo3(signature = (characters, placements=None))]
+    fn new(characters: Vec<PyRef<'_, Character>>, placements: Option<Vec<(f32, f32, f32)>>) -> PyResult<Self> {
+        let placements = placements.unwrap_or_default();
+        if !placements.is_empty() && placements.len() != characters.len() {
+            let (want, found) = (characters.len(), placements.len());
+            return Err(PyValueError::new_err(format!("placements: expected {want}, found {found}")));
+        }
+        let mut doc = SceneDoc::default();
+        for (k, c) in characters.iter().enumerate() {
+            let mut c = c.doc.clone();
+            if let Some(&(x, y, z)) = placements.get(k) {
+                c.placement = PlacementDoc { translation: glam::Vec3::new(x, y, z), ..c.placement };
+            }
+            doc.characters.push(c);
+        }
+        Ok(Self { doc })
+    }
+
+    /// A scene file (`.ron`), its characters' files found beside it.
+    #[staticmethod]
+    fn load(py: Python<'_>, path: PathBuf) -> PyResult<Self> {
+        let doc = py.detach(|| marionette::document::scenes::read_scene(&path)).map_err(file_error)?;
+        Ok(Self { doc })
+    }
+
+    fn __repr__(&self) -> String {
+        format!("<marionette.Scene of {} characters>", self.doc.characters.len())
+    }
+}
+
+thread_local! {
+    /// The renderer of this thread, kept between calls (its app is not to be moved). Never
+    /// dropped as the thread ends: the GPU's own thread-locals are gone by then, and the
+    /// process is ending.
+    static RENDERER: RefCell<ManuallyDrop<Option<Renderer>>> = const { RefCell::new(ManuallyDrop::new(None)) };
+}
+
+/// Runs `draw` with this thread's renderer of pictures of `shot` (made from `library` where
+/// there is none of that size; one of another size is dropped first).
+fn with_renderer<T>(
+    shot: ShotDoc,
+    library: AssetLibrary,
+    draw: impl FnOnce(&mut Renderer) -> Result<T, String>,
+) -> PyResult<T> {
+    RENDERER.with_borrow_mut(|renderer| {
+        if renderer.as_ref().is_some_and(|r| r.picture() != shot) {
+            drop(std::mem::take(&mut **renderer));
+        }
+        if renderer.is_none() {
+            **renderer = Some(Renderer::new(library, shot).map_err(Error::new_err)?);
+        }
+        draw(renderer.as_mut().expect("made above")).map_err(Error::new_err)
+    })
+}
+
+/// What a render wrote, read back.
+struct Drawn {
+    rgb: (Vec<u8>, u32, u32, usize),
+    data: Option<Data>,
+    notes: Vec<String>,
+}
+
+struct Data {
+    depth: Vec<f32>,
+    normal: Vec<f32>,
+    mask: Vec<u16>,
+    coco: String,
+}
+
+/// The scene drawn as `render SCENE --width W --height H [--data] [--controlnet] [--view V]
+/// [--transparent] --out shot.png` draws it: a dict of `rgb` (uint8 (H, W, 3), or (H, W, 4)
+/// with `transparent`), and with `data` `depth` (float32 (H, W) metres along the view axis,
+/// inf where nothing), `normal` (float32 (H, W, 3), the camera frame `--data` documents),
+/// `mask` (uint16 (H, W) instance ids), `coco` (the COCO dict) and `camera` (`K`,
+/// `world_to_camera`: float64); and `notes`.
+#[pyfunction]
+#[pyo3(signature = (scene, *, width=640, height=480, samples=1, data=false, controlnet=false, view=None, transparent=false))]
+#[allow(clippy::too_many_arguments)]
+pub fn render<'py>(
+    py: Python<'py>,
+    scene: &Scene,
+    width: u32,
+    height: u32,
+    samples: u32,
+    data: bool,
+    controlnet: bool,
+    view: Option<String>,
+    transparent: bool,
+) -> PyResult<Bound<'py, PyDict>> {
+    let view: Option<ViewName> = view.map(|v| v.parse().map_err(PyValueError::new_err)).transpose()?;
+    let shot = ShotDoc { width, height, samples };
+    shot.validate().map_err(|e| PyValueError::new_err(e.to_string()))?;
+    let mut doc = scene.doc.clone();
+    let drawn = py.detach(|| -> PyResult<Drawn> {
+        let mut library = AssetLibrary::default();
+        // A still, as the command line draws one: every clip paused where it is.
+        let options = PoseOptions { still: true, ..PoseOptions::default() };
+        let mut notes = apply_options(&mut doc, &options, &mut library).map_err(options_error)?;
+        if transparent {
+            doc.stage.background = BackgroundDoc::Transparent;
+            doc.stage.floor = false;
+        }
+        let framing = startup_view(&mut doc, view, false).unwrap_or(FramingView::default().0);
+        let dir = scratch_dir()?;
+        let out = dir.join("shot.png");
+        let picture = ScenePicture { scene: doc, out: out.clone(), ids: (1, 1), backdrop: None };
+        let beside = Beside { data, controlnet: controlnet.then_some(ControlNet { canny: None }) };
+        let said = with_renderer(shot, library, |r| r.render(vec![picture], framing, beside));
+        let drawn = said.and_then(|said| {
+            notes.extend(said);
+            read_back(&out, data, notes)
+        });
+        let _ = std::fs::remove_dir_all(&dir);
+        drawn
+    })?;
+    drawn_dict(py, drawn)
+}
+
+/// A render read back as the dict [`render`] gives.
+fn drawn_dict(py: Python<'_>, drawn: Drawn) -> PyResult<Bound<'_, PyDict>> {
+    let out = PyDict::new(py);
+    let (rgba, w, h, channels) = drawn.rgb;
+    let (w, h) = (w as usize, h as usize);
+    let rgb = Array3::from_shape_vec((h, w, channels), rgba).expect("a picture's pixels");
+    out.set_item("rgb", rgb.into_pyarray(py))?;
+    if let Some(d) = drawn.data {
+        out.set_item("depth", Array2::from_shape_vec((h, w), d.depth).expect("a pass").into_pyarray(py))?;
+        out.set_item("normal", Array3::from_shape_vec((h, w, 3), d.normal).expect("a pass").into_pyarray(py))?;
+        out.set_item("mask", Array2::from_shape_vec((h, w), d.mask).expect("a pass").into_pyarray(py))?;
+        let coco = py.import("json")?.call_method1("loads", (d.coco,))?;
+        let numpy = py.import("numpy")?;
+        let camera = PyDict::new(py);
+        for key in ["K", "world_to_camera"] {
+            let rows = coco.get_item("camera")?.get_item(key)?;
+            camera.set_item(key, numpy.call_method1("array", (rows, "float64"))?)?;
+        }
+        for key in ["width", "height"] {
+            camera.set_item(key, coco.get_item("camera")?.get_item(key)?)?;
+        }
+        out.set_item("coco", coco)?;
+        out.set_item("camera", camera)?;
+    }
+    out.set_item("notes", drawn.notes)?;
+    Ok(out)
+}
+
+/// A spec read as `generate` reads it: the file's errors as `FileError`, the spec's as
+/// `SpecError`; `count` in place of its count.
+fn read_spec(path: &Path, count: Option<usize>) -> PyResult<marionette::document::generate::Spec> {
+    use marionette::formats::error::{open, read_text};
+    let text = open(path).and_then(|f| read_text(f, path)).map_err(file_error)?;
+    let mut spec =
+        marionette::document::generate::parse_spec(&text, path).map_err(|e| SpecError::new_err(e.to_string()))?;
+    if let Some(count) = count {
+        spec.count = count;
+        spec.check().map_err(|e| SpecError::new_err(format!("count: {e}")))?;
+    }
+    Ok(spec)
+}
+
+/// How many pictures the spec at `spec` makes (`count` in place of its own).
+#[pyfunction]
+#[pyo3(signature = (spec, count=None))]
+pub fn spec_count(spec: PathBuf, count: Option<usize>) -> PyResult<usize> {
+    Ok(read_spec(&spec, count)?.count)
+}
+
+/// Draws the pictures of the spec at `spec` (the shard `shard`, `I/N`, of them; `count` and
+/// `seed` in place of the spec's) into the folder `out` as `generate SPEC --out OUT` does,
+/// with this thread's renderer; returns every picture's key of the shard and whether the
+/// pictures carry data.
+#[pyfunction]
+#[pyo3(signature = (spec, out, shard=None, count=None, seed=None))]
+pub fn generate_pictures(
+    py: Python<'_>,
+    spec: PathBuf,
+    out: PathBuf,
+    shard: Option<String>,
+    count: Option<usize>,
+    seed: Option<u64>,
+) -> PyResult<(Vec<String>, bool)> {
+    use marionette::cli::args::{GenerateArgs, SetFormat};
+    use marionette::document::generate::{coco_ids, picture_stem};
+    read_spec(&spec, count)?;
+    py.detach(|| {
+        let args = GenerateArgs {
+            spec: Some(spec),
+            out: Some(out),
+            shard,
+            shards: None,
+            count,
+            seed,
+            dry_run: false,
+            example: false,
+            merge: None,
+            format: SetFormat::Folder,
+            shard_size: 1000,
+        };
+        let mut plan = marionette::cli::generate::plan(&args)
+            .map_err(|e| SpecError::new_err(format!("{e:#}")))?
+            .ok_or_else(|| Error::new_err("generate: nothing to draw"))?;
+        let keys = plan.shard.pictures(plan.spec.count).map(picture_stem).collect();
+        let controlnet = plan.spec.controlnet.then_some(ControlNet { canny: plan.spec.canny });
+        let beside = Beside { data: plan.spec.data, controlnet };
+        let pictures: Vec<ScenePicture> = std::mem::take(&mut plan.pictures)
+            .into_iter()
+            .map(|(k, scene, backdrop)| ScenePicture { scene, out: plan.out(k), ids: coco_ids(k), backdrop })
+            .collect();
+        if !pictures.is_empty() {
+            let (shot, library) = (plan.picture(), std::mem::take(&mut plan.library));
+            with_renderer(shot, library, |r| r.render(pictures, FramingView::default().0, beside))?;
+        }
+        Ok((keys, plan.spec.data))
+    })
+}
+
+/// A picture `generate` or `render` wrote at `path`, and with `data` the passes and COCO
+/// file beside it, as the dict [`render`] gives.
+#[pyfunction]
+pub fn read_picture(py: Python<'_>, path: PathBuf, data: bool) -> PyResult<Bound<'_, PyDict>> {
+    let drawn = py.detach(|| read_back(&path, data, Vec::new()))?;
+    drawn_dict(py, drawn)
+}
+
+/// A folder of its own for one render's files.
+fn scratch_dir() -> PyResult<PathBuf> {
+    use std::sync::atomic::{AtomicU64, Ordering};
+    static NEXT: AtomicU64 = AtomicU64::new(0);
+    let n = NEXT.fetch_add(1, Ordering::Relaxed);
+    let dir = std::env::temp_dir().join(format!("marionette-python-{}-{n}", std::process::id()));
+    std::fs::create_dir_all(&dir).map_err(|e| Error::new_err(format!("{}: {e}", dir.display())))?;
+    Ok(dir)
+}
+
+/// The picture at `out` and (with `data`) the passes and COCO file beside it.
+fn read_back(out: &Path, data: bool, notes: Vec<String>) -> PyResult<Drawn> {
+    use marionette::document::annotate::write::beside;
+    let failed = |path: &Path, e: &dyn std::fmt::Display| Error::new_err(format!("{}: {e}", path.display()));
+    let picture = image::open(out).map_err(|e| failed(out, &e))?;
+    let (w, h) = (picture.width(), picture.height());
+    let rgb = match picture.color().has_alpha() {
+        true => (picture.to_rgba8().into_raw(), w, h, 4),
+        false => (picture.to_rgb8().into_raw(), w, h, 3),
+    };
+    if !data {
+        return Ok(Drawn { rgb, data: None, notes });
+    }
+    let depth_path = beside(out, "depth.exr");
+    let depth = exr_depth(&depth_path).map_err(|e| failed(&depth_path, &e))?;
+    let normal_path = beside(out, "normal.png");
+    let normal = image::open(&normal_path).map_err(|e| failed(&normal_path, &e))?.to_rgb8();
+    // As `--data` writes them: n · 0.5 + 0.5 a byte a component, black where nothing.
+    let normal = normal
+        .pixels()
+        .flat_map(|p| match p.0 {
+            [0, 0, 0] => [0.0; 3],
+            c => c.map(|v| f32::from(v) / 255.0 * 2.0 - 1.0),
+        })
+        .collect();
+    let mask_path = beside(out, "mask.png");
+    let mask = image::open(&mask_path).map_err(|e| failed(&mask_path, &e))?.to_luma16().into_raw();
+    let coco_path = beside(out, "json");
+    let coco = std::fs::read_to_string(&coco_path).map_err(|e| failed(&coco_path, &e))?;
+    Ok(Drawn { rgb, data: Some(Data { depth, normal, mask, coco }), notes })
+}
+
+/// The `Z` channel of a depth EXR, row by row.
+fn exr_depth(path: &Path) -> Result<Vec<f32>, exr::error::Error> {
+    let image = exr::prelude::read_first_flat_layer_from_file(path)?;
+    let channel = image.layer_data.channel_data.list.iter().find(|c| c.name == *"Z");
+    Ok(channel.map(|c| c.sample_data.values_as_f32().collect()).unwrap_or_default())
+}

@@ -1,0 +1,89 @@
+"""Pictures and data sets drawn in-process against the binary's: `mt.render` equals the files
+`render --data` writes for the same scene, `mt.generate` writes the binary's pictures byte
+for byte, and one renderer serves every call of a process (llvmpipe without a GPU)."""
+
+import os
+import subprocess
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import marionette as mt
+from marionette import _native
+
+ROOT = Path(__file__).resolve().parents[3]
+SCENE = ROOT / "assets/default_scene.ron"
+SPEC = ROOT / "assets/generate_example.ron"
+BIN = os.environ.get("MARIONETTE_BIN", "marionette")
+
+
+def binary(*args, check=True):
+    done = subprocess.run([BIN, *map(str, args)], capture_output=True, text=True)
+    if check:
+        assert done.returncode == 0, done.stderr
+    return done
+
+
+def test_a_render_is_the_binarys_render_with_data(tmp_path):
+    out = mt.render(mt.Scene.load(SCENE), width=160, height=120, data=True)
+    binary("render", SCENE, "--width", 160, "--height", 120, "--data", "--out", tmp_path / "shot.png")
+    want = _native.read_picture(str(tmp_path / "shot.png"), True)
+    assert out["rgb"].dtype == np.uint8 and out["rgb"].shape == (120, 160, 3)
+    assert np.array_equal(out["rgb"], want["rgb"])
+    assert out["depth"].dtype == np.float32 and out["depth"].shape == (120, 160)
+    finite = np.isfinite(want["depth"])
+    assert np.array_equal(np.isfinite(out["depth"]), finite) and finite.any()
+    assert np.abs(out["depth"][finite] - want["depth"][finite]).max() <= 1e-6
+    assert np.array_equal(out["normal"], want["normal"]) and out["normal"].shape == (120, 160, 3)
+    assert out["mask"].dtype == np.uint16 and np.array_equal(out["mask"], want["mask"])
+    assert out["coco"] == want["coco"]
+    # Three puppets, each an instance id of the mask and an annotation with keypoints.
+    assert len(out["coco"]["annotations"]) == 3 and len(np.unique(out["mask"])) == 4
+    assert out["camera"]["K"].shape == (3, 3) and out["camera"]["world_to_camera"].shape == (4, 4)
+
+
+def test_the_renderer_is_kept_and_draws_each_scene_alike():
+    scene = mt.Scene.load(SCENE)
+    first = mt.render(scene, width=160, height=120)["rgb"]
+    c = mt.load(ROOT / "tests/data/rigs/mixamo.glb")
+    other = mt.render(mt.Scene([c], placements=[(0.0, 0.0, 0.0)]), width=160, height=120, view="front")["rgb"]
+    again = mt.render(scene, width=160, height=120)["rgb"]
+    assert not np.array_equal(first, other)
+    assert np.array_equal(first, again)
+    transparent = mt.render(scene, width=160, height=120, transparent=True)["rgb"]
+    assert transparent.shape == (120, 160, 4) and (transparent[..., 3] == 0).any()
+
+
+def test_generate_writes_the_binarys_pictures_byte_for_byte(tmp_path):
+    binary("generate", SPEC, "--out", tmp_path / "cli", "--count", 3)
+    samples = list(mt.generate(SPEC, count=3, out=tmp_path / "py"))
+    assert [s["key"] for s in samples] == ["000000", "000001", "000002"]
+    for s in samples:
+        for suffix in (".png", ".json", ".depth.exr", ".mask.png"):
+            a = (tmp_path / "py" / f"{s['key']}{suffix}").read_bytes()
+            b = (tmp_path / "cli" / f"{s['key']}{suffix}").read_bytes()
+            assert a == b, f"{s['key']}{suffix}"
+        assert s["rgb"].shape == (240, 320, 3) and s["coco"]["images"][0]["file_name"] == f"{s['key']}.png"
+
+
+def test_a_shard_and_a_dataset_split_the_set_as_the_binary_does():
+    keys = [s["key"] for s in mt.generate(SPEC, shard=(1, 2), count=4)]
+    assert keys == ["000001", "000003"]
+    ds = mt.Dataset(SPEC, count=2)
+    assert len(ds) == 2 and [s["key"] for s in ds] == ["000000", "000001"]
+
+
+def test_a_bad_spec_is_a_spec_error_with_the_binarys_message(tmp_path):
+    bad = tmp_path / "bad.ron"
+    bad.write_text(SPEC.read_text().replace("count: 16", "count: -3"))
+    with pytest.raises(mt.SpecError) as raised:
+        list(mt.generate(bad))
+    said = binary("generate", bad, "--out", tmp_path / "set", check=False)
+    assert said.returncode != 0 and str(raised.value) in said.stderr
+    with pytest.raises(mt.FileError):
+        list(mt.generate(tmp_path / "missing.ron"))
+    with pytest.raises(ValueError):
+        mt.render(mt.Scene.load(SCENE), width=0)
+    with pytest.raises(ValueError):
+        mt.render(mt.Scene.load(SCENE), view="sideways")
