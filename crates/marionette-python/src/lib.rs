@@ -230,10 +230,26 @@ impl Character {
     /// Its document with `options` applied as the command line applies them (a still pose
     /// baked in), and what they said.
     fn posed_doc(&mut self, py: Python<'_>, options: &PoseOptions) -> PyResult<(CharacterDoc, Vec<String>)> {
+        let mut doc = self.doc.clone();
+        let mut options = options.clone();
+        // An SMPL body plays its folder's clip (named whole, or by its name's end: `7516`).
+        if let (Some(smpl), SourceDoc::File(dir), Some(wanted)) = (&mut doc.smpl, &self.doc.source, &options.clip) {
+            let set = self.library.smpl(dir).map_err(file_error)?;
+            let names: Vec<&str> = set.clips.iter().map(|(n, _)| n.as_str()).collect();
+            let stem = |n: &str| n.strip_suffix(".txt").unwrap_or(n).to_string();
+            let found =
+                names.iter().find(|n| **n == wanted || stem(n) == *wanted || stem(n).ends_with(wanted.as_str()));
+            let Some(name) = found else {
+                let message = format!("{}: no clip `{wanted}` (its clips: {})", dir.display(), names.join(", "));
+                return Err(PoseError::new_err(message));
+            };
+            smpl.clip = Some(name.to_string());
+            options.clip = None;
+        }
         let mut scene = SceneDoc::default();
-        scene.characters.push(self.doc.clone());
+        scene.characters.push(doc);
         let library = &mut self.library;
-        let notes = py.detach(|| apply_options(&mut scene, options, library)).map_err(options_error)?;
+        let notes = py.detach(|| apply_options(&mut scene, &options, library)).map_err(options_error)?;
         let doc = scene.characters.pop().ok_or_else(|| Error::new_err("the character was not posed"))?;
         Ok((doc, notes))
     }

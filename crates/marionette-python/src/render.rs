@@ -30,8 +30,8 @@ pub struct Scene {
 
 #[pymethods]
 impl Scene {
-    /// The characters as loaded (their betas), each at its placement's `(x, y, z)` (the
-    /// origin without one).
+    /// The characters as loaded or posed (their betas, their poses), each moved by its
+    /// placement's `(x, y, z)` from where it stands (a posed character stands on the floor).
     #[new]
     #[pyo3(signature = (characters, placements=None))]
     fn new(characters: Vec<PyRef<'_, Character>>, placements: Option<Vec<(f32, f32, f32)>>) -> PyResult<Self> {
@@ -44,7 +44,8 @@ impl Scene {
         for (k, c) in characters.iter().enumerate() {
             let mut c = c.doc.clone();
             if let Some(&(x, y, z)) = placements.get(k) {
-                c.placement = PlacementDoc { translation: glam::Vec3::new(x, y, z), ..c.placement };
+                let translation = c.placement.translation + glam::Vec3::new(x, y, z);
+                c.placement = PlacementDoc { translation, ..c.placement };
             }
             doc.characters.push(c);
         }

@@ -106,6 +106,12 @@ def test_an_smpl_body_poses_and_reshapes_as_export_does(tmp_path):
     c.betas = np.array([2.0] + [0.0] * 9)
     assert np.abs(c.rest_vertices - before).max() > 1e-3
     assert c.pose(preset="sit-chair").vertices.shape == p.vertices.shape
+    # Its folder's clips play by name's end, at a time in seconds, as a still.
+    assert c.clips and all(name.endswith(".txt") for name in c.clips)
+    walk = c.pose(clip=c.clips[0][:-4][-4:], time=0.5).vertices
+    assert walk.shape == p.vertices.shape and np.abs(walk - c.pose(clip=c.clips[0], time=1.0).vertices).max() > 1e-3
+    with pytest.raises(mt.PoseError):
+        c.pose(clip="no-such-clip")
 
 
 def test_a_missing_file_is_a_file_error_with_the_binarys_message(tmp_path):
