@@ -17,6 +17,7 @@ use numpy::{IntoPyArray, PyArray1, PyArray2, PyArray3};
 use pyo3::create_exception;
 use pyo3::exceptions::{PyException, PyValueError};
 use pyo3::prelude::*;
+use pyo3::types::PyDict;
 
 use marionette_document::AssetLibrary;
 use marionette_document::options::{OptionsError, PoseOptions, PoseSpecs, apply_options};
@@ -167,22 +168,9 @@ impl Character {
     /// pole optional) and look-ats (`{"head": target}`), skinned by `"lbs"` or `"dq"`:
     /// as `export FILE --clip … --time … --preset … --hand … --pose … --two-bone …
     /// --look-at … --skinning …` poses it.
-    #[pyo3(signature = (*, time=None, clip=None, preset=None, mirrored=false, hands=None, rotations=None, two_bone=None, look_at=None, skinning=None))]
-    #[allow(clippy::too_many_arguments)]
-    fn pose(
-        &mut self,
-        py: Python<'_>,
-        time: Option<f32>,
-        clip: Option<String>,
-        preset: Option<String>,
-        mirrored: bool,
-        hands: Option<BTreeMap<String, String>>,
-        rotations: Option<BTreeMap<String, (f32, f32, f32)>>,
-        two_bone: Option<BTreeMap<String, TwoBoneGoal>>,
-        look_at: Option<BTreeMap<String, (f32, f32, f32)>>,
-        skinning: Option<String>,
-    ) -> PyResult<Pose> {
-        let options = pose_options(time, clip, (preset, mirrored), hands, rotations, two_bone, look_at, skinning)?;
+    #[pyo3(signature = (**arguments))]
+    fn pose(&mut self, py: Python<'_>, arguments: Option<&Bound<'_, PyDict>>) -> PyResult<Pose> {
+        let options = PoseRequest::options(py, arguments)?;
         let (doc, notes) = self.posed_doc(py, &options)?;
         let mut scene = SceneDoc::default();
         scene.characters.push(doc);
@@ -201,22 +189,9 @@ impl Character {
 
     /// A copy of the character that stands in this pose (the arguments of
     /// [`pose`](Self::pose)), for a scene: `mt.Scene([c.posed(preset="wave")])`.
-    #[pyo3(signature = (*, time=None, clip=None, preset=None, mirrored=false, hands=None, rotations=None, two_bone=None, look_at=None, skinning=None))]
-    #[allow(clippy::too_many_arguments)]
-    fn posed(
-        &mut self,
-        py: Python<'_>,
-        time: Option<f32>,
-        clip: Option<String>,
-        preset: Option<String>,
-        mirrored: bool,
-        hands: Option<BTreeMap<String, String>>,
-        rotations: Option<BTreeMap<String, (f32, f32, f32)>>,
-        two_bone: Option<BTreeMap<String, TwoBoneGoal>>,
-        look_at: Option<BTreeMap<String, (f32, f32, f32)>>,
-        skinning: Option<String>,
-    ) -> PyResult<Character> {
-        let options = pose_options(time, clip, (preset, mirrored), hands, rotations, two_bone, look_at, skinning)?;
+    #[pyo3(signature = (**arguments))]
+    fn posed(&mut self, py: Python<'_>, arguments: Option<&Bound<'_, PyDict>>) -> PyResult<Character> {
+        let options = PoseRequest::options(py, arguments)?;
         let (doc, _) = self.posed_doc(py, &options)?;
         Ok(Character { library: AssetLibrary::default(), doc })
     }
@@ -271,46 +246,70 @@ enum TwoBoneGoal {
     Target((f32, f32, f32)),
 }
 
-/// The command line's posing options from [`Character::pose`]'s arguments, each parsed as
-/// the command line parses it.
-#[allow(clippy::too_many_arguments)]
-fn pose_options(
-    time: Option<f32>,
-    clip: Option<String>,
-    (preset, mirrored): (Option<String>, bool),
-    hands: Option<BTreeMap<String, String>>,
-    rotations: Option<BTreeMap<String, (f32, f32, f32)>>,
-    two_bone: Option<BTreeMap<String, TwoBoneGoal>>,
-    look_at: Option<BTreeMap<String, (f32, f32, f32)>>,
-    skinning: Option<String>,
-) -> PyResult<PoseOptions> {
-    let specs = PoseSpecs {
-        preset: preset.map(|name| parsed(&format!("{name}{}", if mirrored { ":mirrored" } else { "" }))).transpose()?,
-        poses: spec_list(rotations, |(joint, (x, y, z))| format!("{joint}={x},{y},{z}"))?,
-        hands: hands
-            .unwrap_or_default()
-            .into_iter()
-            .map(|(side, name)| match side.as_str() {
-                "left" | "right" => parsed(&format!("{side}={name}")),
-                other => Err(PyValueError::new_err(format!("hands: expected \"left\" or \"right\", found {other:?}"))),
-            })
-            .collect::<PyResult<_>>()?,
-        ik: Vec::new(),
-        two_bone: spec_list(two_bone, |(joint, goal)| match goal {
-            TwoBoneGoal::Target((x, y, z)) => format!("{joint}={x},{y},{z}"),
-            TwoBoneGoal::WithPole((x, y, z), (a, b, c)) => format!("{joint}={x},{y},{z}@{a},{b},{c}"),
-        })?,
-        look_at: spec_list(look_at, |(joint, (x, y, z))| format!("{joint}={x},{y},{z}"))?,
-    };
-    let skinning = match skinning.as_deref() {
-        None => None,
-        Some("lbs") => Some(SkinningMethod::Linear),
-        Some("dq") => Some(SkinningMethod::DualQuaternion),
-        Some(other) => {
-            return Err(PyValueError::new_err(format!("skinning: expected \"lbs\" or \"dq\", found {other:?}")));
-        }
-    };
-    Ok(PoseOptions { specs, skinning, clip, time, still: true, ..PoseOptions::default() })
+/// The arguments of [`Character::pose`] and [`Character::posed`] as the command line's
+/// posing options, each parsed as the command line parses it.
+#[pyclass(module = "marionette", frozen)]
+struct PoseRequest {
+    options: PoseOptions,
+}
+
+impl PoseRequest {
+    /// The options keyword `arguments` ask for (a `TypeError` for an argument of another
+    /// name or type).
+    fn options(py: Python<'_>, arguments: Option<&Bound<'_, PyDict>>) -> PyResult<PoseOptions> {
+        let request = py.get_type::<PoseRequest>().call((), arguments)?;
+        Ok(request.extract::<PyRef<'_, PoseRequest>>()?.options.clone())
+    }
+}
+
+#[pymethods]
+impl PoseRequest {
+    #[new]
+    #[pyo3(signature = (*, time=None, clip=None, preset=None, mirrored=false, hands=None, rotations=None, two_bone=None, look_at=None, skinning=None))]
+    #[allow(clippy::too_many_arguments)]
+    fn new(
+        time: Option<f32>,
+        clip: Option<String>,
+        preset: Option<String>,
+        mirrored: bool,
+        hands: Option<BTreeMap<String, String>>,
+        rotations: Option<BTreeMap<String, (f32, f32, f32)>>,
+        two_bone: Option<BTreeMap<String, TwoBoneGoal>>,
+        look_at: Option<BTreeMap<String, (f32, f32, f32)>>,
+        skinning: Option<String>,
+    ) -> PyResult<Self> {
+        let specs = PoseSpecs {
+            preset: preset
+                .map(|name| parsed(&format!("{name}{}", if mirrored { ":mirrored" } else { "" })))
+                .transpose()?,
+            poses: spec_list(rotations, |(joint, (x, y, z))| format!("{joint}={x},{y},{z}"))?,
+            hands: hands
+                .unwrap_or_default()
+                .into_iter()
+                .map(|(side, name)| match side.as_str() {
+                    "left" | "right" => parsed(&format!("{side}={name}")),
+                    other => {
+                        Err(PyValueError::new_err(format!("hands: expected \"left\" or \"right\", found {other:?}")))
+                    }
+                })
+                .collect::<PyResult<_>>()?,
+            ik: Vec::new(),
+            two_bone: spec_list(two_bone, |(joint, goal)| match goal {
+                TwoBoneGoal::Target((x, y, z)) => format!("{joint}={x},{y},{z}"),
+                TwoBoneGoal::WithPole((x, y, z), (a, b, c)) => format!("{joint}={x},{y},{z}@{a},{b},{c}"),
+            })?,
+            look_at: spec_list(look_at, |(joint, (x, y, z))| format!("{joint}={x},{y},{z}"))?,
+        };
+        let skinning = match skinning.as_deref() {
+            None => None,
+            Some("lbs") => Some(SkinningMethod::Linear),
+            Some("dq") => Some(SkinningMethod::DualQuaternion),
+            Some(other) => {
+                return Err(PyValueError::new_err(format!("skinning: expected \"lbs\" or \"dq\", found {other:?}")));
+            }
+        };
+        Ok(Self { options: PoseOptions { specs, skinning, clip, time, still: true, ..PoseOptions::default() } })
+    }
 }
 
 /// A command-line spec parsed as the command line parses it (its message on failure).

@@ -14,20 +14,11 @@ import numpy as np
 import pytest
 
 import marionette as mt
+from conftest import ROOT, binary
 
-ROOT = Path(__file__).resolve().parents[3]
 MIXAMO = ROOT / "tests/data/rigs/mixamo.glb"
-BIN = os.environ.get("MARIONETTE_BIN", "marionette")
 DATA = os.environ.get("MARIONETTE_DATA")
 needs_data = pytest.mark.skipif(not DATA, reason="MARIONETTE_DATA names no data folder")
-
-
-def binary(*args, check=True):
-    """The binary run with `args`: its completed process."""
-    done = subprocess.run([BIN, *map(str, args)], capture_output=True, text=True)
-    if check:
-        assert done.returncode == 0, done.stderr
-    return done
 
 
 def obj_vertices(path):

@@ -2,27 +2,16 @@
 `render --data` writes for the same scene, `mt.generate` writes the binary's pictures byte
 for byte, and one renderer serves every call of a process (llvmpipe without a GPU)."""
 
-import os
-import subprocess
-from pathlib import Path
 
 import numpy as np
 import pytest
 
 import marionette as mt
+from conftest import ROOT, binary
 from marionette import _native
 
-ROOT = Path(__file__).resolve().parents[3]
 SCENE = ROOT / "assets/default_scene.ron"
 SPEC = ROOT / "assets/generate_example.ron"
-BIN = os.environ.get("MARIONETTE_BIN", "marionette")
-
-
-def binary(*args, check=True):
-    done = subprocess.run([BIN, *map(str, args)], capture_output=True, text=True)
-    if check:
-        assert done.returncode == 0, done.stderr
-    return done
 
 
 def test_a_render_is_the_binarys_render_with_data(tmp_path):
