@@ -318,6 +318,18 @@ fn the_openpose_drawing_has_controlnets_colours_and_limbs() {
     const FROM_25: [usize; 18] = [0, 1, 2, 3, 4, 5, 6, 7, 9, 10, 11, 12, 13, 14, 15, 16, 17, 18];
     let dir = scratch("data-openpose");
     render_data(&dir, &[puppet("a", 0.0, 0.3)], &[]);
+    // The keypoint reader (`--fit`'s) reads the OpenPose JSON (BODY_25) and the COCO file
+    // (17 points) the render wrote, each point under the same name in both.
+    use marionette::formats::keypoints::{COCO_17, read_keypoints};
+    let (open, coco) = (read_keypoints(&dir.join("shot.openpose.json")), read_keypoints(&dir.join("shot.json")));
+    let (open, coco) = (open.unwrap(), coco.unwrap());
+    assert_eq!(coco.size, Some((W as f32, H as f32)));
+    let (a, b) = (open.person(None).unwrap(), coco.person(None).unwrap());
+    let shared: Vec<_> = COCO_17.iter().filter_map(|&n| Some((n, a.point(n)?, b.point(n)?))).collect();
+    assert!(shared.len() >= 12, "{} points in both", shared.len());
+    for (name, p, q) in shared {
+        assert!((p.x - q.x).abs() <= 1.0 && (p.y - q.y).abs() <= 1.0, "{name:?}: {p:?} and {q:?}");
+    }
     let drawing = image::open(dir.join("shot.openpose.png")).unwrap().to_rgb8();
     let json: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(dir.join("shot.openpose.json")).unwrap()).unwrap();

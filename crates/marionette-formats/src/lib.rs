@@ -16,6 +16,7 @@ pub mod gltf_import;
 pub mod gltf_materials;
 pub mod gltf_out_materials;
 pub mod homer;
+pub mod keypoints;
 pub mod limits;
 pub mod mit6837;
 pub mod node_tree;
