@@ -286,9 +286,8 @@ fn carry_onto(targets: Vec<CharacterDoc>, library: &mut AssetLibrary) {
                 && f.standing.0 <= f.standing.1
                 && f.standing.1 < 0.02
                 && f.lowest > -1e-3
-                // Where a foot is lifted onto the floor the reach still bends the knee a few
-                // degrees past the source's (issue 64 asks for none): held to today's.
-                && f.knee_past < 5.0
+                // Planting bends no knee further than the source's (2°: the directions' bound).
+                && f.knee_past < 2.0
                 && f.knees_backwards == 0;
             if !ok {
                 failures.push(format!("{bvh} → {} (planting {plant_feet}): {f:?}", target.name));

@@ -17,7 +17,8 @@
 //!   where the source stands on its own).
 //! - **Feet.** Where the source plants a foot (low and still), the target's foot keeps the
 //!   place it had when the contact began, moving only as the source's foot moves (scaled);
-//!   no ankle sinks below its standing height where the source's stands on the floor, and
+//!   no ankle sinks below its standing height (less a two-hundredth of the leg, which a
+//!   straight knee would bend degrees to give) where the source's stands on the floor, and
 //!   no toe below the floor. The legs
 //!   reach by the IK solver, the feet keeping their turn in the world; after a contact
 //!   the correction fades over a few frames.
@@ -463,9 +464,13 @@ impl<'a> Retargeter<'a> {
         // The lowest the target's ankle may go, for the source's ankle at `y`: standing
         // height where the source's stands (or higher), lower in proportion where the
         // source's is lower (a foot rolled onto its toes).
+        // Within a two-hundredth of the leg of it (a few millimetres, which a near-straight
+        // knee would have to bend degrees to give), an ankle is left where the source's
+        // directions put it.
+        let slack = 0.005 * self.target_leg;
         let lowest = |y: f32| {
             let standing = ((y - self.source.floor) / s_ankle.max(1e-6)).clamp(0.0, 1.0);
-            self.target.floor + t_ankle.max(0.0) * standing
+            self.target.floor + t_ankle.max(0.0) * standing - slack
         };
         let fade = (fps * 0.15).round().max(1.0) as usize;
         let mut anchor: Option<(Vec3, Vec3)> = None;
