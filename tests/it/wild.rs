@@ -249,11 +249,14 @@ fn doc_of(library: &mut AssetLibrary, path: &Path) -> CharacterDoc {
     library.new_character_doc(source, &asset)
 }
 
-/// Every BVH fixture onto every target: the figures printed, held to the bounds.
+/// Every BVH fixture (CMU- and Bandai-shaped, and the CMU walk as MotionBuilder and Mixamo
+/// files are shaped) onto every target: the figures printed, held to the bounds.
 fn carry_onto(targets: Vec<CharacterDoc>, library: &mut AssetLibrary) {
     let mut failures = Vec::new();
-    for bvh in ["cmu_walk.bvh", "bandai_walk.bvh"] {
-        let path = fixture(bvh);
+    let mut walks = vec![fixture("cmu_walk.bvh"), fixture("bandai_walk.bvh")];
+    walks.extend(family_walks());
+    for path in walks {
+        let bvh = path.file_name().unwrap().to_string_lossy().into_owned();
         let source = file_motion_doc(library, &path, None).unwrap();
         for (target, plant_feet) in targets.iter().flat_map(|t| [(t, false), (t, true)]) {
             let asset = library.shaped(target).unwrap();
@@ -601,4 +604,133 @@ fn a_still_root_above_moving_hips_exports_as_the_file_defines_it() {
     }
     eprintln!("worst joint off the file's definition: {worst:.2e} of the skeleton's size");
     assert!(worst < 1e-5, "{worst}");
+}
+
+/// A BVH joint read for rewriting: its name, OFFSET, channel names, its motion columns, its
+/// children and its End Site.
+struct BvhNode {
+    name: String,
+    offset: [f64; 3],
+    channels: Vec<String>,
+    columns: std::ops::Range<usize>,
+    children: Vec<BvhNode>,
+    end: Option<[f64; 3]>,
+}
+
+/// `text`'s skeleton and frames (each a row of numbers).
+fn read_bvh_tree(text: &str) -> (BvhNode, String, Vec<Vec<f64>>) {
+    let (hierarchy, motion) = text.split_once("MOTION").unwrap();
+    let mut words = hierarchy.split_whitespace().peekable();
+    let mut column = 0;
+    fn node(words: &mut std::iter::Peekable<std::str::SplitWhitespace<'_>>, column: &mut usize) -> BvhNode {
+        let name = words.next().unwrap().to_string();
+        assert_eq!(words.next(), Some("{"));
+        assert_eq!(words.next(), Some("OFFSET"));
+        let mut v = || words.next().unwrap().parse::<f64>().unwrap();
+        let offset = [v(), v(), v()];
+        assert_eq!(words.next(), Some("CHANNELS"));
+        let n: usize = words.next().unwrap().parse().unwrap();
+        let channels: Vec<String> = (0..n).map(|_| words.next().unwrap().to_string()).collect();
+        let columns = *column..*column + n;
+        *column += n;
+        let (mut children, mut end) = (Vec::new(), None);
+        loop {
+            match words.next().unwrap() {
+                "JOINT" => children.push(node(words, column)),
+                "End" => {
+                    let _site = words.next();
+                    let _open = words.next();
+                    let _offset = words.next();
+                    let mut v = || words.next().unwrap().parse::<f64>().unwrap();
+                    end = Some([v(), v(), v()]);
+                    let _close = words.next();
+                }
+                "}" => break,
+                other => panic!("{other}"),
+            }
+        }
+        BvhNode { name, offset, channels, columns, children, end }
+    }
+    assert_eq!(words.next(), Some("HIERARCHY"));
+    assert_eq!(words.next(), Some("ROOT"));
+    let root = node(&mut words, &mut column);
+    let mut lines = motion.lines().filter(|l| !l.trim().is_empty());
+    let header = format!("{}\n{}\n", lines.next().unwrap().trim(), lines.next().unwrap().trim());
+    let frames = lines.map(|l| l.split_whitespace().map(|x| x.parse().unwrap()).collect()).collect();
+    (root, header, frames)
+}
+
+/// `cmu_walk.bvh` in another family's shape: the joints `drop` names taken out (their
+/// children hung from their parents, moved by their offsets; their channels gone) and every
+/// other renamed by `rename` (a name it does not know kept).
+fn bvh_in_family(drop: &[&str], rename: &dyn Fn(&str) -> Option<String>) -> String {
+    let (root, header, frames) = read_bvh_tree(&std::fs::read_to_string(fixture("cmu_walk.bvh")).unwrap());
+    fn kept(node: BvhNode, drop: &[&str], moved: [f64; 3]) -> Vec<BvhNode> {
+        let offset = [node.offset[0] + moved[0], node.offset[1] + moved[1], node.offset[2] + moved[2]];
+        if drop.contains(&node.name.as_str()) {
+            return node.children.into_iter().flat_map(|c| kept(c, drop, offset)).collect();
+        }
+        let children = node.children.into_iter().flat_map(|c| kept(c, drop, [0.0; 3])).collect();
+        vec![BvhNode { offset, children, ..node }]
+    }
+    let root = kept(root, drop, [0.0; 3]).pop().unwrap();
+    let mut text = String::from("HIERARCHY\n");
+    let mut columns = Vec::new();
+    fn write(
+        node: &BvhNode,
+        root: bool,
+        rename: &dyn Fn(&str) -> Option<String>,
+        text: &mut String,
+        columns: &mut Vec<usize>,
+    ) {
+        let name = rename(&node.name).unwrap_or_else(|| node.name.clone());
+        let [x, y, z] = node.offset;
+        *text += &format!(
+            "{} {name}\n{{\nOFFSET {x} {y} {z}\nCHANNELS {} {}\n",
+            if root { "ROOT" } else { "JOINT" },
+            node.channels.len(),
+            node.channels.join(" ")
+        );
+        columns.extend(node.columns.clone());
+        for child in &node.children {
+            write(child, false, rename, text, columns);
+        }
+        if let Some([x, y, z]) = node.end.filter(|_| node.children.is_empty()) {
+            *text += &format!("End Site\n{{\nOFFSET {x} {y} {z}\n}}\n");
+        }
+        *text += "}\n";
+    }
+    write(&root, true, rename, &mut text, &mut columns);
+    text += &format!("MOTION\n{header}");
+    for row in frames {
+        text += &columns.iter().map(|&c| format!("{}", row[c])).collect::<Vec<_>>().join(" ");
+        text.push('\n');
+    }
+    text
+}
+
+/// The CMU walk written as MotionBuilder (HumanIK) and Mixamo files are shaped: no
+/// pelvis-side hip joints, one neck, no thumbs or finger bases; MotionBuilder's names, and
+/// Mixamo's (`mixamorig:` and its three spine joints).
+fn family_walks() -> Vec<PathBuf> {
+    let drop = ["LHipJoint", "RHipJoint", "Neck1", "LThumb", "RThumb", "LeftFingerBase", "RightFingerBase"];
+    let dir = scratch("bvh-families");
+    let mixamo = |name: &str| {
+        let renamed = match name {
+            "LowerBack" => "Spine",
+            "Spine" => "Spine1",
+            "Spine1" => "Spine2",
+            other => other,
+        };
+        Some(format!("mixamorig:{renamed}"))
+    };
+    let mut out = Vec::new();
+    for (file, rename) in
+        [("motionbuilder_walk.bvh", &(|_: &str| None) as &dyn Fn(&str) -> Option<String>), ("mixamo_walk.bvh", &mixamo)]
+    {
+        let path = dir.join(file);
+        std::fs::write(&path, bvh_in_family(&drop, rename)).unwrap();
+        out.push(path);
+    }
+    out
 }
