@@ -83,14 +83,31 @@ pub(crate) struct Side {
 }
 
 pub(crate) fn side(library: &mut AssetLibrary, doc: &CharacterDoc, floor: f32) -> Side {
+    side_standing(library, doc, floor, None)
+}
+
+/// As [`side`], standing as in `stands` (a motion capture whose rest lies down: its first
+/// frame) in place of its initial pose.
+pub(crate) fn side_standing(
+    library: &mut AssetLibrary,
+    doc: &CharacterDoc,
+    floor: f32,
+    stands: Option<&Frame>,
+) -> Side {
     let asset = library.shaped(doc).unwrap();
     let map = humanoid_map(&asset, &doc.humanoid);
     let skeleton = &asset.skeleton;
-    let at = positions(skeleton, skeleton.joint(0).rest_offset, &skeleton.initial_pose());
+    let at = match stands {
+        Some(frame) => frame.world(skeleton).1,
+        None => positions(skeleton, skeleton.joint(0).rest_offset, &skeleton.initial_pose()),
+    };
     use HumanBone::*;
     let leg = |u, l, f| at[map[&u]].distance(at[map[&l]]) + at[map[&l]].distance(at[map[&f]]);
     let leg = (leg(LeftUpperLeg, LeftLowerLeg, LeftFoot) + leg(RightUpperLeg, RightLowerLeg, RightFoot)) / 2.0;
-    let rest_floor = marionette::document::retarget::floor_of(&asset);
+    let rest_floor = match stands {
+        Some(_) => at.iter().map(|p| p.y).fold(f32::INFINITY, f32::min),
+        None => marionette::document::retarget::floor_of(&asset),
+    };
     let standing = at[map[&Hips]].y - rest_floor;
     let straight = |u, l, f| {
         at[map[&Hips]].y - at[map[&u]].y
@@ -613,7 +630,7 @@ fn the_targets_limits_clamp_and_the_report_says_where() {
         .collect();
     let target = Skeleton::build(raw).unwrap();
     let map = marionette::rig::humanoid::detect(&source).unwrap();
-    let side = |skeleton| Humanoid { skeleton, map: &map, floor: 0.0, rest_floor: 0.0, soles: &[] };
+    let side = |skeleton| Humanoid { skeleton, map: &map, floor: 0.0, rest_floor: 0.0, soles: &[], stands: None };
     let retargeter = Retargeter::new(side(&source), side(&target), RestAlignment::Directions).unwrap();
     let elbow = source.find("l_elbow").unwrap();
     let frames: Vec<Frame> = (0..4)

@@ -26,7 +26,7 @@ use marionette::rig::humanoid::{Found, HumanBone};
 use marionette::rig::retarget::{Frame, Retargeted, world_frames};
 
 use crate::common::scratch;
-use crate::retarget::{Side, side};
+use crate::retarget::{Side, side, side_standing};
 
 fn fixture(file: &str) -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/data/rigs").join(file)
@@ -255,6 +255,7 @@ fn carry_onto(targets: Vec<CharacterDoc>, library: &mut AssetLibrary) {
     let mut failures = Vec::new();
     let mut walks = vec![fixture("cmu_walk.bvh"), fixture("bandai_walk.bvh")];
     walks.extend(family_walks());
+    walks.push(fixture("bandai_lying_walk.bvh"));
     for path in walks {
         let bvh = path.file_name().unwrap().to_string_lossy().into_owned();
         let source = file_motion_doc(library, &path, None).unwrap();
@@ -263,7 +264,11 @@ fn carry_onto(targets: Vec<CharacterDoc>, library: &mut AssetLibrary) {
             let settings =
                 RetargetDoc { plant_feet, ..RetargetDoc::of(MotionSourceDoc::File { path: path.clone(), clip: None }) };
             let done = retarget(library, &source, target, &asset, &settings).unwrap();
-            let (s, t) = (side(library, &source, done.floors.0), side(library, target, done.floors.1));
+            // A source lying down at rest stands as in its first frame.
+            let lying = path.file_name().is_some_and(|n| n.to_string_lossy().contains("lying"));
+            let stands = done.source_frames.first().filter(|_| lying);
+            let s = side_standing(library, &source, done.floors.0, stands);
+            let t = side(library, target, done.floors.1);
             let f = measure(&s, &done.source_frames, &t, &done.report);
             eprintln!(
                 "{bvh} → {} (planting {plant_feet}): worst bone {:.2}° ({}), hips over standing against the source's {:.4}–{:.4} (over the source's × leg ratio {:.4}–{:.4}, × straight {:.4}–{:.4}), lowest point where the source stands {:+.4}–{:+.4} legs, lowest {:+.4}, knees at most {:.2}° past the source's, {} bent backwards, {} leg-frames moved to plant",

@@ -59,6 +59,18 @@ pub fn motion_floor(asset: &CharacterAsset, frames: &[Frame]) -> f32 {
     }
 }
 
+/// Whether a humanoid stands in its initial pose: its hips below its head (else its chest,
+/// neck), the line between within 45° of up.
+fn stands_upright(skeleton: &marionette_rig::Skeleton, map: &HumanoidMap) -> bool {
+    let (_, at) =
+        marionette_rig::retarget::world_frames(skeleton, skeleton.joint(0).rest_offset, &skeleton.initial_pose());
+    let top = [HumanBone::Head, HumanBone::Neck, HumanBone::Chest].iter().find_map(|b| map.get(b));
+    match (map.get(&HumanBone::Hips), top) {
+        (Some(&hips), Some(&top)) => (at[top] - at[hips]).normalize_or_zero().y > std::f32::consts::FRAC_1_SQRT_2,
+        _ => true,
+    }
+}
+
 /// The lowest point of a character in a frame: of its skinned mesh, or of its joints
 /// where it has none (never of the boxes drawn for its bones).
 fn lowest_point(asset: &CharacterAsset, frame: &Frame) -> f32 {
@@ -249,15 +261,20 @@ fn work_out_retargeting(
     let same_rig = source_asset.skeleton == target_asset.skeleton && s_map == t_map;
     let t_floor = if same_rig { s_floor } else { floor_of(target_asset) };
     let (s_soles, t_soles) = (soles(&source_asset, &s_map), soles(target_asset, &t_map));
+    // A source whose rest does not stand (a motion capture lying along +x at zero rotations)
+    // stands as in its first frame.
+    let stands = source_frames.first().filter(|_| !stands_upright(s_skel, &s_map));
+    let s_rest_floor = stands.map_or_else(|| floor_of(&source_asset), |f| lowest_point(&source_asset, f));
     let retargeter = Retargeter::new(
+        Humanoid { skeleton: s_skel, map: &s_map, floor: s_floor, rest_floor: s_rest_floor, soles: &s_soles, stands },
         Humanoid {
-            skeleton: s_skel,
-            map: &s_map,
-            floor: s_floor,
-            rest_floor: floor_of(&source_asset),
-            soles: &s_soles,
+            skeleton: t_skel,
+            map: &t_map,
+            floor: t_floor,
+            rest_floor: floor_of(target_asset),
+            soles: &t_soles,
+            stands: None,
         },
-        Humanoid { skeleton: t_skel, map: &t_map, floor: t_floor, rest_floor: floor_of(target_asset), soles: &t_soles },
         settings.rest,
     )
     .ok_or_else(|| {
@@ -334,7 +351,7 @@ pub fn pose_onto(
             named.push(j);
         }
     }
-    let side = |(skeleton, map)| Humanoid { skeleton, map, floor: 0.0, rest_floor: 0.0, soles: &[] };
+    let side = |(skeleton, map)| Humanoid { skeleton, map, floor: 0.0, rest_floor: 0.0, soles: &[], stands: None };
     let rest = marionette_rig::retarget::RestAlignment::Directions;
     match Retargeter::new(side((s, s_map)), side(target), rest) {
         Some(retargeter) => retargeter.pose_over(&full, current, &named),

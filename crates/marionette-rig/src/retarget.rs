@@ -43,8 +43,10 @@ pub enum RestAlignment {
 
 /// A humanoid to retarget from or onto: its skeleton, map, the height of the floor its
 /// motion stands on in model space, and of its lowest point standing in its initial pose
-/// (for a target, the same); and its soles: points of its skin under its feet, by which
-/// it stands (empty: its foot joints).
+/// (for a target, the same); its soles: points of its skin under its feet, by which it
+/// stands (empty: its foot joints); and the pose it stands in where its initial pose does
+/// not (a motion capture whose rest lies along +x: its motion's first frame), which then
+/// takes the initial pose's place.
 #[derive(Clone, Copy)]
 pub struct Humanoid<'a> {
     pub skeleton: &'a Skeleton,
@@ -52,6 +54,7 @@ pub struct Humanoid<'a> {
     pub floor: f32,
     pub rest_floor: f32,
     pub soles: &'a [Sole],
+    pub stands: Option<&'a Frame>,
 }
 
 /// A skin point as its joints move it: each joint, its weight, and the point in that
@@ -221,7 +224,10 @@ impl<'a> Retargeter<'a> {
     /// shin, foot) or the hips.
     pub fn new(source: Humanoid<'a>, target: Humanoid<'a>, rest: RestAlignment) -> Option<Self> {
         let (s, t) = (source.skeleton, target.skeleton);
-        let (source_rest, source_rest_at) = world_frames(s, s.joint(0).rest_offset, &s.initial_pose());
+        let (source_rest, source_rest_at) = match source.stands {
+            Some(frame) => frame.world(s),
+            None => world_frames(s, s.joint(0).rest_offset, &s.initial_pose()),
+        };
         let (target_rest, target_rest_at) = world_frames(t, t.joint(0).rest_offset, &t.initial_pose());
         source.map.get(&HumanBone::Hips)?;
         target.map.get(&HumanBone::Hips)?;
@@ -599,8 +605,8 @@ pub fn retarget_pose(
     rest: RestAlignment,
 ) -> Option<Vec<JointRotation>> {
     let retargeter = Retargeter::new(
-        Humanoid { skeleton: source.0, map: source.1, floor: 0.0, rest_floor: 0.0, soles: &[] },
-        Humanoid { skeleton: target.0, map: target.1, floor: 0.0, rest_floor: 0.0, soles: &[] },
+        Humanoid { skeleton: source.0, map: source.1, floor: 0.0, rest_floor: 0.0, soles: &[], stands: None },
+        Humanoid { skeleton: target.0, map: target.1, floor: 0.0, rest_floor: 0.0, soles: &[], stands: None },
         rest,
     )?;
     let frame = Frame::posed(source.0.joint(0).rest_offset, source_pose.to_vec());
