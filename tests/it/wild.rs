@@ -152,6 +152,8 @@ struct Figures {
     /// knee bends the other way from a source's bent one.
     knee_past: f32,
     knees_backwards: usize,
+    /// Frames a target elbow bends the other way from a source's bent one.
+    elbows_backwards: usize,
     /// Leg-frames the report says were moved to plant a foot.
     legs_moved: usize,
 }
@@ -183,6 +185,7 @@ fn measure(s: &Side, source: &[Frame], t: &Side, report: &Retargeted) -> Figures
         lowest: f32::MAX,
         knee_past: f32::MIN,
         knees_backwards: 0,
+        elbows_backwards: 0,
         legs_moved: report.legs_moved.iter().map(|side| side.iter().filter(|&&m| m).count()).sum(),
     };
     for (k, (sf, tf)) in source.iter().zip(target).enumerate() {
@@ -217,6 +220,21 @@ fn measure(s: &Side, source: &[Frame], t: &Side, report: &Retargeted) -> Figures
             f.knee_past = f.knee_past.max(t_angle - s_angle);
             if s_angle > 5.0 && t_angle > 5.0 && s_way != t_way {
                 f.knees_backwards += 1;
+            }
+        }
+        // Each elbow bent the same way as the source's (the turn from upper to lower arm).
+        for (upper, lower, hand) in [(LeftUpperArm, LeftLowerArm, LeftHand), (RightUpperArm, RightLowerArm, RightHand)]
+        {
+            let bend = |map: &marionette::rig::humanoid::HumanoidMap, at: &[Vec3]| -> Option<(f32, Vec3)> {
+                let (u, l, h) = (at[*map.get(&upper)?], at[*map.get(&lower)?], at[*map.get(&hand)?]);
+                Some(((l - u).angle_between(h - l).to_degrees(), (l - u).cross(h - l)))
+            };
+            if let (Some((s_angle, s_axis)), Some((t_angle, t_axis))) = (bend(&s.map, &sa), bend(&t.map, &ta))
+                && s_angle > 5.0
+                && t_angle > 5.0
+                && s_axis.dot(t_axis) < 0.0
+            {
+                f.elbows_backwards += 1;
             }
         }
         // Hips hung below the chest (6.837's models) lie from the chest as the source's.
@@ -271,7 +289,7 @@ fn carry_onto(targets: Vec<CharacterDoc>, library: &mut AssetLibrary) {
             let t = side(library, target, done.floors.1);
             let f = measure(&s, &done.source_frames, &t, &done.report);
             eprintln!(
-                "{bvh} → {} (planting {plant_feet}): worst bone {:.2}° ({}), hips over standing against the source's {:.4}–{:.4} (over the source's × leg ratio {:.4}–{:.4}, × straight {:.4}–{:.4}), lowest point where the source stands {:+.4}–{:+.4} legs, lowest {:+.4}, knees at most {:.2}° past the source's, {} bent backwards, {} leg-frames moved to plant",
+                "{bvh} → {} (planting {plant_feet}): worst bone {:.2}° ({}), hips over standing against the source's {:.4}–{:.4} (over the source's × leg ratio {:.4}–{:.4}, × straight {:.4}–{:.4}), lowest point where the source stands {:+.4}–{:+.4} legs, lowest {:+.4}, knees at most {:.2}° past the source's, {} knees and {} elbows bent backwards, {} leg-frames moved to plant",
                 target.name,
                 f.worst.0,
                 f.worst.1,
@@ -286,6 +304,7 @@ fn carry_onto(targets: Vec<CharacterDoc>, library: &mut AssetLibrary) {
                 f.lowest,
                 f.knee_past,
                 f.knees_backwards,
+                f.elbows_backwards,
                 f.legs_moved
             );
             let ok = f.worst.0 < 2.0
@@ -296,7 +315,8 @@ fn carry_onto(targets: Vec<CharacterDoc>, library: &mut AssetLibrary) {
                 && f.lowest > -1e-3
                 // Planting bends no knee further than the source's (2°: the directions' bound).
                 && f.knee_past < 2.0
-                && f.knees_backwards == 0;
+                && f.knees_backwards == 0
+                && f.elbows_backwards == 0;
             if !ok {
                 failures.push(format!("{bvh} → {} (planting {plant_feet}): {f:?}", target.name));
             }
