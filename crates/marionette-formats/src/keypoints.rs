@@ -16,59 +16,38 @@ use serde_json::Value;
 
 use super::error::FormatError;
 
-/// The body points a detector gives, by name.
+/// The body points a detector gives, by name (in alphabetical order; each file's order is
+/// its table's).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
 pub enum BodyPoint {
-    Nose,
-    Neck,
-    RightShoulder,
-    RightElbow,
-    RightWrist,
-    LeftShoulder,
+    LeftAnkle,
+    LeftBigToe,
+    LeftEar,
     LeftElbow,
-    LeftWrist,
-    MidHip,
-    RightHip,
-    RightKnee,
-    RightAnkle,
+    LeftEye,
+    LeftHeel,
     LeftHip,
     LeftKnee,
-    LeftAnkle,
-    RightEye,
-    LeftEye,
-    RightEar,
-    LeftEar,
-    LeftBigToe,
+    LeftShoulder,
     LeftSmallToe,
-    LeftHeel,
+    LeftWrist,
+    MidHip,
+    Neck,
+    Nose,
+    RightAnkle,
     RightBigToe,
-    RightSmallToe,
+    RightEar,
+    RightElbow,
+    RightEye,
     RightHeel,
+    RightHip,
+    RightKnee,
+    RightShoulder,
+    RightSmallToe,
+    RightWrist,
 }
 
 use BodyPoint::*;
-
-/// OpenPose's 18 points (its COCO model, ControlNet's drawing).
-pub const OPENPOSE_18: [BodyPoint; 18] = [
-    Nose,
-    Neck,
-    RightShoulder,
-    RightElbow,
-    RightWrist,
-    LeftShoulder,
-    LeftElbow,
-    LeftWrist,
-    RightHip,
-    RightKnee,
-    RightAnkle,
-    LeftHip,
-    LeftKnee,
-    LeftAnkle,
-    RightEye,
-    LeftEye,
-    RightEar,
-    LeftEar,
-];
 
 /// OpenPose's BODY_25.
 pub const BODY_25: [BodyPoint; 25] = [
@@ -98,6 +77,19 @@ pub const BODY_25: [BodyPoint; 25] = [
     RightSmallToe,
     RightHeel,
 ];
+
+/// OpenPose's 18 points (its COCO model, ControlNet's drawing): BODY_25's without the
+/// middle of the hips and the feet.
+pub const OPENPOSE_18: [BodyPoint; 18] = {
+    let mut out = [Nose; 18];
+    let mut k = 0;
+    while k < 18 {
+        // BODY_25 puts MidHip at 8; the 18 skip it.
+        out[k] = BODY_25[if k < 8 { k } else { k + 1 }];
+        k += 1;
+    }
+    out
+};
 
 /// COCO's 17 keypoints (the first 17 of COCO-WholeBody's 133).
 pub const COCO_17: [BodyPoint; 17] = [
