@@ -283,8 +283,12 @@ fn carry_onto(targets: Vec<CharacterDoc>, library: &mut AssetLibrary) {
                 RetargetDoc { plant_feet, ..RetargetDoc::of(MotionSourceDoc::File { path: path.clone(), clip: None }) };
             let done = retarget(library, &source, target, &asset, &settings).unwrap();
             // A source lying down at rest stands as in its first frame.
-            let lying = path.file_name().is_some_and(|n| n.to_string_lossy().contains("lying"));
-            let stands = done.source_frames.first().filter(|_| lying);
+            let source_asset = library.shaped(&source).unwrap();
+            let upright = marionette::document::retarget::stands_upright(
+                &source_asset.skeleton,
+                &humanoid_map(&source_asset, &source.humanoid),
+            );
+            let stands = done.source_frames.first().filter(|_| !upright);
             let s = side_standing(library, &source, done.floors.0, stands);
             let t = side(library, target, done.floors.1);
             let f = measure(&s, &done.source_frames, &t, &done.report);

@@ -60,8 +60,9 @@ pub fn motion_floor(asset: &CharacterAsset, frames: &[Frame]) -> f32 {
 }
 
 /// Whether a humanoid stands in its initial pose: its hips below its head (else its chest,
-/// neck), the line between within 45° of up.
-fn stands_upright(skeleton: &marionette_rig::Skeleton, map: &HumanoidMap) -> bool {
+/// neck), the line between within 45° of up. A source that does not stands as in its
+/// motion's first frame.
+pub fn stands_upright(skeleton: &marionette_rig::Skeleton, map: &HumanoidMap) -> bool {
     let (_, at) =
         marionette_rig::retarget::world_frames(skeleton, skeleton.joint(0).rest_offset, &skeleton.initial_pose());
     let top = [HumanBone::Head, HumanBone::Neck, HumanBone::Chest].iter().find_map(|b| map.get(b));
@@ -77,9 +78,8 @@ fn lowest_point(asset: &CharacterAsset, frame: &Frame) -> f32 {
     let skeleton = &asset.skeleton;
     let lowest = |points: &[glam::Vec3]| points.iter().map(|p| p.y).fold(f32::INFINITY, f32::min);
     let skin = if asset.skin_kind == SkinKind::Mesh {
-        let rest_root = frame.offsets.as_ref().map_or(skeleton.joint(0).rest_offset, |o| o[0]);
-        let origin = glam::Mat4::from_translation(frame.root - rest_root);
         let rest = RestOverride { offsets: frame.offsets.as_deref(), scales: None };
+        let origin = frame.origin(skeleton);
         lowest(&super::posing::posed_positions_with_rest(asset, &frame.pose, rest, origin, SkinningMethod::Linear))
     } else {
         f32::INFINITY

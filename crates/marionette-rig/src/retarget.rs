@@ -93,6 +93,17 @@ impl Frame {
     pub fn world(&self, skeleton: &Skeleton) -> WorldFrames {
         world_frames_with(skeleton, self.root, &self.pose, self.offsets.as_deref())
     }
+
+    /// The model-space move the matrix stack starts from: the root from its rest offset (or
+    /// the frame's) to the frame's root.
+    pub fn origin(&self, skeleton: &Skeleton) -> Mat4 {
+        origin(skeleton, self.root, self.offsets.as_deref())
+    }
+}
+
+/// The move from the root's rest offset (`offsets`' where given) to `root`.
+fn origin(skeleton: &Skeleton, root: Vec3, offsets: Option<&[Vec3]>) -> Mat4 {
+    Mat4::from_translation(root - offsets.map_or(skeleton.joint(0).rest_offset, |o| o[0]))
 }
 
 /// A retargeted motion: its frames, which of them hold each foot (left, right) planted,
@@ -189,10 +200,8 @@ fn world_frames_with(skeleton: &Skeleton, root: Vec3, pose: &[JointRotation], of
         rotations[j] = (parent * pose[j].to_quat()).normalize();
     }
     let mut world = vec![Mat4::IDENTITY; skeleton.len()];
-    let rest_root = offsets.map_or(skeleton.joint(0).rest_offset, |o| o[0]);
-    let origin = Mat4::from_translation(root - rest_root);
     let rest = super::fk::RestOverride { offsets, scales: None };
-    super::fk::forward_kinematics_with_rest(skeleton, pose, rest, origin, &mut world);
+    super::fk::forward_kinematics_with_rest(skeleton, pose, rest, origin(skeleton, root, offsets), &mut world);
     (rotations, world.iter().map(|m| m.w_axis.truncate()).collect())
 }
 
@@ -536,7 +545,7 @@ impl<'a> Retargeter<'a> {
     /// in the world.
     fn reach(&self, frame: &mut Frame, foot: usize, goal: Vec3) {
         let t = self.target.skeleton;
-        let origin = Mat4::from_translation(frame.root - t.joint(0).rest_offset);
+        let origin = frame.origin(t);
         let (before, _) = world_frames(t, frame.root, &frame.pose);
         let tolerance = 1e-4 * self.target_leg;
         solve_ik(t, &mut frame.pose, origin, &[IkGoal { end: foot, target: goal }], tolerance, 8);
