@@ -47,7 +47,9 @@ impl Plugin for EditorOrderPlugin {
                 PostUpdate,
                 (OpenScene, Edits, SyncViews).chain().in_set(crate::scene::AnimateSteps::Document),
             )
-            .configure_sets(PostUpdate, (Arrange, Present).chain().in_set(MarionetteSystems::Draw));
+            .configure_sets(PostUpdate, (Arrange, Present).chain().in_set(MarionetteSystems::Draw))
+            // A camera's lens set in `Present` is the lens of the frame it is set in.
+            .configure_sets(PostUpdate, Present.before(bevy::camera::CameraUpdateSystems));
     }
 }
 

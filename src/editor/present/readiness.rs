@@ -6,11 +6,11 @@
 //! while the PBR and shadow pipelines were still compiling in the background.)
 //!
 //! Once settled, a picture that only changes what is drawn is captured without waiting
-//! frames of its own: a new pose in the frame that first draws it, a new scene of the same
-//! kinds of meshes and materials in the frame after. The render world says of every frame
-//! whether it drew all it was given (each main-world frame's meshes and targets, by
-//! [`WantedAssets`]'s generation, every pipeline compiled: [`DrawnFrames`]), and such a
-//! capture of a frame that did not is taken again.
+//! frames of its own, in the frame that first draws it: a new pose, or a new scene lit by
+//! lights of the last one's kinds. The render world says of every frame whether it drew
+//! all it was given (each main-world frame's meshes and targets, by [`WantedAssets`]'s
+//! generation, every pipeline compiled: [`DrawnFrames`]), and such a capture of a frame
+//! that did not is taken again.
 
 use std::sync::{Arc, Mutex};
 
@@ -115,8 +115,8 @@ pub struct CaptureGate {
     ready_frames: u32,
     last_frame: u64,
     /// Everything the frames need was on the GPU and drawn before this picture was set up:
-    /// it needs only this many ready frames of its own (none: [`READY_FRAMES`]).
-    settled: Option<u32>,
+    /// it needs one ready frame of its own (else [`READY_FRAMES`]).
+    settled: bool,
     /// The last reason not to capture (for a time-out's message).
     pub last_reason: Option<String>,
     /// Set when the frame can never be ready.
@@ -135,14 +135,14 @@ impl CaptureGate {
         match readiness {
             Readiness::Ready => {
                 let drew_it = frame != self.last_frame && self.generations.1 >= self.since;
-                if drew_it || self.settled.is_some() {
+                if drew_it || self.settled {
                     self.ready_frames += 1;
                 }
                 self.last_reason = None;
             }
             Readiness::Waiting(reason) => {
                 self.ready_frames = 0;
-                self.settled = None;
+                self.settled = false;
                 self.last_reason = Some(reason);
             }
             Readiness::Failed(reason) => {
@@ -157,7 +157,7 @@ impl CaptureGate {
     /// library: its edits land in a later frame), and only frames after the change count.
     pub fn restart(&mut self) {
         self.ready_frames = 0;
-        self.settled = None;
+        self.settled = false;
         self.since = self.generations.0 + 1;
     }
 
@@ -166,23 +166,12 @@ impl CaptureGate {
         self.generations = (now, drawn);
     }
 
-    /// The next picture of a sequence is set up (clips at a new time, the camera turned)
-    /// after a capture: once the gate was ready, its first ready frame may be captured
-    /// (its pose is skinned in the frame it is drawn in).
+    /// The next picture is set up after a capture (clips at a new time, the camera turned,
+    /// or a new scene drawn as plain skins): once the gate was ready, its first ready frame
+    /// may be captured (its pose is skinned, its entities' meshes, materials, shadows and
+    /// the camera's lens taken up in the frame it is drawn in).
     pub fn next_picture(&mut self) {
-        self.settle(1);
-    }
-
-    /// The next picture is a new scene of the kinds of meshes and materials drawn already:
-    /// once the gate was ready, it may be captured in the frame after the one that first
-    /// draws it (the renderer takes up new entities' materials and shadows in their first
-    /// frame).
-    pub fn next_scene(&mut self) {
-        self.settle(2);
-    }
-
-    fn settle(&mut self, frames: u32) {
-        self.settled = self.is_ready().then_some(frames);
+        self.settled = self.is_ready();
         self.ready_frames = 0;
         self.since = self.generations.0 + 1;
     }
@@ -190,12 +179,12 @@ impl CaptureGate {
     /// Whether a capture now is of a picture set up after the gate was ready (and so must
     /// be checked against [`DrawnFrames`] once drawn).
     pub fn is_speculative(&self) -> bool {
-        self.settled.is_some()
+        self.settled
     }
 
     /// Whether enough ready frames passed in a row.
     pub fn is_ready(&self) -> bool {
-        self.ready_frames >= self.settled.unwrap_or(READY_FRAMES) && self.failed.is_none()
+        self.ready_frames >= if self.settled { 1 } else { READY_FRAMES } && self.failed.is_none()
     }
 }
 

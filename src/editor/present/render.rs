@@ -732,8 +732,9 @@ fn next_frame(
 }
 
 /// Sets up a data set's next picture: its scene opened in place of the last (the first is
-/// the one the app opened with), and the gate counts afresh (writes `PendingScene`,
-/// `CaptureGate`).
+/// the one the app opened with); one lit alike to the last and drawn as plain skins is
+/// captured in the frame that first draws it, another once the gate counts afresh (writes
+/// `PendingScene`, `CaptureGate`).
 fn scene_frame(
     mut job: ResMut<RenderJob>,
     mut gate: ResMut<CaptureGate>,
@@ -745,12 +746,12 @@ fn scene_frame(
     let FrameAt::Scene(doc) = &job.frames[job.queue[job.next]].at else { return };
     let lights = light_setup(&doc.stage);
     if job.next > 0 || !job.opened {
-        // Lit as the last scene drawn (of this render, or of the renderer's last), its
-        // characters drawn as plain skins.
-        let lit_alike = job.last_lights.as_ref() == Some(&lights) && doc.stage.lamps.is_empty() && plainly_drawn(doc);
+        // Lit by lights of the kinds the last scene drawn had (of this render, or of the
+        // renderer's last), its characters drawn as plain skins.
+        let lit_alike = job.last_lights.as_ref() == Some(&lights) && plainly_drawn(doc);
         // A scene without a camera is framed as the command line frames it.
         *pending = crate::editor::scene_doc::document::PendingScene { frame: true, doc: Some((**doc).clone()) };
-        if lit_alike { gate.next_scene() } else { gate.restart() }
+        if lit_alike { gate.next_picture() } else { gate.restart() }
     }
     job.last_lights = Some(lights);
     job.set_up = true;
@@ -789,9 +790,10 @@ fn plainly_drawn(doc: &SceneDoc) -> bool {
 type LightSetup = (bool, Vec<(bool, bool)>);
 
 /// What of a stage has the renderer set up its lights' views and passes anew when it
-/// changes: shadows at all, and each lamp's kind and whether it casts shadows. A scene
-/// without lamps lit alike to the last is drawn as it should be from its second frame;
-/// another waits for the renderer to settle (a new lamp's views take frames of their own).
+/// changes: shadows at all, and each lamp's kind and whether it casts shadows. A scene lit
+/// alike to the last (its lamps the last's entities, moved) is drawn as it should be in its
+/// first frame; another waits for the renderer to settle (a new lamp is taken up frames
+/// later).
 fn light_setup(stage: &crate::formats::scene::StageDoc) -> LightSetup {
     (stage.shadows, stage.lamps.iter().map(|l| (l.spot.is_some(), l.shadows)).collect())
 }

@@ -159,8 +159,9 @@ fn linear([r, g, b]: [f32; 3]) -> Color {
 }
 
 /// Applies the stage's settings whenever they change: the floor (shown, height, size,
-/// colour), the sun (direction, light, shadows), the ambient fill, the lamps (spawned
-/// afresh) and the background (reads `StageSettings`; writes floor, sun, lamps,
+/// colour), the sun (direction, light, shadows), the ambient fill, the lamps (each the
+/// entity of the last stage's lamp in its place where that was of its kind) and the
+/// background (reads `StageSettings`; writes floor, sun, lamps,
 /// `GlobalAmbientLight`, `ClearColor`).
 #[allow(clippy::too_many_arguments)]
 pub fn apply_stage_settings(
@@ -170,7 +171,7 @@ pub fn apply_stage_settings(
     mut floors: Query<(&mut Visibility, &mut Transform, &MeshMaterial3d<StandardMaterial>), With<Floor>>,
     mut materials: ResMut<Assets<StandardMaterial>>,
     mut suns: Query<(&mut DirectionalLight, &mut Transform), (With<Sun>, Without<Floor>)>,
-    lamps: Query<Entity, With<Lamp>>,
+    lamps: Query<(Entity, &Lamp, Has<SpotLight>)>,
     mut ambient: ResMut<GlobalAmbientLight>,
     mut clear: ResMut<ClearColor>,
 ) {
@@ -196,10 +197,19 @@ pub fn apply_stage_settings(
     }
     *ambient =
         GlobalAmbientLight { color: linear(stage.ambient.color), brightness: stage.ambient.brightness, ..default() };
-    lamps.iter().for_each(|e| commands.entity(e).despawn());
-    for (i, lamp) in stage.lamps.iter().take(crate::formats::scene::MAX_LAMPS).enumerate() {
-        spawn_lamp(&mut commands, i, lamp);
+    let mut kept: Vec<(Entity, usize, bool)> = lamps.iter().map(|(e, lamp, spot)| (e, lamp.0, spot)).collect();
+    kept.sort_unstable_by_key(|&(_, i, _)| i);
+    let wanted = &stage.lamps[..stage.lamps.len().min(crate::formats::scene::MAX_LAMPS)];
+    for (i, lamp) in wanted.iter().enumerate() {
+        // A lamp of the kind the last stage had in its place stays the same entity.
+        let mut entity = match kept.get(i).filter(|&&(_, at, spot)| at == i && spot == lamp.spot.is_some()) {
+            Some(&(entity, ..)) => commands.entity(entity),
+            None => commands.spawn(Lamp(i)),
+        };
+        light_lamp(&mut entity, lamp);
     }
+    let stays = |&&(_, at, spot): &&(Entity, usize, bool)| wanted.get(at).is_some_and(|l| l.spot.is_some() == spot);
+    kept.iter().filter(|k| !stays(k)).for_each(|&(e, ..)| commands.entity(e).despawn());
     let ([r, g, b], alpha) = stage.background.at(0.5);
     clear.0 = Color::srgba(r, g, b, alpha);
 }
@@ -209,8 +219,8 @@ fn sun_up(toward: Vec3) -> Vec3 {
     if toward.cross(Vec3::Y).length_squared() < 1e-6 { Vec3::Z } else { Vec3::Y }
 }
 
-/// Lamp `i`: a point light, or a spot light aimed at its point.
-fn spawn_lamp(commands: &mut Commands, i: usize, lamp: &crate::formats::scene::LampDoc) {
+/// Gives a lamp its light and place: a point light, or a spot light aimed at its point.
+fn light_lamp(entity: &mut EntityCommands, lamp: &crate::formats::scene::LampDoc) {
     let (color, intensity, shadows_enabled) = (linear(lamp.color), lamp.intensity, lamp.shadows);
     let at = Transform::from_translation(lamp.position);
     match lamp.spot {
@@ -226,11 +236,11 @@ fn spawn_lamp(commands: &mut Commands, i: usize, lamp: &crate::formats::scene::L
                 inner_angle: outer * 0.8,
                 ..default()
             };
-            commands.spawn((Lamp(i), light, at.looking_at(aim, sun_up(aim - lamp.position))));
+            entity.insert((light, at.looking_at(aim, sun_up(aim - lamp.position))));
         }
         None => {
             let light = PointLight { color, intensity, shadow_maps_enabled: shadows_enabled, range: 40.0, ..default() };
-            commands.spawn((Lamp(i), light, at));
+            entity.insert((light, at));
         }
     }
 }
