@@ -1,6 +1,7 @@
 //! `mt.Scene` and `mt.render`: pictures drawn in-process by one renderer kept alive between
-//! calls (its first call pays the start, later ones their drawn frames), read back as
-//! arrays from the files `render --data` writes, so each equals the binary's.
+//! calls (its first call pays the start, later ones their drawn frames), handed over as
+//! arrays of what the files of `render --data` would hold; a data set's pictures
+//! (`mt.generate`) are the files `generate` writes, read back.
 
 use std::cell::RefCell;
 use std::mem::ManuallyDrop;
@@ -14,9 +15,10 @@ use pyo3::types::PyDict;
 
 use marionette::document::AssetLibrary;
 use marionette::document::annotate::controlnet::ControlNet;
+use marionette::document::annotate::controlnet::Maps as ControlNetMaps;
 use marionette::document::options::{PoseOptions, apply_options};
 use marionette::editor::present::data::Beside;
-use marionette::editor::present::render::{Renderer, ScenePicture};
+use marionette::editor::present::render::{Kept, Renderer, ScenePicture};
 use marionette::editor::present::view::{FramingView, startup_view};
 use marionette::formats::scene::{BackgroundDoc, PlacementDoc, SceneDoc, ShotDoc, ViewName};
 
@@ -89,10 +91,11 @@ fn with_renderer<T>(
     })
 }
 
-/// What a render wrote, read back.
+/// A render's picture and data, as arrays.
 struct Drawn {
     rgb: (Vec<u8>, u32, u32, usize),
     data: Option<Data>,
+    controlnet: Option<ControlNetMaps>,
     notes: Vec<String>,
 }
 
@@ -103,12 +106,42 @@ struct Data {
     coco: String,
 }
 
+impl Drawn {
+    /// A picture kept in memory: the picture as its file holds it, the passes and maps as
+    /// the files beside it hold them (normals at full precision).
+    fn from_kept(kept: Kept, notes: Vec<String>) -> Self {
+        use marionette::document::annotate::write::{mask_id, normal_of_map};
+        let rgb = pixels(&kept.picture);
+        let (data, controlnet) = kept.beside.map_or((None, None), |b| {
+            let data = b.coco.map(|coco| Data {
+                normal: b.passes.normal.iter().flat_map(|&n| normal_of_map(n).to_array()).collect(),
+                mask: b.passes.instance.iter().map(|&i| mask_id(i)).collect(),
+                depth: b.passes.depth,
+                coco: coco.to_string(),
+            });
+            (data, b.controlnet)
+        });
+        Self { rgb, data, controlnet, notes }
+    }
+}
+
+/// A picture's bytes, width, height and channels (4 where it has alpha, else 3).
+fn pixels(picture: &image::DynamicImage) -> (Vec<u8>, u32, u32, usize) {
+    let (w, h) = (picture.width(), picture.height());
+    match picture.color().has_alpha() {
+        true => (picture.to_rgba8().into_raw(), w, h, 4),
+        false => (picture.to_rgb8().into_raw(), w, h, 3),
+    }
+}
+
 /// The scene drawn as `render SCENE --width W --height H [--data] [--controlnet] [--view V]
 /// [--transparent] --out shot.png` draws it: a dict of `rgb` (uint8 (H, W, 3), or (H, W, 4)
 /// with `transparent`), and with `data` `depth` (float32 (H, W) metres along the view axis,
 /// inf where nothing), `normal` (float32 (H, W, 3), the camera frame `--data` documents),
 /// `mask` (uint16 (H, W) instance ids), `coco` (the COCO dict) and `camera` (`K`,
-/// `world_to_camera`: float64); and `notes`.
+/// `world_to_camera`: float64); with `controlnet` `controlnet`, the maps as their files hold
+/// them (`openpose`, `depth`, `normal`: uint8 arrays; `openpose_json`: a dict); and `notes`.
+/// Nothing is written to disk.
 #[pyfunction]
 #[pyo3(signature = (scene, *, width=640, height=480, samples=1, data=false, controlnet=false, view=None, transparent=false))]
 #[allow(clippy::too_many_arguments)]
@@ -137,17 +170,12 @@ pub fn render<'py>(
             doc.stage.floor = false;
         }
         let framing = startup_view(&mut doc, view, false).unwrap_or(FramingView::default().0);
-        let dir = scratch_dir()?;
-        let out = dir.join("shot.png");
-        let picture = ScenePicture { scene: doc, out: out.clone(), ids: (1, 1), backdrop: None };
+        let picture = ScenePicture { scene: doc, out: PathBuf::from("shot.png"), ids: (1, 1), backdrop: None };
         let beside = Beside { data, controlnet: controlnet.then_some(ControlNet { canny: None }) };
-        let said = with_renderer(shot, library, |r| r.render(vec![picture], framing, beside));
-        let drawn = said.and_then(|said| {
-            notes.extend(said);
-            read_back(&out, data, notes)
-        });
-        let _ = std::fs::remove_dir_all(&dir);
-        drawn
+        let (said, mut kept) = with_renderer(shot, library, |r| r.draw(vec![picture], framing, beside))?;
+        notes.extend(said);
+        let kept = kept.pop().ok_or_else(|| Error::new_err("the picture was not drawn"))?;
+        Ok(Drawn::from_kept(kept, notes))
     })?;
     drawn_dict(py, drawn)
 }
@@ -175,6 +203,17 @@ fn drawn_dict(py: Python<'_>, drawn: Drawn) -> PyResult<Bound<'_, PyDict>> {
         }
         out.set_item("coco", coco)?;
         out.set_item("camera", camera)?;
+    }
+    if let Some(maps) = drawn.controlnet {
+        let image = |bytes: Vec<u8>, channels: usize| Array3::from_shape_vec((h, w, channels), bytes).expect("a map");
+        let controlnet = PyDict::new(py);
+        controlnet.set_item("openpose", image(maps.openpose.into_raw(), 3).into_pyarray(py))?;
+        controlnet
+            .set_item("openpose_json", py.import("json")?.call_method1("loads", (maps.openpose_json.to_string(),))?)?;
+        let depth = Array2::from_shape_vec((h, w), maps.depth.into_raw()).expect("a map");
+        controlnet.set_item("depth", depth.into_pyarray(py))?;
+        controlnet.set_item("normal", image(maps.normal.into_raw(), 3).into_pyarray(py))?;
+        out.set_item("controlnet", controlnet)?;
     }
     out.set_item("notes", drawn.notes)?;
     Ok(out)
@@ -258,28 +297,13 @@ pub fn read_picture(py: Python<'_>, path: PathBuf, data: bool) -> PyResult<Bound
     drawn_dict(py, drawn)
 }
 
-/// A folder of its own for one render's files.
-fn scratch_dir() -> PyResult<PathBuf> {
-    use std::sync::atomic::{AtomicU64, Ordering};
-    static NEXT: AtomicU64 = AtomicU64::new(0);
-    let n = NEXT.fetch_add(1, Ordering::Relaxed);
-    let dir = std::env::temp_dir().join(format!("marionette-python-{}-{n}", std::process::id()));
-    std::fs::create_dir_all(&dir).map_err(|e| Error::new_err(format!("{}: {e}", dir.display())))?;
-    Ok(dir)
-}
-
 /// The picture at `out` and (with `data`) the passes and COCO file beside it.
 fn read_back(out: &Path, data: bool, notes: Vec<String>) -> PyResult<Drawn> {
     use marionette::document::annotate::write::beside;
     let failed = |path: &Path, e: &dyn std::fmt::Display| Error::new_err(format!("{}: {e}", path.display()));
-    let picture = image::open(out).map_err(|e| failed(out, &e))?;
-    let (w, h) = (picture.width(), picture.height());
-    let rgb = match picture.color().has_alpha() {
-        true => (picture.to_rgba8().into_raw(), w, h, 4),
-        false => (picture.to_rgb8().into_raw(), w, h, 3),
-    };
+    let rgb = pixels(&image::open(out).map_err(|e| failed(out, &e))?);
     if !data {
-        return Ok(Drawn { rgb, data: None, notes });
+        return Ok(Drawn { rgb, data: None, controlnet: None, notes });
     }
     let depth_path = beside(out, "depth.exr");
     let depth = exr_depth(&depth_path).map_err(|e| failed(&depth_path, &e))?;
@@ -297,7 +321,7 @@ fn read_back(out: &Path, data: bool, notes: Vec<String>) -> PyResult<Drawn> {
     let mask = image::open(&mask_path).map_err(|e| failed(&mask_path, &e))?.to_luma16().into_raw();
     let coco_path = beside(out, "json");
     let coco = std::fs::read_to_string(&coco_path).map_err(|e| failed(&coco_path, &e))?;
-    Ok(Drawn { rgb, data: Some(Data { depth, normal, mask, coco }), notes })
+    Ok(Drawn { rgb, data: Some(Data { depth, normal, mask, coco }), controlnet: None, notes })
 }
 
 /// The `Z` channel of a depth EXR, row by row.

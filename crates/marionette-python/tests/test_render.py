@@ -24,12 +24,31 @@ def test_a_render_is_the_binarys_render_with_data(tmp_path):
     finite = np.isfinite(want["depth"])
     assert np.array_equal(np.isfinite(out["depth"]), finite) and finite.any()
     assert np.abs(out["depth"][finite] - want["depth"][finite]).max() <= 1e-6
-    assert np.array_equal(out["normal"], want["normal"]) and out["normal"].shape == (120, 160, 3)
+    # Full precision here, a byte a component in the file (n * 0.5 + 0.5, black where nothing).
+    assert out["normal"].dtype == np.float32 and out["normal"].shape == (120, 160, 3)
+    shown = np.abs(out["normal"]).sum(-1) > 0
+    assert np.array_equal(shown, np.abs(want["normal"]).sum(-1) > 0)
+    assert np.abs(out["normal"] - want["normal"]).max() <= 1.0 / 255 + 1e-6
+    assert np.allclose(np.linalg.norm(out["normal"][shown], axis=-1), 1.0, atol=1e-5)
     assert out["mask"].dtype == np.uint16 and np.array_equal(out["mask"], want["mask"])
     assert out["coco"] == want["coco"]
     # Three puppets, each an instance id of the mask and an annotation with keypoints.
     assert len(out["coco"]["annotations"]) == 3 and len(np.unique(out["mask"])) == 4
     assert out["camera"]["K"].shape == (3, 3) and out["camera"]["world_to_camera"].shape == (4, 4)
+
+
+def test_the_controlnet_maps_are_the_files_render_writes(tmp_path):
+    import json
+
+    out = mt.render(mt.Scene.load(SCENE), width=160, height=120, controlnet=True)
+    binary("render", SCENE, "--width", 160, "--height", 120, "--controlnet", "--out", tmp_path / "shot.png")
+    maps = out["controlnet"]
+    for name in ("openpose", "depth", "normal"):
+        want = _native.read_picture(str(tmp_path / f"shot.cn-{name}.png"), False)["rgb"]
+        want = want[..., 0] if name == "depth" else want
+        assert maps[name].dtype == np.uint8 and np.array_equal(maps[name], want), name
+    assert (maps["openpose"] > 0).any() and (maps["depth"] > 0).any()
+    assert maps["openpose_json"] == json.loads((tmp_path / "shot.cn-openpose.json").read_text())
 
 
 def test_the_renderer_is_kept_and_draws_each_scene_alike():

@@ -59,6 +59,20 @@ impl DataFrame {
         Ok(Some((image, annotate::coco::annotations(&self.camera, &passes, &self.figures, ids.0, ids.1))))
     }
 
+    /// What [`Self::write_all_beside`] writes, kept in memory: `file_name` is the picture's
+    /// in the COCO file, `shown` the picture (for its edges).
+    pub fn keep_beside(self, file_name: &str, shown: &image::RgbImage, beside: Beside) -> KeptBeside {
+        let passes = self.passes();
+        let (camera, figures) = (&self.camera, &self.figures);
+        let controlnet =
+            beside.controlnet.map(|maps| annotate::controlnet::maps(camera, &passes, figures, maps, shown));
+        let coco = beside.data.then(|| {
+            let image = annotate::coco::image_json(1, file_name, camera);
+            annotate::coco::file(vec![image], annotate::coco::annotations(camera, &passes, figures, 1, 1))
+        });
+        KeptBeside { camera: self.camera, passes, coco, controlnet }
+    }
+
     /// [`Self::write_beside`], with the data's COCO file of this one picture.
     pub fn write_all_beside(&self, picture: &std::path::Path, beside: Beside) -> Result<(), String> {
         let Some((image, annotations)) = self.write_beside(picture, (1, 1), beside)? else { return Ok(()) };
@@ -68,6 +82,16 @@ impl DataFrame {
         )
         .map_err(|e| e.to_string())
     }
+}
+
+/// What a picture carries beside it kept in memory ([`DataFrame::keep_beside`]) instead
+/// of written: the camera and passes, the COCO file of the picture alone (with data), the
+/// maps ControlNet reads.
+pub struct KeptBeside {
+    pub camera: Pinhole,
+    pub passes: annotate::Passes,
+    pub coco: Option<serde_json::Value>,
+    pub controlnet: Option<annotate::controlnet::Maps>,
 }
 
 /// What a picture carries beside it: its data (depth, normals, masks, keypoints, COCO), the

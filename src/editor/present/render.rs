@@ -17,7 +17,7 @@ use crate::document::annotate::controlnet::ControlNet;
 use crate::document::frames::{FrameSequence, PictureRequest, Pictures, frame_path, sequence_path};
 use crate::document::picture;
 use crate::document::scenes::{read_scene, scene_path};
-use crate::editor::present::data::{Beside, DataScene};
+use crate::editor::present::data::{Beside, DataFrame, DataScene};
 use crate::editor::present::readiness::{CaptureGate, DrawnFrames, WantedAssets};
 use crate::editor::present::stage;
 use crate::editor::present::view::ViewPlugin;
@@ -83,6 +83,8 @@ struct RenderJob {
     /// The first picture shows the scene the app opened with (else each picture's scene
     /// is opened in place of the last, the first's too).
     opened: bool,
+    /// Keep each picture in memory here instead of writing its files.
+    kept: Option<KeptPictures>,
     /// How the last scene set up was lit (kept from render to render).
     last_lights: Option<LightSetup>,
 }
@@ -117,6 +119,16 @@ pub struct ScenePicture {
 
 /// A picture's COCO image and annotations.
 type CocoPart = (serde_json::Value, Vec<serde_json::Value>);
+
+/// A picture kept in memory ([`Renderer::draw`]): as its file would hold it, and what was
+/// asked beside it.
+pub struct Kept {
+    pub picture: image::DynamicImage,
+    pub beside: Option<crate::editor::present::data::KeptBeside>,
+}
+
+/// Where the pictures of [`Renderer::draw`] are kept as they are captured, by index.
+type KeptPictures = Arc<Mutex<Vec<(usize, Kept)>>>;
 
 /// A render's COCO file as it fills, a picture at a time.
 #[derive(Default)]
@@ -335,7 +347,27 @@ impl Renderer {
         job.started = std::time::Instant::now();
         job.data = beside.data.then(CocoSoFar::default);
         job.controlnet = beside.controlnet;
+        // The first picture's scene opens in the first update, which may capture it.
+        world.run_system_cached(scene_frame).map_err(|e| e.to_string())?;
         self.run()
+    }
+
+    /// Draws `pictures` as [`Self::render`] does, each kept in memory as its files would
+    /// hold it (none is written); returns the notes said meanwhile and the pictures in
+    /// their order.
+    pub fn draw(
+        &mut self,
+        pictures: Vec<ScenePicture>,
+        view: crate::formats::scene::CameraDoc,
+        beside: Beside,
+    ) -> Result<(Vec<String>, Vec<Kept>), String> {
+        let kept = Arc::new(Mutex::new(Vec::new()));
+        self.app.world_mut().resource_mut::<RenderJob>().kept = Some(kept.clone());
+        let said = self.render(pictures, view, beside);
+        self.app.world_mut().resource_mut::<RenderJob>().kept = None;
+        let mut kept = std::mem::take(&mut *kept.lock().map_err(|_| "a picture's thread failed".to_string())?);
+        kept.sort_by_key(|&(k, _)| k);
+        said.map(|said| (said, kept.into_iter().map(|(_, k)| k).collect()))
     }
 
     /// Updates the app until its job is done: the notes said meanwhile, or what failed.
@@ -438,6 +470,7 @@ fn job_app(setup: JobSetup, opened: bool) -> (App, Outcome) {
         coco_per_picture,
         on_written,
         opened,
+        kept: None,
         last_lights: None,
     });
     // The sun's shadow map sized for the picture (the editor's is for a window).
@@ -449,7 +482,7 @@ fn job_app(setup: JobSetup, opened: bool) -> (App, Outcome) {
     });
     app.add_systems(
         Last,
-        (capture_when_ready, report_when_done, next_frame, scene_frame, pose_frame)
+        (draw_only_what_is_captured, capture_when_ready, report_when_done, next_frame, scene_frame, pose_frame)
             .chain()
             .after(crate::editor::present::readiness::UpdateCaptureGate),
     )
@@ -571,22 +604,20 @@ fn capture_when_ready(
             gate.restart();
             return;
         }
-        // Encoded and written on a thread of its own while the next pictures are drawn.
+        // Encoded and written (or kept) on a thread of its own while the next pictures are
+        // drawn.
         let (image, out, frame, written) = (captured.image.clone(), out.clone(), frame.take(), written.clone());
-        let (backdrop, background) = (backdrop.clone(), background.clone());
+        let (backdrop, background, kept) = (backdrop.clone(), background.clone(), job.kept.clone());
+        let beside = Beside { data, controlnet };
         std::thread::spawn(move || {
-            let result = save_picture(&image, samples, &background, backdrop.as_deref(), &out).and_then(|()| {
-                let Some(frame) = frame else { return Ok(None) };
-                let Some((image, annotations)) = frame.write_beside(&out, ids, Beside { data, controlnet })? else {
-                    return Ok(None);
-                };
-                if !coco_per_picture {
-                    return Ok(Some((image, annotations)));
+            let result = composed(&image, samples, &background, backdrop.as_deref()).and_then(|picture| match kept {
+                Some(kept) => {
+                    let name = out.file_name().map_or_else(String::new, |n| n.to_string_lossy().into_owned());
+                    let beside = frame.map(|f| f.keep_beside(&name, &picture.to_rgb8(), beside));
+                    kept.lock().map_err(|_| "a picture's thread failed")?.push((index, Kept { picture, beside }));
+                    Ok(None)
                 }
-                let coco = annotate::coco::file(vec![image], annotations);
-                annotate::write::json(&annotate::write::beside(&out, "json"), &coco)
-                    .map(|()| None)
-                    .map_err(|e| e.to_string())
+                None => write_picture(&picture, &out, frame, ids, beside, coco_per_picture),
             });
             if let Ok(mut written) = written.lock() {
                 written.push((index, result));
@@ -600,6 +631,17 @@ fn capture_when_ready(
     job.captures = Some(job.captures.map_or((now, now, 0), |(first, _, updates)| (first, now, updates)));
     job.next += 1;
     job.set_up = false;
+}
+
+/// Draws frames while pictures are left to capture; once all are captured, the updates that
+/// wait for their pixels and files draw nothing (writes the render camera's `Camera`).
+fn draw_only_what_is_captured(job: Res<RenderJob>, mut cameras: Query<&mut Camera, With<OrbitCamera>>) {
+    let active = job.next < job.queue.len();
+    for mut camera in &mut cameras {
+        if camera.is_active != active {
+            camera.is_active = active;
+        }
+    }
 }
 
 /// Once the render is done (in the update that finished it): its result and the messages
@@ -674,14 +716,13 @@ fn collect_written(job: &mut RenderJob) {
 }
 
 /// The captured pixels averaged down from their samples, over the background (and over
-/// `backdrop`, a picture filling the frame), as PNG.
-fn save_picture(
+/// `backdrop`, a picture filling the frame).
+fn composed(
     image: &Image,
     samples: u32,
     background: &BackgroundDoc,
     backdrop: Option<&std::path::Path>,
-    out: &std::path::Path,
-) -> Result<(), String> {
+) -> Result<image::DynamicImage, String> {
     let rendered = image.clone().try_into_dynamic().map_err(|e| format!("unreadable capture: {e}"))?.to_rgba8();
     let mut picture =
         picture::over_background(picture::downsampled(&rendered, samples), background).map_err(|e| e.to_string())?;
@@ -689,10 +730,30 @@ fn save_picture(
         let behind = image::open(path).map_err(|e| format!("{}: {e}", path.display()))?;
         picture = picture::over_picture(picture, &behind);
     }
+    Ok(picture)
+}
+
+/// Writes `picture` as PNG at `out` and what `beside` asks beside it from `frame`; returns
+/// its share of the render's COCO file (none when each picture has a file of its own).
+fn write_picture(
+    picture: &image::DynamicImage,
+    out: &std::path::Path,
+    frame: Option<DataFrame>,
+    ids: (u64, u64),
+    beside: Beside,
+    coco_per_picture: bool,
+) -> Result<Option<CocoPart>, String> {
     let mut bytes = Vec::new();
     picture.write_to(&mut std::io::Cursor::new(&mut bytes), image::ImageFormat::Png).map_err(|e| e.to_string())?;
     crate::formats::write_atomically(out, |w| std::io::Write::write_all(w, &bytes))
-        .map_err(|e| format!("{}: {e}", out.display()))
+        .map_err(|e| format!("{}: {e}", out.display()))?;
+    let Some(frame) = frame else { return Ok(None) };
+    let Some((image, annotations)) = frame.write_beside(out, ids, beside)? else { return Ok(None) };
+    if !coco_per_picture {
+        return Ok(Some((image, annotations)));
+    }
+    let coco = annotate::coco::file(vec![image], annotations);
+    annotate::write::json(&annotate::write::beside(out, "json"), &coco).map(|()| None).map_err(|e| e.to_string())
 }
 
 /// A gradient or a picture goes behind the picture once captured: the render clears to

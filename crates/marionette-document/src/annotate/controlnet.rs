@@ -25,6 +25,30 @@ pub struct ControlNet {
     pub canny: Option<Canny>,
 }
 
+/// The maps of one picture, as the files beside it hold them.
+pub struct Maps {
+    pub openpose: RgbImage,
+    pub openpose_json: Value,
+    pub depth: GrayImage,
+    pub normal: RgbImage,
+    /// The edges of the picture `shown`, where asked.
+    pub canny: Option<GrayImage>,
+}
+
+/// The maps `maps` asks for of a picture whose passes are `passes` (`shown`: the picture,
+/// for its edges).
+pub fn maps(camera: &Pinhole, passes: &Passes, figures: &[Figure], maps: ControlNet, shown: &RgbImage) -> Maps {
+    let people = people(camera, passes, figures);
+    let (w, h) = (passes.width, passes.height);
+    Maps {
+        openpose: openpose_drawing(w, h, &people),
+        openpose_json: openpose_json(w, h, &people),
+        depth: inverse_depth(passes),
+        normal: normal_map(passes),
+        canny: maps.canny.map(|canny| super::canny::edges(shown, canny)),
+    }
+}
+
 /// A person's 18 points in pixels, where the picture shows them.
 pub type Body18 = [Option<(f32, f32)>; 18];
 

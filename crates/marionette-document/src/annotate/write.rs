@@ -48,20 +48,26 @@ pub fn passes(picture: &Path, camera: &Pinhole, passes: &Passes, figures: &[Figu
         if n == glam::Vec3::ZERO {
             return Rgb([0, 0, 0]);
         }
-        // OpenCV's frame to the normal map's: y up, z towards the camera.
-        let n = glam::Vec3::new(n.x, -n.y, -n.z);
-        Rgb(n.to_array().map(|c| ((c * 0.5 + 0.5) * 255.0).round() as u8))
+        Rgb(normal_of_map(n).to_array().map(|c| ((c * 0.5 + 0.5) * 255.0).round() as u8))
     });
     save(&normals, &beside(picture, "normal.png"))?;
-    let mask = ImageBuffer::<Luma<u16>, _>::from_fn(w, h, |x, y| {
-        let id = passes.instance[passes.at(x, y)];
-        Luma([if id == FLOOR { 0 } else { id }])
-    });
+    let mask = ImageBuffer::<Luma<u16>, _>::from_fn(w, h, |x, y| Luma([mask_id(passes.instance[passes.at(x, y)])]));
     save(&mask, &beside(picture, "mask.png"))?;
     let parts = ImageBuffer::<Luma<u8>, _>::from_fn(w, h, |x, y| Luma([passes.part[passes.at(x, y)]]));
     save(&parts, &beside(picture, "parts.png"))?;
     save(&openpose::drawing(camera, passes, figures), &beside(picture, "openpose.png"))?;
     json(&beside(picture, "openpose.json"), &openpose::json(camera, passes, figures))
+}
+
+/// A normal of the passes (OpenCV's camera frame) in the normal map's: x right, y up, z
+/// towards the camera.
+pub fn normal_of_map(n: glam::Vec3) -> glam::Vec3 {
+    glam::Vec3::new(n.x, -n.y, -n.z)
+}
+
+/// An instance of the passes as the mask holds it: the floor is nothing (0).
+pub fn mask_id(instance: u16) -> u16 {
+    if instance == FLOOR { 0 } else { instance }
 }
 
 /// Writes the maps ControlNet reads beside `picture` ([`super::controlnet`]):
@@ -74,16 +80,18 @@ pub fn controlnet(
     figures: &[Figure],
     maps: ControlNet,
 ) -> Result<(), WriteError> {
-    use super::controlnet::{inverse_depth, normal_map, openpose_drawing, openpose_json, people};
-    let people = people(camera, passes, figures);
-    let (w, h) = (passes.width, passes.height);
-    save(&openpose_drawing(w, h, &people), &beside(picture, "cn-openpose.png"))?;
-    json(&beside(picture, "cn-openpose.json"), &openpose_json(w, h, &people))?;
-    save(&inverse_depth(passes), &beside(picture, "cn-depth.png"))?;
-    save(&normal_map(passes), &beside(picture, "cn-normal.png"))?;
-    let Some(canny) = maps.canny else { return Ok(()) };
-    let shown = image::open(picture).map_err(|source| WriteError::Image { path: picture.to_owned(), source })?;
-    save(&super::canny::edges(&shown.to_rgb8(), canny), &beside(picture, "cn-canny.png"))
+    let shown = match maps.canny {
+        Some(_) => {
+            image::open(picture).map_err(|source| WriteError::Image { path: picture.to_owned(), source })?.to_rgb8()
+        }
+        None => RgbImage::new(0, 0),
+    };
+    let maps = super::controlnet::maps(camera, passes, figures, maps, &shown);
+    save(&maps.openpose, &beside(picture, "cn-openpose.png"))?;
+    json(&beside(picture, "cn-openpose.json"), &maps.openpose_json)?;
+    save(&maps.depth, &beside(picture, "cn-depth.png"))?;
+    save(&maps.normal, &beside(picture, "cn-normal.png"))?;
+    maps.canny.map_or(Ok(()), |edges| save(&edges, &beside(picture, "cn-canny.png")))
 }
 
 /// Writes `value` as JSON.
