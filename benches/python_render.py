@@ -52,6 +52,8 @@ def main():
     print(f"first render {times[0]:.2f} s; later renders median {later * 1e3:.0f} ms "
           f"(min {min(times[1:]) * 1e3:.0f}, max {max(times[1:]) * 1e3:.0f})")
     print(f"the binary's drawn frame {frame_ms:.0f} ms: a later render is {later * 1e3 / frame_ms:.2f} drawn frames")
+    slow = [k + 2 for k, t in enumerate(times[1:]) if t * 1e3 > 2 * frame_ms]
+    print(f"later renders over 2 drawn frames: {len(slow)} of {len(times) - 1} (calls {slow})")
     print(f"resident memory after render 10: {memory[10]:.0f} MiB, after 100: {memory[100]:.0f} MiB "
           f"({(memory[100] / memory[10] - 1) * 100:+.1f} %)")
 

@@ -318,6 +318,10 @@ impl Renderer {
         app.cleanup();
         let mut renderer = Self { app, outcome, picture, said: 0 };
         renderer.run()?;
+        // One picture of the bare stage, kept nowhere: what the first capture sets up (its
+        // read-back's pipeline) is ready before the caller's first picture.
+        let stage = ScenePicture { scene: SceneDoc::default(), out: PathBuf::new(), ids: (1, 1), backdrop: None };
+        renderer.draw(vec![stage], Default::default(), Beside::default())?;
         Ok(renderer)
     }
 
