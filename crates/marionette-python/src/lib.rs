@@ -361,6 +361,7 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(render::read_picture, m)?)?;
     m.add_function(wrap_pyfunction!(render::spec_count, m)?)?;
     m.add_class::<render::Scene>()?;
+    m.add_class::<render::SetPictures>()?;
     m.add_class::<Character>()?;
     m.add_class::<Pose>()?;
     let py = m.py();

@@ -330,3 +330,76 @@ fn exr_depth(path: &Path) -> Result<Vec<f32>, exr::error::Error> {
     let channel = image.layer_data.channel_data.list.iter().find(|c| c.name == *"Z");
     Ok(channel.map(|c| c.sample_data.values_as_f32().collect()).unwrap_or_default())
 }
+
+/// A data set's pictures drawn in memory, a few at a time, by this thread's renderer: the
+/// pictures `generate` makes (each scene as its file reads back), none written to disk.
+#[pyclass(module = "marionette", unsendable)]
+pub struct SetPictures {
+    spec: marionette::document::generate::Spec,
+    /// The pictures of the shard not drawn yet, in order.
+    todo: std::collections::VecDeque<usize>,
+    library: AssetLibrary,
+}
+
+#[pymethods]
+impl SetPictures {
+    /// The pictures of the spec at `spec` (the shard `i/n` of them; `count` and `seed` in
+    /// place of the spec's).
+    #[new]
+    #[pyo3(signature = (spec, shard=None, count=None, seed=None))]
+    fn new(spec: PathBuf, shard: Option<String>, count: Option<usize>, seed: Option<u64>) -> PyResult<Self> {
+        use marionette::document::generate::Shard;
+        let mut spec = read_spec(&spec, count)?;
+        if let Some(seed) = seed {
+            spec.seed = seed;
+        }
+        let shard = Shard::from_environment(shard.as_deref(), None, |_| None)
+            .map_err(|e| PyValueError::new_err(e.to_string()))?;
+        Ok(Self { todo: shard.pictures(spec.count).collect(), spec, library: AssetLibrary::default() })
+    }
+
+    /// The keys of the pictures not drawn yet ("000042").
+    fn keys(&self) -> Vec<String> {
+        self.todo.iter().map(|&k| marionette::document::generate::picture_stem(k)).collect()
+    }
+
+    /// The next `n` pictures (fewer at the end), as dicts of [`render`]'s with their `key`.
+    fn draw<'py>(&mut self, py: Python<'py>, n: usize) -> PyResult<Vec<Bound<'py, PyDict>>> {
+        use marionette::document::generate::{coco_ids, picture_stem, scene_of};
+        let ks: Vec<usize> = (0..n).map_while(|_| self.todo.pop_front()).collect();
+        let (spec, library) = (&self.spec, &mut self.library);
+        let kept = py.detach(|| -> PyResult<Vec<(String, Kept)>> {
+            let mut pictures = Vec::new();
+            for &k in &ks {
+                let (scene, backdrop) =
+                    scene_of(spec, library, k as u64).map_err(|e| SpecError::new_err(e.to_string()))?;
+                let out = PathBuf::from(format!("{}.png", picture_stem(k)));
+                pictures.push(ScenePicture { scene: as_read_back(&scene)?, out, ids: coco_ids(k), backdrop });
+            }
+            if pictures.is_empty() {
+                return Ok(Vec::new());
+            }
+            let shot = ShotDoc { width: spec.width, height: spec.height, samples: 1 };
+            let controlnet = spec.controlnet.then_some(ControlNet { canny: spec.canny });
+            let beside = Beside { data: spec.data, controlnet };
+            let library = std::mem::take(library);
+            let (_, kept) = with_renderer(shot, library, |r| r.draw(pictures, FramingView::default().0, beside))?;
+            Ok(ks.iter().map(|&k| picture_stem(k)).zip(kept).collect())
+        })?;
+        kept.into_iter()
+            .map(|(key, kept)| {
+                let sample = drawn_dict(py, Drawn::from_kept(kept, Vec::new()))?;
+                sample.set_item("key", key)?;
+                Ok(sample)
+            })
+            .collect()
+    }
+}
+
+/// A scene as its file reads back (what `generate` draws: the file it writes beside the
+/// picture, read again).
+fn as_read_back(scene: &SceneDoc) -> PyResult<SceneDoc> {
+    use marionette::formats::scene::{parse_scene, scene_to_string};
+    let text = scene_to_string(scene).map_err(|e| Error::new_err(e.to_string()))?;
+    parse_scene(text.as_bytes(), Path::new("scene.ron")).map_err(file_error)
+}

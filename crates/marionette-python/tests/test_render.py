@@ -75,6 +75,19 @@ def test_generate_writes_the_binarys_pictures_byte_for_byte(tmp_path):
         assert s["rgb"].shape == (240, 320, 3) and s["coco"]["images"][0]["file_name"] == f"{s['key']}.png"
 
 
+def test_generate_in_memory_gives_the_binarys_pictures_and_data(tmp_path):
+    binary("generate", SPEC, "--out", tmp_path / "cli", "--count", 5)
+    samples = list(mt.generate(SPEC, count=5, batch=2))
+    assert [s["key"] for s in samples] == [f"{k:06}" for k in range(5)]
+    for s in samples:
+        want = _native.read_picture(str(tmp_path / "cli" / f"{s['key']}.png"), True)
+        assert np.array_equal(s["rgb"], want["rgb"]), s["key"]
+        assert np.array_equal(s["mask"], want["mask"]) and s["coco"] == want["coco"], s["key"]
+        finite = np.isfinite(want["depth"])
+        assert np.array_equal(np.isfinite(s["depth"]), finite)
+        assert np.abs(s["depth"][finite] - want["depth"][finite]).max() <= 1e-6
+
+
 def test_a_shard_and_a_dataset_split_the_set_as_the_binary_does():
     keys = [s["key"] for s in mt.generate(SPEC, shard=(1, 2), count=4)]
     assert keys == ["000001", "000003"]

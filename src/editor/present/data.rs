@@ -59,16 +59,17 @@ impl DataFrame {
         Ok(Some((image, annotate::coco::annotations(&self.camera, &passes, &self.figures, ids.0, ids.1))))
     }
 
-    /// What [`Self::write_all_beside`] writes, kept in memory: `file_name` is the picture's
-    /// in the COCO file, `shown` the picture (for its edges).
-    pub fn keep_beside(self, file_name: &str, shown: &image::RgbImage, beside: Beside) -> KeptBeside {
+    /// What [`Self::write_beside`] writes, kept in memory, with the COCO file of this one
+    /// picture (`file_name` its name there, `ids` its image's and first annotation's ids);
+    /// `shown` is the picture (for its edges).
+    pub fn keep_beside(self, file_name: &str, ids: (u64, u64), shown: &image::RgbImage, beside: Beside) -> KeptBeside {
         let passes = self.passes();
         let (camera, figures) = (&self.camera, &self.figures);
         let controlnet =
             beside.controlnet.map(|maps| annotate::controlnet::maps(camera, &passes, figures, maps, shown));
         let coco = beside.data.then(|| {
-            let image = annotate::coco::image_json(1, file_name, camera);
-            annotate::coco::file(vec![image], annotate::coco::annotations(camera, &passes, figures, 1, 1))
+            let image = annotate::coco::image_json(ids.0, file_name, camera);
+            annotate::coco::file(vec![image], annotate::coco::annotations(camera, &passes, figures, ids.0, ids.1))
         });
         KeptBeside { camera: self.camera, passes, coco, controlnet }
     }

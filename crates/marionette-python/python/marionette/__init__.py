@@ -7,7 +7,6 @@ same Rust code as the `marionette` binary, numpy arrays in and out.
     out = mt.render(mt.Scene([c]), width=640, height=480, data=True)
 """
 
-import tempfile
 from pathlib import Path
 
 from ._native import (  # noqa: F401
@@ -29,20 +28,27 @@ __all__ = [
 ]
 
 
-def generate(spec, shard=None, *, count=None, seed=None, out=None):
+def generate(spec, shard=None, *, count=None, seed=None, out=None, batch=8):
     """The pictures of a data-set spec (`generate SPEC`), as dicts: `key` ("000042"), `rgb`,
-    `coco` (and with the spec's `data`: `depth`, `normal`, `mask`, `camera`), the same
-    pictures the binary makes. `shard=(i, n)` takes the pictures k with k mod n = i, as
-    `--shard i/n`; `count` and `seed` override the spec's. The pictures are drawn into `out`
-    (a temporary folder without one), then yielded one by one."""
-    with tempfile.TemporaryDirectory(prefix="marionette-generate-") as scratch:
-        folder = Path(out) if out is not None else Path(scratch)
-        shard_text = None if shard is None else f"{int(shard[0])}/{int(shard[1])}"
-        keys, data = _native.generate_pictures(str(spec), str(folder), shard_text, count, seed)
-        for key in keys:
-            sample = _native.read_picture(str(folder / f"{key}.png"), data)
-            sample["key"] = key
-            yield sample
+    `coco` (and with the spec's `data`: `depth`, `normal`, `mask`, `camera`; with its
+    `controlnet`: `controlnet`), the same pictures the binary makes. `shard=(i, n)` takes
+    the pictures k with k mod n = i, as `--shard i/n`; `count` and `seed` override the
+    spec's. Without `out` the pictures are drawn in memory, `batch` at a time, and yielded
+    as they are drawn (nothing is written); with `out` they are written there as
+    `generate SPEC --out OUT` writes them, then yielded."""
+    shard_text = None if shard is None else f"{int(shard[0])}/{int(shard[1])}"
+    if out is None:
+        pictures = _native.SetPictures(str(spec), shard_text, count, seed)
+        while True:
+            drawn = pictures.draw(batch)
+            if not drawn:
+                return
+            yield from drawn
+    keys, data = _native.generate_pictures(str(spec), str(out), shard_text, count, seed)
+    for key in keys:
+        sample = _native.read_picture(str(Path(out) / f"{key}.png"), data)
+        sample["key"] = key
+        yield sample
 
 
 def _torch_base():
