@@ -62,11 +62,19 @@ impl DataFrame {
     /// What [`Self::write_beside`] writes, kept in memory, with the COCO file of this one
     /// picture (`file_name` its name there, `ids` its image's and first annotation's ids);
     /// `shown` is the picture (for its edges).
-    pub fn keep_beside(self, file_name: &str, ids: (u64, u64), shown: &image::RgbImage, beside: Beside) -> KeptBeside {
+    pub fn keep_beside(
+        self,
+        file_name: &str,
+        ids: (u64, u64),
+        shown: &image::DynamicImage,
+        beside: Beside,
+    ) -> KeptBeside {
         let passes = self.passes();
         let (camera, figures) = (&self.camera, &self.figures);
-        let controlnet =
-            beside.controlnet.map(|maps| annotate::controlnet::maps(camera, &passes, figures, maps, shown));
+        let controlnet = beside.controlnet.map(|maps| {
+            let shown = if maps.canny.is_some() { shown.to_rgb8() } else { image::RgbImage::new(0, 0) };
+            annotate::controlnet::maps(camera, &passes, figures, maps, &shown)
+        });
         let coco = beside.data.then(|| {
             let image = annotate::coco::image_json(ids.0, file_name, camera);
             annotate::coco::file(vec![image], annotate::coco::annotations(camera, &passes, figures, ids.0, ids.1))

@@ -617,7 +617,7 @@ fn capture_when_ready(
             let result = composed(&image, samples, &background, backdrop.as_deref()).and_then(|picture| match kept {
                 Some(kept) => {
                     let name = out.file_name().map_or_else(String::new, |n| n.to_string_lossy().into_owned());
-                    let beside = frame.map(|f| f.keep_beside(&name, ids, &picture.to_rgb8(), beside));
+                    let beside = frame.map(|f| f.keep_beside(&name, ids, &picture, beside));
                     kept.lock().map_err(|_| "a picture's thread failed")?.push((index, Kept { picture, beside }));
                     Ok(None)
                 }
