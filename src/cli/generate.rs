@@ -78,7 +78,7 @@ pub fn plan(args: &GenerateArgs) -> Result<Option<Plan>> {
     }
     if let Some(count) = args.count {
         spec.count = count;
-        spec.check().map_err(|e| anyhow!("--count: {e}"))?;
+        spec.check().map_err(|e| anyhow!("--count: {}", e.expected))?;
     }
     let shard = Shard::from_environment(args.shard.as_deref(), args.shards, |k| std::env::var(k).ok())
         .map_err(anyhow::Error::msg)?;

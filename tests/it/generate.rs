@@ -165,6 +165,19 @@ fn spec_errors_stop_generate_before_rendering() {
         assert!(!output.status.success() && stderr.contains(words), "{words}: {stderr}");
         assert!(!out.exists(), "{words}: nothing written");
     }
+    std::fs::write(&spec, &text).unwrap();
+    let output = Command::new(env!("CARGO_BIN_EXE_marionette"))
+        .arg("generate")
+        .arg(&spec)
+        .args(["--count", "20000000", "--out"])
+        .arg(dir.join("out"))
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert!(
+        !output.status.success() && stderr.contains("--count: expected 1 to 10000000 pictures, found 20000000"),
+        "{stderr}"
+    );
 }
 
 /// Digests of the tars in `dir`, by name.

@@ -228,7 +228,7 @@ fn read_spec(path: &Path, count: Option<usize>) -> PyResult<marionette::document
         marionette::document::generate::parse_spec(&text, path).map_err(|e| SpecError::new_err(e.to_string()))?;
     if let Some(count) = count {
         spec.count = count;
-        spec.check().map_err(|e| SpecError::new_err(format!("count: {e}")))?;
+        spec.check().map_err(|e| SpecError::new_err(format!("count: {}", e.expected)))?;
     }
     Ok(spec)
 }
@@ -366,6 +366,9 @@ impl SetPictures {
     /// The next `n` pictures (fewer at the end), as dicts of [`render`]'s with their `key`.
     fn draw<'py>(&mut self, py: Python<'py>, n: usize) -> PyResult<Vec<Bound<'py, PyDict>>> {
         use marionette::document::generate::{coco_ids, picture_stem, scene_of};
+        if n == 0 {
+            return Err(PyValueError::new_err("batch: expected at least 1 picture, found 0"));
+        }
         let ks: Vec<usize> = (0..n).map_while(|_| self.todo.pop_front()).collect();
         let (spec, library) = (&self.spec, &mut self.library);
         let kept = py.detach(|| -> PyResult<Vec<(String, Kept)>> {

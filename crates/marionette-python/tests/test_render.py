@@ -88,6 +88,13 @@ def test_generate_in_memory_gives_the_binarys_pictures_and_data(tmp_path):
         assert np.abs(s["depth"][finite] - want["depth"][finite]).max() <= 1e-6
 
 
+def test_a_bad_count_or_batch_is_refused_by_name():
+    with pytest.raises(mt.SpecError, match=r"^count: expected 1 to \d+ pictures, found 1000000000000$"):
+        next(mt.generate(SPEC, count=10**12))
+    with pytest.raises(ValueError, match="batch: expected at least 1 picture, found 0"):
+        next(mt.generate(SPEC, count=2, batch=0))
+
+
 def test_a_shard_and_a_dataset_split_the_set_as_the_binary_does():
     keys = [s["key"] for s in mt.generate(SPEC, shard=(1, 2), count=4)]
     assert keys == ["000001", "000003"]
