@@ -32,7 +32,7 @@ pub struct Plan {
 
 impl Plan {
     pub fn picture(&self) -> ShotDoc {
-        ShotDoc { width: self.spec.width, height: self.spec.height, samples: 1 }
+        self.spec.shot()
     }
 
     /// The file of picture `k`.
@@ -130,7 +130,6 @@ pub fn plan(args: &GenerateArgs) -> Result<Option<Plan>> {
 /// once the tar's pictures are all there), a progress bar with pictures a second and the
 /// time left.
 pub fn run(args: &GenerateArgs) -> Result<()> {
-    use crate::document::annotate::controlnet::ControlNet;
     use crate::editor::present::data::Beside;
     use crate::editor::present::render::{ScenePicture, render_scenes};
     let Some(mut plan) = plan(args)? else { return Ok(()) };
@@ -154,8 +153,7 @@ pub fn run(args: &GenerateArgs) -> Result<()> {
     let first_scene = plan.scene_file(numbers[0]);
     let library = std::mem::take(&mut plan.library);
     let picture = plan.picture();
-    let controlnet = plan.spec.controlnet.then_some(ControlNet { canny: plan.spec.canny });
-    let beside = Beside { data: plan.spec.data, controlnet };
+    let beside = Beside::of_spec(&plan.spec);
     let bar = indicatif::ProgressBar::new(todo as u64);
     bar.set_style(
         indicatif::ProgressStyle::with_template("{bar:40} {pos}/{len} pictures, {per_sec}, {elapsed} (left {eta})")

@@ -394,15 +394,18 @@ impl Spec {
         }
     }
 
+    /// The size each picture is drawn at (one sample a pixel).
+    pub fn shot(&self) -> ShotDoc {
+        ShotDoc { width: self.width, height: self.height, samples: 1 }
+    }
+
     /// Every field: sizes within what a picture may be, distributions not empty, weights
     /// positive, the characters that may be asked for fitting in the area `spacing` apart,
     /// presets known, files there. The error names the field (`camera.fov`).
     pub fn check(&self) -> Result<(), SpecError> {
-        ShotDoc { width: self.width, height: self.height, samples: 1 }.validate().map_err(|e| {
-            match e.split_once(": ") {
-                Some((at, expected)) => SpecError::at(at, expected.to_owned()),
-                None => SpecError::at("shot", e),
-            }
+        self.shot().validate().map_err(|e| match e.split_once(": ") {
+            Some((at, expected)) => SpecError::at(at, expected.to_owned()),
+            None => SpecError::at("shot", e),
         })?;
         if let Some(poses) = &self.poses {
             poses.check()?;
@@ -712,13 +715,7 @@ pub fn scene_of(spec: &Spec, library: &mut AssetLibrary, k: u64) -> Result<(Scen
             }
         };
     }
-    let scene = SceneDoc {
-        characters,
-        camera: Some(camera_doc),
-        stage,
-        shot: ShotDoc { width: spec.width, height: spec.height, samples: 1 },
-        ..SceneDoc::default()
-    };
+    let scene = SceneDoc { characters, camera: Some(camera_doc), stage, shot: spec.shot(), ..SceneDoc::default() };
     scene.validate().map_err(|message| GenerateError::Picture { k, message })?;
     Ok((scene, backdrop))
 }

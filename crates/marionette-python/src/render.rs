@@ -275,8 +275,7 @@ pub fn generate_pictures(
             .map_err(|e| SpecError::new_err(format!("{e:#}")))?
             .ok_or_else(|| Error::new_err("generate: nothing to draw"))?;
         let keys = plan.shard.pictures(plan.spec.count).map(picture_stem).collect();
-        let controlnet = plan.spec.controlnet.then_some(ControlNet { canny: plan.spec.canny });
-        let beside = Beside { data: plan.spec.data, controlnet };
+        let beside = Beside::of_spec(&plan.spec);
         let pictures: Vec<ScenePicture> = std::mem::take(&mut plan.pictures)
             .into_iter()
             .map(|(k, scene, backdrop)| ScenePicture { scene, out: plan.out(k), ids: coco_ids(k), backdrop })
@@ -382,10 +381,7 @@ impl SetPictures {
             if pictures.is_empty() {
                 return Ok(Vec::new());
             }
-            let shot = ShotDoc { width: spec.width, height: spec.height, samples: 1 };
-            let controlnet = spec.controlnet.then_some(ControlNet { canny: spec.canny });
-            let beside = Beside { data: spec.data, controlnet };
-            let library = std::mem::take(library);
+            let (shot, beside, library) = (spec.shot(), Beside::of_spec(spec), std::mem::take(library));
             let (_, kept) = with_renderer(shot, library, |r| r.draw(pictures, FramingView::default().0, beside))?;
             Ok(ks.iter().map(|&k| picture_stem(k)).zip(kept).collect())
         })?;

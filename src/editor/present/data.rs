@@ -111,6 +111,14 @@ pub struct Beside {
     pub controlnet: Option<annotate::controlnet::ControlNet>,
 }
 
+impl Beside {
+    /// What a data set's spec asks beside each picture.
+    pub fn of_spec(spec: &crate::document::generate::Spec) -> Self {
+        let controlnet = spec.controlnet.then_some(annotate::controlnet::ControlNet { canny: spec.canny });
+        Self { data: spec.data, controlnet }
+    }
+}
+
 /// The ControlNet maps a panel asks for: whether, and whether with the canny edges at
 /// thresholds kept while they are off.
 #[derive(Debug, Clone, Copy, Default, PartialEq)]

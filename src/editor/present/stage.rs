@@ -197,19 +197,21 @@ pub fn apply_stage_settings(
     }
     *ambient =
         GlobalAmbientLight { color: linear(stage.ambient.color), brightness: stage.ambient.brightness, ..default() };
-    let mut kept: Vec<(Entity, usize, bool)> = lamps.iter().map(|(e, lamp, spot)| (e, lamp.0, spot)).collect();
-    kept.sort_unstable_by_key(|&(_, i, _)| i);
     let wanted = &stage.lamps[..stage.lamps.len().min(crate::formats::scene::MAX_LAMPS)];
-    for (i, lamp) in wanted.iter().enumerate() {
-        // A lamp of the kind the last stage had in its place stays the same entity.
-        let mut entity = match kept.get(i).filter(|&&(_, at, spot)| at == i && spot == lamp.spot.is_some()) {
-            Some(&(entity, ..)) => commands.entity(entity),
-            None => commands.spawn(Lamp(i)),
-        };
-        light_lamp(&mut entity, lamp);
+    // A lamp of the kind the last stage had in its place stays the same entity.
+    let mut placed = vec![false; wanted.len()];
+    for (entity, lamp, spot) in &lamps {
+        match wanted.get(lamp.0).filter(|l| l.spot.is_some() == spot && !placed[lamp.0]) {
+            Some(doc) => {
+                placed[lamp.0] = true;
+                light_lamp(&mut commands.entity(entity), doc);
+            }
+            None => commands.entity(entity).despawn(),
+        }
     }
-    let stays = |&&(_, at, spot): &&(Entity, usize, bool)| wanted.get(at).is_some_and(|l| l.spot.is_some() == spot);
-    kept.iter().filter(|k| !stays(k)).for_each(|&(e, ..)| commands.entity(e).despawn());
+    for (i, doc) in wanted.iter().enumerate().filter(|&(i, _)| !placed[i]) {
+        light_lamp(&mut commands.spawn(Lamp(i)), doc);
+    }
     let ([r, g, b], alpha) = stage.background.at(0.5);
     clear.0 = Color::srgba(r, g, b, alpha);
 }
