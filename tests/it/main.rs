@@ -13,6 +13,7 @@ mod ecs;
 mod editor;
 mod edits;
 mod fbx;
+mod fit;
 mod fuzz;
 mod generate;
 mod gizmo;

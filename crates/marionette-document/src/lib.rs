@@ -8,6 +8,7 @@ pub mod annotate;
 pub mod crowd;
 pub mod default_scene;
 pub mod export;
+pub mod fit;
 pub mod frames;
 pub mod generate;
 pub mod layout;

@@ -49,6 +49,40 @@ pub enum BodyPoint {
 
 use BodyPoint::*;
 
+impl BodyPoint {
+    /// Its name as Marionette's data pictures and OpenPose's drawing call it (`left_big_toe`,
+    /// `mid_hip`).
+    pub fn name(self) -> &'static str {
+        match self {
+            LeftAnkle => "left_ankle",
+            LeftBigToe => "left_big_toe",
+            LeftEar => "left_ear",
+            LeftElbow => "left_elbow",
+            LeftEye => "left_eye",
+            LeftHeel => "left_heel",
+            LeftHip => "left_hip",
+            LeftKnee => "left_knee",
+            LeftShoulder => "left_shoulder",
+            LeftSmallToe => "left_small_toe",
+            LeftWrist => "left_wrist",
+            MidHip => "mid_hip",
+            Neck => "neck",
+            Nose => "nose",
+            RightAnkle => "right_ankle",
+            RightBigToe => "right_big_toe",
+            RightEar => "right_ear",
+            RightElbow => "right_elbow",
+            RightEye => "right_eye",
+            RightHeel => "right_heel",
+            RightHip => "right_hip",
+            RightKnee => "right_knee",
+            RightShoulder => "right_shoulder",
+            RightSmallToe => "right_small_toe",
+            RightWrist => "right_wrist",
+        }
+    }
+}
+
 /// OpenPose's BODY_25.
 pub const BODY_25: [BodyPoint; 25] = [
     Nose,

@@ -478,6 +478,18 @@ pub fn apply_body_pose(
     body: &BodyPose,
     mirrored: bool,
 ) -> Option<BodyPoseReport> {
+    aim_body(skeleton, map, pose, &body.directions(mirrored), body.look(mirrored))
+}
+
+/// Puts a body pose given by its bones' directions (unit, in the facing frame, the bones of
+/// [`AIMED`] in their order) and its look on `pose`, as [`apply_body_pose`] does.
+pub fn aim_body(
+    skeleton: &Skeleton,
+    map: &HumanoidMap,
+    pose: &mut [JointRotation],
+    directions: &[(HumanBone, Vec3)],
+    look_along: Option<Vec3>,
+) -> Option<BodyPoseReport> {
     let frame = facing_frame(skeleton, map)?;
     let rest = skeleton.initial_pose();
     let fingers: Vec<usize> = map.iter().filter(|(b, _)| b.is_finger()).map(|(_, &j)| j).collect();
@@ -492,7 +504,7 @@ pub fn apply_body_pose(
     let mut report = BodyPoseReport::default();
     let mut aim = |pose: &mut [JointRotation], start: usize, end: usize, wanted: Vec3, report: &mut BodyPoseReport| {
         let joint = turned_joint(skeleton, start, end);
-        forward_kinematics(skeleton, pose, Mat4::IDENTITY, &mut world);
+        refresh(skeleton, pose, &mut world, &[start, end]);
         let now = world[end].w_axis.truncate() - world[start].w_axis.truncate();
         if now.length_squared() < 1e-12 {
             return;
@@ -503,17 +515,17 @@ pub fn apply_body_pose(
             report.limited.push(joint);
         }
     };
-    for (bone, direction) in body.directions(mirrored) {
+    for &(bone, direction) in directions {
         if bone == LeftUpperArm {
             // The look turns the chest and neck, before the limbs hung from them are aimed.
-            look(skeleton, map, pose, body, mirrored, frame, &rest_world, &mut report);
+            look(skeleton, map, pose, look_along, frame, &rest_world, &mut report);
         }
         let (Some(start), Some(end)) = (aim_start(map, bone), aim_end(map, bone)) else { continue };
         aim(pose, start, end, frame * direction, &mut report);
     }
     for (shin, foot) in [(LeftLowerLeg, LeftFoot), (RightLowerLeg, RightFoot)] {
         let (Some(&shin), Some(&foot)) = (map.get(&shin), map.get(&foot)) else { continue };
-        forward_kinematics(skeleton, pose, Mat4::IDENTITY, &mut world);
+        refresh(skeleton, pose, &mut world, &[shin, foot]);
         let down = (world[foot].w_axis.truncate() - world[shin].w_axis.truncate()).normalize_or(Vec3::NEG_Y);
         if down.dot(Vec3::NEG_Y) > std::f32::consts::FRAC_1_SQRT_2 {
             let turn = rotation_of(rest_world[foot]) * rotation_of(world[foot]).inverse();
@@ -526,19 +538,27 @@ pub fn apply_body_pose(
     Some(report)
 }
 
+/// `world` brought up to date for `joints` and every joint above them (the rest may be
+/// stale): forward kinematics along their chains only.
+fn refresh(skeleton: &Skeleton, pose: &[JointRotation], world: &mut [Mat4], joints: &[usize]) {
+    for &j in joints {
+        let mut path: Vec<usize> = std::iter::successors(Some(j), |&k| skeleton.parent(k)).collect();
+        path.reverse();
+        crate::fk::forward_kinematics_along(skeleton, pose, Mat4::IDENTITY, &path, world);
+    }
+}
+
 /// Turns the head (with shares of the chest and neck) to face along the pose's look.
-#[allow(clippy::too_many_arguments)]
 fn look(
     skeleton: &Skeleton,
     map: &HumanoidMap,
     pose: &mut [JointRotation],
-    body: &BodyPose,
-    mirrored: bool,
+    look: Option<Vec3>,
     frame: Quat,
     rest_world: &[Mat4],
     report: &mut BodyPoseReport,
 ) {
-    let (Some(look), Some(&head)) = (body.look(mirrored), map.get(&Head)) else { return };
+    let (Some(look), Some(&head)) = (look, map.get(&Head)) else { return };
     let mut world = vec![Mat4::IDENTITY; skeleton.len()];
     forward_kinematics(skeleton, pose, Mat4::IDENTITY, &mut world);
     let face = rotation_of(rest_world[head]).inverse() * (frame * Vec3::Z);

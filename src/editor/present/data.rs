@@ -220,22 +220,5 @@ fn figure(
     };
     let positions: Vec<Vec3> = model.iter().map(|&p| world.transform_point3(p)).collect();
     let joint_world: Vec<Vec3> = joints.matrices.iter().map(|m| world.transform_point3(m.w_axis.truncate())).collect();
-    let joint_parts = annotate::joint_parts(&asset.skeleton, map);
-    let parts = annotate::vertex_parts(asset, &joint_parts);
-    let (points, bones) = match map {
-        Some(map) if joint_world.len() == asset.skeleton.len() => (
-            annotate::keypoints(&asset.skeleton, map, &joint_world, &joint_parts, &positions, smpl),
-            map.iter().filter_map(|(&bone, &j)| Some((bone, *joint_world.get(j)?))).collect(),
-        ),
-        _ => Default::default(),
-    };
-    Figure {
-        name: name.to_string(),
-        instance,
-        positions,
-        triangles: asset.skin.triangles.clone(),
-        parts,
-        points,
-        bones,
-    }
+    Figure::new(name, instance, asset, map, positions, &joint_world, smpl)
 }

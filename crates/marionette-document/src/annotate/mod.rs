@@ -140,6 +140,38 @@ pub struct Figure {
 }
 
 impl Figure {
+    /// The character `asset` as drawn: its skinned vertices and joints in the world
+    /// (`positions`, `joint_world`), its humanoid map where it has one (else a prop without
+    /// keypoints), and whether it is an SMPL body (its face and feet from the mesh).
+    pub fn new(
+        name: &str,
+        instance: u16,
+        asset: &CharacterAsset,
+        map: Option<&HumanoidMap>,
+        positions: Vec<Vec3>,
+        joint_world: &[Vec3],
+        smpl: bool,
+    ) -> Self {
+        let joint_parts = joint_parts(&asset.skeleton, map);
+        let parts = vertex_parts(asset, &joint_parts);
+        let (points, bones) = match map {
+            Some(map) if joint_world.len() == asset.skeleton.len() => (
+                keypoints(&asset.skeleton, map, joint_world, &joint_parts, &positions, smpl),
+                map.iter().filter_map(|(&bone, &j)| Some((bone, *joint_world.get(j)?))).collect(),
+            ),
+            _ => Default::default(),
+        };
+        Figure {
+            name: name.to_string(),
+            instance,
+            positions,
+            triangles: asset.skin.triangles.clone(),
+            parts,
+            points,
+            bones,
+        }
+    }
+
     /// Its triangles for the rasteriser.
     pub fn surface(&self) -> Surface<'_> {
         Surface { instance: self.instance, positions: &self.positions, triangles: &self.triangles, parts: &self.parts }

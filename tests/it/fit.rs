@@ -1,0 +1,297 @@
+//! Pose from a photo: characters nobody here made, posed in every built-in body pose, seen
+//! from three cameras; the keypoint files `render --data` writes for those pictures (COCO's
+//! and OpenPose's, made here by the document layer's own annotation of the posed skin,
+//! which is what `render --data` runs on the drawn frame) fed back to the fit. Checked
+//! against the truth: the reprojection, the 3D joints after a similarity (Procrustes)
+//! alignment, and the knees' bends.
+
+use std::path::{Path, PathBuf};
+
+use glam::{Mat4, Vec3};
+use marionette::document::AssetLibrary;
+use marionette::document::annotate::{self, Figure, Pinhole, Surface, raster::FLOOR};
+use marionette::document::fit::{FitSpec, Fitted, fit, is_smpl};
+use marionette::document::options::{PoseOptions, PoseSpecs, apply_options};
+use marionette::document::retarget::humanoid_map;
+use marionette::formats::keypoints::parse_keypoints;
+use marionette::formats::scene::{CharacterDoc, SceneDoc, SourceDoc};
+use marionette::formats::stage::CameraDoc;
+use marionette::rig::body_poses::POSES;
+use marionette::rig::fk::forward_kinematics;
+use marionette::rig::humanoid::{HumanBone, HumanoidMap};
+use marionette::rig::{CharacterAsset, JointRotation};
+
+use HumanBone::*;
+
+const SIZE: (u32, u32) = (640, 480);
+
+fn rig(file: &str) -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/data/rigs").join(file)
+}
+
+fn doc_of(library: &mut AssetLibrary, path: &Path) -> CharacterDoc {
+    let source = SourceDoc::File(path.to_path_buf());
+    let asset = library.load(&source).unwrap();
+    library.new_character_doc(source, &asset)
+}
+
+/// A character in a built-in pose, as `--preset` poses it (feet on the floor).
+struct Posed {
+    asset: std::sync::Arc<CharacterAsset>,
+    map: HumanoidMap,
+    pose: Vec<JointRotation>,
+    placement: Mat4,
+    smpl: bool,
+}
+
+fn posed(library: &mut AssetLibrary, doc: &CharacterDoc, preset: &str) -> Posed {
+    let mut scene = SceneDoc { characters: vec![doc.clone()], ..SceneDoc::default() };
+    let specs = PoseSpecs { preset: Some(preset.parse().unwrap()), ..PoseSpecs::default() };
+    apply_options(&mut scene, &PoseOptions { specs, ..PoseOptions::default() }, library).unwrap();
+    let c = &scene.characters[0];
+    let asset = library.shaped(c).unwrap();
+    let (pose, _) = marionette::document::scenes::pose_from_doc(&asset, c);
+    let map = humanoid_map(&asset, &c.humanoid);
+    Posed { asset, map, pose, placement: c.placement.to_mat4(), smpl: is_smpl(c) }
+}
+
+fn joints_world(asset: &CharacterAsset, pose: &[JointRotation], placement: Mat4) -> Vec<Vec3> {
+    let mut world = vec![Mat4::IDENTITY; asset.skeleton.len()];
+    forward_kinematics(&asset.skeleton, pose, placement, &mut world);
+    world.iter().map(|m| m.w_axis.truncate()).collect()
+}
+
+/// The three cameras: ahead and a little to the side, from the character's right, and from
+/// behind its left shoulder; each aimed at the hips' height.
+fn cameras(height: f32) -> [CameraDoc; 3] {
+    let at = |yaw: f32, pitch: f32, distance: f32| CameraDoc {
+        focus: Vec3::new(0.0, height * 0.5, 0.0),
+        yaw,
+        pitch,
+        distance: distance * height,
+        ..CameraDoc::default()
+    };
+    [at(0.35, -0.12, 2.2), at(-1.35, -0.3, 2.4), at(2.5, -0.2, 2.3)]
+}
+
+/// The keypoint files of the picture: `(coco, openpose)` as `render --data` and
+/// `render --controlnet` write them.
+fn keypoint_files(p: &Posed, camera: &CameraDoc) -> (String, String) {
+    let pinhole = Pinhole::of(camera, SIZE.0, SIZE.1).unwrap();
+    let positions = marionette::document::posing::posed_positions(&p.asset, &p.pose, p.placement);
+    let joints = joints_world(&p.asset, &p.pose, p.placement);
+    let figure = Figure::new("figure", 1, &p.asset, Some(&p.map), positions, &joints, p.smpl);
+    let floor = [
+        Vec3::new(-20.0, 0.0, -20.0),
+        Vec3::new(20.0, 0.0, -20.0),
+        Vec3::new(20.0, 0.0, 20.0),
+        Vec3::new(-20.0, 0.0, 20.0),
+    ];
+    let surfaces = [
+        figure.surface(),
+        Surface { instance: FLOOR, positions: &floor, triangles: &[[0, 2, 1], [0, 3, 2]], parts: &[] },
+    ];
+    let passes = annotate::rasterize(&pinhole, &surfaces);
+    let figures = [figure];
+    let image = annotate::coco::image_json(1, "picture.png", &pinhole);
+    let annotations = annotate::coco::annotations(&pinhole, &passes, &figures, 1, 1);
+    let coco = annotate::coco::file(vec![image], annotations);
+    let openpose = annotate::openpose::json(&pinhole, &passes, &figures);
+    (coco.to_string(), openpose.to_string())
+}
+
+/// The body joints the error is measured on: the humanoid map's, fingers and toes aside.
+fn measured(map: &HumanoidMap) -> Vec<usize> {
+    HumanBone::ALL
+        .iter()
+        .filter(|b| !b.is_finger() && !matches!(b, LeftToes | RightToes | LeftShoulder | RightShoulder))
+        .filter_map(|b| map.get(b).copied())
+        .collect()
+}
+
+/// Mean distance between matching points after the best similarity (rotation, scale,
+/// translation) takes `a` onto `b` (Umeyama's).
+fn procrustes_error(a: &[Vec3], b: &[Vec3]) -> f32 {
+    let n = a.len() as f64;
+    let mean = |p: &[Vec3]| p.iter().fold(glam::DVec3::ZERO, |s, v| s + v.as_dvec3()) / n;
+    let (ma, mb) = (mean(a), mean(b));
+    let cov = faer::Mat::<f64>::from_fn(3, 3, |i, j| {
+        a.iter().zip(b).map(|(x, y)| (y.as_dvec3() - mb)[i] * (x.as_dvec3() - ma)[j]).sum::<f64>() / n
+    });
+    let svd = cov.svd().unwrap();
+    let (u, s, v) = (svd.U(), svd.S(), svd.V());
+    let um = glam::DMat3::from_cols_array(&std::array::from_fn(|k| u[(k % 3, k / 3)]));
+    let vm = glam::DMat3::from_cols_array(&std::array::from_fn(|k| v[(k % 3, k / 3)]));
+    let sign = if (um * vm.transpose()).determinant() < 0.0 { -1.0 } else { 1.0 };
+    let d = glam::DMat3::from_diagonal(glam::DVec3::new(1.0, 1.0, sign));
+    let rotation = um * d * vm.transpose();
+    let var_a = a.iter().map(|x| (x.as_dvec3() - ma).length_squared()).sum::<f64>() / n;
+    let scale = (s[0] + s[1] + s[2] * sign) / var_a;
+    let sum: f64 =
+        a.iter().zip(b).map(|(x, y)| ((rotation * (x.as_dvec3() - ma)) * scale + mb - y.as_dvec3()).length()).sum();
+    (sum / n) as f32
+}
+
+/// How far a knee bends backwards: a knee bends about the body's left (from the right hip
+/// to the left), the shin turning behind the thigh; the most either turns the other way.
+fn knees_backwards(map: &HumanoidMap, at: &[Vec3]) -> f32 {
+    let left = (at[map[&LeftUpperLeg]] - at[map[&RightUpperLeg]]).normalize();
+    let mut worst: f32 = 0.0;
+    for (hip, knee, ankle) in [(LeftUpperLeg, LeftLowerLeg, LeftFoot), (RightUpperLeg, RightLowerLeg, RightFoot)] {
+        let (h, k, a) = (at[map[&hip]], at[map[&knee]], at[map[&ankle]]);
+        let bend = (k - h).normalize().cross((a - k).normalize()).dot(left);
+        worst = worst.max(-bend);
+    }
+    worst
+}
+
+/// Whether the pose stands or sits (the poses the 50 mm bound is for).
+fn stands_or_sits(name: &str) -> bool {
+    let pose = marionette::rig::body_poses::body_pose(name).unwrap();
+    let dirs = pose.directions(false);
+    let of = |b: HumanBone| dirs.iter().find(|(x, _)| *x == b).unwrap().1;
+    let down = |b| of(b).angle_between(Vec3::NEG_Y) < 25f32.to_radians();
+    name.starts_with("sit-") || (down(LeftUpperLeg) && down(RightUpperLeg) && of(Hips).angle_between(Vec3::Y) < 0.45)
+}
+
+/// One character's round trip: every pose from every camera, COCO and OpenPose files.
+struct Figures {
+    reprojection: Vec<f32>,
+    standing: Vec<f32>,
+    all: Vec<f32>,
+    failures: Vec<String>,
+}
+
+fn round_trip(library: &mut AssetLibrary, doc: &CharacterDoc, formats: &[usize]) -> Figures {
+    let mut out = Figures { reprojection: Vec::new(), standing: Vec::new(), all: Vec::new(), failures: Vec::new() };
+    let rest = posed(library, doc, "stand");
+    let height = {
+        let at = joints_world(&rest.asset, &rest.pose, rest.placement);
+        at.iter().map(|p| p.y).fold(0.0, f32::max)
+    };
+    for body in &POSES {
+        let truth = posed(library, doc, body.name);
+        let true_joints = joints_world(&truth.asset, &truth.pose, truth.placement);
+        for (k, camera) in cameras(height).iter().enumerate() {
+            let files = keypoint_files(&truth, camera);
+            for &format in formats {
+                let text = if format == 0 { &files.0 } else { &files.1 };
+                let keypoints = parse_keypoints(text, Path::new("keypoints.json")).unwrap();
+                let spec = FitSpec { file: "keypoints.json".into(), ..FitSpec::default() };
+                let fitted: Fitted =
+                    fit(&truth.asset, &truth.map, rest.placement, truth.smpl, &keypoints, &spec).unwrap();
+                let at = joints_world(&truth.asset, &fitted.pose, fitted.placement);
+                let joints = measured(&truth.map);
+                let fit_points: Vec<Vec3> = joints.iter().map(|&j| at[j]).collect();
+                let true_points: Vec<Vec3> = joints.iter().map(|&j| true_joints[j]).collect();
+                let mm = 1000.0 * procrustes_error(&fit_points, &true_points) * 1.75 / height;
+                let what = format!("{} {} camera {k} {}", doc.name, body.name, ["coco", "openpose"][format]);
+                out.reprojection.push(fitted.error);
+                out.all.push(mm);
+                if stands_or_sits(body.name) {
+                    out.standing.push(mm);
+                }
+                if fitted.error > 3.0 || mm > 120.0 {
+                    out.failures.push(format!("{what}: {:.2} px, {mm:.0} mm (from {})", fitted.error, fitted.mode));
+                }
+                let backwards = knees_backwards(&truth.map, &at);
+                if backwards > 0.1 + knees_backwards(&truth.map, &true_joints) {
+                    out.failures.push(format!("{what}: a knee bent backwards ({backwards:.2})"));
+                }
+            }
+        }
+    }
+    out
+}
+
+fn mean(v: &[f32]) -> f32 {
+    v.iter().sum::<f32>() / v.len().max(1) as f32
+}
+
+fn check(name: &str, figures: &Figures) {
+    let worst = figures.reprojection.iter().copied().fold(0.0, f32::max);
+    println!(
+        "{name}: reprojection mean {:.2} px (worst {worst:.2}); PA-MPJPE standing/sitting {:.1} mm, all {:.1} mm over {} fits",
+        mean(&figures.reprojection),
+        mean(&figures.standing),
+        mean(&figures.all),
+        figures.all.len()
+    );
+    for f in &figures.failures {
+        println!("  {f}");
+    }
+    assert!(mean(&figures.reprojection) <= 3.0, "{name}: reprojection");
+    assert!(mean(&figures.standing) <= 50.0, "{name}: standing and sitting");
+    assert!(mean(&figures.all) <= 80.0, "{name}: all poses");
+    assert!(!figures.failures.iter().any(|f| f.contains("backwards")), "{name}: knees");
+}
+
+fn own_round_trip(library: &mut AssetLibrary, path: &Path) {
+    let doc = doc_of(library, path);
+    let figures = round_trip(library, &doc, &[0, 1]);
+    check(&doc.name, &figures);
+}
+
+#[test]
+fn a_mixamo_figure_fitted_to_its_own_keypoints_takes_its_pose() {
+    own_round_trip(&mut AssetLibrary::default(), &rig("mixamo.glb"));
+}
+
+#[test]
+fn a_rigify_figure_fitted_to_its_own_keypoints_takes_its_pose() {
+    own_round_trip(&mut AssetLibrary::default(), &rig("rigify.glb"));
+}
+
+#[test]
+fn a_vroid_figure_fitted_to_its_own_keypoints_takes_its_pose() {
+    own_round_trip(&mut AssetLibrary::default(), &rig("vroid.glb"));
+}
+
+#[test]
+#[cfg_attr(not(marionette_data), ignore)]
+fn cesium_man_fitted_to_its_own_keypoints_takes_its_pose() {
+    own_round_trip(&mut AssetLibrary::default(), &crate::common::data_dir().join("khronos/CesiumMan.glb"));
+}
+
+#[test]
+#[cfg_attr(not(marionette_data), ignore)]
+fn an_smpl_body_fitted_to_its_own_keypoints_takes_its_pose() {
+    own_round_trip(&mut AssetLibrary::default(), &crate::common::data_dir().join("smpl"));
+}
+
+/// The Mixamo figure's keypoints (its COCO file, every pose from every camera) fitted to
+/// CesiumMan and to an SMPL body: they cannot match its proportions exactly, but come
+/// within 5 px mean.
+#[test]
+#[cfg_attr(not(marionette_data), ignore)]
+fn keypoints_of_one_figure_fit_another_character() {
+    let data = crate::common::data_dir();
+    let mut library = AssetLibrary::default();
+    let mixamo = doc_of(&mut library, &rig("mixamo.glb"));
+    let height = {
+        let rest = posed(&mut library, &mixamo, "stand");
+        joints_world(&rest.asset, &rest.pose, rest.placement).iter().map(|p| p.y).fold(0.0, f32::max)
+    };
+    for target in ["khronos/CesiumMan.glb", "smpl"] {
+        let doc = doc_of(&mut library, &data.join(target));
+        let other = posed(&mut library, &doc, "stand");
+        let mut errors = Vec::new();
+        for body in &POSES {
+            let truth = posed(&mut library, &mixamo, body.name);
+            for camera in &cameras(height) {
+                let (coco, _) = keypoint_files(&truth, camera);
+                let keypoints = parse_keypoints(&coco, Path::new("keypoints.json")).unwrap();
+                let spec = FitSpec { file: "keypoints.json".into(), ..FitSpec::default() };
+                let fitted = fit(&other.asset, &other.map, other.placement, other.smpl, &keypoints, &spec).unwrap();
+                errors.push(fitted.error);
+            }
+        }
+        let worst = errors.iter().copied().fold(0.0, f32::max);
+        println!(
+            "mixamo onto {target}: reprojection mean {:.2} px (worst {worst:.2}) over {} fits",
+            mean(&errors),
+            errors.len()
+        );
+        assert!(mean(&errors) <= 5.0, "{target}");
+    }
+}
