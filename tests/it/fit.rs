@@ -295,3 +295,79 @@ fn keypoints_of_one_figure_fit_another_character() {
         assert!(mean(&errors) <= 5.0, "{target}");
     }
 }
+
+/// A 2-second walk (CMU's, retargeted onto the Mixamo figure) drawn at 30 fps from one
+/// camera, its OpenPose files fitted as a sequence: each frame of the fitted clip within
+/// 80 mm PA-MPJPE of the walk, and no frame-to-frame jump of the joints over 3× the walk's
+/// own (or 5 mm, where the walk barely moves).
+#[test]
+fn a_walks_keypoints_fitted_as_a_sequence_give_the_walk() {
+    use marionette::formats::scene::{AnimDoc, MotionSourceDoc, RetargetDoc};
+    let mut library = AssetLibrary::default();
+    let mut doc = doc_of(&mut library, &rig("mixamo.glb"));
+    let walk = rig("cmu_walk.bvh");
+    doc.anim = Some(AnimDoc {
+        retarget: Some(RetargetDoc::of(MotionSourceDoc::File { path: walk, clip: None })),
+        ..AnimDoc::default()
+    });
+    let asset = library.shaped(&doc).unwrap();
+    let map = humanoid_map(&asset, &doc.humanoid);
+    let scene = SceneDoc { characters: vec![doc.clone()], ..SceneDoc::default() };
+    let truth: Vec<Posed> = (0..60)
+        .map(|k| {
+            let mut at = scene.clone();
+            marionette::document::options::pause_clips_at(&mut at, k as f32 / 30.0);
+            let c = &at.characters[0];
+            let (pose, shift) = marionette::document::export::still_pose(&mut library, &at, c, &asset).unwrap();
+            let placement = c.placement.to_mat4() * Mat4::from_translation(shift);
+            Posed { asset: asset.clone(), map: map.clone(), pose, placement, smpl: false }
+        })
+        .collect();
+    let hips: Vec<Vec3> = truth.iter().map(|p| joints_world(&asset, &p.pose, p.placement)[map[&Hips]]).collect();
+    let middle = (hips[0] + hips[59]) / 2.0;
+    let camera = CameraDoc { focus: middle, yaw: 0.9, pitch: -0.15, distance: 6.0, ..CameraDoc::default() };
+    let folder = crate::common::scratch("fit_sequence");
+    for (k, p) in truth.iter().enumerate() {
+        let (_, openpose) = keypoint_files(p, &camera);
+        std::fs::write(folder.join(format!("walk_{k:012}_keypoints.json")), openpose).unwrap();
+    }
+    let spec = marionette::document::fit::SequenceSpec { frames: folder, fps: 30.0, person: None, fov: None };
+    let fitted = marionette::document::fit::fit_sequence(&asset, &map, doc.placement.to_mat4(), false, &spec).unwrap();
+    let joints = measured(&map);
+    let rest_root = asset.skeleton.joint(0).rest_offset;
+    let mut errors = Vec::new();
+    let (mut fit_before, mut true_before): (Option<Vec<Vec3>>, Option<Vec<Vec3>>) = (None, None);
+    let mut failures = Vec::new();
+    for (k, p) in truth.iter().enumerate() {
+        let (root, pose) = fitted.clip.pose_at(&asset.skeleton, k as f32 / 30.0, &asset.skeleton.initial_pose());
+        let placement = doc.placement.to_mat4() * Mat4::from_translation(root - rest_root);
+        let fit_at = joints_world(&asset, &pose, placement);
+        let true_at = joints_world(&asset, &p.pose, p.placement);
+        let fit_points: Vec<Vec3> = joints.iter().map(|&j| fit_at[j]).collect();
+        let true_points: Vec<Vec3> = joints.iter().map(|&j| true_at[j]).collect();
+        let mm = 1000.0 * procrustes_error(&fit_points, &true_points);
+        errors.push(mm);
+        if mm > 80.0 {
+            failures.push(format!("frame {k}: {mm:.0} mm"));
+        }
+        if let (Some(a), Some(b)) = (&fit_before, &true_before) {
+            // Each joint's move against the hips' (the body's own motion, not its travel).
+            let jump = |now: &[Vec3], before: &[Vec3]| {
+                let moved = |k: usize| (now[k] - now[0]) - (before[k] - before[0]);
+                1000.0 * (0..now.len()).map(|k| moved(k).length()).sum::<f32>() / now.len() as f32
+            };
+            let (fitted_jump, true_jump) = (jump(&fit_points, a), jump(&true_points, b));
+            if fitted_jump > 3.0 * true_jump.max(5.0) {
+                failures.push(format!("frame {k}: a jump of {fitted_jump:.0} mm against the walk's {true_jump:.0} mm"));
+            }
+        }
+        (fit_before, true_before) = (Some(fit_points), Some(true_points));
+    }
+    println!(
+        "{}; PA-MPJPE mean {:.1} mm, worst {:.1} mm",
+        fitted.describe(),
+        mean(&errors),
+        errors.iter().copied().fold(0.0, f32::max)
+    );
+    assert!(failures.is_empty(), "{}", failures.join("\n"));
+}

@@ -11,7 +11,10 @@
 //! forward costs as much as a large miss. Fingers then follow the hand points where the rig
 //! has mapped fingers. The character is stood on the floor and the camera moved with it.
 
+mod sequence;
 mod solve;
+
+pub use sequence::{FittedClip, SequenceSpec, fit_sequence, frame_files};
 
 use std::path::{Path, PathBuf};
 

@@ -16,6 +16,9 @@ use crate::annotate::camera::Pinhole;
 const REFINED: usize = 5;
 /// The most Levenberg–Marquardt steps of one refinement.
 const STEPS: usize = 40;
+/// The pull toward a mode of the prior, and toward the frame before in a sequence.
+const MODE_PULL: f32 = 0.03;
+const FOLLOW_PULL: f32 = 0.2;
 /// The field of view a camera starts from where none is given, degrees.
 const START_FOV: f32 = 45.0;
 
@@ -24,8 +27,8 @@ const START_FOV: f32 = 45.0;
 pub(super) struct Camera {
     yaw: f32,
     pitch: f32,
-    eye: Vec3,
-    fov: f32,
+    pub(super) eye: Vec3,
+    pub(super) fov: f32,
 }
 
 impl Camera {
@@ -33,8 +36,13 @@ impl Camera {
         Quat::from_euler(glam::EulerRot::YXZ, self.yaw, self.pitch, 0.0)
     }
 
+    /// Camera to world (the renderer's: it looks along its -z).
+    pub(super) fn to_world(self) -> Mat4 {
+        Mat4::from_rotation_translation(self.rotation(), self.eye)
+    }
+
     /// The scene's camera, its focus `distance` ahead.
-    fn doc(&self, distance: f32) -> CameraDoc {
+    pub(super) fn doc(&self, distance: f32) -> CameraDoc {
         let focus = self.eye - self.rotation() * Vec3::new(0.0, 0.0, distance);
         CameraDoc { focus, yaw: self.yaw, pitch: self.pitch, distance, fov: self.fov, ortho: None }
     }
@@ -42,8 +50,33 @@ impl Camera {
 
 #[derive(Debug, Clone, Copy)]
 pub(super) struct State {
-    camera: Camera,
+    pub(super) camera: Camera,
     pub(super) body: BodyState,
+}
+
+impl State {
+    /// The weighted mean of states: the camera's numbers, and each direction's (made unit).
+    pub(super) fn mean(states: &[(f32, &State)]) -> State {
+        let total: f32 = states.iter().map(|(w, _)| w).sum();
+        let centre = states[states.len() / 2].1;
+        let mut out = *centre;
+        let sum = |f: &dyn Fn(&State) -> f32| states.iter().map(|(w, s)| w * f(s)).sum::<f32>() / total;
+        // Yaw about the centre's, so a turn through ±π averages right.
+        let wrap = |a: f32| (a + std::f32::consts::PI).rem_euclid(std::f32::consts::TAU) - std::f32::consts::PI;
+        out.camera.yaw = centre.camera.yaw + sum(&|s| wrap(s.camera.yaw - centre.camera.yaw));
+        out.camera.pitch = sum(&|s| s.camera.pitch);
+        out.camera.fov = sum(&|s| s.camera.fov);
+        out.camera.eye = states.iter().map(|(w, s)| s.camera.eye * *w).sum::<Vec3>() / total;
+        for k in 0..out.body.directions.len() {
+            let d: Vec3 = states.iter().map(|(w, s)| s.body.directions[k] * *w).sum();
+            out.body.directions[k] = d.normalize_or(centre.body.directions[k]);
+        }
+        if let Some(look) = centre.body.look {
+            let d: Vec3 = states.iter().filter_map(|(w, s)| s.body.look.map(|l| l * *w)).sum();
+            out.body.look = Some(d.normalize_or(look));
+        }
+        out
+    }
 }
 
 /// The fit that won.
@@ -81,6 +114,11 @@ pub(super) struct Problem<'a> {
     /// The person's size in the picture (pixels): the prior's weights scale with it.
     scale: f32,
     hinges: Vec<Hinge>,
+    /// The camera's pitch where it is held (a sequence's frames after the first).
+    pitch: Option<f32>,
+    /// How hard the body is pulled toward its mode, per unit of each direction's change
+    /// and pixel of the person's size.
+    pull: f32,
 }
 
 /// The camera's parameters in the step vector (yaw, pitch, eye), then the field of view
@@ -93,7 +131,7 @@ impl<'a> Problem<'a> {
             (lo.min(s.at), hi.max(s.at))
         });
         let scale = (hi - lo).length().max(10.0);
-        Self { body, seen, size, fov, scale, hinges: hinges(body) }
+        Self { body, seen, size, fov, scale, hinges: hinges(body), pitch: None, pull: MODE_PULL }
     }
 
     /// The best fit from the modes.
@@ -115,13 +153,37 @@ impl<'a> Problem<'a> {
         for (_, state, mode, floors) in started.into_iter().take(REFINED) {
             let (state, cost) = self.refine(state, mode, &floors, true);
             if best.as_ref().is_none_or(|b| cost < b.cost) {
-                let (points, _) = self.posed_points(&state.body);
-                let error = self.mean_error(&state.camera, &points);
-                let hips = self.hips(&state.body);
-                best = Some(Best { state, error, mode: mode.name.clone(), cost, hips });
+                best = Some(self.best_of(state, cost, mode));
             }
         }
         best.expect("at least one mode")
+    }
+
+    /// A sequence's later frame: the camera's pitch held at the first frame's `state`, the
+    /// body pulled harder toward the frame before.
+    pub(super) fn follow(&mut self, first: &State) {
+        self.pitch = Some(first.camera.pitch);
+        self.pull = FOLLOW_PULL;
+    }
+
+    /// The fit warm-started from `previous` (a frame before), pulled toward its body.
+    pub(super) fn from(&self, previous: &State) -> Best {
+        let mode = Mode { name: "the frame before".into(), body: previous.body };
+        let (_, bends) = self.posed_points(&previous.body);
+        let floors: Vec<f32> = bends.iter().map(|b| b.min(0.0) - 0.05).collect();
+        let (state, cost) = self.refine(*previous, &mode, &floors, true);
+        self.best_of(state, cost, &mode)
+    }
+
+    /// The mean pixel error of a state.
+    pub(super) fn error_of(&self, state: &State) -> f32 {
+        let (points, _) = self.posed_points(&state.body);
+        self.mean_error(&state.camera, &points)
+    }
+
+    fn best_of(&self, state: State, cost: f64, mode: &Mode) -> Best {
+        let hips = self.hips(&state.body);
+        Best { state, error: self.error_of(&state), mode: mode.name.clone(), cost, hips }
     }
 
     /// Where the hips joint is at this pose.
@@ -185,7 +247,7 @@ impl<'a> Problem<'a> {
             let miss = (Self::pixel(&pinhole, posed.0[s.anchor]) - s.at) * s.weight;
             out.extend([miss.x as f64, miss.y as f64]);
         }
-        let pull = 0.03 * self.scale;
+        let pull = self.pull * self.scale;
         for (d, m) in body.directions.iter().zip(&mode.body.directions) {
             let off = (*d - *m) * pull;
             out.extend([off.x as f64, off.y as f64, off.z as f64]);
@@ -272,7 +334,7 @@ impl<'a> Problem<'a> {
     fn moved(&self, state: &State, step: &[f32], fov_free: usize) -> State {
         let mut s = *state;
         s.camera.yaw += step[0];
-        s.camera.pitch = (s.camera.pitch + step[1]).clamp(-1.55, 1.55);
+        s.camera.pitch = self.pitch.unwrap_or((s.camera.pitch + step[1]).clamp(-1.55, 1.55));
         s.camera.eye += Vec3::new(step[2], step[3], step[4]);
         if fov_free == 1 {
             s.camera.fov = (s.camera.fov * step[CAMERA].exp()).clamp(5.0, 150.0);
