@@ -8,7 +8,7 @@ use crate::cli::args::{BenchArgs, EditArgs, RenderArgs};
 /// `edit`: the editor on the paths (or the newest recovery file), with the command line's
 /// options applied first (one naming what no character has fails before the window opens).
 pub fn edit(args: EditArgs) -> Result<()> {
-    let EditArgs { paths, clip, pose, recover } = args;
+    let EditArgs { paths, clip, pose, recover, fps } = args;
     let paths = if recover {
         use crate::editor::ui::unsaved::{newest_recovery, recovery_dir};
         let newest =
@@ -18,7 +18,7 @@ pub fn edit(args: EditArgs) -> Result<()> {
         paths
     };
     let edits = crate::editor::StartupEdits {
-        pose: pose.specs(),
+        pose: pose.specs(fps),
         recovered: recover,
         anim: clip.anim_doc(true),
         time: clip.time,
@@ -39,7 +39,7 @@ pub fn render(args: RenderArgs) -> Result<()> {
     let RenderArgs { paths, out, shot, pose, skinning, match_height, clip, frames } = args;
     let started = std::time::Instant::now();
     let edits = crate::editor::StartupEdits {
-        pose: pose.specs(),
+        pose: pose.specs(frames.fps),
         skinning: skinning.map(Into::into),
         match_height,
         anim: clip.anim_doc(false),

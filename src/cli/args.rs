@@ -174,9 +174,10 @@ pub struct FrameArgs {
     /// The last frame's time (seconds), with `--from`.
     #[arg(long, requires = "from", value_parser = finite_seconds)]
     pub to: Option<f32>,
-    /// Frames per second of `--from`/`--to` and `--turntable`.
-    #[arg(long, default_value_t = 24.0)]
-    pub fps: f32,
+    /// Frames per second of `--from`/`--to` and `--turntable` (default 24), and of
+    /// `--fit-sequence`'s files (default 30).
+    #[arg(long, value_parser = positive_fps)]
+    pub fps: Option<f32>,
     /// The camera goes once round the scene in this many seconds: the frames of one turn
     /// (from `--from`, or 0), or the turn over `--from`/`--to`.
     #[arg(long, value_name = "SECONDS", value_parser = finite_seconds)]
@@ -203,8 +204,9 @@ impl FrameArgs {
     pub fn sequence(&self) -> Option<crate::document::frames::FrameSequence> {
         let from = self.from.unwrap_or(0.0);
         // One turn without --to: every frame before the turn comes round to the first.
-        let to = self.to.or_else(|| self.turntable.map(|s| from + s - 1.0 / self.fps))?;
-        Some(crate::document::frames::FrameSequence { from, to, fps: self.fps, turntable: self.turntable })
+        let fps = self.fps.unwrap_or(24.0);
+        let to = self.to.or_else(|| self.turntable.map(|s| from + s - 1.0 / fps))?;
+        Some(crate::document::frames::FrameSequence { from, to, fps, turntable: self.turntable })
     }
 }
 
@@ -277,6 +279,9 @@ pub struct ExportArgs {
     /// scene's or `--anim`'s, as cubic splines keyed at their keys).
     #[arg(long)]
     pub animation: bool,
+    /// Frames a second of `--fit-sequence`'s files (default 30).
+    #[arg(long, requires = "fit_sequence", value_parser = positive_fps)]
+    pub fps: Option<f32>,
 }
 
 /// `bind`'s flags.
@@ -410,11 +415,30 @@ pub struct PoseArgs {
     /// humanoid's head spreads the turn over its chest and neck). Repeatable.
     #[arg(long = "look-at", value_name = "JOINT=x,y,z")]
     pub look_at: Vec<LookAtSpec>,
+    /// A pose detector's keypoints (OpenPose JSON, COCO keypoints, COCO-WholeBody or
+    /// DWPose's 133): the first humanoid posed and the camera placed to match them, the
+    /// picture's size from the file (and the picture behind, where it lies beside it).
+    #[arg(long, value_name = "FILE.json", conflicts_with_all = ["preset", "fit_sequence"])]
+    pub fit: Option<PathBuf>,
+    /// A video's keypoints: a folder of per-frame files (OpenPose's `*_keypoints.json`, in
+    /// name order) or a list of them, fitted into a clip on the first humanoid at `--fps`.
+    #[arg(long, value_name = "DIR", conflicts_with = "preset")]
+    pub fit_sequence: Option<PathBuf>,
+    /// With `--fit` or `--fit-sequence`: the person of the file (from 0; default: the
+    /// largest).
+    #[arg(long, value_name = "N")]
+    pub person: Option<usize>,
+    /// With `--fit` or `--fit-sequence`: the camera's vertical field of view in degrees
+    /// (default: estimated).
+    #[arg(long, value_name = "DEG", value_parser = parse_fov)]
+    pub fov: Option<f32>,
 }
 
 impl PoseArgs {
-    /// The specs as every command applies them.
-    pub fn specs(&self) -> crate::document::options::PoseSpecs {
+    /// The specs as every command applies them (`fps`: the frames a second of a
+    /// `--fit-sequence`, 30 where not given).
+    pub fn specs(&self, fps: Option<f32>) -> crate::document::options::PoseSpecs {
+        use crate::document::fit::{FitSpec, SequenceSpec};
         crate::document::options::PoseSpecs {
             preset: self.preset.clone(),
             poses: self.poses.clone(),
@@ -422,7 +446,22 @@ impl PoseArgs {
             ik: self.ik.clone(),
             two_bone: self.two_bone.clone(),
             look_at: self.look_at.clone(),
+            fit: self.fit.clone().map(|file| FitSpec { file, person: self.person, fov: self.fov }),
+            fit_sequence: self.fit_sequence.clone().map(|frames| SequenceSpec {
+                frames,
+                fps: fps.unwrap_or(30.0),
+                person: self.person,
+                fov: self.fov,
+            }),
         }
+    }
+}
+
+/// A field of view in degrees, more than 0 and less than 180.
+fn parse_fov(s: &str) -> Result<f32, String> {
+    match s.trim().parse::<f32>() {
+        Ok(v) if v > 0.0 && v < 180.0 => Ok(v),
+        _ => Err(format!("expected degrees between 0 and 180, found `{s}`")),
     }
 }
 
@@ -441,6 +480,17 @@ pub struct EditArgs {
     /// `$XDG_STATE_HOME/marionette/recovery`).
     #[arg(long, conflicts_with = "paths")]
     pub recover: bool,
+    /// Frames a second of `--fit-sequence`'s files (default 30).
+    #[arg(long, requires = "fit_sequence", value_parser = positive_fps)]
+    pub fps: Option<f32>,
+}
+
+/// Frames a second: a positive, finite number.
+fn positive_fps(s: &str) -> Result<f32, String> {
+    match s.trim().parse::<f32>() {
+        Ok(v) if v > 0.0 && v.is_finite() && v <= 1000.0 => Ok(v),
+        _ => Err(format!("expected frames a second between 0 and 1000, found `{s}`")),
+    }
 }
 
 /// What `render` is given.

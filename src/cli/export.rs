@@ -38,7 +38,7 @@ pub fn run(a: &ExportArgs) -> Result<()> {
 /// The posing options `export` was given.
 fn pose_options(a: &ExportArgs) -> PoseOptions {
     PoseOptions {
-        specs: a.pose.specs(),
+        specs: a.pose.specs(a.fps),
         skinning: a.skinning.map(Into::into),
         anim: a.clip.anim_doc(false),
         clip: a.clip.own_clip(),

@@ -25,7 +25,7 @@ impl Options {
         let cli = <Cli as clap::Parser>::try_parse_from(&args).unwrap();
         let Some(Command::Render(RenderArgs { pose, skinning, clip, .. })) = cli.command else { unreachable!() };
         StartupEdits {
-            pose: pose.specs(),
+            pose: pose.specs(None),
             skinning: skinning.map(Into::into),
             anim: clip.anim_doc(false),
             time: clip.time,

@@ -355,6 +355,7 @@ fn every_combination_of_posing_options_reports_the_written_pose() {
             } else {
                 vec![]
             },
+            ..PoseSpecs::default()
         };
         let mut doc = base.clone();
         let options = PoseOptions { specs, still: true, ..PoseOptions::default() };

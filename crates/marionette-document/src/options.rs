@@ -37,6 +37,10 @@ pub enum OptionsError {
     NoFileHasClip { spec: String, files: String },
     #[error("--preset {preset}: no character has a humanoid map (hips, two legs)")]
     NoHumanoidForPreset { preset: String },
+    #[error(transparent)]
+    Fit(#[from] crate::fit::FitError),
+    #[error("{option}: no character has a humanoid map (hips, two legs, two arms) to fit")]
+    NoHumanoidToFit { option: &'static str },
     #[error("{option}: no character has a joint named or numbered `{joint}` ({known})")]
     UnknownJoint { option: &'static str, joint: String, known: String },
 }
@@ -58,6 +62,25 @@ pub struct PoseSpecs {
     pub two_bone: Vec<TwoBoneSpec>,
     /// `--look-at JOINT=x,y,z`.
     pub look_at: Vec<LookAtSpec>,
+    /// `--fit FILE.json`: the first humanoid posed, and the camera placed, to match a pose
+    /// detector's keypoints.
+    pub fit: Option<crate::fit::FitSpec>,
+    /// `--fit-sequence DIR`: per-frame keypoint files fitted into a clip on the first
+    /// humanoid.
+    pub fit_sequence: Option<crate::fit::SequenceSpec>,
+}
+
+impl PoseSpecs {
+    /// The size of the picture a fit's keypoints were found in (`--fit`'s file, or
+    /// `--fit-sequence`'s first), where the file gives it and can be read.
+    pub fn fitted_picture_size(&self) -> Option<(u32, u32)> {
+        let (file, person) = match (&self.fit, &self.fit_sequence) {
+            (Some(fit), _) => (fit.file.clone(), fit.person),
+            (None, Some(sequence)) => (crate::fit::frame_files(&sequence.frames).ok()?.remove(0), sequence.person),
+            (None, None) => return None,
+        };
+        crate::fit::file_picture_size(&file, person)
+    }
 }
 
 /// What the command line asks of the characters.
@@ -87,6 +110,7 @@ impl PoseOptions {
             || !self.specs.look_at.is_empty()
             || !self.specs.hands.is_empty()
             || self.specs.preset.is_some()
+            || self.specs.fit.is_some()
     }
 }
 
@@ -106,6 +130,9 @@ pub fn apply_options(
     }
     if let Some(spec) = &options.clip {
         play_own_clip(doc, spec, library)?;
+    }
+    if let Some(spec) = &options.specs.fit_sequence {
+        notes.push(fit_clip(doc, spec, library)?);
     }
     match options.time {
         Some(t) => pause_clips_at(doc, t),
@@ -250,6 +277,7 @@ fn pose_characters(
     ];
     let mut joints_seen = Vec::new();
     let mut preset_used = false;
+    let mut fitted: Option<crate::fit::Fitted> = None;
     for c in &mut doc.characters {
         let asset = match library.shaped(c) {
             Ok(asset) => asset,
@@ -272,6 +300,7 @@ fn pose_characters(
             && look_at.is_empty()
             && options.specs.hands.is_empty()
             && options.specs.preset.is_none()
+            && options.specs.fit.is_none()
         {
             continue;
         }
@@ -282,7 +311,11 @@ fn pose_characters(
         names.zip(&mut used).filter(|(j, _)| has(j)).for_each(|(_, u)| *u = true);
         let (mut pose, root_shift) = crate::export::still_pose(library, &scene, c, &asset)?;
         // The humanoid map, once, for the body pose, the hands and the look-at.
-        let map = if options.specs.hands.is_empty() && look_at.is_empty() && options.specs.preset.is_none() {
+        let map = if options.specs.hands.is_empty()
+            && look_at.is_empty()
+            && options.specs.preset.is_none()
+            && options.specs.fit.is_none()
+        {
             Default::default()
         } else {
             crate::retarget::humanoid_map(&asset, &c.humanoid)
@@ -297,23 +330,40 @@ fn pose_characters(
                 None => notes.push(format!("{}: no humanoid map (hips, two legs); {} skipped", c.name, spec.name)),
             }
         }
+        let placement = c.placement.to_mat4() * Mat4::from_translation(root_shift);
+        let fits_here = options.specs.fit.as_ref().filter(|_| fitted.is_none());
+        if let Some(spec) = fits_here {
+            match crate::fit::fit_file(&asset, &map, placement, crate::fit::is_smpl(c), spec) {
+                Ok(fit) => {
+                    pose.clone_from(&fit.pose);
+                    notes.push(format!("{}: {}", c.name, fit.describe()));
+                    fitted = Some(fit);
+                }
+                Err(crate::fit::FitError::NoHumanoid) => {}
+                Err(e) => return Err(e.into()),
+            }
+        }
+        let fitted_here = fits_here.is_some() && fitted.is_some();
         apply_pose_specs(skeleton, &mut pose, &poses)?;
         let hands = crate::posing::apply_hand_specs(skeleton, &map, &mut pose, &options.specs.hands);
         notes.extend(hands.into_iter().map(|n| format!("{}: {n}", c.name)));
         // A body pose stands on the floor before the goals are solved: they are where the
         // written pose reaches.
-        let placement = c.placement.to_mat4() * Mat4::from_translation(root_shift);
-        let placement = match options.specs.preset.is_some() {
+        let placement = match options.specs.preset.is_some() || fitted_here {
             true => crate::posing::stood_on_floor(&asset, &pose, placement),
             false => placement,
         };
+        if let (true, Some(fit)) = (fitted_here, &mut fitted) {
+            // The camera moves with the character, so the picture is the same.
+            fit.camera.focus += (placement * fit.placement.inverse()).w_axis.truncate();
+        }
         let goals = (&ik[..], &two_bone[..], &look_at[..]);
         let reports = solve_constraints(skeleton, &map, &mut pose, placement, goals)?;
         notes.extend(reports.lines(skeleton, &c.name));
         let initial = skeleton.initial_pose();
         c.pose =
             (0..skeleton.len()).filter(|&j| pose[j] != initial[j]).map(|j| (pose_key(skeleton, j), pose[j])).collect();
-        if root_shift != Vec3::ZERO || options.specs.preset.is_some() {
+        if root_shift != Vec3::ZERO || options.specs.preset.is_some() || fitted_here {
             c.placement = marionette_formats::scene::PlacementDoc::from_mat4(placement);
         }
         bake_clips(c);
@@ -329,11 +379,65 @@ fn pose_characters(
     if let (Some(spec), false) = (&options.specs.preset, preset_used) {
         return Err(OptionsError::NoHumanoidForPreset { preset: spec.name.clone() });
     }
+    match (&options.specs.fit, fitted) {
+        (Some(_), None) => return Err(OptionsError::NoHumanoidToFit { option: "--fit" }),
+        (Some(spec), Some(fit)) => frame_the_fit(doc, fit.camera, fit.size, &spec.file),
+        _ => {}
+    }
     if let Some((option, joint)) = specs.zip(&used).find(|(_, u)| !**u).map(|(s, _)| s) {
         let known = joints_seen.join("; ");
         return Err(OptionsError::UnknownJoint { option, joint: joint.clone(), known });
     }
     Ok(notes)
+}
+
+/// The scene seen as the keypoints' picture was: the fitted camera, the picture's size,
+/// and the picture itself behind the figures where it lies beside the keypoint file.
+fn frame_the_fit(
+    doc: &mut SceneDoc,
+    camera: marionette_formats::stage::CameraDoc,
+    size: (u32, u32),
+    file: &std::path::Path,
+) {
+    doc.camera = Some(camera);
+    (doc.shot.width, doc.shot.height) = size;
+    if let Some(path) = crate::fit::picture_beside(file) {
+        doc.stage.background = marionette_formats::stage::BackgroundDoc::Image { path, fill: false };
+    }
+}
+
+/// `--fit-sequence`: the clip fitted to the keypoint files on the first humanoid, its first
+/// frame on the floor, and the scene seen by the first frame's camera.
+fn fit_clip(
+    doc: &mut SceneDoc,
+    spec: &crate::fit::SequenceSpec,
+    library: &mut AssetLibrary,
+) -> Result<String, OptionsError> {
+    for k in 0..doc.characters.len() {
+        let c = &doc.characters[k];
+        let Ok(asset) = library.shaped(c) else { continue };
+        let map = crate::retarget::humanoid_map(&asset, &c.humanoid);
+        let placement = c.placement.to_mat4();
+        let mut fitted = match crate::fit::fit_sequence(&asset, &map, placement, crate::fit::is_smpl(c), spec) {
+            Err(crate::fit::FitError::NoHumanoid) => continue,
+            fitted => fitted?,
+        };
+        let skeleton = &asset.skeleton;
+        let (root, pose) = fitted.clip.pose_at(skeleton, 0.0, &skeleton.initial_pose());
+        let first = placement * Mat4::from_translation(root - skeleton.joint(0).rest_offset);
+        let lift = (crate::posing::stood_on_floor(&asset, &pose, first) * first.inverse()).w_axis.truncate();
+        fitted.camera.focus += lift;
+        let note = format!("{}: {}", c.name, fitted.describe());
+        let c = &mut doc.characters[k];
+        c.placement = marionette_formats::scene::PlacementDoc::from_mat4(Mat4::from_translation(lift) * placement);
+        c.anim = Some(AnimDoc { keys: Some(fitted.clip), ..AnimDoc::default() });
+        c.playback = None;
+        c.smpl.iter_mut().for_each(|s| (s.clip, s.blend_clip) = (None, None));
+        let first_file = crate::fit::frame_files(&spec.frames)?.remove(0);
+        frame_the_fit(doc, fitted.camera, fitted.size, &first_file);
+        return Ok(note);
+    }
+    Err(OptionsError::NoHumanoidToFit { option: "--fit-sequence" })
 }
 
 /// A character posed by hand holds its still pose: its clips are off.

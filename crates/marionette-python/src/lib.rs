@@ -299,6 +299,7 @@ impl PoseRequest {
                 TwoBoneGoal::WithPole((x, y, z), (a, b, c)) => format!("{joint}={x},{y},{z}@{a},{b},{c}"),
             })?,
             look_at: spec_list(look_at, |(joint, (x, y, z))| format!("{joint}={x},{y},{z}"))?,
+            ..PoseSpecs::default()
         };
         let skinning = match skinning.as_deref() {
             None => None,

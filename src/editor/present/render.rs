@@ -193,7 +193,10 @@ pub fn render_with(
         }
         (true, Pictures::Still) => Some(CocoSoFar { path: annotate::write::beside(&out, "json"), ..default() }),
     };
-    let (library, shot, poses) = preload(&paths, &edits)?;
+    let (library, mut shot, poses) = preload(&paths, &edits)?;
+    if let Some(size) = edits.pose.fitted_picture_size() {
+        (shot.width, shot.height) = size;
+    }
     let cells = std::env::temp_dir().join(format!("marionette-sheet-{}", std::process::id()));
     let (frames, sequence): (Vec<(FrameAt, PathBuf)>, _) = match pictures {
         Pictures::Sequence(sequence) => {

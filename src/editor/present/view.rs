@@ -134,8 +134,10 @@ fn queue_startup_scene(
             }
         }
     }
+    // A fitted character stays where its camera sees it.
+    let fitted = edits.pose.fit.is_some() || edits.pose.fit_sequence.is_some();
     *arrange = crate::editor::scene_doc::arrange::ArrangeWhenSkinned {
-        side_by_side: !paths.0.is_empty() && scene_path(&paths.0).is_none(),
+        side_by_side: !paths.0.is_empty() && scene_path(&paths.0).is_none() && !fitted,
         match_height: edits.match_height,
     };
     notes.into_iter().for_each(|m| messages.push(m));
@@ -193,9 +195,10 @@ fn apply_startup_options(
     library: &mut AssetLibrary,
 ) -> Result<Vec<String>, String> {
     // Character files are posed where their files put them (so `--ik` targets are in the
-    // file's space, as `export` reads them), then stood where the layout puts them.
-    let layout: Option<Vec<_>> = scene_path(paths)
-        .is_none()
+    // file's space, as `export` reads them), then stood where the layout puts them; a fit
+    // is made where the layout puts them (its camera sees them there).
+    let fitting = edits.pose.fit.is_some() || edits.pose.fit_sequence.is_some();
+    let layout: Option<Vec<_>> = (scene_path(paths).is_none() && !fitting)
         .then(|| doc.characters.iter_mut().map(|c| std::mem::take(&mut c.placement)).collect());
     let notes =
         crate::document::options::apply_options(doc, &edits.pose_options(), library).map_err(|e| e.to_string())?;

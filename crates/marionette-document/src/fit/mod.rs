@@ -252,6 +252,14 @@ fn picture_size(keypoints: &Keypoints, person: &Person2d) -> (u32, u32) {
     ((w * 1.1).ceil() as u32, (h * 1.1).ceil() as u32)
 }
 
+/// The picture size a keypoint file gives for its person `person` (see [`fit`]); none
+/// where it cannot be read (the fit says why).
+pub fn file_picture_size(file: &Path, person: Option<usize>) -> Option<(u32, u32)> {
+    let keypoints = marionette_formats::keypoints::read_keypoints(file).ok()?;
+    let person = keypoints.person(person).ok()?;
+    Some(picture_size(&keypoints, person))
+}
+
 /// Fits `asset` (its humanoid map `map`, at `placement`) to person `spec.person` of the
 /// keypoint file `keypoints` (read from `file`).
 pub fn fit(
