@@ -371,3 +371,159 @@ fn a_walks_keypoints_fitted_as_a_sequence_give_the_walk() {
     );
     assert!(failures.is_empty(), "{}", failures.join("\n"));
 }
+
+fn marionette(args: &[&std::ffi::OsStr]) -> std::process::Output {
+    std::process::Command::new(env!("CARGO_BIN_EXE_marionette")).args(args).output().unwrap()
+}
+
+fn obj_positions(path: &Path) -> Vec<Vec3> {
+    let text = std::fs::read_to_string(path).unwrap();
+    text.lines()
+        .filter_map(|l| l.strip_prefix("v "))
+        .map(|l| {
+            let v: Vec<f32> = l.split_whitespace().map(|x| x.parse().unwrap()).collect();
+            Vec3::new(v[0], v[1], v[2])
+        })
+        .collect()
+}
+
+/// `export --fit` on the Mixamo figure's own COCO file of `wave` writes the mesh `export
+/// --preset wave` writes (within 0.1 mm a vertex).
+#[test]
+fn export_fit_writes_the_pose_the_keypoints_were_drawn_in() {
+    let mut library = AssetLibrary::default();
+    let file = rig("mixamo.glb");
+    let doc = doc_of(&mut library, &file);
+    let truth = posed(&mut library, &doc, "wave");
+    let camera =
+        CameraDoc { focus: Vec3::new(0.2, 0.9, 0.0), yaw: 0.5, pitch: -0.2, distance: 3.5, ..CameraDoc::default() };
+    let folder = crate::common::scratch("export_fit");
+    let keypoints = folder.join("photo.json");
+    std::fs::write(&keypoints, keypoint_files(&truth, &camera).0).unwrap();
+    let (fitted, preset) = (folder.join("fitted.obj"), folder.join("preset.obj"));
+    let out = marionette(&[
+        "export".as_ref(),
+        file.as_ref(),
+        "--fit".as_ref(),
+        keypoints.as_ref(),
+        "--out".as_ref(),
+        fitted.as_ref(),
+    ]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(
+        String::from_utf8_lossy(&out.stderr).contains("fitted to 12 points"),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let out = marionette(&[
+        "export".as_ref(),
+        file.as_ref(),
+        "--preset".as_ref(),
+        "wave".as_ref(),
+        "--out".as_ref(),
+        preset.as_ref(),
+    ]);
+    assert!(out.status.success());
+    let (a, b) = (obj_positions(&fitted), obj_positions(&preset));
+    assert_eq!(a.len(), b.len());
+    let worst = a.iter().zip(&b).map(|(x, y)| x.distance(*y)).fold(0.0, f32::max);
+    assert!(worst < 1e-4, "{worst} m");
+}
+
+/// Malformed keypoint files are refused with the field's path, never a crash.
+#[test]
+fn malformed_keypoint_files_are_refused_by_field() {
+    let folder = crate::common::scratch("fit_malformed");
+    let body = |n: usize| (0..n).map(|k| format!("{}", 100 + k)).collect::<Vec<_>>().join(",");
+    let cases = [
+        (
+            "short.json",
+            format!(r#"{{"people":[{{"pose_keypoints_2d":[{}]}}]}}"#, body(52)),
+            "people[0].pose_keypoints_2d: 52 numbers, expected 54 or 75",
+        ),
+        (
+            "nan.json",
+            r#"{"people":[{"pose_keypoints_2d":["nan"]}]}"#.to_string(),
+            "people[0].pose_keypoints_2d[0]: expected a finite number",
+        ),
+        (
+            "negative.json",
+            format!(r#"{{"canvas_width":-640,"canvas_height":480,"people":[{{"pose_keypoints_2d":[{}]}}]}}"#, body(54)),
+            "canvas_width: expected a positive size",
+        ),
+        ("empty.json", r#"{"people":[]}"#.to_string(), "people: expected at least one person"),
+        (
+            "absent.json",
+            format!(r#"{{"people":[{{"pose_keypoints_2d":[{}]}}]}}"#, vec!["0"; 54].join(",")),
+            "people[0]: every point absent",
+        ),
+        (
+            "coco.json",
+            r#"{"annotations":[{"keypoints":[1,2]}]}"#.to_string(),
+            "annotations[0].keypoints: 2 numbers, expected 51",
+        ),
+        ("text.json", "not json".to_string(), "expected JSON"),
+    ];
+    let out_obj = folder.join("out.obj");
+    for (name, text, expected) in cases {
+        let path = folder.join(name);
+        std::fs::write(&path, text).unwrap();
+        let out = marionette(&[
+            "export".as_ref(),
+            rig("mixamo.glb").as_ref(),
+            "--fit".as_ref(),
+            path.as_ref(),
+            "--out".as_ref(),
+            out_obj.as_ref(),
+        ]);
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(1), "{name}: {stderr}");
+        assert!(stderr.contains(expected) && stderr.contains(name), "{name}: {stderr}");
+        assert!(!stderr.contains("panicked"), "{name}: {stderr}");
+    }
+    assert!(!out_obj.exists(), "nothing written");
+}
+
+/// `export --fit-sequence DIR --fps 30 --animation --out walk.glb`: a glTF animation of
+/// the frames' span.
+#[test]
+fn a_fitted_sequence_exports_as_an_animation() {
+    let mut library = AssetLibrary::default();
+    let file = rig("mixamo.glb");
+    let doc = doc_of(&mut library, &file);
+    let folder = crate::common::scratch("fit_sequence_export");
+    let frames = folder.join("frames");
+    std::fs::create_dir_all(&frames).unwrap();
+    let camera =
+        CameraDoc { focus: Vec3::new(0.0, 0.9, 0.0), yaw: 0.4, pitch: -0.15, distance: 4.0, ..CameraDoc::default() };
+    for (k, pose) in ["stand", "walk", "run", "walk:mirrored", "stand"].iter().enumerate() {
+        let truth = posed(&mut library, &doc, pose);
+        std::fs::write(frames.join(format!("clip_{k:012}_keypoints.json")), keypoint_files(&truth, &camera).1).unwrap();
+    }
+    let glb = folder.join("walk.glb");
+    let out = marionette(&[
+        "export".as_ref(),
+        file.as_ref(),
+        "--fit-sequence".as_ref(),
+        frames.as_ref(),
+        "--fps".as_ref(),
+        "10".as_ref(),
+        "--animation".as_ref(),
+        "--out".as_ref(),
+        glb.as_ref(),
+    ]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(
+        String::from_utf8_lossy(&out.stderr).contains("fitted 5 frames"),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let gltf = gltf::Gltf::from_slice(&std::fs::read(&glb).unwrap()).unwrap();
+    let animation = gltf.animations().next().expect("an animation");
+    let end = animation
+        .channels()
+        .filter_map(|c| c.sampler().input().max())
+        .filter_map(|m| m.as_array()?.first()?.as_f64())
+        .fold(0.0, f64::max) as f32;
+    assert!((end - 0.4).abs() < 1e-4, "{end}");
+}
