@@ -52,7 +52,7 @@ fn posed(library: &mut AssetLibrary, doc: &CharacterDoc, preset: &str) -> Posed 
     let asset = library.shaped(c).unwrap();
     let (pose, _) = marionette::document::scenes::pose_from_doc(&asset, c);
     let map = humanoid_map(&asset, &c.humanoid);
-    Posed { asset, map, pose, placement: c.placement.to_mat4(), smpl: is_smpl(c) }
+    Posed { asset, map, pose, placement: c.placement.to_mat4(), smpl: is_smpl(&c.source) }
 }
 
 fn joints_world(asset: &CharacterAsset, pose: &[JointRotation], placement: Mat4) -> Vec<Vec3> {

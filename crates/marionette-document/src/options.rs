@@ -333,7 +333,7 @@ fn pose_characters(
         let placement = c.placement.to_mat4() * Mat4::from_translation(root_shift);
         let fits_here = options.specs.fit.as_ref().filter(|_| fitted.is_none());
         if let Some(spec) = fits_here {
-            match crate::fit::fit_file(&asset, &map, placement, crate::fit::is_smpl(c), spec) {
+            match crate::fit::fit_file(&asset, &map, placement, crate::fit::is_smpl(&c.source), spec) {
                 Ok(fit) => {
                     pose.clone_from(&fit.pose);
                     notes.push(format!("{}: {}", c.name, fit.describe()));
@@ -418,7 +418,7 @@ fn fit_clip(
         let Ok(asset) = library.shaped(c) else { continue };
         let map = crate::retarget::humanoid_map(&asset, &c.humanoid);
         let placement = c.placement.to_mat4();
-        let mut fitted = match crate::fit::fit_sequence(&asset, &map, placement, crate::fit::is_smpl(c), spec) {
+        let mut fitted = match crate::fit::fit_sequence(&asset, &map, placement, crate::fit::is_smpl(&c.source), spec) {
             Err(crate::fit::FitError::NoHumanoid) => continue,
             fitted => fitted?,
         };

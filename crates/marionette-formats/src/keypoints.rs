@@ -200,7 +200,12 @@ impl Keypoints {
     pub fn person(&self, n: Option<usize>) -> Result<&Person2d, String> {
         match n {
             Some(n) => self.people.get(n).ok_or_else(|| {
-                format!("--person {n}: the file has {} people (0 to {})", self.people.len(), self.people.len() - 1)
+                format!(
+                    "--person {n}: the file has {} {} (0 to {})",
+                    self.people.len(),
+                    if self.people.len() == 1 { "person" } else { "people" },
+                    self.people.len() - 1
+                )
             }),
             None => Ok(self.people.iter().max_by(|a, b| a.area().total_cmp(&b.area())).expect("a file has people")),
         }

@@ -19,6 +19,8 @@ pub enum DialogPurpose {
     AddFile,
     ExportGltf,
     ScreenshotFolder,
+    /// A keypoint file to fit this character to.
+    FitKeypoints(crate::formats::scene::CharacterId),
 }
 
 /// The file dialog and what it was opened for.
@@ -46,6 +48,7 @@ impl FileDialogs {
             DialogPurpose::AddFile => ("Add a character, a clip or a scene", None),
             DialogPurpose::ExportGltf => ("Export the scene as glTF", Some("scene.glb")),
             DialogPurpose::ScreenshotFolder => ("Screenshot folder", None),
+            DialogPurpose::FitKeypoints(_) => ("Fit to a keypoint file", None),
         };
         let mut dialog = FileDialog::new().title(title);
         if let Some(folder) = folder {
@@ -57,7 +60,7 @@ impl FileDialogs {
         match purpose {
             DialogPurpose::SaveScene | DialogPurpose::ExportGltf => dialog.save_file(),
             DialogPurpose::ScreenshotFolder => dialog.pick_directory(),
-            DialogPurpose::OpenScene | DialogPurpose::AddFile => dialog.pick_file(),
+            DialogPurpose::OpenScene | DialogPurpose::AddFile | DialogPurpose::FitKeypoints(_) => dialog.pick_file(),
         }
         self.dialog = dialog;
         self.purpose = Some(purpose);
@@ -92,6 +95,7 @@ pub fn show(ctx: &egui::Context, state: &mut InspectorState, panels: &mut Panels
         DialogPurpose::AddFile => super::open::open_path(&text, state, panels),
         DialogPurpose::ExportGltf => export_gltf(&path, panels),
         DialogPurpose::ScreenshotFolder => shot.dir_text = text,
+        DialogPurpose::FitKeypoints(id) => super::fit::fit_to_keypoints(&path, id, state, panels),
     }
 }
 

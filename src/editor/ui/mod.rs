@@ -6,6 +6,7 @@ pub mod attach_panel;
 pub mod clip_panel;
 pub mod conditioning;
 pub mod dialogs;
+pub mod fit;
 pub mod joint_panel;
 pub mod keyframe_panel;
 pub mod motion_panel;
@@ -37,6 +38,8 @@ pub struct InspectorState {
     pub scene_path: String,
     /// The DOF being dragged and its value, shown in the viewport.
     pub active_dof: Option<String>,
+    /// The keypoints last fitted, drawn over the view.
+    pub keypoints: Option<fit::KeypointOverlay>,
     /// How many characters "Add crowd" adds.
     pub crowd_size: usize,
     /// Joint rotations copied to paste as keys.
@@ -80,6 +83,7 @@ impl Default for InspectorState {
             pose_name: "pose 1".into(),
             dialogs: Default::default(),
             active_dof: None,
+            keypoints: None,
             crowd_size: 16,
             bookmark_name: "view 1".into(),
             frame_guide: true,
@@ -178,7 +182,7 @@ impl Plugin for InspectorPlugin {
             .init_resource::<ViewportArea>()
             .init_resource::<crate::editor::present::frames_job::FramesJob>()
             .add_systems(Update, crate::editor::present::frames_job::finish_frames_job)
-            .add_systems(Startup, save_to_the_opened_scene)
+            .add_systems(Startup, (save_to_the_opened_scene, fit::show_startup_keypoints))
             .add_systems(PostUpdate, fit_camera_viewport)
             .add_systems(EguiPrimaryContextPass, inspector_ui)
             .add_systems(Update, (open_dropped_files, scene_panel::file_shortcuts));
@@ -234,6 +238,9 @@ fn inspector_ui(
         let frame = crate::editor::ui::conditioning::frame_rect(central, &panels.scene.shot.0);
         let whole = egui::Rect::from_min_max(egui::pos2(0.0, 0.0), egui::pos2(1.0, 1.0));
         ui.painter().image(texture, frame, whole, egui::Color32::WHITE);
+    }
+    if let Some(points) = &state.keypoints {
+        points.draw(ui.painter(), central);
     }
     dialogs::show(&ctx, &mut state, &mut panels, &mut shot);
     let mode = overlays.draw_mode.as_deref().copied().unwrap_or_default();

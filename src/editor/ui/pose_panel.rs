@@ -35,6 +35,7 @@ pub fn pose_panel(ui: &mut egui::Ui, state: &mut InspectorState, panels: &mut Pa
     egui::CollapsingHeader::new("Body poses").default_open(true).show(ui, |ui| {
         if map.contains_key(&crate::rig::humanoid::HumanBone::Hips) {
             let placement = c.placement.0;
+            super::fit::fit_row(ui, state, id);
             body_poses(ui, state, &mut panels.posing, &mut edits, id, (&character.asset, &map, &pose), placement);
         } else {
             ui.label("No humanoid map (hips, two legs): assign bones under Retarget.");

@@ -241,7 +241,7 @@ fn seen_points(body: &Body, person: &Person2d) -> Vec<Seen> {
 }
 
 /// The picture's size: the file's, else the box around the points doubled from the origin.
-fn picture_size(keypoints: &Keypoints, person: &Person2d) -> (u32, u32) {
+pub fn picture_size(keypoints: &Keypoints, person: &Person2d) -> (u32, u32) {
     if let Some((w, h)) = keypoints.size {
         return (w.round().max(1.0) as u32, h.round().max(1.0) as u32);
     }
@@ -295,9 +295,10 @@ pub fn fit(
     })
 }
 
-/// Whether a character is an SMPL body (its keypoints' face and feet from the mesh).
-pub fn is_smpl(c: &marionette_formats::scene::CharacterDoc) -> bool {
-    matches!(&c.source, marionette_formats::scene::SourceDoc::File(dir) if marionette_formats::smpl::is_smpl_dir(dir))
+/// Whether a character of this source is an SMPL body (its keypoints' face and feet from
+/// the mesh).
+pub fn is_smpl(source: &marionette_formats::scene::SourceDoc) -> bool {
+    matches!(source, marionette_formats::scene::SourceDoc::File(dir) if marionette_formats::smpl::is_smpl_dir(dir))
 }
 
 /// Reads the keypoint file and fits (see [`fit`]).

@@ -1,0 +1,155 @@
+//! "Fit to keypoints…": a pose detector's keypoint file fitted onto the selected character
+//! (the document layer's [`fit`](crate::document::fit)), as one undo step (its pose, its
+//! place on the floor, the picture behind it and the picture's size), the view moved to
+//! the fitted camera, and the file's points drawn over the view until hidden.
+
+use std::path::Path;
+
+use bevy_egui::egui;
+
+use super::{InspectorState, Panels};
+use crate::document::annotate::openpose::HAND_EDGES;
+use crate::editor::edits::kinds;
+use crate::formats::keypoints::{BodyPoint, HAND_POINTS, Person2d};
+use crate::formats::scene::{BackgroundDoc, CharacterId, ShotDoc};
+
+/// The file's points over the view, in its picture's pixels.
+#[derive(Debug, Clone, PartialEq)]
+pub struct KeypointOverlay {
+    pub size: (u32, u32),
+    pub points: Vec<egui::Pos2>,
+    pub lines: Vec<(egui::Pos2, egui::Pos2)>,
+}
+
+/// The body's limbs between detector points.
+const LIMBS: [(BodyPoint, BodyPoint); 17] = {
+    use BodyPoint::*;
+    [
+        (Nose, Neck),
+        (Neck, RightShoulder),
+        (RightShoulder, RightElbow),
+        (RightElbow, RightWrist),
+        (Neck, LeftShoulder),
+        (LeftShoulder, LeftElbow),
+        (LeftElbow, LeftWrist),
+        (RightShoulder, RightHip),
+        (LeftShoulder, LeftHip),
+        (RightHip, LeftHip),
+        (RightHip, RightKnee),
+        (RightKnee, RightAnkle),
+        (LeftHip, LeftKnee),
+        (LeftKnee, LeftAnkle),
+        (Nose, LeftEye),
+        (Nose, RightEye),
+        (LeftAnkle, LeftBigToe),
+    ]
+};
+
+impl KeypointOverlay {
+    fn of(person: &Person2d, size: (u32, u32)) -> Self {
+        let at = |p: crate::formats::keypoints::Point2d| egui::pos2(p.x, p.y);
+        let mut points: Vec<egui::Pos2> = person.body.iter().map(|(_, p)| at(*p)).collect();
+        let mut lines: Vec<(egui::Pos2, egui::Pos2)> =
+            LIMBS.iter().filter_map(|&(a, b)| Some((at(person.point(a)?), at(person.point(b)?)))).collect();
+        for hand in [&person.left_hand, &person.right_hand].into_iter().filter(|h| h.len() == HAND_POINTS) {
+            points.extend(hand.iter().flatten().map(|p| at(*p)));
+            lines.extend(HAND_EDGES.iter().filter_map(|&[a, b]| Some((at(hand[a]?), at(hand[b]?)))));
+        }
+        Self { size, points, lines }
+    }
+
+    /// The points of person `person` (the largest where none) of a keypoint file; none
+    /// where it cannot be read.
+    pub fn of_file(path: &Path, person: Option<usize>) -> Option<Self> {
+        let keypoints = crate::formats::keypoints::read_keypoints(path).ok()?;
+        let person = keypoints.person(person).ok()?;
+        Some(Self::of(person, crate::document::fit::picture_size(&keypoints, person)))
+    }
+
+    /// Draws the points and limbs over the view `viewport`, where the camera (whose field of
+    /// view spans the view's height) puts the picture's pixels.
+    pub fn draw(&self, painter: &egui::Painter, viewport: egui::Rect) {
+        let height = viewport.height();
+        let width = height * self.size.0 as f32 / self.size.1.max(1) as f32;
+        let frame = egui::Rect::from_center_size(viewport.center(), egui::vec2(width, height));
+        let scale = egui::vec2(frame.width() / self.size.0 as f32, frame.height() / self.size.1 as f32);
+        let on_screen = |p: egui::Pos2| frame.min + p.to_vec2() * scale;
+        let colour = egui::Color32::from_rgb(255, 200, 0);
+        for &(a, b) in &self.lines {
+            painter.line_segment([on_screen(a), on_screen(b)], egui::Stroke::new(2.0, colour));
+        }
+        for &p in &self.points {
+            painter.circle_filled(on_screen(p), 3.5, colour);
+        }
+    }
+}
+
+/// Fits character `id` to the keypoint file at `path`: the edits (one undo step), the
+/// camera, the overlay and a message saying how well it fits (or why it cannot).
+pub fn fit_to_keypoints(path: &Path, id: CharacterId, state: &mut InspectorState, panels: &mut Panels) {
+    let Some(c) = panels.scene.characters.iter().find(|c| c.scene.id == id) else { return };
+    let asset = c.character.asset.clone();
+    let map = c.humanoid_map.map(|m| m.0.clone()).unwrap_or_default();
+    let pose: Vec<crate::rig::JointRotation> =
+        c.character.joints.iter().map(|&e| panels.scene.poses.get(e).map_or(Default::default(), |p| p.0)).collect();
+    let placement = c.placement.0.to_mat4();
+    let smpl = crate::document::fit::is_smpl(&c.scene.source);
+    let name = c.scene.name.clone();
+    let spec = crate::document::fit::FitSpec { file: path.to_path_buf(), ..Default::default() };
+    let read = crate::formats::keypoints::read_keypoints(path).map_err(crate::document::fit::FitError::from);
+    let fitted = read.and_then(|keypoints| {
+        let fitted = crate::document::fit::fit(&asset, &map, placement, smpl, &keypoints, &spec)?;
+        let person = keypoints.person(None).expect("the fit found one");
+        Ok((fitted, KeypointOverlay::of(person, crate::document::fit::picture_size(&keypoints, person))))
+    });
+    let (fitted, overlay) = match fitted {
+        Ok(done) => done,
+        Err(e) => {
+            panels.messages.push(format!("Fit to keypoints: {e}"));
+            return;
+        }
+    };
+    let stood = crate::document::posing::stood_on_floor(&asset, &fitted.pose, placement);
+    let mut camera = fitted.camera;
+    camera.focus += (stood * placement.inverse()).w_axis.truncate();
+    if let Some(edit) = kinds::Pose::change(id, &pose, &fitted.pose) {
+        panels.push(edit);
+    }
+    panels.push(kinds::Place { character: id, placement: crate::formats::scene::PlacementDoc::from_mat4(stood) });
+    if let Some(picture) = crate::document::fit::picture_beside(path) {
+        let mut stage = panels.scene.stage.0.clone();
+        stage.background = BackgroundDoc::Image { path: picture, fill: false };
+        panels.push(kinds::Stage(stage));
+    }
+    let shot = ShotDoc { width: fitted.size.0, height: fitted.size.1, ..panels.scene.shot.0 };
+    if shot != panels.scene.shot.0 {
+        panels.push(kinds::Shot(shot));
+    }
+    panels.camera_request.0 = Some(camera);
+    panels.messages.push(format!("{name}: {}", fitted.describe()));
+    state.keypoints = Some(overlay);
+}
+
+/// `edit --fit FILE`: the file's points drawn over the view from the start.
+pub fn show_startup_keypoints(
+    edits: Option<bevy::prelude::Res<crate::editor::StartupEdits>>,
+    mut state: bevy::prelude::ResMut<InspectorState>,
+) {
+    let Some(spec) = edits.as_ref().and_then(|e| e.pose.fit.as_ref()) else { return };
+    state.keypoints = KeypointOverlay::of_file(&spec.file, spec.person);
+}
+
+/// The "Fit to keypoints…" button and, while points are shown, the one that hides them.
+pub fn fit_row(ui: &mut egui::Ui, state: &mut InspectorState, id: CharacterId) {
+    ui.horizontal(|ui| {
+        let hint = "a pose detector's keypoints (OpenPose JSON, COCO, DWPose): this character posed and the \
+                    camera placed to match them; the picture beside the file shown behind. One undo step.";
+        if ui.button("Fit to keypoints…").on_hover_text(hint).clicked() {
+            let near = state.add_path.clone();
+            state.dialogs.open(super::dialogs::DialogPurpose::FitKeypoints(id), &near);
+        }
+        if state.keypoints.is_some() && ui.button("Hide keypoints").clicked() {
+            state.keypoints = None;
+        }
+    });
+}
