@@ -527,3 +527,56 @@ fn a_fitted_sequence_exports_as_an_animation() {
         .fold(0.0, f64::max) as f32;
     assert!((end - 0.4).abs() < 1e-4, "{end}");
 }
+
+/// Fingers from the hand points: the Mixamo figure waving with a fist and a pointing hand,
+/// its OpenPose file (hands of 21) fitted: the fitted hand points land within 3 px mean of
+/// the file's, against more than 3 times that with the fingers left at rest.
+#[test]
+fn fingers_follow_the_hand_points() {
+    let mut library = AssetLibrary::default();
+    let doc = doc_of(&mut library, &rig("mixamo.glb"));
+    let mut scene = SceneDoc { characters: vec![doc], ..SceneDoc::default() };
+    let specs = PoseSpecs {
+        preset: Some("wave".parse().unwrap()),
+        hands: vec!["left=fist".parse().unwrap(), "right=point".parse().unwrap()],
+        ..PoseSpecs::default()
+    };
+    apply_options(&mut scene, &PoseOptions { specs, ..PoseOptions::default() }, &mut library).unwrap();
+    let c = &scene.characters[0];
+    let asset = library.shaped(c).unwrap();
+    let map = humanoid_map(&asset, &c.humanoid);
+    let (pose, _) = marionette::document::scenes::pose_from_doc(&asset, c);
+    let truth = Posed { asset: asset.clone(), map: map.clone(), pose, placement: c.placement.to_mat4(), smpl: false };
+    let camera =
+        CameraDoc { focus: Vec3::new(0.3, 1.2, 0.0), yaw: 0.2, pitch: -0.1, distance: 1.6, ..CameraDoc::default() };
+    let (_, openpose) = keypoint_files(&truth, &camera);
+    let keypoints = parse_keypoints(&openpose, Path::new("hands.json")).unwrap();
+    let spec = FitSpec { file: "hands.json".into(), ..FitSpec::default() };
+    let fitted = fit(&asset, &map, truth.placement, false, &keypoints, &spec).unwrap();
+    assert!(fitted.finger_points >= 20, "{}", fitted.describe());
+    let person = &keypoints.people[0];
+    let pinhole = fitted.pinhole();
+    let hand_error = |pose: &[JointRotation]| {
+        let joints = joints_world(&asset, pose, fitted.placement);
+        let positions = marionette::document::posing::posed_positions(&asset, pose, fitted.placement);
+        let figure = Figure::new("fitted", 1, &asset, Some(&map), positions, &joints, false);
+        let mut errors = Vec::new();
+        for (side, hand) in [("left", &person.left_hand), ("right", &person.right_hand)] {
+            for (k, p) in hand.iter().enumerate().skip(1) {
+                let (Some(p), Some(point)) = (p, figure.points.get(&format!("{side}_hand_{k}"))) else { continue };
+                let (x, y, _) = pinhole.project(point.at).unwrap();
+                errors.push(glam::Vec2::new(x - p.x, y - p.y).length());
+            }
+        }
+        mean(&errors)
+    };
+    let with_fingers = hand_error(&fitted.pose);
+    let mut rest_fingers = fitted.pose.clone();
+    let rest = asset.skeleton.initial_pose();
+    for (_, &j) in map.iter().filter(|(b, _)| b.is_finger()) {
+        rest_fingers[j] = rest[j];
+    }
+    let without = hand_error(&rest_fingers);
+    println!("hand points: {with_fingers:.2} px mean with the fingers fitted, {without:.2} px at rest");
+    assert!(with_fingers <= 3.0 && without > 3.0 * with_fingers, "{with_fingers} vs {without}");
+}

@@ -323,8 +323,9 @@ pub fn picture_beside(file: &Path) -> Option<PathBuf> {
     ["png", "jpg", "jpeg", "PNG", "JPG"].iter().map(|ext| folder.join(format!("{stem}.{ext}"))).find(|p| p.is_file())
 }
 
-/// Turns each mapped finger's bones to point, as the camera sees them, along the hand
-/// points' segments (keeping the depth each had where it can); returns the points used.
+/// Turns each mapped finger's bones, from the palm out, so that each bone's end lands on its
+/// hand point as the camera sees it (its depth making up its length, toward the camera or
+/// away as it was); returns the points used.
 fn fit_fingers(
     body: &Body,
     pose: &mut [JointRotation],
@@ -346,7 +347,7 @@ fn fit_fingers(
             let [Some(a), Some(b), Some(c)] = joints[..] else { continue };
             let tip_name = format!("{}_hand_{}", if left { "left" } else { "right" }, 4 * finger + 4);
             for (p, (from, to)) in [(a, Some(b)), (b, Some(c)), (c, None)].into_iter().enumerate() {
-                let (Some(p0), Some(p1)) = (hand[1 + 4 * finger + p], hand[2 + 4 * finger + p]) else { continue };
+                let Some(p1) = hand[2 + 4 * finger + p] else { continue };
                 forward_kinematics(skeleton, pose, body.placement, &mut world);
                 let start = world[from].w_axis.truncate();
                 let end = match to {
@@ -356,10 +357,12 @@ fn fit_fingers(
                         _ => continue,
                     },
                 };
-                let Some(wanted) = direction_seen_along(&pinhole, start, end, Vec2::new(p1.x - p0.x, p1.y - p0.y))
-                else {
+                // From where the bone starts now (the bones before put it on its point).
+                let Some((x0, y0, _)) = pinhole.project(start) else { continue };
+                let Some(wanted) = direction_seen_along(&pinhole, start, end, Vec2::new(p1.x - x0, p1.y - y0)) else {
                     continue;
                 };
+                let wanted = wanted.normalize();
                 let now = (end - start).normalize_or_zero();
                 if now == Vec3::ZERO {
                     continue;
@@ -373,8 +376,10 @@ fn fit_fingers(
     used
 }
 
-/// The unit direction nearest `end - start` that the camera sees along `along` (pixels)
-/// from `start`: in the plane of the view ray and the picture's direction.
+/// The direction from `start` of a bone as long as `end - start` that the camera sees as
+/// the picture's segment `along` (pixels) from `start`: in the plane of the view ray and the
+/// picture's direction, its depth making up the length the picture does not show, toward
+/// the camera or away as the bone is now.
 fn direction_seen_along(pinhole: &Pinhole, start: Vec3, end: Vec3, along: Vec2) -> Option<Vec3> {
     if along.length() < 1e-3 {
         return None;
@@ -389,28 +394,33 @@ fn direction_seen_along(pinhole: &Pinhole, start: Vec3, end: Vec3, along: Vec2) 
     let across = to_world.transform_vector3(Vec3::new(along.x, along.y, 0.0).normalize()).normalize();
     let ray = to_world.transform_vector3(c.normalize()).normalize();
     let across = (across - ray * across.dot(ray)).normalize();
-    let now = (end - start).normalize_or_zero();
-    let (u, v) = (now.dot(across), now.dot(ray));
-    Some(if u <= 1e-3 { across } else { (across * u + ray * v).normalize() })
+    let length = end.distance(start);
+    let seen = along.length() * c.z / pinhole.focal;
+    if seen >= length {
+        return Some(across * length);
+    }
+    let away = if (end - start).dot(ray) >= 0.0 { 1.0 } else { -1.0 };
+    Some(across * seen + ray * away * (length * length - seen * seen).sqrt())
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
 
-    /// A ray's plane: the chosen direction projects along the wanted picture direction.
+    /// The chosen bone, from its start, ends where the picture's segment does.
     #[test]
     fn a_direction_seen_along_projects_along_it() {
         let camera =
             CameraDoc { focus: Vec3::new(0.0, 1.0, 0.0), yaw: 0.3, pitch: -0.2, distance: 3.0, ..Default::default() };
         let pinhole = Pinhole::of(&camera, 640, 480).unwrap();
         let start = Vec3::new(0.1, 1.2, 0.2);
-        for along in [Vec2::new(1.0, 0.0), Vec2::new(-0.3, 0.8), Vec2::new(0.0, -1.0)] {
+        for along in [Vec2::new(10.0, 0.0), Vec2::new(-3.0, 8.0), Vec2::new(0.0, -12.0)] {
             let d = direction_seen_along(&pinhole, start, start + Vec3::new(0.0, 0.1, 0.05), along).unwrap();
             let (x0, y0, _) = pinhole.project(start).unwrap();
-            let (x1, y1, _) = pinhole.project(start + d * 0.01).unwrap();
-            let seen = Vec2::new(x1 - x0, y1 - y0).normalize();
-            assert!(seen.dot(along.normalize()) > 0.999, "{seen} vs {along}");
+            let (x1, y1, _) = pinhole.project(start + d).unwrap();
+            let seen = Vec2::new(x1 - x0, y1 - y0);
+            assert!((seen - along).length() < 0.5, "{seen} vs {along}");
+            assert!((d.length() - Vec3::new(0.0, 0.1, 0.05).length()).abs() < 1e-5);
         }
     }
 }
