@@ -52,7 +52,7 @@ use BodyPoint::*;
 impl BodyPoint {
     /// Its name as Marionette's data pictures and OpenPose's drawing call it (`left_big_toe`,
     /// `mid_hip`).
-    pub fn name(self) -> &'static str {
+    pub const fn name(self) -> &'static str {
         match self {
             LeftAnkle => "left_ankle",
             LeftBigToe => "left_big_toe",

@@ -9,33 +9,15 @@ use serde_json::{Value, json};
 use super::{Figure, Passes, Pinhole, seen};
 
 /// OpenPose's BODY_25 points, in its order (our keypoint names).
-pub const BODY_25: [&str; 25] = [
-    "nose",
-    "neck",
-    "right_shoulder",
-    "right_elbow",
-    "right_wrist",
-    "left_shoulder",
-    "left_elbow",
-    "left_wrist",
-    "mid_hip",
-    "right_hip",
-    "right_knee",
-    "right_ankle",
-    "left_hip",
-    "left_knee",
-    "left_ankle",
-    "right_eye",
-    "left_eye",
-    "right_ear",
-    "left_ear",
-    "left_big_toe",
-    "left_small_toe",
-    "left_heel",
-    "right_big_toe",
-    "right_small_toe",
-    "right_heel",
-];
+pub const BODY_25: [&str; 25] = {
+    let mut out = [""; 25];
+    let mut k = 0;
+    while k < 25 {
+        out[k] = marionette_formats::keypoints::BODY_25[k].name();
+        k += 1;
+    }
+    out
+};
 
 /// The 18 points ControlNet draws (OpenPose's COCO-18 order).
 pub const BODY_18: [&str; 18] = [

@@ -83,7 +83,7 @@ pub enum FitError {
     #[error(transparent)]
     Format(#[from] marionette_formats::FormatError),
     #[error("{file}: {message}")]
-    Person { file: String, message: String },
+    File { file: String, message: String },
     #[error("--fit: the character has no humanoid map (hips, two legs, two arms)")]
     NoHumanoid,
     #[error("{file}: person {person} has {found} body points the character has, expected at least 6")]
@@ -271,7 +271,7 @@ pub fn fit(
     spec: &FitSpec,
 ) -> Result<Fitted, FitError> {
     let file = spec.file.display().to_string();
-    let person = keypoints.person(spec.person).map_err(|message| FitError::Person { file: file.clone(), message })?;
+    let person = keypoints.person(spec.person).map_err(|message| FitError::File { file: file.clone(), message })?;
     let body = Body::new(asset, map, placement, smpl).ok_or(FitError::NoHumanoid)?;
     let seen = seen_points(&body, person);
     if seen.len() < 6 {

@@ -59,7 +59,7 @@ impl FittedClip {
 /// The frames' files: a folder's `.json` files in name order, or a list's lines (relative
 /// to the list's folder).
 pub fn frame_files(path: &Path) -> Result<Vec<PathBuf>, FitError> {
-    let fail = |message: String| FitError::Person { file: path.display().to_string(), message };
+    let fail = |message: String| FitError::File { file: path.display().to_string(), message };
     let files: Vec<PathBuf> = if path.is_dir() {
         let entries = std::fs::read_dir(path).map_err(|e| fail(format!("cannot read the folder: {e}")))?;
         let mut files: Vec<PathBuf> = entries
@@ -101,7 +101,7 @@ pub fn fit_sequence(
         let keypoints = read_keypoints(file)?;
         let person = keypoints
             .person(spec.person)
-            .map_err(|message| FitError::Person { file: file.display().to_string(), message })?;
+            .map_err(|message| FitError::File { file: file.display().to_string(), message })?;
         let seen = seen_points(&body, person);
         if seen.len() < 6 {
             let index = spec.person.unwrap_or(0);
