@@ -132,24 +132,9 @@ pub fn fit_to_keypoints(path: &Path, id: CharacterId, state: &mut InspectorState
 
 /// `edit --fit FILE`: the file's points drawn over the view from the start.
 pub fn show_startup_keypoints(
-    edits: Option<bevy::prelude::Res<crate::editor::StartupEdits>>,
+    edits: Option<bevy::prelude::Res<crate::editor::state::StartupEdits>>,
     mut state: bevy::prelude::ResMut<InspectorState>,
 ) {
     let Some(spec) = edits.as_ref().and_then(|e| e.pose.fit.as_ref()) else { return };
     state.keypoints = KeypointOverlay::of_file(&spec.file, spec.person);
-}
-
-/// The "Fit to keypoints…" button and, while points are shown, the one that hides them.
-pub fn fit_row(ui: &mut egui::Ui, state: &mut InspectorState, id: CharacterId) {
-    ui.horizontal(|ui| {
-        let hint = "a pose detector's keypoints (OpenPose JSON, COCO, DWPose): this character posed and the \
-                    camera placed to match them; the picture beside the file shown behind. One undo step.";
-        if ui.button("Fit to keypoints…").on_hover_text(hint).clicked() {
-            let near = state.add_path.clone();
-            state.dialogs.open(super::dialogs::DialogPurpose::FitKeypoints(id), &near);
-        }
-        if state.keypoints.is_some() && ui.button("Hide keypoints").clicked() {
-            state.keypoints = None;
-        }
-    });
 }

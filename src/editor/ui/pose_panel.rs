@@ -35,7 +35,7 @@ pub fn pose_panel(ui: &mut egui::Ui, state: &mut InspectorState, panels: &mut Pa
     egui::CollapsingHeader::new("Body poses").default_open(true).show(ui, |ui| {
         if map.contains_key(&crate::rig::humanoid::HumanBone::Hips) {
             let placement = c.placement.0;
-            super::fit::fit_row(ui, state, id);
+            fit_row(ui, state, id);
             body_poses(ui, state, &mut panels.posing, &mut edits, id, (&character.asset, &map, &pose), placement);
         } else {
             ui.label("No humanoid map (hips, two legs): assign bones under Retarget.");
@@ -103,6 +103,22 @@ pub fn pose_panel(ui: &mut egui::Ui, state: &mut InspectorState, panels: &mut Pa
         }
     });
     edits.into_iter().for_each(|e| panels.push(e));
+}
+
+/// The "Fit to keypoints…" button (the file dialog, then [`super::fit::fit_to_keypoints`])
+/// and, while the file's points are shown, the one that hides them.
+fn fit_row(ui: &mut egui::Ui, state: &mut InspectorState, id: CharacterId) {
+    ui.horizontal(|ui| {
+        let hint = "a pose detector's keypoints (OpenPose JSON, COCO, DWPose): this character posed and the \
+                    camera placed to match them; the picture beside the file shown behind. One undo step.";
+        if ui.button("Fit to keypoints…").on_hover_text(hint).clicked() {
+            let near = state.add_path.clone();
+            state.dialogs.open(super::dialogs::DialogPurpose::FitKeypoints(id), &near);
+        }
+        if state.keypoints.is_some() && ui.button("Hide keypoints").clicked() {
+            state.keypoints = None;
+        }
+    });
 }
 
 /// The built-in body poses as a grid of thumbnails to click, with the blend, mirrored,
