@@ -390,9 +390,10 @@ pub enum SetFormat {
 /// `--two-bone`, `--look-at`.
 #[derive(clap::Args, Debug, Clone, Default)]
 pub struct PoseArgs {
-    /// `NAME` or `NAME:mirrored`: a built-in body pose on every humanoid (`t-pose`,
+    /// `NAME` or `NAME:mirrored`, either with `@BLEND` (0 to 1: that far from the pose it
+    /// is put over, as `--time` has it): a built-in body pose on every humanoid (`t-pose`,
     /// `sit-chair`, `wave`, …; `marionette info` lists them), feet on the floor.
-    #[arg(long = "preset", value_name = "NAME[:mirrored]")]
+    #[arg(long = "preset", value_name = "NAME[:mirrored][@BLEND]")]
     pub preset: Option<crate::document::posing::BodyPoseSpec>,
     /// `JOINT=rx,ry,rz` in radians (x applied first); JOINT is a name or an index. Angles
     /// outside the joint's limits are clamped. Repeatable.

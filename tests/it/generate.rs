@@ -320,8 +320,16 @@ fn a_generated_picture_is_its_scene_rendered_alone() {
 /// The first picture's scene of the small spec in `dir` with `asked` added to it and three
 /// characters a picture, as `--dry-run` prints it (`name` tells the files apart).
 fn first_scene_with(dir: &Path, name: &str, asked: &str) -> marionette::formats::scene::SceneDoc {
+    let doc = first_scene_of(dir, name, "Puppet", asked);
+    assert_eq!(doc.characters.len(), 3);
+    doc
+}
+
+/// As [`first_scene_with`], the characters of kind `who` (a spec's `Who`).
+fn first_scene_of(dir: &Path, name: &str, who: &str, asked: &str) -> marionette::formats::scene::SceneDoc {
     let spec = dir.join(format!("{name}.ron"));
     let text = std::fs::read_to_string(small_spec(dir, 1)).unwrap();
+    let text = text.replacen("(what: Puppet, weight: 1.0),", &format!("(what: {who}, weight: 1.0),"), 1);
     let text = text.replacen("canny: None,", &format!("canny: None,\n    {asked}"), 1);
     std::fs::write(&spec, text.replacen("per_picture: (1, 3)", "per_picture: (3, 3)", 1)).unwrap();
     let output = Command::new(env!("CARGO_BIN_EXE_marionette"))
@@ -333,9 +341,7 @@ fn first_scene_with(dir: &Path, name: &str, asked: &str) -> marionette::formats:
     assert!(output.status.success(), "{}", String::from_utf8_lossy(&output.stderr));
     let scene = dir.join(format!("{name}.scene.ron"));
     std::fs::write(&scene, String::from_utf8_lossy(&output.stdout).replacen("// picture 0", "", 1)).unwrap();
-    let doc = marionette::document::scenes::read_scene(&scene).unwrap();
-    assert_eq!(doc.characters.len(), 3);
-    doc
+    marionette::document::scenes::read_scene(&scene).unwrap()
 }
 
 /// `poses:` puts a drawn built-in body pose on every humanoid: the puppets of a spec asking
@@ -366,4 +372,118 @@ fn a_spec_draws_each_characters_tint() {
     let dir = scratch("generate-tint");
     let doc = first_scene_with(&dir, "tint", "tint: Some((Fixed(0.25), Fixed(0.5), Uniform(0.75, 0.75))),");
     assert!(doc.characters.iter().all(|c| c.view.tint == [0.25, 0.5, 0.75]), "{:?}", doc.characters[0].view.tint);
+}
+
+fn rigs() -> std::path::PathBuf {
+    std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/data/rigs")
+}
+
+/// `File(path: …, motions: FOLDER)`: each character plays a clip of the folder retargeted
+/// onto it, at the drawn time, posed as `--retarget CLIP --time T` poses it; the Mixamo
+/// figure and the VRoid avatar, with CMU's and Bandai's walks.
+#[test]
+fn a_spec_retargets_a_folder_of_clips_onto_character_files() {
+    use marionette::document::AssetLibrary;
+    let dir = scratch("generate-motions");
+    let motions = dir.join("motions");
+    std::fs::create_dir_all(&motions).unwrap();
+    for clip in ["cmu_walk.bvh", "bandai_walk.bvh"] {
+        std::fs::copy(rigs().join(clip), motions.join(clip)).unwrap();
+    }
+    let mut library = AssetLibrary::default();
+    let mut clips_seen = std::collections::BTreeSet::new();
+    for rig in ["mixamo.glb", "vroid.glb"] {
+        let who = format!("File(path: {:?}, motions: Some(\"motions\"))", rigs().join(rig));
+        let doc = first_scene_of(&dir, rig, &who, "");
+        for c in &doc.characters {
+            let anim = c.anim.as_ref().expect("a clip");
+            let Some(marionette::formats::scene::RetargetDoc {
+                from: marionette::formats::scene::MotionSourceDoc::File { path, .. },
+                ..
+            }) = &anim.retarget
+            else {
+                panic!("{}: not retargeted: {anim:?}", c.name)
+            };
+            assert!(path.starts_with(&motions), "{}", path.display());
+            clips_seen.insert(path.file_name().unwrap().to_owned());
+            // Its pose is the walk's at that time, not the rest pose.
+            let asset = library.shaped(c).unwrap();
+            let (pose, _) = marionette::document::export::still_pose(&mut library, &doc, c, &asset).unwrap();
+            let turned = pose.iter().filter(|r| r.to_quat().angle_between(bevy::math::Quat::IDENTITY) > 0.1).count();
+            assert!(turned >= 4, "{rig} {}: {turned} joints turned", c.name);
+        }
+    }
+    assert!(!clips_seen.is_empty());
+}
+
+/// `poses.blend`: 0 leaves each character in its clip's pose, 1 puts the body pose on whole,
+/// and a half turns each joint halfway between (within 1°).
+#[test]
+fn a_spec_blends_body_poses_with_the_clip() {
+    use marionette::document::AssetLibrary;
+    let dir = scratch("generate-blend");
+    let motions = dir.join("motions");
+    std::fs::create_dir_all(&motions).unwrap();
+    std::fs::copy(rigs().join("cmu_walk.bvh"), motions.join("cmu_walk.bvh")).unwrap();
+    let who = format!("File(path: {:?}, motions: Some(\"motions\"))", rigs().join("mixamo.glb"));
+    let mut library = AssetLibrary::default();
+    let mut poses = |blend: &str| {
+        let asked = format!("poses: Some((body: [\"t-pose\"], blend: Some(Fixed({blend})))),");
+        let doc = first_scene_of(&dir, &format!("blend{blend}"), &who, &asked);
+        let c = doc.characters[0].clone();
+        let asset = library.shaped(&c).unwrap();
+        marionette::document::export::still_pose(&mut library, &doc, &c, &asset).unwrap().0
+    };
+    let (clip, half, whole) = (poses("0.0"), poses("0.5"), poses("1.0"));
+    let mut compared = 0;
+    for ((a, h), w) in clip.iter().zip(&half).zip(&whole) {
+        let (a, h, w) = (a.to_quat(), h.to_quat(), w.to_quat());
+        if a.angle_between(w) > 0.2 {
+            let off = h.angle_between(a.slerp(w, 0.5)).to_degrees();
+            assert!(off < 1.0, "a joint {off:.2}° from halfway");
+            compared += 1;
+        }
+    }
+    assert!(compared >= 4, "{compared} joints differ between the clip and the t-pose");
+}
+
+/// `props:` stands a prop (an OBJ box) on the floor between the camera and one of the
+/// people, as a prop of its own id.
+#[test]
+fn a_spec_stands_props_between_the_camera_and_the_people() {
+    let dir = scratch("generate-props");
+    let props = dir.join("props");
+    std::fs::create_dir_all(&props).unwrap();
+    let corners: Vec<String> = (0..8)
+        .map(|k| {
+            format!(
+                "v {} {} {}",
+                0.4 * (k & 1) as f32 - 0.2,
+                0.8 * (k >> 1 & 1) as f32,
+                0.4 * (k >> 2 & 1) as f32 - 0.2
+            )
+        })
+        .collect();
+    let faces = "f 1 3 4 2\nf 5 6 8 7\nf 1 2 6 5\nf 3 7 8 4\nf 1 5 7 3\nf 2 4 8 6";
+    std::fs::write(props.join("box.obj"), format!("{}\n{faces}\n", corners.join("\n"))).unwrap();
+    let doc = first_scene_of(&dir, "props", "Puppet", "props: Some((folder: \"props\", per_picture: (2, 2))),");
+    assert_eq!(doc.characters.len(), 5);
+    let camera = doc.camera.unwrap();
+    let eye = camera.eye() * bevy::math::Vec3::new(1.0, 0.0, 1.0);
+    let people: Vec<bevy::math::Vec3> = doc.characters[..3].iter().map(|c| c.placement.translation).collect();
+    for prop in &doc.characters[3..] {
+        assert!(matches!(&prop.source, marionette::formats::scene::SourceDoc::File(p) if p.ends_with("box.obj")));
+        let at = prop.placement.translation;
+        assert!(at.y.abs() < 1e-4, "on the floor: {at}");
+        // On the floor's line from the camera to some person, 40–70 % of the way.
+        let on_a_line = people.iter().any(|p| {
+            let to = *p * bevy::math::Vec3::new(1.0, 0.0, 1.0) - eye;
+            let along = (at - eye).dot(to) / to.length_squared();
+            let off = (at - eye - to * along).length();
+            (0.35..=0.75).contains(&along) && off < 0.35
+        });
+        assert!(on_a_line, "{at} is not between the camera {eye} and a person {people:?}");
+    }
+    let ids: std::collections::BTreeSet<_> = doc.characters.iter().map(|c| c.id).collect();
+    assert_eq!(ids.len(), 5, "each its own id");
 }

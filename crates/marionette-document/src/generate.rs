@@ -124,6 +124,84 @@ pub struct Spec {
     /// drawn (none: the character's own).
     #[serde(default)]
     pub tint: Option<(Draw, Draw, Draw)>,
+    /// Props from a folder put between the camera and the people, hiding parts of them.
+    #[serde(default)]
+    pub props: Option<PropsSpec>,
+}
+
+/// Props (OBJ meshes, metres, of a folder relative to the spec) as occluders: each picture
+/// draws how many, and for each a file, a person it stands in front of, how far along the
+/// floor from the camera to that person (0 the camera, 1 the person) and a turn.
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+pub struct PropsSpec {
+    pub folder: PathBuf,
+    /// How many a picture: (least, most).
+    #[serde(default = "one_prop")]
+    pub per_picture: (usize, usize),
+    /// Where along the way from the camera to its person each stands.
+    #[serde(default = "halfway")]
+    pub between: Draw,
+}
+
+fn one_prop() -> (usize, usize) {
+    (1, 1)
+}
+
+fn halfway() -> Draw {
+    Draw::Uniform(0.4, 0.7)
+}
+
+/// The props (OBJ meshes) of a folder, by name.
+pub fn prop_files(folder: &Path) -> Vec<PathBuf> {
+    files_named(folder, |name| name.to_ascii_lowercase().ends_with(".obj"))
+}
+
+impl PropsSpec {
+    fn check(&self) -> Result<(), SpecError> {
+        if prop_files(&self.folder).is_empty() {
+            return Err(SpecError::at(
+                "props.folder",
+                format!("an empty distribution: no OBJ props in {}", self.folder.display()),
+            ));
+        }
+        let (least, most) = self.per_picture;
+        if least > most || most > MAX_PER_PICTURE {
+            return Err(SpecError::at(
+                "props.per_picture",
+                format!("expected (least, most) with least ≤ most ≤ {MAX_PER_PICTURE}, found ({least}, {most})"),
+            ));
+        }
+        self.between.check("props.between")
+    }
+
+    /// The props of a picture whose camera stands at `eye`, before the `people` (their
+    /// places on the floor), their ids following theirs.
+    fn draw(
+        &self,
+        rng: &mut Rng,
+        library: &mut AssetLibrary,
+        eye: Vec3,
+        people: &[Vec3],
+    ) -> Result<Vec<CharacterDoc>, GenerateError> {
+        let files = prop_files(&self.folder);
+        let (least, most) = self.per_picture;
+        let n = least + rng.below(most - least + 1);
+        let mut props = Vec::with_capacity(n);
+        for i in 0..n {
+            let file = files[rng.below(files.len())].clone();
+            let person = people.get(rng.below(people.len().max(1))).copied().unwrap_or(Vec3::ZERO);
+            let along = self.between.draw(rng).clamp(0.0, 1.0);
+            let yaw = rng.unit() * std::f32::consts::TAU;
+            let ground = Vec3::new(eye.x, 0.0, eye.z);
+            let at = ground + (Vec3::new(person.x, 0.0, person.z) - ground) * along;
+            let mut prop = CharacterDoc::new(SourceDoc::File(file), format!("prop {}", i + 1));
+            prop.id = Some(marionette_formats::scene::CharacterId((people.len() + i) as u64 + 1));
+            prop.placement = PlacementDoc::new(at, yaw, 1.0);
+            stand_at(library, &mut prop, at)?;
+            props.push(prop);
+        }
+        Ok(props)
+    }
 }
 
 /// The body poses and hand presets a spec draws from for each humanoid: the body pose is put
@@ -141,6 +219,10 @@ pub struct PosesSpec {
     /// they are.
     #[serde(default)]
     pub hands: Vec<String>,
+    /// How far from the clip's pose at the drawn time to the body pose, drawn from 0 to 1
+    /// (each joint turned the shortest way); none: all the way.
+    #[serde(default)]
+    pub blend: Option<Draw>,
 }
 
 impl PosesSpec {
@@ -170,6 +252,9 @@ impl PosesSpec {
                 format!("expected a share from 0 to 1, found {}", self.mirrored),
             ));
         }
+        if let Some(blend) = &self.blend {
+            blend.check("poses.blend")?;
+        }
         Ok(())
     }
 
@@ -187,7 +272,11 @@ impl PosesSpec {
             true => Vec::new(),
             false => hands.map(|(left, k)| crate::posing::HandSpec { left, preset: self.hands[k].clone() }).to_vec(),
         };
-        (crate::posing::BodyPoseSpec { name, mirrored }, hands)
+        let mut body = crate::posing::BodyPoseSpec::new(name, mirrored);
+        if let Some(blend) = &self.blend {
+            body.blend = blend.draw(rng).clamp(0.0, 1.0);
+        }
+        (body, hands)
     }
 }
 
@@ -218,11 +307,16 @@ pub enum Who {
     /// The built-in puppet, its arms, legs and head turned a little at random.
     Puppet,
     /// A character file (relative to the spec), playing its own clip (glTF, FBX, BVH) or
-    /// `anim` (a `.anim` file) at the drawn time; the file's first character.
+    /// `anim` (a `.anim` file) at the drawn time; the file's first character. With
+    /// `motions`, a folder of clips (BVH, glTF, FBX; relative to the spec): one drawn for
+    /// each character and retargeted onto it through the humanoid maps (a Mixamo or VRM
+    /// character walking CMU motion).
     File {
         path: PathBuf,
         #[serde(default)]
         anim: Option<PathBuf>,
+        #[serde(default)]
+        motions: Option<PathBuf>,
     },
     /// An SMPL body of the folder (relative to the spec), its ten β each drawn from `betas`,
     /// playing one of the folder's clips at the drawn time.
@@ -378,10 +472,10 @@ impl Spec {
         for c in &mut self.characters {
             match &mut c.what {
                 Who::Puppet => {}
-                Who::File { path, anim } => {
+                Who::File { path, anim, motions } => {
                     *path = dir.join(&*path);
-                    if let Some(anim) = anim {
-                        *anim = dir.join(&*anim);
+                    for file in [anim, motions].into_iter().flatten() {
+                        *file = dir.join(&*file);
                     }
                 }
                 Who::Smpl { folder, .. } => *folder = dir.join(&*folder),
@@ -391,6 +485,9 @@ impl Spec {
             if let Background::Images(folder) = &mut b.what {
                 *folder = dir.join(&*folder);
             }
+        }
+        if let Some(props) = &mut self.props {
+            props.folder = dir.join(&props.folder);
         }
     }
 
@@ -410,6 +507,9 @@ impl Spec {
         if let Some(poses) = &self.poses {
             poses.check()?;
         }
+        if let Some(props) = &self.props {
+            props.check()?;
+        }
         if let Some((r, g, b)) = &self.tint {
             r.check("tint.0")?;
             g.check("tint.1")?;
@@ -426,10 +526,18 @@ impl Spec {
             let at = format!("characters[{k}]");
             match &c.what {
                 Who::Puppet => {}
-                Who::File { path, anim } => {
+                Who::File { path, anim, motions } => {
                     exists(&format!("{at}.path"), path)?;
                     if let Some(anim) = anim {
                         exists(&format!("{at}.anim"), anim)?;
+                    }
+                    if let Some(folder) = motions
+                        && clip_files(folder).is_empty()
+                    {
+                        return Err(SpecError::at(
+                            format!("{at}.motions"),
+                            format!("an empty distribution: no BVH, glTF or FBX clips in {}", folder.display()),
+                        ));
                     }
                 }
                 Who::Smpl { folder, betas } => {
@@ -526,15 +634,20 @@ impl Spec {
         Ok(())
     }
 
-    /// The folder of SMPL bodies and the character files it names, to load before rendering.
+    /// The folder of SMPL bodies, the character files it names, the clips retargeted onto
+    /// them and the props, to load before rendering.
     pub fn sources(&self) -> Vec<SourceDoc> {
         self.characters
             .iter()
-            .map(|c| match &c.what {
-                Who::Puppet => SourceDoc::Embedded("puppet".into()),
-                Who::File { path, .. } => SourceDoc::File(path.clone()),
-                Who::Smpl { folder, .. } => SourceDoc::File(folder.clone()),
+            .flat_map(|c| match &c.what {
+                Who::Puppet => vec![SourceDoc::Embedded("puppet".into())],
+                Who::File { path, motions, .. } => std::iter::once(path.clone())
+                    .chain(motions.iter().flat_map(|folder| clip_files(folder)))
+                    .map(SourceDoc::File)
+                    .collect(),
+                Who::Smpl { folder, .. } => vec![SourceDoc::File(folder.clone())],
             })
+            .chain(self.props.iter().flat_map(|p| prop_files(&p.folder)).map(SourceDoc::File))
             .collect()
     }
 }
@@ -583,6 +696,14 @@ pub fn image_files(folder: &Path) -> Vec<PathBuf> {
     files_named(folder, |name| {
         let lower = name.to_ascii_lowercase();
         [".png", ".jpg", ".jpeg"].iter().any(|e| lower.ends_with(e))
+    })
+}
+
+/// The motion clips (BVH, glTF, FBX) of a folder, by name.
+pub fn clip_files(folder: &Path) -> Vec<PathBuf> {
+    files_named(folder, |name| {
+        let lower = name.to_ascii_lowercase();
+        [".bvh", ".glb", ".gltf", ".fbx"].iter().any(|e| lower.ends_with(e))
     })
 }
 
@@ -715,6 +836,11 @@ pub fn scene_of(spec: &Spec, library: &mut AssetLibrary, k: u64) -> Result<(Scen
             }
         };
     }
+    if let Some(props) = &spec.props {
+        let people: Vec<Vec3> = characters.iter().map(|c| c.placement.translation).collect();
+        let eye = camera_doc.eye();
+        characters.extend(props.draw(&mut rng, library, eye, &people)?);
+    }
     let scene = SceneDoc { characters, camera: Some(camera_doc), stage, shot: spec.shot(), ..SceneDoc::default() };
     scene.validate().map_err(|message| GenerateError::Picture { k, message })?;
     Ok((scene, backdrop))
@@ -772,12 +898,19 @@ fn character(
             c.view.tint = [0.45 + 0.4 * rng.unit(), 0.45 + 0.4 * rng.unit(), 0.45 + 0.4 * rng.unit()];
             c
         }
-        Who::File { path, anim } => {
+        Who::File { path, anim, motions } => {
             let source = SourceDoc::File(path.clone());
             let asset = library.load(&source)?;
             let mut c = CharacterDoc { name, ..library.new_character_doc(source.clone(), &asset) };
             if let Some(file) = anim {
                 c.anim = Some(marionette_formats::scene::AnimDoc::of(file.clone()));
+            }
+            if let Some(folder) = motions {
+                use marionette_formats::scene::{AnimDoc, MotionSourceDoc, RetargetDoc};
+                let files = clip_files(folder);
+                let from = MotionSourceDoc::File { path: files[rng.below(files.len())].clone(), clip: None };
+                c.anim = Some(AnimDoc { retarget: Some(RetargetDoc::of(from)), ..AnimDoc::default() });
+                c.playback = None;
             }
             if let Some(anim) = c.anim.as_mut() {
                 (anim.time, anim.playing) = (time, false);

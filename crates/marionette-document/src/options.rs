@@ -321,7 +321,7 @@ fn pose_characters(
             crate::retarget::humanoid_map(&asset, &c.humanoid)
         };
         if let Some(spec) = &options.specs.preset {
-            match crate::posing::body_posed(skeleton, &map, &pose, spec, 1.0) {
+            match crate::posing::body_posed(skeleton, &map, &pose, spec, spec.blend) {
                 Some((posed, limited)) => {
                     pose = posed;
                     notes.push(format!("{}: {}", c.name, crate::posing::describe_body_pose(skeleton, spec, &limited)));

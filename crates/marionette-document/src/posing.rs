@@ -324,30 +324,48 @@ impl std::str::FromStr for LookAtSpec {
     }
 }
 
-/// A parsed `NAME` or `NAME:mirrored`: a built-in body pose (`sit-chair`, `wave`, …).
+/// A parsed `NAME`, `NAME:mirrored` and either with `@BLEND`: a built-in body pose
+/// (`sit-chair`, `wave`, …), blended from the pose it is put over by `blend` (1, all the
+/// way, unless given; `walk@0.5` halfway from a clip's pose at `--time`).
 #[derive(Debug, Clone, PartialEq)]
 pub struct BodyPoseSpec {
     pub name: String,
     pub mirrored: bool,
+    pub blend: f32,
+}
+
+impl BodyPoseSpec {
+    /// The body pose `name`, as it is or mirrored, all the way.
+    pub fn new(name: impl Into<String>, mirrored: bool) -> Self {
+        Self { name: name.into(), mirrored, blend: 1.0 }
+    }
 }
 
 impl std::str::FromStr for BodyPoseSpec {
     type Err = PoseSpecError;
 
     fn from_str(spec: &str) -> Result<Self, Self::Err> {
-        let (name, mirrored) = match spec.trim().split_once(':') {
+        let expected = |what: String| PoseSpecError::Expected { spec: spec.to_string(), expected: what };
+        let (pose, blend) = match spec.trim().split_once('@') {
+            Some((pose, blend)) => match blend.trim().parse::<f32>() {
+                Ok(b) if (0.0..=1.0).contains(&b) => (pose, b),
+                _ => return Err(expected(format!("expected a blend from 0 to 1 after `@`, found `{blend}`"))),
+            },
+            None => (spec.trim(), 1.0),
+        };
+        let (name, mirrored) = match pose.trim().split_once(':') {
             Some((name, "mirrored" | "mirror")) => (name, true),
             Some(_) => ("", false),
-            None => (spec.trim(), false),
+            None => (pose.trim(), false),
         };
         if marionette_rig::body_poses::body_pose(name).is_none() {
             let names: Vec<&str> = marionette_rig::body_poses::POSES.iter().map(|p| p.name).collect();
-            return Err(PoseSpecError::Expected {
-                spec: spec.to_string(),
-                expected: format!("expected NAME or NAME:mirrored, NAME one of {}", names.join(", ")),
-            });
+            return Err(expected(format!(
+                "expected NAME or NAME:mirrored (then @BLEND), NAME one of {}",
+                names.join(", ")
+            )));
         }
-        Ok(Self { name: name.to_string(), mirrored })
+        Ok(Self { name: name.to_string(), mirrored, blend })
     }
 }
 
@@ -376,7 +394,10 @@ pub fn body_posed(
 
 /// What a body pose did, for the notes.
 pub fn describe_body_pose(skeleton: &Skeleton, spec: &BodyPoseSpec, limited: &[usize]) -> String {
-    let name = if spec.mirrored { format!("{} (mirrored)", spec.name) } else { spec.name.clone() };
+    let mut name = if spec.mirrored { format!("{} (mirrored)", spec.name) } else { spec.name.clone() };
+    if spec.blend < 1.0 {
+        name += &format!(" blended {:.2} of the way", spec.blend);
+    }
     match limited {
         [] => format!("pose {name}"),
         _ => {

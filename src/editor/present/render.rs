@@ -893,7 +893,7 @@ fn pose_frame(
     let rig = kept.and_then(|pose| pose.rig.as_ref()).and_then(|rig| assets.rig(rig).ok());
     let from = rig.as_ref().map(|(a, m)| (&a.skeleton, &**m));
     // A pose of the scene's library, else the built-in body pose of that name.
-    let body = crate::document::posing::BodyPoseSpec { name: name.clone(), mirrored: false };
+    let body = crate::document::posing::BodyPoseSpec::new(name.clone(), false);
     for (sc, character, map, placement) in &characters {
         let map = map.map(|m| m.0.clone()).unwrap_or_default();
         let current: Vec<_> =

@@ -173,7 +173,7 @@ fn body_poses(
         }
     });
     if let Some(name) = clicked {
-        let spec = crate::document::posing::BodyPoseSpec { name: name.into(), mirrored: state.body_mirrored };
+        let spec = crate::document::posing::BodyPoseSpec::new(name, state.body_mirrored);
         edits.extend(body_pose_edits(id, target, placement, &spec, state.body_blend).into_iter().flatten());
     }
 }
