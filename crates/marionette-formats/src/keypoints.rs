@@ -7,7 +7,9 @@
 //! `righthand_kpts`; the picture's size from `images[]`).
 //!
 //! Each point is `x, y, c`; a point of confidence (or COCO visibility) 0 is absent, not at
-//! (0, 0). Every number is checked: an error names the field's path
+//! (0, 0). OpenPose points all within 0 to 1 with a canvas given are normalised to it (as
+//! controlnet_aux writes them) and are scaled by it; a list of OpenPose frames (ComfyUI's
+//! `POSE_KEYPOINT`) gives its first. Every number is checked: an error names the field's path
 //! (`people[0].pose_keypoints_2d: 52 numbers, expected 54 or 75`).
 
 use std::path::Path;
@@ -178,10 +180,22 @@ impl Person2d {
         self.body.iter().find(|(n, _)| *n == name).map(|&(_, p)| p)
     }
 
+    /// Every point given: the body's, then the hands'.
+    pub fn points(&self) -> impl Iterator<Item = &Point2d> {
+        self.body.iter().map(|(_, p)| p).chain(self.left_hand.iter().chain(&self.right_hand).flatten())
+    }
+
+    /// Every point's x times `w` and y times `h`.
+    fn scale(&mut self, w: f32, h: f32) {
+        let hands = self.left_hand.iter_mut().chain(&mut self.right_hand).flatten();
+        for p in self.body.iter_mut().map(|(_, p)| p).chain(hands) {
+            (p.x, p.y) = (p.x * w, p.y * h);
+        }
+    }
+
     /// The area of the box around every point given (pixels²).
     pub fn area(&self) -> f32 {
-        let points = self.body.iter().map(|(_, p)| p).chain(self.left_hand.iter().chain(&self.right_hand).flatten());
-        let (lo, hi) = points.fold(([f32::INFINITY; 2], [f32::NEG_INFINITY; 2]), |(lo, hi), p| {
+        let (lo, hi) = self.points().fold(([f32::INFINITY; 2], [f32::NEG_INFINITY; 2]), |(lo, hi), p| {
             ([lo[0].min(p.x), lo[1].min(p.y)], [hi[0].max(p.x), hi[1].max(p.y)])
         });
         ((hi[0] - lo[0]) * (hi[1] - lo[1])).max(0.0)
@@ -223,6 +237,14 @@ pub fn parse_keypoints(text: &str, path: &Path) -> Result<Keypoints, FormatError
     let json: Value = serde_json::from_str(text)
         .map_err(|e| FormatError::syntax(path, e.line().max(1), format!("expected JSON: {e}")))?;
     let fail = |message: String| FormatError::other(path, message);
+    // ComfyUI's POSE_KEYPOINT: a list of frames, each OpenPose's object; the first is read.
+    let json = match json {
+        Value::Array(mut frames) if frames.first().is_some_and(|f| f.get("people").is_some()) => frames.swap_remove(0),
+        Value::Array(_) => {
+            return Err(fail("expected a list of OpenPose frames (`people`), found another list".into()));
+        }
+        json => json,
+    };
     let keypoints = if json.get("people").is_some() {
         openpose(&json)
     } else if json.get("annotations").is_some() {
@@ -265,6 +287,16 @@ fn openpose(json: &Value) -> Result<Keypoints, String> {
         };
         let (left_hand, right_hand) = (hand("hand_left_keypoints_2d")?, hand("hand_right_keypoints_2d")?);
         out.push(person_of(names, &points(&body), left_hand, right_hand, &format!("people[{k}]"))?);
+    }
+    if let Some((w, h)) = size
+        && w > 2.0
+        && h > 2.0
+        && out.iter().all(|p| p.points().all(|q| (0.0..=1.0).contains(&q.x) && (0.0..=1.0).contains(&q.y)))
+    {
+        // Normalised to the canvas (as controlnet_aux and some ComfyUI nodes write it).
+        for p in &mut out {
+            p.scale(w, h);
+        }
     }
     Ok(Keypoints { size, people: out })
 }

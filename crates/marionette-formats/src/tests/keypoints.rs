@@ -126,3 +126,26 @@ fn malformed_keypoint_files_are_refused_with_the_fields_path() {
         assert!(got.contains(want), "{text}: {got}");
     }
 }
+
+/// Points normalised to the canvas (controlnet_aux's) are scaled by it; a list of frames
+/// (ComfyUI's POSE_KEYPOINT) gives its first; pixel points are left as they are.
+#[test]
+fn normalised_points_and_comfyui_lists_are_read_in_pixels() {
+    let normalised: Vec<String> = (0..18).map(|k| format!("{}, {}, 1", 0.05 * k as f32, 0.04 * k as f32)).collect();
+    let frame = format!(
+        r#"{{"canvas_width": 512, "canvas_height": 768, "people": [{{"pose_keypoints_2d": [{}]}}]}}"#,
+        normalised.join(", ")
+    );
+    for text in [frame.clone(), format!("[{frame}, {frame}]")] {
+        let k = parse(&text).unwrap();
+        let shoulder = k.people[0].point(BodyPoint::RightShoulder).unwrap();
+        assert!((shoulder.x - 0.1 * 512.0).abs() < 1e-3 && (shoulder.y - 0.08 * 768.0).abs() < 1e-3, "{shoulder:?}");
+    }
+    let pixels = parse(&format!(
+        r#"{{"canvas_width": 512, "canvas_height": 768, "people": [{{"pose_keypoints_2d": {}}}]}}"#,
+        flat(18, &[])
+    ))
+    .unwrap();
+    assert_eq!(pixels.people[0].point(BodyPoint::RightShoulder).map(|q| q.x), Some(20.0));
+    assert!(parse("[1, 2]").unwrap_err().contains("expected a list of OpenPose frames"));
+}
