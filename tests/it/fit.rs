@@ -485,7 +485,7 @@ fn malformed_keypoint_files_are_refused_by_field() {
 }
 
 /// `export --fit-sequence DIR --fps 30 --animation --out walk.glb`: a glTF animation of
-/// the frames' span.
+/// the frames' span; the same from one file listing the frames (ComfyUI's).
 #[test]
 fn a_fitted_sequence_exports_as_an_animation() {
     let mut library = AssetLibrary::default();
@@ -496,36 +496,39 @@ fn a_fitted_sequence_exports_as_an_animation() {
     std::fs::create_dir_all(&frames).unwrap();
     let camera =
         CameraDoc { focus: Vec3::new(0.0, 0.9, 0.0), yaw: 0.4, pitch: -0.15, distance: 4.0, ..CameraDoc::default() };
+    let mut video = Vec::new();
     for (k, pose) in ["stand", "walk", "run", "walk:mirrored", "stand"].iter().enumerate() {
         let truth = posed(&mut library, &doc, pose);
-        std::fs::write(frames.join(format!("clip_{k:012}_keypoints.json")), keypoint_files(&truth, &camera).1).unwrap();
+        let openpose = keypoint_files(&truth, &camera).1;
+        std::fs::write(frames.join(format!("clip_{k:012}_keypoints.json")), &openpose).unwrap();
+        video.push(openpose);
     }
-    let glb = folder.join("walk.glb");
-    let out = marionette(&[
-        "export".as_ref(),
-        file.as_ref(),
-        "--fit-sequence".as_ref(),
-        frames.as_ref(),
-        "--fps".as_ref(),
-        "10".as_ref(),
-        "--animation".as_ref(),
-        "--out".as_ref(),
-        glb.as_ref(),
-    ]);
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
-    assert!(
-        String::from_utf8_lossy(&out.stderr).contains("fitted 5 frames"),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let gltf = gltf::Gltf::from_slice(&std::fs::read(&glb).unwrap()).unwrap();
-    let animation = gltf.animations().next().expect("an animation");
-    let end = animation
-        .channels()
-        .filter_map(|c| c.sampler().input().max())
-        .filter_map(|m| m.as_array()?.first()?.as_f64())
-        .fold(0.0, f64::max) as f32;
-    assert!((end - 0.4).abs() < 1e-4, "{end}");
+    // The same frames as one list (ComfyUI's POSE_KEYPOINT of a video).
+    let list = folder.join("video.json");
+    std::fs::write(&list, format!("[{}]", video.join(","))).unwrap();
+    for (from, glb) in [(frames, folder.join("walk.glb")), (list, folder.join("video.glb"))] {
+        let out = marionette(&[
+            "export".as_ref(),
+            file.as_ref(),
+            "--fit-sequence".as_ref(),
+            from.as_ref(),
+            "--fps".as_ref(),
+            "10".as_ref(),
+            "--animation".as_ref(),
+            "--out".as_ref(),
+            glb.as_ref(),
+        ]);
+        let said = String::from_utf8_lossy(&out.stderr);
+        assert!(out.status.success() && said.contains("fitted 5 frames"), "{}: {said}", from.display());
+        let gltf = gltf::Gltf::from_slice(&std::fs::read(&glb).unwrap()).unwrap();
+        let animation = gltf.animations().next().expect("an animation");
+        let end = animation
+            .channels()
+            .filter_map(|c| c.sampler().input().max())
+            .filter_map(|m| m.as_array()?.first()?.as_f64())
+            .fold(0.0, f64::max) as f32;
+        assert!((end - 0.4).abs() < 1e-4, "{}: {end}", from.display());
+    }
 }
 
 /// Fingers from the hand points: the Mixamo figure waving with a fist and a pointing hand,

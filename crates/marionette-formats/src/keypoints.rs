@@ -9,7 +9,7 @@
 //! Each point is `x, y, c`; a point of confidence (or COCO visibility) 0 is absent, not at
 //! (0, 0). OpenPose points all within 0 to 1 with a canvas given are normalised to it (as
 //! controlnet_aux writes them) and are scaled by it; a list of OpenPose frames (ComfyUI's
-//! `POSE_KEYPOINT`) gives its first. Every number is checked: an error names the field's path
+//! `POSE_KEYPOINT`) gives its first, or every frame to a sequence. Every number is checked: an error names the field's path
 //! (`people[0].pose_keypoints_2d: 52 numbers, expected 54 or 75`).
 
 use std::path::Path;
@@ -232,29 +232,45 @@ pub fn read_keypoints(path: &Path) -> Result<Keypoints, FormatError> {
     parse_keypoints(&text, path)
 }
 
-/// Parses the text of a keypoint file read from `path`.
+/// Reads a keypoint file's frames: each of a list of OpenPose frames (ComfyUI's
+/// `POSE_KEYPOINT` of a video), or the file's one.
+pub fn read_keypoint_frames(path: &Path) -> Result<Vec<Keypoints>, FormatError> {
+    let text = super::error::read_text(super::error::open(path)?, path)?;
+    parse_keypoint_frames(&text, path)
+}
+
+/// Parses the text of a keypoint file read from `path` (of a list of frames, the first).
 pub fn parse_keypoints(text: &str, path: &Path) -> Result<Keypoints, FormatError> {
+    Ok(parse_keypoint_frames(text, path)?.swap_remove(0))
+}
+
+/// Parses the frames of a keypoint file read from `path` (see [`read_keypoint_frames`]).
+pub fn parse_keypoint_frames(text: &str, path: &Path) -> Result<Vec<Keypoints>, FormatError> {
     let json: Value = serde_json::from_str(text)
         .map_err(|e| FormatError::syntax(path, e.line().max(1), format!("expected JSON: {e}")))?;
     let fail = |message: String| FormatError::other(path, message);
-    // ComfyUI's POSE_KEYPOINT: a list of frames, each OpenPose's object; the first is read.
-    let json = match json {
-        Value::Array(mut frames) if frames.first().is_some_and(|f| f.get("people").is_some()) => frames.swap_remove(0),
-        Value::Array(_) => {
-            return Err(fail("expected a list of OpenPose frames (`people`), found another list".into()));
-        }
-        json => json,
-    };
+    match json {
+        Value::Array(frames) if !frames.is_empty() && frames.iter().all(|f| f.get("people").is_some()) => frames
+            .iter()
+            .enumerate()
+            .map(|(k, frame)| keypoints_of(frame).map_err(|m| fail(format!("[{k}].{m}"))))
+            .collect(),
+        Value::Array(_) => Err(fail("expected a list of OpenPose frames (each with `people`)".into())),
+        json => Ok(vec![keypoints_of(&json).map_err(fail)?]),
+    }
+}
+
+/// One frame's keypoints: OpenPose's or COCO's, with at least one person.
+fn keypoints_of(json: &Value) -> Result<Keypoints, String> {
     let keypoints = if json.get("people").is_some() {
-        openpose(&json)
+        openpose(json)
     } else if json.get("annotations").is_some() {
-        coco(&json)
+        coco(json)
     } else {
         Err("expected OpenPose's `people` or COCO's `annotations`, found neither".to_string())
-    }
-    .map_err(fail)?;
+    }?;
     if keypoints.people.is_empty() {
-        return Err(fail("people: expected at least one person, found none".into()));
+        return Err("people: expected at least one person, found none".into());
     }
     Ok(keypoints)
 }

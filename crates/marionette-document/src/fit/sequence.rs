@@ -9,7 +9,7 @@
 use std::path::{Path, PathBuf};
 
 use glam::{Mat4, Vec3};
-use marionette_formats::keypoints::read_keypoints;
+use marionette_formats::keypoints::{Keypoints, read_keypoint_frames};
 use marionette_rig::CharacterAsset;
 use marionette_rig::anim::Clip;
 use marionette_rig::humanoid::HumanoidMap;
@@ -56,18 +56,18 @@ impl FittedClip {
     }
 }
 
-/// The frames' files: a folder's `.json` files in name order, or a list's lines (relative
-/// to the list's folder).
+/// The frames' files: a folder's `.json` files in name order, a `.json` file itself (a
+/// list of frames, ComfyUI's), or a list's lines (relative to the list's folder).
 pub fn frame_files(path: &Path) -> Result<Vec<PathBuf>, FitError> {
     let fail = |message: String| FitError::File { file: path.display().to_string(), message };
+    let is_json = |p: &Path| p.extension().is_some_and(|e| e.eq_ignore_ascii_case("json"));
     let files: Vec<PathBuf> = if path.is_dir() {
         let entries = std::fs::read_dir(path).map_err(|e| fail(format!("cannot read the folder: {e}")))?;
-        let mut files: Vec<PathBuf> = entries
-            .filter_map(|e| e.ok().map(|e| e.path()))
-            .filter(|p| p.extension().is_some_and(|e| e.eq_ignore_ascii_case("json")))
-            .collect();
+        let mut files: Vec<PathBuf> = entries.filter_map(|e| e.ok().map(|e| e.path())).filter(|p| is_json(p)).collect();
         files.sort();
         files
+    } else if is_json(path) {
+        vec![path.to_path_buf()]
     } else {
         let text = std::fs::read_to_string(path).map_err(|e| fail(format!("cannot read the list: {e}")))?;
         let folder = path.parent().unwrap_or(Path::new("."));
@@ -77,6 +77,15 @@ pub fn frame_files(path: &Path) -> Result<Vec<PathBuf>, FitError> {
         return Err(fail("expected keypoint files (`*.json`), found none".into()));
     }
     Ok(files)
+}
+
+/// Every frame of the files, in order, each with the file it came from.
+fn frames_of(files: &[PathBuf]) -> Result<Vec<(&PathBuf, Keypoints)>, FitError> {
+    let mut frames = Vec::new();
+    for file in files {
+        frames.extend(read_keypoint_frames(file)?.into_iter().map(|k| (file, k)));
+    }
+    Ok(frames)
 }
 
 /// Frames averaged over this many on either side (weights falling off linearly).
@@ -97,8 +106,8 @@ pub fn fit_sequence(
     let mut seens = Vec::with_capacity(files.len());
     let mut fov = spec.fov;
     let mut size = None;
-    for file in &files {
-        let keypoints = read_keypoints(file)?;
+    let frames = frames_of(&files)?;
+    for (file, keypoints) in &frames {
         let person = keypoints
             .person(spec.person)
             .map_err(|message| FitError::File { file: file.display().to_string(), message })?;
@@ -107,7 +116,7 @@ pub fn fit_sequence(
             let index = spec.person.unwrap_or(0);
             return Err(FitError::TooFewPoints { file: file.display().to_string(), person: index, found: seen.len() });
         }
-        let frame_size = *size.get_or_insert_with(|| picture_size(&keypoints, person));
+        let frame_size = *size.get_or_insert_with(|| picture_size(keypoints, person));
         let mut problem = Problem::new(&body, &seen, frame_size, fov);
         if let Some(first) = states.first() {
             problem.follow(first);

@@ -148,4 +148,9 @@ fn normalised_points_and_comfyui_lists_are_read_in_pixels() {
     .unwrap();
     assert_eq!(pixels.people[0].point(BodyPoint::RightShoulder).map(|q| q.x), Some(20.0));
     assert!(parse("[1, 2]").unwrap_err().contains("expected a list of OpenPose frames"));
+    let frames = crate::keypoints::parse_keypoint_frames(&format!("[{frame}, {frame}, {frame}]"), Path::new("k.json"));
+    assert_eq!(frames.unwrap().len(), 3);
+    let broken = format!(r#"[{frame}, {{"people": [{{"pose_keypoints_2d": [1, 2]}}]}}]"#);
+    let e = crate::keypoints::parse_keypoint_frames(&broken, Path::new("k.json")).unwrap_err().to_string();
+    assert!(e.contains("[1].people[0].pose_keypoints_2d: 2 numbers"), "{e}");
 }
