@@ -313,13 +313,22 @@ pub fn fit_file(
     fit(asset, map, placement, smpl, &keypoints, spec)
 }
 
-/// The picture a keypoint file was made from, where it lies beside it: COCO's
-/// `images[].file_name`, or the file's name without `_keypoints` (OpenPose's naming) or
-/// `.json`, as PNG or JPEG.
+/// The picture a keypoint file was made from, where it lies beside it: COCO's first
+/// `images[].file_name`, else the file's name without `.json` and then without
+/// `_keypoints` (OpenPose's naming) or `.openpose` / `.cn-openpose` (the files `render
+/// --data` and `--controlnet` write beside a picture), as PNG or JPEG.
 pub fn picture_beside(file: &Path) -> Option<PathBuf> {
     let folder = file.parent()?;
+    let named = std::fs::read_to_string(file)
+        .ok()
+        .and_then(|text| serde_json::from_str::<serde_json::Value>(&text).ok())
+        .and_then(|json| json["images"][0]["file_name"].as_str().map(|name| folder.join(name)))
+        .filter(|p| p.is_file());
+    if named.is_some() {
+        return named;
+    }
     let stem = file.file_stem()?.to_string_lossy();
-    let stem = stem.strip_suffix("_keypoints").unwrap_or(&stem);
+    let stem = ["_keypoints", ".cn-openpose", ".openpose"].iter().find_map(|s| stem.strip_suffix(s)).unwrap_or(&stem);
     ["png", "jpg", "jpeg", "PNG", "JPG"].iter().map(|ext| folder.join(format!("{stem}.{ext}"))).find(|p| p.is_file())
 }
 
@@ -406,6 +415,27 @@ fn direction_seen_along(pinhole: &Pinhole, start: Vec3, end: Vec3, along: Vec2) 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The picture beside a keypoint file: COCO's file name, else the file's own name less
+    /// what OpenPose and `render` add to it.
+    #[test]
+    fn the_picture_beside_a_keypoint_file_is_found() {
+        let dir = std::env::temp_dir().join(format!("marionette-beside-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        for name in ["shot.png", "photo.jpg", "frame_000001.png"] {
+            std::fs::write(dir.join(name), b"").unwrap();
+        }
+        let file = |name: &str, text: &str| {
+            std::fs::write(dir.join(name), text).unwrap();
+            picture_beside(&dir.join(name)).map(|p| p.file_name().unwrap().to_string_lossy().into_owned())
+        };
+        assert_eq!(file("shot.openpose.json", "{}"), Some("shot.png".into()));
+        assert_eq!(file("shot.cn-openpose.json", "{}"), Some("shot.png".into()));
+        assert_eq!(file("frame_000001_keypoints.json", "{}"), Some("frame_000001.png".into()));
+        assert_eq!(file("coco.json", r#"{"images": [{"file_name": "photo.jpg"}]}"#), Some("photo.jpg".into()));
+        assert_eq!(file("alone.json", "{}"), None);
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
 
     /// The chosen bone, from its start, ends where the picture's segment does.
     #[test]
