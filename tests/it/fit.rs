@@ -583,3 +583,73 @@ fn fingers_follow_the_hand_points() {
     println!("hand points: {with_fingers:.2} px mean with the fingers fitted, {without:.2} px at rest");
     assert!(with_fingers <= 3.0 && without > 3.0 * with_fingers, "{with_fingers} vs {without}");
 }
+
+/// The editor's "Fit to keypoints…": its edits, pushed together, are one undo step that
+/// poses the character as the file shows it (its keypoints within 0.05 px of the file's
+/// under the fitted camera) and stands it on the floor; undoing it returns the scene.
+#[test]
+fn fitting_in_the_editor_is_one_undo_step() {
+    use bevy::prelude::App;
+    use marionette::editor::edits::commands::EditQueue;
+    use marionette::editor::edits::history::{History, HistoryRequest};
+    use marionette::editor::ui::fit::{FitTarget, fit_outcome};
+    let mut library = AssetLibrary::default();
+    let doc = doc_of(&mut library, &rig("mixamo.glb"));
+    let truth = posed(&mut library, &doc, "wave");
+    let camera =
+        CameraDoc { focus: Vec3::new(0.1, 0.9, 0.0), yaw: -0.4, pitch: -0.2, distance: 3.2, ..CameraDoc::default() };
+    let folder = crate::common::scratch("fit_in_the_editor");
+    let path = folder.join("photo.json");
+    std::fs::write(&path, keypoint_files(&truth, &camera).0).unwrap();
+
+    let mut app = crate::edits::scene_app();
+    let id = marionette::formats::scene::CharacterId(1);
+    let opened = SceneDoc { characters: vec![CharacterDoc { id: Some(id), ..doc.clone() }], ..SceneDoc::default() };
+    *app.world_mut().resource_mut::<marionette::editor::scene_doc::document::PendingScene>() =
+        marionette::editor::scene_doc::document::PendingScene { doc: Some(opened), frame: false };
+    app.update();
+    app.update();
+    let before = crate::edits::state(&mut app).0;
+    let scene_now = |app: &App| app.world().resource::<crate::edits::Captured>().0.clone();
+    let c = &before.characters[0];
+    let asset = library.shaped(c).unwrap();
+    let map = humanoid_map(&asset, &c.humanoid);
+    let (pose, _) = marionette::document::scenes::pose_from_doc(&asset, c);
+    let target = FitTarget {
+        id,
+        name: &c.name,
+        source: &c.source,
+        asset: &asset,
+        map: &map,
+        pose: &pose,
+        placement: c.placement.to_mat4(),
+    };
+    let outcome = fit_outcome(&path, &target, &before.stage, before.shot).unwrap();
+    assert!(outcome.message.contains("fitted to 12 points"), "{}", outcome.message);
+    for edit in outcome.edits {
+        app.world_mut().resource_mut::<EditQueue>().push(edit);
+    }
+    app.update();
+    app.update();
+    assert_eq!(app.world().resource::<History>().undo_steps(), 1, "one undo step");
+    let after = scene_now(&app);
+    let c = &after.characters[0];
+    let (fitted, _) = marionette::document::scenes::pose_from_doc(&asset, c);
+    let at = joints_world(&asset, &fitted, c.placement.to_mat4());
+    let pinhole = Pinhole::of(&outcome.camera, SIZE.0, SIZE.1).unwrap();
+    let true_at = joints_world(&asset, &truth.pose, truth.placement);
+    let true_pinhole = Pinhole::of(&camera, SIZE.0, SIZE.1).unwrap();
+    for bone in [LeftHand, RightHand, LeftFoot, RightFoot, LeftLowerArm, RightLowerLeg] {
+        let (x, y, _) = pinhole.project(at[map[&bone]]).unwrap();
+        let (tx, ty, _) = true_pinhole.project(true_at[map[&bone]]).unwrap();
+        assert!(glam::Vec2::new(x - tx, y - ty).length() < 0.05, "{bone:?}: ({x}, {y}) vs ({tx}, {ty})");
+    }
+    assert_eq!((after.shot.width, after.shot.height), SIZE, "the shot at the picture's size");
+    app.world_mut().resource_mut::<History>().request = Some(HistoryRequest::Undo);
+    app.update();
+    app.update();
+    let undone = scene_now(&app);
+    assert_eq!(undone.characters[0].pose, before.characters[0].pose);
+    assert_eq!(undone.characters[0].placement, before.characters[0].placement);
+    assert_eq!(undone.shot, before.shot);
+}

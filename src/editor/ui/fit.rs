@@ -84,50 +84,89 @@ impl KeypointOverlay {
     }
 }
 
-/// Fits character `id` to the keypoint file at `path`: the edits (one undo step), the
-/// camera, the overlay and a message saying how well it fits (or why it cannot).
+/// What fitting a character to a keypoint file asks of the editor: the edits (one undo
+/// step), the camera, the points to draw and what to say.
+pub struct FitOutcome {
+    pub edits: Vec<crate::editor::edits::edit::Edit>,
+    pub camera: crate::formats::scene::CameraDoc,
+    pub overlay: KeypointOverlay,
+    pub message: String,
+}
+
+/// A character as it is now, to fit: its id, name, source, asset, humanoid map, pose and
+/// placement.
+pub struct FitTarget<'a> {
+    pub id: CharacterId,
+    pub name: &'a str,
+    pub source: &'a crate::formats::scene::SourceDoc,
+    pub asset: &'a crate::rig::CharacterAsset,
+    pub map: &'a crate::rig::humanoid::HumanoidMap,
+    pub pose: &'a [crate::rig::JointRotation],
+    pub placement: glam::Mat4,
+}
+
+/// Fits `target` to the keypoint file at `path` (the scene's stage and shot as they are):
+/// its pose, its place on the floor, the picture beside the file behind it and the shot at
+/// the picture's size, and the fitted camera moved with it; or why it cannot be fitted.
+pub fn fit_outcome(
+    path: &Path,
+    target: &FitTarget,
+    stage: &crate::formats::scene::StageDoc,
+    shot: ShotDoc,
+) -> Result<FitOutcome, String> {
+    let FitTarget { id, name, source, asset, map, pose, placement } = *target;
+    let spec = crate::document::fit::FitSpec { file: path.to_path_buf(), ..Default::default() };
+    let smpl = crate::document::fit::is_smpl(source);
+    let keypoints = crate::formats::keypoints::read_keypoints(path).map_err(|e| e.to_string())?;
+    let fitted =
+        crate::document::fit::fit(asset, map, placement, smpl, &keypoints, &spec).map_err(|e| e.to_string())?;
+    let person = keypoints.person(None).expect("the fit found one");
+    let overlay = KeypointOverlay::of(person, crate::document::fit::picture_size(&keypoints, person));
+    let stood = crate::document::posing::stood_on_floor(asset, &fitted.pose, placement);
+    let mut camera = fitted.camera;
+    camera.focus += (stood * placement.inverse()).w_axis.truncate();
+    let mut edits: Vec<crate::editor::edits::edit::Edit> =
+        kinds::Pose::change(id, pose, &fitted.pose).into_iter().map(Into::into).collect();
+    edits.push(kinds::Place { character: id, placement: crate::formats::scene::PlacementDoc::from_mat4(stood) }.into());
+    if let Some(picture) = crate::document::fit::picture_beside(path) {
+        let stage = crate::formats::scene::StageDoc {
+            background: BackgroundDoc::Image { path: picture, fill: false },
+            ..stage.clone()
+        };
+        edits.push(kinds::Stage(stage).into());
+    }
+    let sized = ShotDoc { width: fitted.size.0, height: fitted.size.1, ..shot };
+    if sized != shot {
+        edits.push(kinds::Shot(sized).into());
+    }
+    Ok(FitOutcome { edits, camera, overlay, message: format!("{name}: {}", fitted.describe()) })
+}
+
+/// "Fit to keypoints…" on character `id`: [`fit_outcome`]'s edits pushed together (one
+/// undo step), the view moved to its camera, its points drawn, its words said.
 pub fn fit_to_keypoints(path: &Path, id: CharacterId, state: &mut InspectorState, panels: &mut Panels) {
     let Some(c) = panels.scene.characters.iter().find(|c| c.scene.id == id) else { return };
-    let asset = c.character.asset.clone();
     let map = c.humanoid_map.map(|m| m.0.clone()).unwrap_or_default();
     let pose: Vec<crate::rig::JointRotation> =
         c.character.joints.iter().map(|&e| panels.scene.poses.get(e).map_or(Default::default(), |p| p.0)).collect();
-    let placement = c.placement.0.to_mat4();
-    let smpl = crate::document::fit::is_smpl(&c.scene.source);
-    let name = c.scene.name.clone();
-    let spec = crate::document::fit::FitSpec { file: path.to_path_buf(), ..Default::default() };
-    let read = crate::formats::keypoints::read_keypoints(path).map_err(crate::document::fit::FitError::from);
-    let fitted = read.and_then(|keypoints| {
-        let fitted = crate::document::fit::fit(&asset, &map, placement, smpl, &keypoints, &spec)?;
-        let person = keypoints.person(None).expect("the fit found one");
-        Ok((fitted, KeypointOverlay::of(person, crate::document::fit::picture_size(&keypoints, person))))
-    });
-    let (fitted, overlay) = match fitted {
-        Ok(done) => done,
-        Err(e) => {
-            panels.messages.push(format!("Fit to keypoints: {e}"));
-            return;
-        }
+    let target = FitTarget {
+        id,
+        name: &c.scene.name,
+        source: &c.scene.source,
+        asset: &c.character.asset,
+        map: &map,
+        pose: &pose,
+        placement: c.placement.0.to_mat4(),
     };
-    let stood = crate::document::posing::stood_on_floor(&asset, &fitted.pose, placement);
-    let mut camera = fitted.camera;
-    camera.focus += (stood * placement.inverse()).w_axis.truncate();
-    if let Some(edit) = kinds::Pose::change(id, &pose, &fitted.pose) {
-        panels.push(edit);
+    match fit_outcome(path, &target, &panels.scene.stage.0, panels.scene.shot.0) {
+        Ok(outcome) => {
+            outcome.edits.into_iter().for_each(|e| panels.push(e));
+            panels.camera_request.0 = Some(outcome.camera);
+            panels.messages.push(outcome.message);
+            state.keypoints = Some(outcome.overlay);
+        }
+        Err(e) => panels.messages.push(format!("Fit to keypoints: {e}")),
     }
-    panels.push(kinds::Place { character: id, placement: crate::formats::scene::PlacementDoc::from_mat4(stood) });
-    if let Some(picture) = crate::document::fit::picture_beside(path) {
-        let mut stage = panels.scene.stage.0.clone();
-        stage.background = BackgroundDoc::Image { path: picture, fill: false };
-        panels.push(kinds::Stage(stage));
-    }
-    let shot = ShotDoc { width: fitted.size.0, height: fitted.size.1, ..panels.scene.shot.0 };
-    if shot != panels.scene.shot.0 {
-        panels.push(kinds::Shot(shot));
-    }
-    panels.camera_request.0 = Some(camera);
-    panels.messages.push(format!("{name}: {}", fitted.describe()));
-    state.keypoints = Some(overlay);
 }
 
 /// `edit --fit FILE`: the file's points drawn over the view from the start.
