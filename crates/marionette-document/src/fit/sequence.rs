@@ -174,7 +174,7 @@ fn smoothed(states: &[State]) -> Vec<State> {
             let hi = (t + SMOOTHING).min(states.len() - 1);
             let weighted: Vec<(f32, &State)> =
                 (lo..=hi).map(|k| ((SMOOTHING + 1 - k.abs_diff(t)) as f32, &states[k])).collect();
-            State::mean(&weighted)
+            State::mean(&states[t], &weighted)
         })
         .collect()
 }

@@ -55,10 +55,10 @@ pub(super) struct State {
 }
 
 impl State {
-    /// The weighted mean of states: the camera's numbers, and each direction's (made unit).
-    pub(super) fn mean(states: &[(f32, &State)]) -> State {
+    /// The weighted mean of states about `centre` (one of them, whose look is kept where
+    /// others have none): the camera's numbers, and each direction's (made unit).
+    pub(super) fn mean(centre: &State, states: &[(f32, &State)]) -> State {
         let total: f32 = states.iter().map(|(w, _)| w).sum();
-        let centre = states[states.len() / 2].1;
         let mut out = *centre;
         let sum = |f: &dyn Fn(&State) -> f32| states.iter().map(|(w, s)| w * f(s)).sum::<f32>() / total;
         // Yaw about the centre's, so a turn through ±π averages right.
