@@ -240,7 +240,7 @@ fn seen_points(body: &Body, person: &Person2d) -> Vec<Seen> {
         .collect()
 }
 
-/// The picture's size: the file's, else the box around the points doubled from the origin.
+/// The picture's size: the file's, else the points' farthest x and y and a tenth more.
 pub fn picture_size(keypoints: &Keypoints, person: &Person2d) -> (u32, u32) {
     if let Some((w, h)) = keypoints.size {
         return (w.round().max(1.0) as u32, h.round().max(1.0) as u32);
