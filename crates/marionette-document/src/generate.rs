@@ -153,7 +153,7 @@ fn halfway() -> Draw {
 
 /// The props (OBJ meshes) of a folder, by name.
 pub fn prop_files(folder: &Path) -> Vec<PathBuf> {
-    files_named(folder, |name| name.to_ascii_lowercase().ends_with(".obj"))
+    files_ending(folder, &[".obj"])
 }
 
 impl PropsSpec {
@@ -693,17 +693,19 @@ fn grid_side(area: f32, spacing: f32) -> usize {
 
 /// The pictures (PNG, JPEG) of a folder, by name.
 pub fn image_files(folder: &Path) -> Vec<PathBuf> {
-    files_named(folder, |name| {
-        let lower = name.to_ascii_lowercase();
-        [".png", ".jpg", ".jpeg"].iter().any(|e| lower.ends_with(e))
-    })
+    files_ending(folder, &[".png", ".jpg", ".jpeg"])
 }
 
 /// The motion clips (BVH, glTF, FBX) of a folder, by name.
 pub fn clip_files(folder: &Path) -> Vec<PathBuf> {
+    files_ending(folder, &[".bvh", ".glb", ".gltf", ".fbx"])
+}
+
+/// The files of a folder whose names end, in any case, with one of `endings`, by name.
+fn files_ending(folder: &Path, endings: &[&str]) -> Vec<PathBuf> {
     files_named(folder, |name| {
         let lower = name.to_ascii_lowercase();
-        [".bvh", ".glb", ".gltf", ".fbx"].iter().any(|e| lower.ends_with(e))
+        endings.iter().any(|e| lower.ends_with(e))
     })
 }
 

@@ -32,8 +32,9 @@ pub(super) struct Camera {
 }
 
 impl Camera {
+    /// The scene camera's turn (its yaw, then its pitch).
     fn rotation(&self) -> Quat {
-        Quat::from_euler(glam::EulerRot::YXZ, self.yaw, self.pitch, 0.0)
+        CameraDoc { yaw: self.yaw, pitch: self.pitch, ..CameraDoc::default() }.rotation()
     }
 
     /// Camera to world (the renderer's: it looks along its -z).
@@ -379,11 +380,10 @@ impl<'a> Problem<'a> {
     /// The eye that puts `points` nearest the file's for a camera turned by yaw and pitch:
     /// each point's projection equations are linear in the camera-frame translation.
     fn eye_for(&self, yaw: f32, pitch: f32, fov: f32, points: &[Vec3]) -> Option<Vec3> {
-        let rotation = Camera { yaw, pitch, eye: Vec3::ZERO, fov }.rotation();
-        // World to the camera's frame (OpenCV's axes), rotation only.
-        let q = glam::Mat3::from_diagonal(Vec3::new(1.0, -1.0, -1.0)) * glam::Mat3::from_quat(rotation.inverse());
-        let f = self.size.1 as f64 / 2.0 / (fov.to_radians() as f64 / 2.0).tan();
-        let (cx, cy) = (self.size.0 as f64 / 2.0, self.size.1 as f64 / 2.0);
+        // World to the camera's frame (OpenCV's axes) of the camera at the origin: its turn.
+        let pinhole = self.pinhole(&Camera { yaw, pitch, eye: Vec3::ZERO, fov });
+        let q = glam::Mat3::from_mat4(pinhole.world_to_camera);
+        let [[f, _, cx], [_, _, cy], _] = pinhole.k().map(|row| row.map(f64::from));
         let (mut a, mut b) = (DMat3::ZERO, DVec3::ZERO);
         for s in self.seen {
             let p = (q * points[s.anchor]).as_dvec3();
