@@ -112,10 +112,14 @@ pub struct ShotArgs {
     /// in place of --width and --height.
     #[arg(long, value_name = "WxH", value_parser = parse_size, conflicts_with_all = ["width", "height"])]
     pub size: Option<(u32, u32)>,
-    /// Supersampling: each pixel the mean of N×N rendered ones (1 to 4; edges are
-    /// multisampled either way).
+    /// Supersampling: each pixel the mean of N×N rendered ones (1 to 4), on top of
+    /// --antialias.
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..=4))]
     pub samples: Option<u32>,
+    /// How edges are smoothed: multisample (four samples a pixel, the default), fxaa (found
+    /// and blended in the finished picture: much cheaper on a CPU renderer) or off.
+    #[arg(long, value_parser = parse_antialias)]
+    pub antialias: Option<crate::formats::scene::Antialias>,
     /// No background and no floor: a PNG with alpha.
     #[arg(long)]
     pub transparent: bool,
@@ -151,15 +155,23 @@ fn parse_size(s: &str) -> Result<(u32, u32), String> {
     Ok((side(w).ok_or_else(expected)?, side(h).ok_or_else(expected)?))
 }
 
+fn parse_antialias(s: &str) -> Result<crate::formats::scene::Antialias, String> {
+    use crate::formats::scene::Antialias;
+    Antialias::named(s).ok_or_else(|| {
+        let names: Vec<_> = Antialias::ALL.iter().map(|a| a.name()).collect();
+        format!("expected one of {}, found {s:?}", names.join(", "))
+    })
+}
+
 fn parse_view(s: &str) -> Result<crate::formats::scene::ViewName, String> {
     s.parse()
 }
 
 impl ShotArgs {
-    /// The size and samples asked for (each none: the scene's).
+    /// The size, samples and smoothing asked for (each none: the scene's).
     pub fn picture(&self) -> crate::document::frames::PictureRequest {
         let (width, height) = self.size.map_or((self.width, self.height), |(w, h)| (Some(w), Some(h)));
-        crate::document::frames::PictureRequest { width, height, samples: self.samples }
+        crate::document::frames::PictureRequest { width, height, samples: self.samples, antialias: self.antialias }
     }
 }
 

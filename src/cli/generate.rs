@@ -131,7 +131,7 @@ pub fn plan(args: &GenerateArgs) -> Result<Option<Plan>> {
 /// time left.
 pub fn run(args: &GenerateArgs) -> Result<()> {
     use crate::editor::present::data::Beside;
-    use crate::editor::present::render::{ScenePicture, render_scenes};
+    use crate::editor::present::render::{ScenePicture, opening_picture, render_scenes};
     let Some(mut plan) = plan(args)? else { return Ok(()) };
     let (todo, finished, shard) = (plan.pictures.len(), plan.finished, plan.shard);
     eprintln!(
@@ -145,11 +145,14 @@ pub fn run(args: &GenerateArgs) -> Result<()> {
         return Ok(());
     }
     let started = std::time::Instant::now();
-    let numbers: Vec<usize> = plan.pictures.iter().map(|p| p.0).collect();
-    let pictures: Vec<ScenePicture> = std::mem::take(&mut plan.pictures)
+    let mut numbers: Vec<usize> = plan.pictures.iter().map(|p| p.0).collect();
+    let mut pictures: Vec<ScenePicture> = std::mem::take(&mut plan.pictures)
         .into_iter()
         .map(|(k, scene, backdrop)| ScenePicture { scene, out: plan.out(k), ids: generate::coco_ids(k), backdrop })
         .collect();
+    let opening = opening_picture(&pictures);
+    pictures.swap(0, opening);
+    numbers.swap(0, opening);
     let first_scene = plan.scene_file(numbers[0]);
     let library = std::mem::take(&mut plan.library);
     let picture = plan.picture();

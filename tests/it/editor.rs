@@ -628,7 +628,7 @@ fn the_editor_renders_frames_in_its_own_process() {
     let puppet = CharacterDoc::new(SourceDoc::Embedded("puppet".into()), "p");
     let doc = SceneDoc {
         characters: vec![puppet],
-        shot: ShotDoc { width: 64, height: 48, samples: 1 },
+        shot: ShotDoc { width: 64, height: 48, samples: 1, ..ShotDoc::default() },
         ..SceneDoc::default()
     };
     let pattern = dir.join("f_%02d.png").display().to_string();

@@ -98,6 +98,28 @@ fn a_transparent_picture_is_clear_around_the_characters_and_opaque_on_them() {
     assert_eq!(picture.get_pixel((x0 + x1) / 2, y0 + (y1 - y0) / 3).0[3], 255);
 }
 
+/// Edges are multisampled unless the shot or `--antialias` says otherwise: over nothing, the
+/// puppet's edge pixels are partly covered when multisampled and never without smoothing;
+/// FXAA blends the edges of the finished picture (another picture than the unsmoothed one);
+/// a scene whose shot says `Off` draws what `--antialias off` draws.
+#[test]
+fn edges_are_smoothed_as_the_shot_or_the_flag_asks() {
+    let dir = scratch("shot-antialias");
+    let mut doc = puppet_lit_from(30.0);
+    let scene = scene_file(&dir, "p.ron", &doc);
+    let drawn = |flags: &[&str], name: &str| render(&scene, flags, &dir.join(name));
+    let partly_covered = |p: &image::RgbaImage| p.pixels().filter(|p| p.0[3] > 0 && p.0[3] < 255).count();
+    let multisampled = drawn(&[], "m.png");
+    let unsmoothed = drawn(&["--antialias", "off"], "o.png");
+    let fxaa = drawn(&["--antialias", "fxaa"], "f.png");
+    assert!(partly_covered(&multisampled) > 20, "{} edge pixels partly covered", partly_covered(&multisampled));
+    assert_eq!(partly_covered(&unsmoothed), 0);
+    assert!(fxaa != unsmoothed && fxaa != multisampled);
+    doc.shot.antialias = marionette::formats::scene::Antialias::Off;
+    let said_off = render(&scene_file(&dir, "off.ron", &doc), &[], &dir.join("s.png"));
+    assert!(said_off == unsmoothed);
+}
+
 #[test]
 fn a_gradient_background_fills_behind_the_characters() {
     let dir = scratch("shot-gradient");

@@ -506,7 +506,7 @@ fn render_of_a_scene_whose_clip_fails_to_load_fails_and_writes_nothing() {
         vec![scene],
         Default::default(),
         out.clone(),
-        PictureRequest { width: Some(64), height: Some(64), samples: None },
+        PictureRequest { width: Some(64), height: Some(64), samples: None, antialias: None },
         Pictures::Still,
         false,
     )

@@ -93,12 +93,14 @@ fn pattern_parts(pattern: &Path) -> Result<(String, usize, String), FramesError>
     Ok((start.to_string(), width.parse().unwrap_or(0), tail.to_string()))
 }
 
-/// The picture's size and samples asked for on the command line (each none: the scene's).
+/// The picture's size, samples and smoothing asked for on the command line (each none: the
+/// scene's).
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
 pub struct PictureRequest {
     pub width: Option<u32>,
     pub height: Option<u32>,
     pub samples: Option<u32>,
+    pub antialias: Option<marionette_formats::scene::Antialias>,
 }
 
 impl PictureRequest {
@@ -112,6 +114,7 @@ impl PictureRequest {
             width: self.width.unwrap_or(shot.width),
             height: self.height.unwrap_or(shot.height),
             samples: self.samples.unwrap_or(shot.samples),
+            antialias: self.antialias.unwrap_or(shot.antialias),
         };
         picture.validate().map(|()| picture).map_err(FramesError::Picture)
     }

@@ -13,7 +13,7 @@ use serde::Deserialize;
 
 use marionette_formats::FormatError;
 use marionette_formats::scene::{
-    BackgroundDoc, CameraDoc, CharacterDoc, PlacementDoc, PlaybackDoc, SceneDoc, ShotDoc, SmplDoc, SourceDoc,
+    Antialias, BackgroundDoc, CameraDoc, CharacterDoc, PlacementDoc, PlaybackDoc, SceneDoc, ShotDoc, SmplDoc, SourceDoc,
 };
 use marionette_formats::stage::LightPreset;
 use marionette_rig::JointRotation;
@@ -86,6 +86,9 @@ pub struct Spec {
     pub width: u32,
     #[serde(default = "default_height")]
     pub height: u32,
+    /// How the pictures' edges are smoothed (multisampled where not said).
+    #[serde(default)]
+    pub antialias: Antialias,
     /// Write each picture's data (depth, normals, masks, keypoints, COCO) beside it.
     #[serde(default)]
     pub data: bool,
@@ -493,7 +496,7 @@ impl Spec {
 
     /// The size each picture is drawn at (one sample a pixel).
     pub fn shot(&self) -> ShotDoc {
-        ShotDoc { width: self.width, height: self.height, samples: 1 }
+        ShotDoc { width: self.width, height: self.height, samples: 1, antialias: self.antialias }
     }
 
     /// Every field: sizes within what a picture may be, distributions not empty, weights

@@ -521,7 +521,7 @@ pub use marionette_rig::bind::Binding as BindingDoc;
 pub use marionette_rig::dqs::SkinningMethod as SkinningDoc;
 
 pub use super::stage::{
-    AmbientDoc, BackgroundDoc, CameraDoc, LampDoc, MAX_LAMPS, ShotDoc, SpotDoc, StageDoc, SunDoc, ViewName,
+    AmbientDoc, Antialias, BackgroundDoc, CameraDoc, LampDoc, MAX_LAMPS, ShotDoc, SpotDoc, StageDoc, SunDoc, ViewName,
 };
 
 #[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]

@@ -433,20 +433,53 @@ impl StageDoc {
     }
 }
 
-/// The picture `render` takes when no flag says otherwise: its size and samples.
+/// The picture `render` takes when no flag says otherwise: its size, samples and how its
+/// edges are smoothed.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(default)]
 pub struct ShotDoc {
     pub width: u32,
     pub height: u32,
-    /// Supersampling: each pixel the mean of `samples`² rendered ones (1: none; multisample
-    /// anti-aliasing smooths edges either way).
+    /// Supersampling: each pixel the mean of `samples`² rendered ones (1: none), on top of
+    /// `antialias`.
     pub samples: u32,
+    pub antialias: Antialias,
 }
 
 impl Default for ShotDoc {
     fn default() -> Self {
-        Self { width: 1280, height: 720, samples: 1 }
+        Self { width: 1280, height: 720, samples: 1, antialias: Antialias::default() }
+    }
+}
+
+/// How a picture's edges are smoothed as it is drawn.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Hash, Serialize, Deserialize)]
+pub enum Antialias {
+    /// Four samples a pixel (multisampling): the smoothest edges.
+    #[default]
+    Multisample,
+    /// One sample a pixel, edges found and blended in the finished picture (FXAA): softer
+    /// edges for a fraction of multisampling's cost where the renderer runs on the CPU.
+    Fxaa,
+    /// One sample a pixel, nothing smoothed.
+    Off,
+}
+
+impl Antialias {
+    pub const ALL: [Antialias; 3] = [Antialias::Multisample, Antialias::Fxaa, Antialias::Off];
+
+    /// Its name on the command line and in specs' comments.
+    pub fn name(self) -> &'static str {
+        match self {
+            Antialias::Multisample => "multisample",
+            Antialias::Fxaa => "fxaa",
+            Antialias::Off => "off",
+        }
+    }
+
+    /// The one named `name` (as [`Self::name`] says it, any case).
+    pub fn named(name: &str) -> Option<Antialias> {
+        Self::ALL.into_iter().find(|a| a.name().eq_ignore_ascii_case(name))
     }
 }
 

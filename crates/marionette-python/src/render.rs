@@ -20,7 +20,7 @@ use marionette::document::options::{PoseOptions, apply_options};
 use marionette::editor::present::data::Beside;
 use marionette::editor::present::render::{Kept, Renderer, ScenePicture};
 use marionette::editor::present::view::{FramingView, startup_view};
-use marionette::formats::scene::{BackgroundDoc, PlacementDoc, SceneDoc, ShotDoc, ViewName};
+use marionette::formats::scene::{Antialias, BackgroundDoc, PlacementDoc, SceneDoc, ShotDoc, ViewName};
 
 use super::{Character, Error, SpecError, file_error, options_error};
 
@@ -134,8 +134,8 @@ fn pixels(picture: &image::DynamicImage) -> (Vec<u8>, u32, u32, usize) {
     }
 }
 
-/// The scene drawn as `render SCENE --width W --height H [--data] [--controlnet] [--view V]
-/// [--transparent] --out shot.png` draws it: a dict of `rgb` (uint8 (H, W, 3), or (H, W, 4)
+/// The scene drawn as `render SCENE --width W --height H [--samples N] [--antialias A]
+/// [--data] [--controlnet] [--view V] [--transparent] --out shot.png` draws it: a dict of `rgb` (uint8 (H, W, 3), or (H, W, 4)
 /// with `transparent`), and with `data` `depth` (float32 (H, W) metres along the view axis,
 /// inf where nothing), `normal` (float32 (H, W, 3), the camera frame `--data` documents),
 /// `mask` (uint16 (H, W) instance ids), `coco` (the COCO dict) and `camera` (`K`,
@@ -143,7 +143,7 @@ fn pixels(picture: &image::DynamicImage) -> (Vec<u8>, u32, u32, usize) {
 /// them (`openpose`, `depth`, `normal`: uint8 arrays; `openpose_json`: a dict); and `notes`.
 /// Nothing is written to disk.
 #[pyfunction]
-#[pyo3(signature = (scene, *, width=640, height=480, samples=1, data=false, controlnet=false, view=None, transparent=false))]
+#[pyo3(signature = (scene, *, width=640, height=480, samples=1, antialias="multisample", data=false, controlnet=false, view=None, transparent=false))]
 #[allow(clippy::too_many_arguments)]
 pub fn render<'py>(
     py: Python<'py>,
@@ -151,13 +151,17 @@ pub fn render<'py>(
     width: u32,
     height: u32,
     samples: u32,
+    antialias: &str,
     data: bool,
     controlnet: bool,
     view: Option<String>,
     transparent: bool,
 ) -> PyResult<Bound<'py, PyDict>> {
     let view: Option<ViewName> = view.map(|v| v.parse().map_err(PyValueError::new_err)).transpose()?;
-    let shot = ShotDoc { width, height, samples };
+    let antialias = Antialias::named(antialias).ok_or_else(|| {
+        PyValueError::new_err(format!("antialias: expected multisample, fxaa or off, found {antialias:?}"))
+    })?;
+    let shot = ShotDoc { width, height, samples, antialias };
     shot.validate().map_err(|e| PyValueError::new_err(e.to_string()))?;
     let mut doc = scene.doc.clone();
     let drawn = py.detach(|| -> PyResult<Drawn> {

@@ -24,7 +24,7 @@ use crate::editor::present::view::ViewPlugin;
 use crate::editor::scene_doc::document::Library;
 use crate::editor::state::camera::OrbitCamera;
 use crate::editor::state::{Messages, StartupEdits, StartupPaths};
-use crate::formats::scene::{BackgroundDoc, BindingDoc, Clocked, SceneDoc, ShotDoc, SourceDoc};
+use crate::formats::scene::{Antialias, BackgroundDoc, BindingDoc, Clocked, SceneDoc, ShotDoc, SourceDoc};
 use crate::formats::scene::{MotionSourceDoc, RetargetDoc};
 use crate::scene::{RigCorePlugin, SkinningPlugin};
 
@@ -284,6 +284,13 @@ pub fn render_scenes(
     run_job(setup)
 }
 
+/// The picture a data set's app best opens with: the first of those with the most lamps
+/// (the scenes drawn after it then bring no lamp it lacks; see [`drawing_order`]).
+pub fn opening_picture(pictures: &[ScenePicture]) -> usize {
+    let lamps = |k: usize| pictures[k].scene.stage.lamps.len();
+    (0..pictures.len()).max_by_key(|&k| (lamps(k), std::cmp::Reverse(k))).unwrap_or(0)
+}
+
 /// A renderer kept between renders in one process (the Python package's): its app starts
 /// once, on the default scene; each render opens its pictures' scenes in place of the last
 /// and draws them, so a render after the first costs its drawn frames.
@@ -483,9 +490,11 @@ fn job_app(setup: JobSetup, opened: bool) -> (App, Outcome) {
     // The sun's shadow map sized for the picture (the editor's is for a window).
     let shadow_map = stage::shadow_map_for(width * picture.samples, height * picture.samples);
     app.add_systems(PostStartup, move |mut commands: Commands| commands.insert_resource(shadow_map.clone()));
+    let antialias = picture.antialias;
     app.add_systems(Startup, move |mut commands: Commands| {
         let orbit = OrbitCamera::default();
-        commands.spawn((Camera3d::default(), RenderTarget::Image(target.clone().into()), orbit, orbit.transform()));
+        let camera = (Camera3d::default(), RenderTarget::Image(target.clone().into()), orbit, orbit.transform());
+        smoothed(&mut commands.spawn(camera), antialias);
     });
     app.add_systems(
         Last,
@@ -495,6 +504,15 @@ fn job_app(setup: JobSetup, opened: bool) -> (App, Outcome) {
     )
     .add_systems(PostUpdate, clear_behind_gradient.after(stage::apply_stage_settings));
     (app, outcome)
+}
+
+/// Gives the render's camera the smoothing `antialias` asks for.
+fn smoothed(camera: &mut EntityCommands, antialias: Antialias) {
+    match antialias {
+        Antialias::Multisample => camera.insert(Msaa::Sample4),
+        Antialias::Fxaa => camera.insert((Msaa::Off, bevy::anti_alias::fxaa::Fxaa::default())),
+        Antialias::Off => camera.insert(Msaa::Off),
+    };
 }
 
 /// Loads everything the render will show before any window or GPU work, so that a missing
@@ -814,9 +832,9 @@ fn scene_frame(
     let FrameAt::Scene(doc) = &job.frames[job.queue[job.next]].at else { return };
     let lights = light_setup(&doc.stage);
     if job.next > 0 || !job.opened {
-        // Lit by lights of the kinds the last scene drawn had (of this render, or of the
-        // renderer's last), its characters drawn as plain skins.
-        let lit_alike = job.last_lights.as_ref() == Some(&lights) && plainly_drawn(doc);
+        // Lit by lamps the last scene drawn had (of this render, or of the renderer's
+        // last), its characters drawn as plain skins.
+        let lit_alike = job.last_lights.as_ref().is_some_and(|last| lamps_kept(last, &lights)) && plainly_drawn(doc);
         // A scene without a camera is framed as the command line frames it.
         *pending = crate::editor::scene_doc::document::PendingScene { frame: true, doc: Some((**doc).clone()) };
         if lit_alike { gate.next_picture() } else { gate.restart() }
@@ -826,8 +844,9 @@ fn scene_frame(
 }
 
 /// The order to draw `frames` in: the first (the scene the app opens with) first; a data
-/// set's scenes then grouped by how they are lit, those lit like the first first, so that
-/// the renderer settles once a group (the pictures do not depend on the order).
+/// set's scenes then grouped by how they are lit, those lit like the first first, then the
+/// groups with more lamps before those with fewer, so that the renderer settles only where
+/// a group brings a lamp the last had not (the pictures do not depend on the order).
 fn drawing_order(frames: &[Frame]) -> Vec<usize> {
     let lights = |k: usize| match &frames[k].at {
         FrameAt::Scene(doc) => Some(light_setup(&doc.stage)),
@@ -837,10 +856,19 @@ fn drawing_order(frames: &[Frame]) -> Vec<usize> {
     if let Some(first) = frames.first().and_then(|_| lights(0)) {
         order[1..].sort_by_cached_key(|&k| {
             let lit = lights(k);
-            (lit.as_ref() != Some(&first), lit)
+            let lamps = lit.as_ref().map_or(0, |l| l.1.len());
+            (lit.as_ref() != Some(&first), std::cmp::Reverse(lamps), lit)
         });
     }
     order
+}
+
+/// Whether a scene lit as `next` is drawn as it should be in its first frame after one lit
+/// as `last`: each of its lamps takes the place of one of the last's of its kind (and
+/// shadows), so no lamp entity is new (a new lamp is taken up frames after it is spawned;
+/// the sun's shadows and lamps removed are taken up at once).
+fn lamps_kept(last: &LightSetup, next: &LightSetup) -> bool {
+    next.1.len() <= last.1.len() && next.1.iter().zip(&last.1).all(|(n, l)| n == l)
 }
 
 /// Whether every character of `doc` is drawn as a plain skin: no skeleton drawn, no weight
@@ -858,10 +886,8 @@ fn plainly_drawn(doc: &SceneDoc) -> bool {
 type LightSetup = (bool, Vec<(bool, bool)>);
 
 /// What of a stage has the renderer set up its lights' views and passes anew when it
-/// changes: shadows at all, and each lamp's kind and whether it casts shadows. A scene lit
-/// alike to the last (its lamps the last's entities, moved) is drawn as it should be in its
-/// first frame; another waits for the renderer to settle (a new lamp is taken up frames
-/// later).
+/// changes: shadows at all, and each lamp's kind and whether it casts shadows (see
+/// [`lamps_kept`]).
 fn light_setup(stage: &crate::formats::scene::StageDoc) -> LightSetup {
     (stage.shadows, stage.lamps.iter().map(|l| (l.spot.is_some(), l.shadows)).collect())
 }
@@ -932,4 +958,60 @@ fn contact_sheet(cells: &[PathBuf], out: &std::path::Path) -> Result<(), String>
         .map_err(|e| e.to_string())?;
     crate::formats::write_atomically(out, |w| std::io::Write::write_all(w, &bytes))
         .map_err(|e| format!("{}: {e}", out.display()))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::formats::scene::{LampDoc, SpotDoc, StageDoc};
+
+    fn lit(shadows: bool, lamps: &[(bool, bool)]) -> StageDoc {
+        let lamp = |&(spot, shadows): &(bool, bool)| LampDoc {
+            spot: spot.then_some(SpotDoc { aim: Vec3::ZERO, angle: 30.0 }),
+            shadows,
+            ..LampDoc::default()
+        };
+        StageDoc { shadows, lamps: lamps.iter().map(lamp).collect(), ..StageDoc::default() }
+    }
+
+    fn scene(stage: StageDoc) -> Frame {
+        Frame::new(FrameAt::Scene(Box::new(SceneDoc { stage, ..SceneDoc::default() })), PathBuf::new(), 0)
+    }
+
+    /// A scene is captured in its first frame only where none of its lamps is new: the
+    /// last's lamps moved, fewer of them, the sun's shadows switched; a lamp added, or one
+    /// of another kind or shadows in its place, waits for the renderer to settle.
+    #[test]
+    fn only_scenes_that_bring_no_new_lamp_are_drawn_at_once() {
+        let setup = |shadows, lamps: &[(bool, bool)]| light_setup(&lit(shadows, lamps));
+        let studio = setup(true, &[(false, false), (true, false)]);
+        assert!(lamps_kept(&studio, &studio));
+        assert!(lamps_kept(&studio, &setup(false, &[])));
+        assert!(lamps_kept(&studio, &setup(true, &[(false, false)])));
+        assert!(lamps_kept(&setup(false, &[]), &setup(true, &[])));
+        assert!(!lamps_kept(&setup(true, &[]), &studio));
+        assert!(!lamps_kept(&studio, &setup(true, &[(true, false)])));
+        assert!(!lamps_kept(&studio, &setup(true, &[(false, true), (true, false)])));
+    }
+
+    /// The opened scene first, its lighting's group next, then the groups with more lamps
+    /// before those with fewer: every change after the first group takes lamps away.
+    #[test]
+    fn scenes_are_drawn_in_groups_of_lighting_lamps_going_down() {
+        let frames = [
+            scene(lit(true, &[])),
+            scene(lit(false, &[])),
+            scene(lit(true, &[(false, false), (true, false)])),
+            scene(lit(true, &[])),
+            scene(lit(true, &[(false, false)])),
+            scene(lit(true, &[(false, false), (true, false)])),
+        ];
+        let order = drawing_order(&frames);
+        assert_eq!(order, [0, 3, 2, 5, 4, 1]);
+        let lights = |k: usize| match &frames[k].at {
+            FrameAt::Scene(doc) => light_setup(&doc.stage),
+            _ => unreachable!(),
+        };
+        assert!(order[2..].windows(2).all(|w| lamps_kept(&lights(w[0]), &lights(w[1]))));
+    }
 }

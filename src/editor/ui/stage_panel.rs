@@ -7,7 +7,9 @@ use crate::editor::present::data::ControlNetChoice;
 use bevy_egui::egui;
 
 use super::{InspectorState, Panels};
-use crate::formats::scene::{BackgroundDoc, CameraDoc, LampDoc, MAX_LAMPS, ShotDoc, SpotDoc, StageDoc, ViewName};
+use crate::formats::scene::{
+    Antialias, BackgroundDoc, CameraDoc, LampDoc, MAX_LAMPS, ShotDoc, SpotDoc, StageDoc, ViewName,
+};
 use crate::formats::stage::{LightPreset, MAX_PICTURE_SIDE, MAX_SAMPLES, RESOLUTION_PRESETS};
 
 /// The three sections, each folded away until opened.
@@ -353,6 +355,11 @@ fn shot_rows(ui: &mut egui::Ui, state: &mut InspectorState, shot: &mut ShotDoc) 
         ui.label("samples");
         ui.add(egui::Slider::new(&mut shot.samples, 1..=MAX_SAMPLES))
             .on_hover_text("supersampling for stills: each pixel the mean of N×N");
+    });
+    egui::ComboBox::from_label("edges").selected_text(shot.antialias.name()).show_ui(ui, |ui| {
+        for antialias in Antialias::ALL {
+            ui.selectable_value(&mut shot.antialias, antialias, antialias.name());
+        }
     });
     shot.width = shot.width.min(MAX_PICTURE_SIDE / shot.samples);
     shot.height = shot.height.min(MAX_PICTURE_SIDE / shot.samples);
