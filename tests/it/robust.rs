@@ -214,6 +214,20 @@ fn the_capture_waits_while_a_pipeline_is_pending_and_counts_distinct_ready_frame
     gate.observe(9, Readiness::Waiting("1 pipeline(s) compiling".into()));
     assert!(!gate.is_ready(), "a new pipeline starts the count again");
     assert_eq!(gate.last_reason.as_deref(), Some("1 pipeline(s) compiling"));
+    for frame in 10..=12 {
+        gate.observe(frame, Readiness::Ready);
+    }
+    assert!(gate.is_ready() && !gate.is_speculative());
+    // A picture set up once all was drawn, waiting for a pipeline of its own: captured in
+    // its first ready frame after, a capture to be checked against what was drawn.
+    gate.next_picture();
+    gate.observe(13, Readiness::Waiting("1 pipeline(s) compiling".into()));
+    assert!(!gate.is_ready());
+    gate.observe(14, Readiness::Ready);
+    assert!(gate.is_ready() && gate.is_speculative());
+    gate.restart();
+    gate.observe(15, Readiness::Ready);
+    assert!(!gate.is_ready() && !gate.is_speculative(), "a restart counts three ready frames again");
 }
 
 fn marionette(args: &[&str]) -> std::process::Output {

@@ -140,9 +140,10 @@ impl CaptureGate {
                 }
                 self.last_reason = None;
             }
+            // A settled picture that waits (for a pipeline or a mesh of its own) stays
+            // settled: its capture is checked against `DrawnFrames` all the same.
             Readiness::Waiting(reason) => {
                 self.ready_frames = 0;
-                self.settled = false;
                 self.last_reason = Some(reason);
             }
             Readiness::Failed(reason) => {
