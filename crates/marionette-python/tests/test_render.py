@@ -63,6 +63,16 @@ def test_the_renderer_is_kept_and_draws_each_scene_alike():
     assert transparent.shape == (120, 160, 4) and (transparent[..., 3] == 0).any()
 
 
+def test_edges_are_smoothed_as_the_binary_smooths_them(tmp_path):
+    scene = mt.Scene.load(SCENE)
+    fxaa = mt.render(scene, width=160, height=120, antialias="fxaa")["rgb"]
+    binary("render", SCENE, "--width", 160, "--height", 120, "--antialias", "fxaa", "--out", tmp_path / "f.png")
+    assert np.array_equal(fxaa, _native.read_picture(str(tmp_path / "f.png"), False)["rgb"])
+    assert not np.array_equal(fxaa, mt.render(scene, width=160, height=120)["rgb"])
+    with pytest.raises(ValueError, match="antialias: expected multisample, fxaa or off"):
+        mt.render(scene, width=160, height=120, antialias="smaa")
+
+
 def test_generate_writes_the_binarys_pictures_byte_for_byte(tmp_path):
     binary("generate", SPEC, "--out", tmp_path / "cli", "--count", 3)
     samples = list(mt.generate(SPEC, count=3, out=tmp_path / "py"))

@@ -498,10 +498,11 @@ fn job_app(setup: JobSetup, opened: bool) -> (App, Outcome) {
     });
     app.add_systems(
         Last,
-        (draw_only_what_is_captured, capture_when_ready, report_when_done, next_frame, scene_frame, pose_frame)
+        (capture_when_ready, report_when_done, next_frame, scene_frame, pose_frame)
             .chain()
             .after(crate::editor::present::readiness::UpdateCaptureGate),
     )
+    .add_systems(First, draw_only_what_is_captured)
     .add_systems(PostUpdate, clear_behind_gradient.after(stage::apply_stage_settings));
     (app, outcome)
 }
@@ -659,7 +660,9 @@ fn capture_when_ready(
 }
 
 /// Draws frames while pictures are left to capture; once all are captured, the updates that
-/// wait for their pixels and files draw nothing (writes the render camera's `Camera`).
+/// wait for their pixels and files draw nothing. In `First`: a camera drawing again (a kept
+/// renderer's next render) is active before the lights are assigned to its view, so its
+/// first frame is lit by the lamps of its own scene (writes the render camera's `Camera`).
 fn draw_only_what_is_captured(job: Res<RenderJob>, mut cameras: Query<&mut Camera, With<OrbitCamera>>) {
     let active = job.next < job.queue.len();
     for mut camera in &mut cameras {
