@@ -120,6 +120,46 @@ fn edges_are_smoothed_as_the_shot_or_the_flag_asks() {
     assert!(said_off == unsmoothed);
 }
 
+/// Sharp shadows have narrower edges than soft ones: against the same scene without
+/// shadows, a sharp shadow darkens fewer pixels part of the way (its edge) for each pixel
+/// it darkens fully (its core) than a soft one.
+#[test]
+fn sharp_shadows_have_narrower_edges_than_soft_ones() {
+    let dir = scratch("shot-shadow-edges");
+    let mut doc = puppet_lit_from(30.0);
+    (doc.stage.floor, doc.stage.shadows, doc.stage.sun.elevation) = (true, true, 35.0);
+    doc.stage.background = BackgroundDoc::Color([0.0, 0.0, 1.0]);
+    let drawn = |doc: &SceneDoc, name: &str| {
+        render(
+            &scene_file(&dir, &format!("{name}.ron"), doc),
+            &["--antialias", "off"],
+            &dir.join(format!("{name}.png")),
+        )
+    };
+    let soft = drawn(&doc, "soft");
+    doc.stage.soft_shadows = false;
+    let sharp = drawn(&doc, "sharp");
+    doc.stage.shadows = false;
+    let unshadowed = drawn(&doc, "unshadowed");
+    // How much darker each pixel is than without shadows: the edge (a fifth to four fifths
+    // of the deepest) against the core (beyond four fifths).
+    let edge_per_core = |shadowed: &image::RgbaImage| {
+        let dark: Vec<i32> = shadowed
+            .pixels()
+            .zip(unshadowed.pixels())
+            .map(|(s, u)| (0..3).map(|c| i32::from(u.0[c]) - i32::from(s.0[c])).sum::<i32>())
+            .collect();
+        let deepest = *dark.iter().max().unwrap();
+        let edge = dark.iter().filter(|&&d| d * 5 > deepest && d * 5 <= deepest * 4).count();
+        let core = dark.iter().filter(|&&d| d * 5 > deepest * 4).count();
+        assert!(core > 0, "no shadow drawn");
+        edge as f64 / core as f64
+    };
+    assert!(soft != sharp);
+    let (soft_edge, sharp_edge) = (edge_per_core(&soft), edge_per_core(&sharp));
+    assert!(sharp_edge < soft_edge * 0.7, "edge pixels a core pixel: soft {soft_edge:.2}, sharp {sharp_edge:.2}");
+}
+
 #[test]
 fn a_gradient_background_fills_behind_the_characters() {
     let dir = scratch("shot-gradient");

@@ -419,11 +419,13 @@ pub struct LightSpec {
     pub sun_azimuth: Option<Draw>,
     /// The sun's elevation (degrees); none: the preset's.
     pub sun_elevation: Option<Draw>,
+    /// Shadows' edges softened (else sharp: far cheaper where the renderer runs on the CPU).
+    pub soft_shadows: bool,
 }
 
 impl Default for LightSpec {
     fn default() -> Self {
-        Self { presets: vec!["default".into()], sun_azimuth: None, sun_elevation: None }
+        Self { presets: vec!["default".into()], sun_azimuth: None, sun_elevation: None, soft_shadows: true }
     }
 }
 
@@ -822,6 +824,7 @@ pub fn scene_of(spec: &Spec, library: &mut AssetLibrary, k: u64) -> Result<(Scen
     let preset =
         preset_named(&spec.lights.presets[rng.below(spec.lights.presets.len())]).unwrap_or(LightPreset::Default);
     let mut stage = preset.lighting(&marionette_formats::scene::StageDoc::default());
+    stage.soft_shadows = spec.lights.soft_shadows;
     if let Some(d) = spec.lights.sun_azimuth {
         stage.sun.azimuth = d.draw(&mut rng);
     }

@@ -293,6 +293,9 @@ pub struct StageDoc {
     pub floor: bool,
     /// The sun casts shadows.
     pub shadows: bool,
+    /// Shadows' edges softened (filtered over many texels of the shadow map); else sharp
+    /// (four texels: far cheaper where the renderer runs on the CPU).
+    pub soft_shadows: bool,
     /// Draw the world axes.
     pub axes: bool,
     /// Height of the floor plane (world y).
@@ -313,6 +316,7 @@ impl Default for StageDoc {
         Self {
             floor: true,
             shadows: true,
+            soft_shadows: true,
             axes: false,
             floor_height: 0.0,
             floor_size: None,

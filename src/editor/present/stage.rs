@@ -1,7 +1,7 @@
 //! The stage: a floor with a subtle grid, a sun that casts shadows, an ambient fill, up to
 //! three lamps, the background; all as the scene's `StageDoc` says.
 
-use bevy::light::{CascadeShadowConfig, CascadeShadowConfigBuilder, DirectionalLightShadowMap};
+use bevy::light::{CascadeShadowConfig, CascadeShadowConfigBuilder, DirectionalLightShadowMap, ShadowFilteringMethod};
 use bevy::prelude::*;
 
 use crate::editor::state::StageSettings;
@@ -214,6 +214,26 @@ pub fn apply_stage_settings(
     }
     let ([r, g, b], alpha) = stage.background.at(0.5);
     clear.0 = Color::srgba(r, g, b, alpha);
+}
+
+/// Softens or sharpens every 3D camera's shadows as the stage says, when it changes or a
+/// camera comes (reads `StageSettings`; writes cameras' `ShadowFilteringMethod`).
+pub fn filter_shadows(
+    mut commands: Commands,
+    settings: Res<StageSettings>,
+    cameras: Query<Entity, With<Camera3d>>,
+    added: Query<(), Added<Camera3d>>,
+) {
+    if !settings.is_changed() && added.is_empty() {
+        return;
+    }
+    let method = match settings.soft_shadows {
+        true => ShadowFilteringMethod::Gaussian,
+        false => ShadowFilteringMethod::Hardware2x2,
+    };
+    for camera in &cameras {
+        commands.entity(camera).insert(method);
+    }
 }
 
 /// An up direction for a light looking along `toward` (any but `toward` itself).

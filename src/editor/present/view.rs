@@ -10,7 +10,8 @@ use crate::editor::edits::history;
 use crate::editor::present::draw;
 use crate::editor::present::skin_material::{self, SkinAttributeStore, SkinMaterial, SkinMaterialAsset, SkinTextures};
 use crate::editor::present::stage::{
-    StageExtent, apply_stage_settings, draw_grid_and_axes, fit_shadows_to_camera, fit_stage_to_scene, spawn_stage,
+    StageExtent, apply_stage_settings, draw_grid_and_axes, filter_shadows, fit_shadows_to_camera, fit_stage_to_scene,
+    spawn_stage,
 };
 use crate::editor::scene_doc::document::{Library, NextCharacterId, PendingScene, SceneCharacter, spawn_from_doc};
 use crate::editor::state::StageSettings;
@@ -96,6 +97,7 @@ impl Plugin for ViewPlugin {
                     choose_skin_material,
                     apply_display_mode,
                     apply_stage_settings,
+                    filter_shadows,
                     frame_when_skinned,
                     apply_orbit_camera,
                     draw::draw_skeletons,

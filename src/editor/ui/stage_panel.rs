@@ -216,6 +216,8 @@ fn light_rows(ui: &mut egui::Ui, stage: &mut StageDoc) {
         ui.add(egui::Slider::new(&mut stage.sun.illuminance, 0.0..=20_000.0).suffix(" lx"));
         color(ui, &mut stage.sun.color);
         ui.checkbox(&mut stage.shadows, "shadows");
+        ui.checkbox(&mut stage.soft_shadows, "soft")
+            .on_hover_text("shadows' edges softened; sharp ones draw faster without a GPU");
     });
     ui.horizontal(|ui| {
         ui.label("Ambient");
