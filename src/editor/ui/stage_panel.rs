@@ -215,8 +215,10 @@ fn light_rows(ui: &mut egui::Ui, stage: &mut StageDoc) {
     ui.horizontal(|ui| {
         ui.add(egui::Slider::new(&mut stage.sun.illuminance, 0.0..=20_000.0).suffix(" lx"));
         color(ui, &mut stage.sun.color);
+    });
+    ui.horizontal(|ui| {
         ui.checkbox(&mut stage.shadows, "shadows");
-        ui.checkbox(&mut stage.soft_shadows, "soft")
+        ui.add_enabled(stage.shadows, egui::Checkbox::new(&mut stage.soft_shadows, "soft edges"))
             .on_hover_text("shadows' edges softened; sharp ones draw faster without a GPU");
     });
     ui.horizontal(|ui| {
