@@ -118,7 +118,7 @@ pub struct ShotArgs {
     pub samples: Option<u32>,
     /// How edges are smoothed: multisample (four samples a pixel, the default), fxaa (found
     /// and blended in the finished picture: much cheaper on a CPU renderer) or off.
-    #[arg(long, value_parser = parse_antialias)]
+    #[arg(long)]
     pub antialias: Option<crate::formats::scene::Antialias>,
     /// No background and no floor: a PNG with alpha.
     #[arg(long)]
@@ -153,14 +153,6 @@ fn parse_size(s: &str) -> Result<(u32, u32), String> {
     let (w, h) = s.split_once(['x', 'X', '×']).ok_or_else(expected)?;
     let side = |t: &str| t.trim().parse::<u32>().ok().filter(|&v| v >= 1 && i64::from(v) <= MAX_PICTURE_SIDE);
     Ok((side(w).ok_or_else(expected)?, side(h).ok_or_else(expected)?))
-}
-
-fn parse_antialias(s: &str) -> Result<crate::formats::scene::Antialias, String> {
-    use crate::formats::scene::Antialias;
-    Antialias::named(s).ok_or_else(|| {
-        let names: Vec<_> = Antialias::ALL.iter().map(|a| a.name()).collect();
-        format!("expected one of {}, found {s:?}", names.join(", "))
-    })
 }
 
 fn parse_view(s: &str) -> Result<crate::formats::scene::ViewName, String> {

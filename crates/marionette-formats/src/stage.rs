@@ -472,7 +472,7 @@ pub enum Antialias {
 impl Antialias {
     pub const ALL: [Antialias; 3] = [Antialias::Multisample, Antialias::Fxaa, Antialias::Off];
 
-    /// Its name on the command line and in specs' comments.
+    /// Its name on the command line and in the editor.
     pub fn name(self) -> &'static str {
         match self {
             Antialias::Multisample => "multisample",
@@ -480,10 +480,17 @@ impl Antialias {
             Antialias::Off => "off",
         }
     }
+}
 
-    /// The one named `name` (as [`Self::name`] says it, any case).
-    pub fn named(name: &str) -> Option<Antialias> {
-        Self::ALL.into_iter().find(|a| a.name().eq_ignore_ascii_case(name))
+impl std::str::FromStr for Antialias {
+    type Err = String;
+
+    /// The one [`Antialias::name`] names (any case).
+    fn from_str(s: &str) -> Result<Self, String> {
+        Self::ALL.into_iter().find(|a| a.name().eq_ignore_ascii_case(s)).ok_or_else(|| {
+            let names: Vec<&str> = Self::ALL.iter().map(|a| a.name()).collect();
+            format!("expected {}, found `{s}`", names.join(", "))
+        })
     }
 }
 

@@ -135,9 +135,10 @@ fn pixels(picture: &image::DynamicImage) -> (Vec<u8>, u32, u32, usize) {
 }
 
 /// The scene drawn as `render SCENE --width W --height H [--samples N] [--antialias A]
-/// [--data] [--controlnet] [--view V] [--transparent] --out shot.png` draws it: a dict of `rgb` (uint8 (H, W, 3), or (H, W, 4)
-/// with `transparent`), and with `data` `depth` (float32 (H, W) metres along the view axis,
-/// inf where nothing), `normal` (float32 (H, W, 3), the camera frame `--data` documents),
+/// [--data] [--controlnet] [--view V] [--transparent] --out shot.png` draws it: a dict of
+/// `rgb` (uint8 (H, W, 3), or (H, W, 4) with `transparent`), and with `data` `depth`
+/// (float32 (H, W) metres along the view axis, inf where nothing), `normal` (float32
+/// (H, W, 3), the camera frame `--data` documents),
 /// `mask` (uint16 (H, W) instance ids), `coco` (the COCO dict) and `camera` (`K`,
 /// `world_to_camera`: float64); with `controlnet` `controlnet`, the maps as their files hold
 /// them (`openpose`, `depth`, `normal`: uint8 arrays; `openpose_json`: a dict); and `notes`.
@@ -158,9 +159,7 @@ pub fn render<'py>(
     transparent: bool,
 ) -> PyResult<Bound<'py, PyDict>> {
     let view: Option<ViewName> = view.map(|v| v.parse().map_err(PyValueError::new_err)).transpose()?;
-    let antialias = Antialias::named(antialias).ok_or_else(|| {
-        PyValueError::new_err(format!("antialias: expected multisample, fxaa or off, found {antialias:?}"))
-    })?;
+    let antialias: Antialias = antialias.parse().map_err(|e| PyValueError::new_err(format!("antialias: {e}")))?;
     let shot = ShotDoc { width, height, samples, antialias };
     shot.validate().map_err(|e| PyValueError::new_err(e.to_string()))?;
     let mut doc = scene.doc.clone();
