@@ -221,7 +221,7 @@ pub fn apply_stage_settings(
 pub fn filter_shadows(
     mut commands: Commands,
     settings: Res<StageSettings>,
-    cameras: Query<Entity, With<Camera3d>>,
+    cameras: Query<(Entity, Option<&ShadowFilteringMethod>), With<Camera3d>>,
     added: Query<(), Added<Camera3d>>,
 ) {
     if !settings.is_changed() && added.is_empty() {
@@ -231,7 +231,7 @@ pub fn filter_shadows(
         true => ShadowFilteringMethod::Gaussian,
         false => ShadowFilteringMethod::Hardware2x2,
     };
-    for camera in &cameras {
+    for (camera, _) in cameras.iter().filter(|(_, now)| *now != Some(&method)) {
         commands.entity(camera).insert(method);
     }
 }
