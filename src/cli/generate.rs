@@ -173,8 +173,15 @@ pub fn run(args: &GenerateArgs) -> Result<()> {
         recorder.inc(1);
         Ok(())
     });
-    let notes =
-        render_scenes(first_scene, library, pictures, picture, beside, on_written).map_err(anyhow::Error::msg)?;
+    let notes = render_scenes(
+        first_scene,
+        library,
+        (pictures, args.scenes_a_frame.map(usize::from)),
+        picture,
+        beside,
+        on_written,
+    )
+    .map_err(anyhow::Error::msg)?;
     bar.finish();
     for n in notes {
         eprintln!("note: {n}");

@@ -321,7 +321,8 @@ fn spawn_offscreen_camera(mut commands: Commands, mut images: ResMut<Assets<Imag
     image.texture_descriptor.usage |= TextureUsages::COPY_SRC;
     let target = images.add(image);
     let orbit = OrbitCamera::default();
-    commands.spawn((Camera3d::default(), RenderTarget::Image(target.into()), orbit, orbit.transform()));
+    let slot = crate::editor::present::stage::slot_camera(crate::scene::Slot(0));
+    commands.spawn((Camera3d::default(), RenderTarget::Image(target.into()), orbit, orbit.transform(), slot));
 }
 
 /// Puppets have no clips: every joint sways with time, so every puppet re-skins each frame.

@@ -124,7 +124,7 @@ pub fn run(paths: Vec<PathBuf>, edits: StartupEdits, library: crate::document::A
 /// window after it, a camera that carries egui's context and renders nothing else.
 fn spawn_window_camera(mut commands: Commands) {
     let orbit = OrbitCamera::default();
-    commands.spawn((Camera3d::default(), orbit, orbit.transform()));
+    commands.spawn((Camera3d::default(), orbit, orbit.transform(), present::stage::slot_camera(crate::scene::Slot(0))));
     commands.spawn((
         Camera2d,
         Camera { order: 1, clear_color: ClearColorConfig::None, ..default() },

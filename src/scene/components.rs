@@ -7,6 +7,20 @@ use bevy::prelude::*;
 use crate::formats::scene::{PlacementDoc, ViewDoc};
 use crate::rig::{CharacterAsset, DofLimits, JointRotation};
 
+/// Which of the scenes drawn in one frame an entity belongs to: a camera that draws it,
+/// its characters, its floor, sun and lamps; each slot on the render layer of its number.
+/// The editor draws one scene, slot 0 (Bevy's default layer); a data set's render draws
+/// several a frame, one a slot.
+#[derive(Component, Clone, Copy, Debug, Default, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub struct Slot(pub usize);
+
+impl Slot {
+    /// What marks an entity as the slot's: the slot, and its render layer.
+    pub fn marks(self) -> (Self, bevy::camera::visibility::RenderLayers) {
+        (self, bevy::camera::visibility::RenderLayers::layer(self.0))
+    }
+}
+
 /// A character: the loaded asset it was made from (shared by every character made from
 /// the same files), its joint entities by joint index and the entity that draws its skin.
 #[derive(Component, Clone)]
@@ -22,7 +36,8 @@ use crate::rig::{CharacterAsset, DofLimits, JointRotation};
     super::handoff::SkinUpload,
     super::handoff::SkinAttributes,
     SkinOnGpu,
-    super::handoff::GpuSkinJob
+    super::handoff::GpuSkinJob,
+    Slot
 )]
 pub struct Character {
     pub asset: Arc<CharacterAsset>,

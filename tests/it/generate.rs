@@ -1,5 +1,6 @@
-//! `marionette generate`: a data set rendered whole and as four shards (two by `--shard`,
-//! one as a Slurm array task, one as a Kubernetes Indexed Job's) gives the same files; a
+//! `marionette generate`: a data set rendered whole (four scenes a frame, one, three) and as
+//! four shards (two by `--shard`, one as a Slurm array task, one as a Kubernetes Indexed
+//! Job's) gives the same files; a
 //! run killed halfway and started again finishes them, rendering only what was missing;
 //! `--merge` joins the pictures' COCO files; spec errors stop it before anything renders.
 
@@ -60,6 +61,14 @@ fn a_data_set_is_the_same_whole_as_in_shards_and_resumed() {
         for tail in [".png", ".json", ".scene.ron", ".depth.exr", ".mask.png", ".openpose.json"] {
             assert!(expected.contains_key(&format!("{stem}{tail}")), "{stem}{tail}");
         }
+    }
+
+    // The whole run drew four scenes a frame (its pictures are small); one a frame and three
+    // a frame draw the same files.
+    for n in ["1", "3"] {
+        let apart = dir.join(format!("scenes-a-frame-{n}"));
+        let said = generate(&spec, &apart, &["--scenes-a-frame", n], &[]);
+        assert_eq!(files(&apart), expected, "{n} scenes a frame give the files of four:\n{said}");
     }
 
     let shards = dir.join("shards");

@@ -205,7 +205,12 @@ impl Plugin for MoveGizmoPlugin {
                     .chain()
                     .in_set(crate::editor::order::EditorSystems::MoveGizmo),
             )
-            .add_systems(PostUpdate, draw_move_gizmo.in_set(crate::editor::order::EditorSystems::Present));
+            .add_systems(
+                PostUpdate,
+                draw_move_gizmo
+                    .in_set(crate::editor::order::EditorSystems::Present)
+                    .after(crate::editor::present::stage::apply_stage_settings),
+            );
     }
 }
 

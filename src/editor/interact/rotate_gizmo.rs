@@ -156,7 +156,12 @@ impl Plugin for RotateGizmoPlugin {
                     .chain()
                     .in_set(crate::editor::order::EditorSystems::Gizmo),
             )
-            .add_systems(PostUpdate, draw_rotate_gizmo.in_set(crate::editor::order::EditorSystems::Present));
+            .add_systems(
+                PostUpdate,
+                draw_rotate_gizmo
+                    .in_set(crate::editor::order::EditorSystems::Present)
+                    .after(crate::editor::present::stage::apply_stage_settings),
+            );
     }
 }
 

@@ -12,7 +12,7 @@ use crate::editor::scene_doc::document::{HumanoidMapOf, SceneCharacter};
 use crate::editor::state::camera::OrbitCamera;
 use crate::formats::scene::DisplayDoc;
 use crate::scene::smpl::SmplCharacter;
-use crate::scene::{Character, CharacterSkinning, CharacterView, JointScratch, SkinScratch};
+use crate::scene::{Character, CharacterSkinning, CharacterView, JointScratch, SkinScratch, Slot};
 
 /// What a data picture is made from.
 pub struct DataFrame {
@@ -151,39 +151,44 @@ pub struct DataScene<'w, 's> {
             &'static CharacterSkinning,
             Option<&'static HumanoidMapOf>,
             Has<SmplCharacter>,
+            &'static Slot,
         ),
     >,
-    floors: Query<'w, 's, (&'static Transform, &'static Visibility), With<Floor>>,
-    cameras: Query<'w, 's, &'static OrbitCamera>,
+    floors: Query<'w, 's, (&'static Transform, &'static Visibility, &'static Slot), With<Floor>>,
+    cameras: Query<'w, 's, (&'static OrbitCamera, &'static Slot)>,
 }
 
 impl DataScene<'_, '_> {
-    /// The frame now, for a picture of `width` × `height`. Characters are numbered in the
-    /// order of their scene ids (from 1), so a sequence keeps each one's number.
-    pub fn frame(&self, width: u32, height: u32) -> Result<DataFrame, String> {
-        Ok(self.frame_through(self.camera(width, height)?))
+    /// The slot's frame now, for a picture of `width` × `height`. Characters are numbered in
+    /// the order of their scene ids (from 1), so a sequence keeps each one's number.
+    pub fn frame(&self, slot: Slot, width: u32, height: u32) -> Result<DataFrame, String> {
+        Ok(self.frame_through(slot, self.camera(slot, width, height)?))
     }
 
-    /// The scene's camera over a picture of `width` × `height`.
-    pub fn camera(&self, width: u32, height: u32) -> Result<Pinhole, String> {
-        let orbit = self.cameras.iter().next().ok_or("the render has no camera")?;
+    /// The slot's camera over a picture of `width` × `height`.
+    pub fn camera(&self, slot: Slot, width: u32, height: u32) -> Result<Pinhole, String> {
+        let (orbit, _) = self.cameras.iter().find(|c| *c.1 == slot).ok_or("the render has no camera")?;
         Pinhole::of(orbit, width, height).map_err(|e| e.to_string())
     }
 
-    /// The frame now, seen through `camera`.
-    pub fn frame_through(&self, camera: Pinhole) -> DataFrame {
-        let mut characters: Vec<_> = self.characters.iter().collect();
+    /// The slot's frame now, seen through `camera`.
+    pub fn frame_through(&self, slot: Slot, camera: Pinhole) -> DataFrame {
+        let mut characters: Vec<_> = self.characters.iter().filter(|c| *c.9 == slot).collect();
         characters.sort_by_key(|c| c.0.id);
         let figures = characters
             .into_iter()
             .enumerate()
             .filter(|(_, c)| c.5.0.visible && c.5.0.display != DisplayDoc::Skeleton)
-            .map(|(k, (scene, character, skin, joints, place, _, method, map, smpl))| {
+            .map(|(k, (scene, character, skin, joints, place, _, method, map, smpl, _))| {
                 let drawn = Drawn { character, skin, joints, method: method.0 };
                 figure(k as u16 + 1, &scene.name, drawn, place.to_matrix(), map.map(|m| &m.0), smpl)
             })
             .collect();
-        let floor = self.floors.iter().find(|(_, v)| **v != Visibility::Hidden).map(|(t, _)| floor_corners(t));
+        let floor = self
+            .floors
+            .iter()
+            .find(|(_, v, s)| **v != Visibility::Hidden && **s == slot)
+            .map(|(t, ..)| floor_corners(t));
         DataFrame { camera, figures, floor }
     }
 }

@@ -112,7 +112,8 @@ fn spawn_fast_camera(
     view.image = images.add(image);
     let camera = Camera { is_active: false, order: -1, ..default() };
     let target = RenderTarget::Image(view.image.clone().into());
-    commands.entity(parent).with_child((FastCamera, Camera3d::default(), camera, target, Msaa::Off));
+    let slot = crate::scene::Slot(0).marks();
+    commands.entity(parent).with_child((FastCamera, Camera3d::default(), camera, target, Msaa::Off, slot));
 }
 
 /// Shows the fast view while the user works the view and the full one once it is still:

@@ -20,13 +20,13 @@ use crate::document::scenes::{read_scene, scene_path};
 use crate::editor::present::data::{Beside, DataFrame, DataScene};
 use crate::editor::present::readiness::{CaptureGate, DrawnFrames, WantedAssets};
 use crate::editor::present::stage;
-use crate::editor::present::view::ViewPlugin;
+use crate::editor::present::view::{SceneToOpen, ViewPlugin};
 use crate::editor::scene_doc::document::Library;
 use crate::editor::state::camera::OrbitCamera;
 use crate::editor::state::{Messages, StartupEdits, StartupPaths};
 use crate::formats::scene::{Antialias, BackgroundDoc, BindingDoc, Clocked, SceneDoc, ShotDoc, SourceDoc};
 use crate::formats::scene::{MotionSourceDoc, RetargetDoc};
-use crate::scene::{RigCorePlugin, SkinningPlugin};
+use crate::scene::{RigCorePlugin, SkinningPlugin, Slot};
 
 /// Seconds a picture may wait to be ready (from the start, or from the last picture
 /// captured) before the render gives up, saying what was still pending.
@@ -49,10 +49,13 @@ struct RenderJob {
     /// The place in `queue` of the picture being set up or captured next (all are captured
     /// once it is the queue's length).
     next: usize,
+    /// The scenes a frame draws, slot by slot.
+    slots: Vec<SlotView>,
+    /// How many pictures from `next` on are set up, in the slots from the first.
+    drawing: usize,
     sequence: Option<FrameSequence>,
     /// The camera's yaw at the first frame (a turntable turns from it).
     first_yaw: Option<f32>,
-    target: Handle<Image>,
     started: std::time::Instant,
     /// Pictures captured whose files are not written yet.
     in_flight: usize,
@@ -85,7 +88,12 @@ struct RenderJob {
     opened: bool,
     /// Keep each picture in memory here instead of writing its files.
     kept: Option<KeptPictures>,
-    /// How the last scene set up was lit (kept from render to render).
+}
+
+/// One of the scenes a frame draws: where its picture is drawn, and how the last scene
+/// set up in it was lit (kept from render to render).
+struct SlotView {
+    target: Handle<Image>,
     last_lights: Option<LightSetup>,
 }
 
@@ -240,6 +248,7 @@ pub fn render_with(
         controlnet,
         coco_per_picture: false,
         on_written,
+        scenes_a_frame: Some(1),
     };
     let done = run_job(setup);
     let done = match (pictures, done) {
@@ -255,11 +264,12 @@ pub fn render_with(
 /// Renders a data set's pictures, each its own scene, in one app: `first_scene` (the file
 /// of the first picture's scene) opens it; every picture after loads its scene in place of
 /// the last, with what `beside` asks written beside it; `on_written` is called with a
-/// picture's index once its files are written. Returns the notes.
+/// picture's index once its files are written; `scenes_a_frame` of them drawn in each frame
+/// (else as many as [`scenes_a_frame`] finds for their size). Returns the notes.
 pub fn render_scenes(
     first_scene: PathBuf,
     library: AssetLibrary,
-    pictures: Vec<ScenePicture>,
+    (pictures, scenes_a_frame): (Vec<ScenePicture>, Option<usize>),
     picture: ShotDoc,
     beside: Beside,
     on_written: OnWritten,
@@ -280,6 +290,7 @@ pub fn render_scenes(
         controlnet: beside.controlnet,
         coco_per_picture: true,
         on_written: Some(on_written),
+        scenes_a_frame,
     };
     run_job(setup)
 }
@@ -319,6 +330,7 @@ impl Renderer {
             coco_per_picture: true,
             // Said by the caller, not on standard error.
             on_written: Some(Box::new(|_| Ok(()))),
+            scenes_a_frame: Some(1),
         };
         let (mut app, outcome) = job_app(setup, false);
         while app.plugins_state() == bevy::app::PluginsState::Adding {
@@ -412,6 +424,8 @@ struct JobSetup {
     /// Each picture's data has a COCO file of its own instead.
     coco_per_picture: bool,
     on_written: Option<OnWritten>,
+    /// The scenes a frame draws, where asked (else chosen from the size).
+    scenes_a_frame: Option<usize>,
 }
 
 /// Where a render's result and messages are left for the caller.
@@ -434,8 +448,19 @@ fn run_job(setup: JobSetup) -> Result<Vec<String>, String> {
 /// The app of a render and where its outcome is left; `opened`: the first picture shows the
 /// scene the app opens with (else every picture's scene is opened in place of the last).
 fn job_app(setup: JobSetup, opened: bool) -> (App, Outcome) {
-    let JobSetup { paths, library, edits, picture, frames, sequence, data, controlnet, coco_per_picture, on_written } =
-        setup;
+    let JobSetup {
+        paths,
+        library,
+        edits,
+        picture,
+        frames,
+        sequence,
+        data,
+        controlnet,
+        coco_per_picture,
+        on_written,
+        scenes_a_frame: asked,
+    } = setup;
     let (width, height) = (picture.width, picture.height);
     // A render in a process that logs already (the editor's frames) logs through its log;
     // a renderer kept in another program's process (Python's) does not log.
@@ -448,19 +473,25 @@ fn job_app(setup: JobSetup, opened: bool) -> (App, Outcome) {
     if opened {
         app.add_plugins(ScheduleRunnerPlugin::run_loop(Duration::from_millis(2)));
     }
-    app.insert_resource(ClearColor(stage::SKY))
+    app.insert_resource(stage::BackgroundAfterCapture)
         .insert_resource(crate::editor::state::camera::FramingAspect(width as f32 / height as f32))
         .insert_resource(StartupPaths(paths))
         .insert_resource(Library(library))
         .insert_resource(edits)
         .add_plugins((RigCorePlugin, SkinningPlugin, ViewPlugin));
-    let target = {
-        let mut images = app.world_mut().resource_mut::<Assets<Image>>();
-        let (w, h) = (width * picture.samples, height * picture.samples);
-        let mut image = Image::new_target_texture(w, h, TextureFormat::Rgba8UnormSrgb, None);
-        image.texture_descriptor.usage |= TextureUsages::COPY_SRC;
-        images.add(image)
+    let (w, h) = (width * picture.samples, height * picture.samples);
+    let count = match asked {
+        _ if !frames.iter().all(|f| matches!(&f.at, FrameAt::Scene(doc) if shares_a_frame(doc))) => 1,
+        Some(n) => n.clamp(1, MAX_SCENES_A_FRAME),
+        None => scenes_a_frame(w, h),
     };
+    let targets: Vec<Handle<Image>> = (0..count)
+        .map(|_| {
+            let mut image = Image::new_target_texture(w, h, TextureFormat::Rgba8UnormSrgb, None);
+            image.texture_descriptor.usage |= TextureUsages::COPY_SRC;
+            app.world_mut().resource_mut::<Assets<Image>>().add(image)
+        })
+        .collect();
     let outcome = Arc::new(Mutex::new((None, Vec::new())));
     app.insert_resource(RenderJob {
         queue: drawing_order(&frames),
@@ -468,9 +499,10 @@ fn job_app(setup: JobSetup, opened: bool) -> (App, Outcome) {
         set_up: false,
         samples: picture.samples,
         next: 0,
+        slots: targets.iter().map(|target| SlotView { target: target.clone(), last_lights: None }).collect(),
+        drawing: 0,
         sequence,
         first_yaw: None,
-        target: target.clone(),
         started: std::time::Instant::now(),
         in_flight: 0,
         written: Default::default(),
@@ -485,17 +517,27 @@ fn job_app(setup: JobSetup, opened: bool) -> (App, Outcome) {
         on_written,
         opened,
         kept: None,
-        last_lights: None,
     });
     // The sun's shadow map sized for the picture (the editor's is for a window).
     let shadow_map = stage::shadow_map_for(width * picture.samples, height * picture.samples);
     app.add_systems(PostStartup, move |mut commands: Commands| commands.insert_resource(shadow_map.clone()));
     let antialias = picture.antialias;
-    app.add_systems(Startup, move |mut commands: Commands| {
-        let orbit = OrbitCamera::default();
-        let camera = (Camera3d::default(), RenderTarget::Image(target.clone().into()), orbit, orbit.transform());
-        smoothed(&mut commands.spawn(camera), antialias);
-    });
+    app.add_systems(
+        Startup,
+        move |mut commands: Commands,
+              mut meshes: ResMut<Assets<Mesh>>,
+              mut materials: ResMut<Assets<StandardMaterial>>,
+              mut gizmos: ResMut<Assets<GizmoAsset>>| {
+            for (k, target) in targets.iter().enumerate() {
+                let orbit = OrbitCamera::default();
+                let lens = (Camera3d::default(), RenderTarget::Image(target.clone().into()), orbit, orbit.transform());
+                smoothed(&mut commands.spawn((lens, stage::slot_camera(Slot(k)), SceneToOpen::default())), antialias);
+                if k > 0 {
+                    stage::spawn_slot_stage(&mut commands, &mut meshes, &mut materials, &mut gizmos, Slot(k));
+                }
+            }
+        },
+    );
     app.add_systems(
         Last,
         (capture_when_ready, report_when_done, next_frame, scene_frame, pose_frame)
@@ -503,8 +545,44 @@ fn job_app(setup: JobSetup, opened: bool) -> (App, Outcome) {
             .after(crate::editor::present::readiness::UpdateCaptureGate),
     )
     .add_systems(First, draw_only_what_is_captured)
-    .add_systems(PostUpdate, clear_behind_gradient.after(stage::apply_stage_settings));
+    .add_systems(Startup, cluster_lamps_by_layer);
     (app, outcome)
+}
+
+/// The most scenes a frame draws.
+const MAX_SCENES_A_FRAME: usize = 4;
+
+/// The pixels a frame draws at most when it draws several scenes.
+const PIXELS_A_FRAME: u32 = 1280 * 960;
+
+/// How many scenes a frame draws for pictures drawn at `width` × `height`: as many as fill
+/// [`PIXELS_A_FRAME`], from one to [`MAX_SCENES_A_FRAME`].
+pub fn scenes_a_frame(width: u32, height: u32) -> usize {
+    (PIXELS_A_FRAME / (width * height).max(1)).clamp(1, MAX_SCENES_A_FRAME as u32) as usize
+}
+
+/// Whether a scene may be drawn beside others in one frame: its characters drawn as plain
+/// skins (the editor's drawings are on the first scene's layer), none held by or moving
+/// with another (characters are found by ids, which the scenes of a frame share), no lamp
+/// casting shadows (Bevy details every lamp's shadow map for one camera of the world).
+fn shares_a_frame(doc: &SceneDoc) -> bool {
+    let by_id = |c: &crate::formats::scene::CharacterDoc| {
+        c.attached.is_some()
+            || c.anim
+                .as_ref()
+                .is_some_and(|a| matches!(a.retarget.as_ref().map(|r| &r.from), Some(MotionSourceDoc::Character(_))))
+    };
+    plainly_drawn(doc) && !doc.characters.iter().any(by_id) && !doc.stage.lamps.iter().any(|l| l.shadows)
+}
+
+/// Assigns lamps to the parts of a view they light on the CPU, which leaves out the lamps of
+/// other slots (Bevy's clustering on the GPU lights every view by every lamp), in every
+/// render, so that a picture is the same however many scenes share its frame (writes
+/// `GlobalClusterSettings`).
+fn cluster_lamps_by_layer(settings: Option<ResMut<bevy::light::cluster::GlobalClusterSettings>>) {
+    if let Some(mut settings) = settings {
+        settings.gpu_clustering = None;
+    }
 }
 
 /// Gives the render's camera the smoothing `antialias` asks for.
@@ -562,17 +640,16 @@ fn preload(paths: &[PathBuf], edits: &StartupEdits) -> Result<(AssetLibrary, Sho
     Ok((library, shot, poses))
 }
 
-/// Once the gate opens, captures the target once, saves it and exits; gives up when a
-/// picture waits [`GIVE_UP_SECONDS`] or a pipeline failed, saying what was pending. A
-/// capture of a frame the GPU did not draw whole is thrown away and its picture drawn
-/// again after the others.
-#[allow(clippy::too_many_arguments)]
+/// Once the gate opens, captures the pictures set up, each slot's target once, and saves
+/// them; gives up when a picture waits [`GIVE_UP_SECONDS`] or a pipeline failed, saying what
+/// was pending. A capture of a frame the GPU did not draw whole is thrown away and its
+/// picture drawn again after the others.
 fn capture_when_ready(
     mut commands: Commands,
     mut job: ResMut<RenderJob>,
     gate: Res<CaptureGate>,
     wanted: Res<WantedAssets>,
-    stage: Res<crate::editor::state::StageSettings>,
+    stages: Query<(&Slot, &stage::DrawnStage), With<OrbitCamera>>,
     scene: DataScene,
 ) {
     if job.done.is_some() {
@@ -602,70 +679,101 @@ fn capture_when_ready(
     if let Some((_, _, updates)) = job.captures.as_mut() {
         *updates += 1;
     }
-    if !job.set_up || !gate.is_ready() || job.in_flight >= MAX_IN_FLIGHT {
+    if !job.set_up || !gate.is_ready() || job.in_flight >= MAX_IN_FLIGHT_A_SLOT * job.slots.len() {
         return;
     }
-    let index = job.queue[job.next];
-    let frame_now = &job.frames[index];
-    let (out, ids, backdrop) = (frame_now.out.clone(), frame_now.ids, frame_now.backdrop.clone());
-    let (samples, background, coco_per_picture) = (job.samples, stage.background.clone(), job.coco_per_picture);
-    // What the data pictures show is taken now, with the frame the capture draws.
-    let (data, controlnet) = (job.data.is_some(), job.controlnet);
-    let mut frame = match (data || controlnet.is_some()).then(|| scene.frame(job.size.0, job.size.1)).transpose() {
-        Ok(frame) => frame,
-        Err(e) => {
-            job.done = Some(Err(e));
-            return;
-        }
-    };
-    let (written, generation, speculative) = (job.written.clone(), wanted.generation, gate.is_speculative());
-    let on_captured = move |captured: On<ScreenshotCaptured>,
-                            drawn: Res<DrawnFrames>,
-                            mut job: ResMut<RenderJob>,
-                            mut gate: ResMut<CaptureGate>| {
-        if speculative && drawn.drawn_whole(generation) != Some(true) {
-            // Drawn before all of it was on the GPU: again, once everything is.
-            job.queue.push(index);
-            job.in_flight -= 1;
-            gate.restart();
-            return;
-        }
-        // Encoded and written (or kept) on a thread of its own while the next pictures are
-        // drawn.
-        let (image, out, frame, written) = (captured.image.clone(), out.clone(), frame.take(), written.clone());
-        let (backdrop, background, kept) = (backdrop.clone(), background.clone(), job.kept.clone());
-        let beside = Beside { data, controlnet };
-        std::thread::spawn(move || {
-            let result = composed(&image, samples, &background, backdrop.as_deref()).and_then(|picture| match kept {
-                Some(kept) => {
-                    let name = out.file_name().map_or_else(String::new, |n| n.to_string_lossy().into_owned());
-                    let beside = frame.map(|f| f.keep_beside(&name, ids, &picture, beside));
-                    kept.lock().map_err(|_| "a picture's thread failed")?.push((index, Kept { picture, beside }));
-                    Ok(None)
-                }
-                None => write_picture(&picture, &out, frame, ids, beside, coco_per_picture),
-            });
-            if let Ok(mut written) = written.lock() {
-                written.push((index, result));
+    let capture = Capture { generation: wanted.generation, speculative: gate.is_speculative() };
+    for k in 0..job.drawing {
+        let slot = Slot(k);
+        let background = stages.iter().find(|s| *s.0 == slot).map(|s| s.1.0.background.clone()).unwrap_or_default();
+        // What the data pictures show is taken now, with the frame the capture draws.
+        let wants_data = job.data.is_some() || job.controlnet.is_some();
+        match wants_data.then(|| scene.frame(slot, job.size.0, job.size.1)).transpose() {
+            Ok(frame) => capture.picture(&mut commands, &job, k, frame, background),
+            Err(e) => {
+                job.done = Some(Err(e));
+                return;
             }
-        });
-    };
-    commands.spawn(Screenshot::image(job.target.clone())).observe(on_captured);
-    // This frame is the one captured: the next picture is set up from the next frame on.
-    job.in_flight += 1;
+        }
+    }
+    // These frames are the ones captured: the next pictures are set up from the next frame on.
+    job.in_flight += job.drawing;
     let now = std::time::Instant::now();
     job.captures = Some(job.captures.map_or((now, now, 0), |(first, _, updates)| (first, now, updates)));
-    job.next += 1;
+    job.next += job.drawing;
     job.set_up = false;
+}
+
+/// What every capture of one frame shares: the main world's frame it draws, and whether it
+/// was taken before the gate knew that frame drawn whole.
+#[derive(Clone, Copy)]
+struct Capture {
+    generation: u64,
+    speculative: bool,
+}
+
+impl Capture {
+    /// Captures slot `k`'s target, the picture `k`-th from the job's next, with what the data
+    /// pictures show (`frame`) and the background to put behind it; once captured it is
+    /// encoded and written (or kept) on a thread of its own while the next pictures are
+    /// drawn.
+    fn picture(
+        self,
+        commands: &mut Commands,
+        job: &RenderJob,
+        k: usize,
+        mut frame: Option<DataFrame>,
+        background: BackgroundDoc,
+    ) {
+        let index = job.queue[job.next + k];
+        let frame_now = &job.frames[index];
+        let (out, ids, backdrop) = (frame_now.out.clone(), frame_now.ids, frame_now.backdrop.clone());
+        let (samples, coco_per_picture, written) = (job.samples, job.coco_per_picture, job.written.clone());
+        let beside = Beside { data: job.data.is_some(), controlnet: job.controlnet };
+        let Capture { generation, speculative } = self;
+        let on_captured = move |captured: On<ScreenshotCaptured>,
+                                drawn: Res<DrawnFrames>,
+                                mut job: ResMut<RenderJob>,
+                                mut gate: ResMut<CaptureGate>| {
+            if speculative && drawn.drawn_whole(generation) != Some(true) {
+                // Drawn before all of it was on the GPU: again, once everything is.
+                job.queue.push(index);
+                job.in_flight -= 1;
+                gate.restart();
+                return;
+            }
+            let (image, out, frame, written) = (captured.image.clone(), out.clone(), frame.take(), written.clone());
+            let (backdrop, background, kept) = (backdrop.clone(), background.clone(), job.kept.clone());
+            std::thread::spawn(move || {
+                let result =
+                    composed(&image, samples, &background, backdrop.as_deref()).and_then(|picture| match kept {
+                        Some(kept) => {
+                            let name = out.file_name().map_or_else(String::new, |n| n.to_string_lossy().into_owned());
+                            let beside = frame.map(|f| f.keep_beside(&name, ids, &picture, beside));
+                            kept.lock()
+                                .map_err(|_| "a picture's thread failed")?
+                                .push((index, Kept { picture, beside }));
+                            Ok(None)
+                        }
+                        None => write_picture(&picture, &out, frame, ids, beside, coco_per_picture),
+                    });
+                if let Ok(mut written) = written.lock() {
+                    written.push((index, result));
+                }
+            });
+        };
+        commands.spawn(Screenshot::image(job.slots[k].target.clone())).observe(on_captured);
+    }
 }
 
 /// Draws frames while pictures are left to capture; once all are captured, the updates that
 /// wait for their pixels and files draw nothing. In `First`: a camera drawing again (a kept
 /// renderer's next render) is active before the lights are assigned to its view, so its
 /// first frame is lit by the lamps of its own scene (writes the render camera's `Camera`).
-fn draw_only_what_is_captured(job: Res<RenderJob>, mut cameras: Query<&mut Camera, With<OrbitCamera>>) {
-    let active = job.next < job.queue.len();
-    for mut camera in &mut cameras {
+fn draw_only_what_is_captured(job: Res<RenderJob>, mut cameras: Query<(&mut Camera, &Slot), With<OrbitCamera>>) {
+    for (mut camera, slot) in &mut cameras {
+        // The first slot draws the scene the app opens with; the others what is set up in them.
+        let active = job.next < job.queue.len() && (slot.0 == 0 || slot.0 < job.drawing);
         if camera.is_active != active {
             camera.is_active = active;
         }
@@ -682,8 +790,8 @@ fn report_when_done(job: Res<RenderJob>, messages: Res<Messages>, mut exit: Mess
     exit.write(AppExit::Success);
 }
 
-/// Pictures captured and not yet written at most (their pixels held in memory).
-const MAX_IN_FLIGHT: usize = 4;
+/// Pictures captured and not yet written at most, a slot (their pixels held in memory).
+const MAX_IN_FLIGHT_A_SLOT: usize = 4;
 
 /// Once every picture is written: the COCO file of `--data`, and the pictures' rate.
 fn finish(job: &mut RenderJob) -> Result<(), String> {
@@ -784,16 +892,6 @@ fn write_picture(
     annotate::write::json(&annotate::write::beside(out, "json"), &coco).map(|()| None).map_err(|e| e.to_string())
 }
 
-/// A gradient or a picture goes behind the picture once captured: the render clears to
-/// nothing (reads `StageSettings`; writes `ClearColor`).
-fn clear_behind_gradient(settings: Res<crate::editor::state::StageSettings>, mut clear: ResMut<ClearColor>) {
-    if settings.is_changed()
-        && matches!(settings.background, BackgroundDoc::Gradient { .. } | BackgroundDoc::Image { .. })
-    {
-        clear.0 = Color::NONE;
-    }
-}
-
 /// Sets up the next picture of a sequence once the last was captured: every clip paused at
 /// its time, a turntable's camera turned to it, and the gate told that only the new pose
 /// must be drawn (writes `ClipPlayer`, `SmplCharacter`, `NodeClipPlayer`, `OrbitCamera`,
@@ -820,29 +918,46 @@ fn next_frame(
     gate.next_picture();
 }
 
-/// Sets up a data set's next picture: its scene opened in place of the last (the first is
-/// the one the app opened with); one lit alike to the last and drawn as plain skins is
-/// captured in the frame that first draws it, another once the gate counts afresh (writes
-/// `PendingScene`, `CaptureGate`).
+/// Sets up a data set's next pictures, one a slot: each scene opened in place of the
+/// slot's last (the first picture's is the one the app opened with); where each is lit alike
+/// to its slot's last and drawn as plain skins they are captured in the frame that first
+/// draws them, else once the gate counts afresh (writes `PendingScene`, `SceneToOpen`,
+/// `CaptureGate`).
 fn scene_frame(
     mut job: ResMut<RenderJob>,
     mut gate: ResMut<CaptureGate>,
     mut pending: ResMut<crate::editor::scene_doc::document::PendingScene>,
+    mut to_open: Query<(&Slot, &mut SceneToOpen)>,
 ) {
     if job.set_up || job.done.is_some() || job.next == job.queue.len() {
         return;
     }
-    let FrameAt::Scene(doc) = &job.frames[job.queue[job.next]].at else { return };
-    let lights = light_setup(&doc.stage);
-    if job.next > 0 || !job.opened {
-        // Lit by lamps the last scene drawn had (of this render, or of the renderer's
-        // last), its characters drawn as plain skins.
-        let lit_alike = job.last_lights.as_ref().is_some_and(|last| lamps_kept(last, &lights)) && plainly_drawn(doc);
-        // A scene without a camera is framed as the command line frames it.
-        *pending = crate::editor::scene_doc::document::PendingScene { frame: true, doc: Some((**doc).clone()) };
+    if !matches!(job.frames[job.queue[job.next]].at, FrameAt::Scene(_)) {
+        return;
+    }
+    let count = job.slots.len().min(job.queue.len() - job.next);
+    let (mut opened, mut lit_alike) = (false, true);
+    for k in 0..count {
+        let FrameAt::Scene(doc) = &job.frames[job.queue[job.next + k]].at else { continue };
+        let (doc, lights) = ((**doc).clone(), light_setup(&doc.stage));
+        if job.next > 0 || k > 0 || !job.opened {
+            // Lit by lamps the slot's last scene had (of this render, or of the renderer's
+            // last), its characters drawn as plain skins.
+            let last = job.slots[k].last_lights.as_ref();
+            lit_alike &= last.is_some_and(|last| lamps_kept(last, &lights)) && plainly_drawn(&doc);
+            opened = true;
+            match k {
+                // A scene without a camera is framed as the command line frames it.
+                0 => *pending = crate::editor::scene_doc::document::PendingScene { frame: true, doc: Some(doc) },
+                _ => to_open.iter_mut().filter(|o| o.0.0 == k).for_each(|mut o| o.1.0 = Some(Box::new(doc.clone()))),
+            }
+        }
+        job.slots[k].last_lights = Some(lights);
+    }
+    if opened {
         if lit_alike { gate.next_picture() } else { gate.restart() }
     }
-    job.last_lights = Some(lights);
+    job.drawing = count;
     job.set_up = true;
 }
 
@@ -915,7 +1030,7 @@ fn pose_frame(
     if job.set_up || job.done.is_some() || job.next == job.queue.len() {
         return;
     }
-    job.set_up = true;
+    (job.set_up, job.drawing) = (true, 1);
     let FrameAt::Pose(name) = &job.frames[job.queue[job.next]].at else { return };
     let kept = library.0.get(name);
     let joints: Vec<_> = kept.iter().flat_map(|pose| pose.joints.iter().map(|(k, r)| (k.clone(), *r))).collect();
@@ -995,6 +1110,44 @@ mod tests {
         assert!(!lamps_kept(&setup(true, &[]), &studio));
         assert!(!lamps_kept(&studio, &setup(true, &[(true, false)])));
         assert!(!lamps_kept(&studio, &setup(true, &[(false, true), (true, false)])));
+    }
+
+    /// Small pictures fill a frame with four scenes, large ones with fewer, the largest with one.
+    #[test]
+    fn a_frame_draws_as_many_scenes_as_fill_its_pixels() {
+        assert_eq!(scenes_a_frame(96, 72), 4);
+        assert_eq!(scenes_a_frame(640, 480), 4);
+        assert_eq!(scenes_a_frame(1280, 720), 1);
+        assert_eq!(scenes_a_frame(800, 600), 2);
+        assert_eq!(scenes_a_frame(4096, 4096), 1);
+        assert_eq!(scenes_a_frame(0, 0), 4);
+    }
+
+    /// A scene shares its frame unless the editor's drawings show in it, a character is found
+    /// by its id (held by, or moved by, another) or a lamp casts shadows.
+    #[test]
+    fn only_scenes_of_plain_independent_characters_share_a_frame() {
+        use crate::formats::scene::{AnimDoc, AttachDoc, CharacterDoc, CharacterId, DisplayDoc};
+        let with = |change: &dyn Fn(&mut CharacterDoc)| {
+            let puppet = || CharacterDoc::new(SourceDoc::Embedded("puppet".into()), "puppet");
+            let mut c = puppet();
+            change(&mut c);
+            SceneDoc { characters: vec![puppet(), c], ..SceneDoc::default() }
+        };
+        let moved_by = |from| Some(AnimDoc { retarget: Some(RetargetDoc::of(from)), ..AnimDoc::default() });
+        assert!(shares_a_frame(&with(&|_| {})));
+        assert!(!shares_a_frame(&with(&|c| c.view.display = DisplayDoc::Skeleton)));
+        assert!(!shares_a_frame(&with(&|c| c.view.weight_colors = true)));
+        let held = AttachDoc { to: CharacterId(1), joint: "hand".into(), offset: Mat4::IDENTITY };
+        assert!(!shares_a_frame(&with(&|c| c.attached = Some(held.clone()))));
+        assert!(!shares_a_frame(&with(&|c| c.anim = moved_by(MotionSourceDoc::Character(CharacterId(1))))));
+        let walk = MotionSourceDoc::File { path: "walk.bvh".into(), clip: None };
+        assert!(shares_a_frame(&with(&|c| c.anim = moved_by(walk.clone()))));
+        let mut lit = with(&|_| {});
+        lit.stage.lamps = vec![crate::formats::scene::LampDoc::default()];
+        assert!(shares_a_frame(&lit));
+        lit.stage.lamps[0].shadows = true;
+        assert!(!shares_a_frame(&lit));
     }
 
     /// The opened scene first, its lighting's group next, then the groups with more lamps

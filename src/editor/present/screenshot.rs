@@ -127,7 +127,7 @@ fn take_requested_screenshot(
     let size = windows.iter().next().map(|w| (w.physical_width(), w.physical_height()));
     let (data, controlnet) = (request.with_data, request.controlnet.maps());
     let frame = match (data || controlnet.is_some(), size) {
-        (true, Some((w, h))) => match scene.frame(w, h) {
+        (true, Some((w, h))) => match scene.frame(crate::scene::Slot(0), w, h) {
             Ok(frame) => Some(frame),
             Err(e) => {
                 messages.push(format!("no data pictures: {e}"));

@@ -6,6 +6,8 @@ use bevy::prelude::*;
 
 use crate::editor::state::StageSettings;
 use crate::editor::state::camera::OrbitCamera;
+use crate::formats::scene::StageDoc;
+use crate::scene::Slot;
 
 /// The sky (clear) colour.
 pub const SKY: Color =
@@ -24,9 +26,10 @@ pub fn floor_corners(transform: &Transform) -> [Vec3; 4] {
 /// The side of the floor mesh (metres) before it is scaled to the scene.
 const FLOOR_SIZE: f32 = 40.0;
 
-/// How far floor and grid reach from the origin, and the grid's spacing: at least 10 m,
-/// and twice the farthest character (a grid of about 40 lines each way).
-#[derive(Resource, Clone, Copy, Debug, PartialEq)]
+/// How far a slot's floor and grid reach from the origin, and the grid's spacing: at least
+/// 10 m, and twice the farthest character (a grid of about 40 lines each way); on the slot's
+/// camera.
+#[derive(Component, Clone, Copy, Debug, PartialEq)]
 pub struct StageExtent {
     pub half: f32,
     pub step: f32,
@@ -50,43 +53,47 @@ impl StageExtent {
     }
 }
 
-/// Sizes floor and grid to the characters whenever one moves or deforms (reads skin
-/// bounds and placements; writes `StageExtent`, the floor's scale).
+/// Sizes each slot's floor and grid to its characters whenever one moves or deforms
+/// (reads skin bounds and placements; writes the slot camera's `StageExtent`, the floor's
+/// scale).
 pub fn fit_stage_to_scene(
-    characters: Query<(&crate::scene::Character, &crate::scene::Placement)>,
+    characters: Query<(&crate::scene::Character, &crate::scene::Placement, &Slot)>,
     changed: Query<(), Or<(Changed<bevy::camera::primitives::Aabb>, Changed<crate::scene::Placement>)>>,
     bounds: Query<&bevy::camera::primitives::Aabb>,
-    mut extent: ResMut<StageExtent>,
-    mut floors: Query<&mut Transform, With<Floor>>,
-    settings: Res<StageSettings>,
+    mut cameras: Query<(&Slot, Ref<DrawnStage>, &mut StageExtent), With<OrbitCamera>>,
+    mut floors: Query<(&Slot, &mut Transform), With<Floor>>,
 ) {
-    if changed.is_empty() && !settings.is_changed() {
-        return;
-    }
-    let reach = characters
-        .iter()
-        .filter_map(|(character, placement)| {
-            let aabb = bounds.get(character.skins.first()?.entity).ok()?;
-            let m = placement.to_mat4();
-            let (a, b) = (Vec3::from(aabb.min()), Vec3::from(aabb.max()));
-            Some(
-                [a, b, Vec3::new(a.x, 0.0, b.z), Vec3::new(b.x, 0.0, a.z)]
-                    .map(|c| m.transform_point3(c))
-                    .into_iter()
-                    .map(|p| p.x.abs().max(p.z.abs()))
-                    .fold(0.0f32, f32::max),
-            )
-        })
-        .fold(0.0f32, f32::max);
-    let wanted = match settings.floor_size {
-        Some(size) => StageExtent::reaching(size / 4.0),
-        None => StageExtent::reaching(reach),
-    };
-    if *extent != wanted {
-        *extent = wanted;
-        let side = settings.floor_size.unwrap_or(2.0 * wanted.half) / FLOOR_SIZE;
-        for mut floor in &mut floors {
-            floor.scale = Vec3::new(side, 1.0, side);
+    let anything_moved = !changed.is_empty();
+    for (slot, stage, mut extent) in &mut cameras {
+        if !anything_moved && !stage.is_changed() {
+            continue;
+        }
+        let reach = characters
+            .iter()
+            .filter(|c| c.2 == slot)
+            .filter_map(|(character, placement, _)| {
+                let aabb = bounds.get(character.skins.first()?.entity).ok()?;
+                let m = placement.to_mat4();
+                let (a, b) = (Vec3::from(aabb.min()), Vec3::from(aabb.max()));
+                Some(
+                    [a, b, Vec3::new(a.x, 0.0, b.z), Vec3::new(b.x, 0.0, a.z)]
+                        .map(|c| m.transform_point3(c))
+                        .into_iter()
+                        .map(|p| p.x.abs().max(p.z.abs()))
+                        .fold(0.0f32, f32::max),
+                )
+            })
+            .fold(0.0f32, f32::max);
+        let wanted = match stage.0.floor_size {
+            Some(size) => StageExtent::reaching(size / 4.0),
+            None => StageExtent::reaching(reach),
+        };
+        if *extent != wanted {
+            *extent = wanted;
+            let side = stage.0.floor_size.unwrap_or(2.0 * wanted.half) / FLOOR_SIZE;
+            for (_, mut floor) in floors.iter_mut().filter(|f| f.0 == slot) {
+                floor.scale = Vec3::new(side, 1.0, side);
+            }
         }
     }
 }
@@ -119,14 +126,16 @@ pub fn sun_shadow_cascades(camera_distance: f32) -> CascadeShadowConfig {
     .build()
 }
 
-/// Fits the sun's shadow cascades to the orbit camera whenever it moves (reads the
-/// `OrbitCamera`; writes the sun's `CascadeShadowConfig`).
+/// Fits each slot's sun's shadow cascades to the slot's orbit camera whenever it moves
+/// (reads the `OrbitCamera`; writes the sun's `CascadeShadowConfig`).
 pub fn fit_shadows_to_camera(
-    cameras: Query<&OrbitCamera, Changed<OrbitCamera>>,
-    mut suns: Query<&mut CascadeShadowConfig, With<Sun>>,
+    cameras: Query<(&OrbitCamera, &Slot), Changed<OrbitCamera>>,
+    mut suns: Query<(&mut CascadeShadowConfig, &Slot), With<Sun>>,
 ) {
-    if let Some(distance) = cameras.iter().map(|orbit| orbit.distance).reduce(f32::max) {
-        suns.iter_mut().for_each(|mut cascades| *cascades = sun_shadow_cascades(distance));
+    for (orbit, slot) in &cameras {
+        for (mut cascades, _) in suns.iter_mut().filter(|s| s.1 == slot) {
+            *cascades = sun_shadow_cascades(orbit.distance);
+        }
     }
 }
 
@@ -137,20 +146,62 @@ pub struct Sun;
 #[derive(Component)]
 pub struct Lamp(pub usize);
 
-/// Spawns floor and sun; the stage's settings light them (writes entities).
+/// The stage a slot draws, on the slot's camera: the editor's is its `StageSettings`
+/// ([`stage_the_settings`]); a data set's render sets each slot's from its picture's scene.
+#[derive(Component, Clone, Debug, Default, PartialEq)]
+pub struct DrawnStage(pub StageDoc);
+
+/// What a slot's camera carries besides its lens: the slot, the stage it draws and how far
+/// that reaches.
+pub fn slot_camera(slot: Slot) -> impl Bundle {
+    (slot.marks(), DrawnStage::default(), StageExtent::default())
+}
+
+/// The floor grid of a slot (a gizmo of its own, on the slot's layer).
+#[derive(Component)]
+pub struct Grid;
+
+/// Spawns slot 0's stage (writes entities, `DirectionalLightShadowMap`).
 pub fn spawn_stage(
     mut commands: Commands,
     mut meshes: ResMut<Assets<Mesh>>,
     mut materials: ResMut<Assets<StandardMaterial>>,
+    mut gizmos: ResMut<Assets<GizmoAsset>>,
 ) {
     commands.insert_resource(DirectionalLightShadowMap { size: 2048 });
+    spawn_slot_stage(&mut commands, &mut meshes, &mut materials, &mut gizmos, Slot(0));
+}
+
+/// Spawns a slot's floor, grid and sun, on its layer; its camera's `DrawnStage` lights them.
+pub fn spawn_slot_stage(
+    commands: &mut Commands,
+    meshes: &mut Assets<Mesh>,
+    materials: &mut Assets<StandardMaterial>,
+    gizmos: &mut Assets<GizmoAsset>,
+    slot: Slot,
+) {
     commands.spawn((
         Floor,
+        slot.marks(),
         Mesh3d(meshes.add(Plane3d::default().mesh().size(FLOOR_SIZE, FLOOR_SIZE))),
         MeshMaterial3d(materials.add(StandardMaterial { perceptual_roughness: 0.95, ..default() })),
         Transform::default(),
     ));
-    commands.spawn((Sun, DirectionalLight::default(), Transform::default()));
+    commands.spawn((Grid, slot.marks(), Gizmo { handle: gizmos.add(GizmoAsset::default()), ..default() }));
+    commands.spawn((Sun, slot.marks(), DirectionalLight::default(), Transform::default()));
+}
+
+/// Gives slot 0's camera the editor's stage whenever it changes (reads `StageSettings`;
+/// writes `DrawnStage`).
+pub fn stage_the_settings(
+    settings: Res<StageSettings>,
+    mut cameras: Query<(&Slot, &mut DrawnStage), With<OrbitCamera>>,
+) {
+    for (slot, mut drawn) in &mut cameras {
+        if *slot == Slot(0) && drawn.0 != settings.0 {
+            drawn.0 = settings.0.clone();
+        }
+    }
 }
 
 /// Linear RGB as a colour.
@@ -158,81 +209,92 @@ fn linear([r, g, b]: [f32; 3]) -> Color {
     Color::linear_rgb(r, g, b)
 }
 
-/// Applies the stage's settings whenever they change: the floor (shown, height, size,
-/// colour), the sun (direction, light, shadows), the ambient fill, the lamps (each the
-/// entity of the last stage's lamp in its place where that was of its kind) and the
-/// background (reads `StageSettings`; writes floor, sun, lamps,
-/// `GlobalAmbientLight`, `ClearColor`).
+/// The render puts a gradient or a picture behind its pictures once captured: a stage with
+/// one clears to nothing.
+#[derive(Resource)]
+pub struct BackgroundAfterCapture;
+
+/// Applies each slot's stage whenever it changes: the floor (shown, height, size, colour),
+/// the sun (direction, light, shadows), the lamps (each the entity of the last stage's lamp
+/// in its place where that was of its kind), and on every camera of the slot the ambient
+/// fill, the clear colour and the shadows' filter (reads `DrawnStage`, `StageExtent`; writes
+/// floor, sun, lamps, cameras).
 #[allow(clippy::too_many_arguments)]
 pub fn apply_stage_settings(
     mut commands: Commands,
-    settings: Res<StageSettings>,
-    extent: Res<StageExtent>,
-    mut floors: Query<(&mut Visibility, &mut Transform, &MeshMaterial3d<StandardMaterial>), With<Floor>>,
+    stages: Query<(&Slot, Ref<DrawnStage>, &StageExtent), With<OrbitCamera>>,
+    mut cameras: Query<(Entity, &Slot, &mut Camera, Option<&ShadowFilteringMethod>), With<Camera3d>>,
+    added: Query<(), Added<Camera3d>>,
+    mut floors: Query<(&Slot, &mut Visibility, &mut Transform, &MeshMaterial3d<StandardMaterial>), With<Floor>>,
     mut materials: ResMut<Assets<StandardMaterial>>,
-    mut suns: Query<(&mut DirectionalLight, &mut Transform), (With<Sun>, Without<Floor>)>,
-    lamps: Query<(Entity, &Lamp, Has<SpotLight>)>,
-    mut ambient: ResMut<GlobalAmbientLight>,
-    mut clear: ResMut<ClearColor>,
+    mut suns: Query<(&Slot, &mut DirectionalLight, &mut Transform), (With<Sun>, Without<Floor>)>,
+    lamps: Query<(Entity, &Slot, &Lamp, Has<SpotLight>)>,
+    after_capture: Option<Res<BackgroundAfterCapture>>,
 ) {
-    if !settings.is_changed() {
-        return;
-    }
-    let stage = &settings.0;
-    for (mut visibility, mut transform, material) in &mut floors {
-        *visibility = if stage.floor { Visibility::Inherited } else { Visibility::Hidden };
-        transform.translation.y = stage.floor_height;
-        let side = stage.floor_size.unwrap_or(2.0 * extent.half) / FLOOR_SIZE;
-        transform.scale = Vec3::new(side, 1.0, side);
-        if let Some(mut m) = materials.get_mut(&material.0) {
-            let [r, g, b] = stage.floor_color;
-            m.base_color = Color::srgb(r, g, b);
+    for (&slot, stage, extent) in &stages {
+        if !stage.is_changed() && added.is_empty() {
+            continue;
+        }
+        let stage = &stage.0;
+        for (_, mut visibility, mut transform, material) in floors.iter_mut().filter(|f| *f.0 == slot) {
+            *visibility = if stage.floor { Visibility::Inherited } else { Visibility::Hidden };
+            transform.translation.y = stage.floor_height;
+            let side = stage.floor_size.unwrap_or(2.0 * extent.half) / FLOOR_SIZE;
+            transform.scale = Vec3::new(side, 1.0, side);
+            if let Some(mut m) = materials.get_mut(&material.0) {
+                let [r, g, b] = stage.floor_color;
+                m.base_color = Color::srgb(r, g, b);
+            }
+        }
+        for (_, mut sun, mut transform) in suns.iter_mut().filter(|s| *s.0 == slot) {
+            sun.illuminance = stage.sun.illuminance;
+            sun.color = linear(stage.sun.color);
+            sun.shadow_maps_enabled = stage.shadows;
+            *transform =
+                Transform::from_translation(stage.sun.toward()).looking_at(Vec3::ZERO, sun_up(stage.sun.toward()));
+        }
+        light_lamps(&mut commands, stage, lamps.iter().filter(|l| *l.1 == slot).map(|(e, _, l, s)| (e, l.0, s)), slot);
+        let ambient =
+            AmbientLight { color: linear(stage.ambient.color), brightness: stage.ambient.brightness, ..default() };
+        use crate::formats::scene::BackgroundDoc::{Gradient, Image};
+        let behind = after_capture.is_some() && matches!(stage.background, Gradient { .. } | Image { .. });
+        let ([r, g, b], alpha) = if behind { ([0.0; 3], 0.0) } else { stage.background.at(0.5) };
+        let filter = match stage.soft_shadows {
+            true => ShadowFilteringMethod::Gaussian,
+            false => ShadowFilteringMethod::Hardware2x2,
+        };
+        for (entity, _, mut camera, now) in cameras.iter_mut().filter(|c| *c.1 == slot) {
+            camera.clear_color = ClearColorConfig::Custom(Color::srgba(r, g, b, alpha));
+            let mut entity = commands.entity(entity);
+            entity.insert(ambient.clone());
+            if now != Some(&filter) {
+                entity.insert(filter);
+            }
         }
     }
-    for (mut sun, mut transform) in &mut suns {
-        sun.illuminance = stage.sun.illuminance;
-        sun.color = linear(stage.sun.color);
-        sun.shadow_maps_enabled = stage.shadows;
-        *transform = Transform::from_translation(stage.sun.toward()).looking_at(Vec3::ZERO, sun_up(stage.sun.toward()));
-    }
-    *ambient =
-        GlobalAmbientLight { color: linear(stage.ambient.color), brightness: stage.ambient.brightness, ..default() };
+}
+
+/// Lights the stage's lamps in a slot: each of `lamps` (entity, place, spot) kept where the
+/// stage has a lamp of its kind in its place, else despawned; the others spawned.
+fn light_lamps(
+    commands: &mut Commands,
+    stage: &StageDoc,
+    lamps: impl Iterator<Item = (Entity, usize, bool)>,
+    slot: Slot,
+) {
     let wanted = &stage.lamps[..stage.lamps.len().min(crate::formats::scene::MAX_LAMPS)];
-    // A lamp of the kind the last stage had in its place stays the same entity.
     let mut placed = vec![false; wanted.len()];
-    for (entity, lamp, spot) in &lamps {
-        match wanted.get(lamp.0).filter(|l| l.spot.is_some() == spot && !placed[lamp.0]) {
+    for (entity, place, spot) in lamps {
+        match wanted.get(place).filter(|l| l.spot.is_some() == spot && !placed[place]) {
             Some(doc) => {
-                placed[lamp.0] = true;
+                placed[place] = true;
                 light_lamp(&mut commands.entity(entity), doc);
             }
             None => commands.entity(entity).despawn(),
         }
     }
     for (i, doc) in wanted.iter().enumerate().filter(|&(i, _)| !placed[i]) {
-        light_lamp(&mut commands.spawn(Lamp(i)), doc);
-    }
-    let ([r, g, b], alpha) = stage.background.at(0.5);
-    clear.0 = Color::srgba(r, g, b, alpha);
-}
-
-/// Softens or sharpens every 3D camera's shadows as the stage says, when it changes or a
-/// camera comes (reads `StageSettings`; writes cameras' `ShadowFilteringMethod`).
-pub fn filter_shadows(
-    mut commands: Commands,
-    settings: Res<StageSettings>,
-    cameras: Query<(Entity, Option<&ShadowFilteringMethod>), With<Camera3d>>,
-    added: Query<(), Added<Camera3d>>,
-) {
-    if !settings.is_changed() && added.is_empty() {
-        return;
-    }
-    let method = match settings.soft_shadows {
-        true => ShadowFilteringMethod::Gaussian,
-        false => ShadowFilteringMethod::Hardware2x2,
-    };
-    for (camera, _) in cameras.iter().filter(|(_, now)| *now != Some(&method)) {
-        commands.entity(camera).insert(method);
+        light_lamp(&mut commands.spawn((Lamp(i), slot.marks())), doc);
     }
 }
 
@@ -267,19 +329,42 @@ fn light_lamp(entity: &mut EntityCommands, lamp: &crate::formats::scene::LampDoc
     }
 }
 
-/// Draws the floor grid and, when on, the world axes (reads `StageSettings`; draws gizmos).
-pub fn draw_grid_and_axes(settings: Res<StageSettings>, extent: Res<StageExtent>, mut gizmos: Gizmos) {
-    if settings.floor {
-        let y = settings.floor_height + 0.001;
-        let color = Color::srgba(0.2, 0.22, 0.25, 0.5);
-        let (half, step) = (extent.half, extent.step);
-        let lines = (half / step).round() as i32;
-        for i in -lines..=lines {
-            let t = i as f32 * step;
-            gizmos.line(Vec3::new(t, y, -half), Vec3::new(t, y, half), color);
-            gizmos.line(Vec3::new(-half, y, t), Vec3::new(half, y, t), color);
+/// Draws each slot's floor grid anew when its stage or extent changes (reads
+/// `DrawnStage`, `StageExtent`; writes the grid's gizmo).
+pub fn draw_grids(
+    stages: Query<
+        (&Slot, &DrawnStage, &StageExtent),
+        (With<OrbitCamera>, Or<(Changed<DrawnStage>, Changed<StageExtent>)>),
+    >,
+    grids: Query<(&Slot, &Gizmo), With<Grid>>,
+    mut gizmos: ResMut<Assets<GizmoAsset>>,
+) {
+    for (slot, stage, extent) in &stages {
+        for (_, grid) in grids.iter().filter(|g| g.0 == slot) {
+            let Some(mut lines) = gizmos.get_mut(&grid.handle) else { continue };
+            lines.clear();
+            if stage.0.floor {
+                let y = stage.0.floor_height + 0.001;
+                let color = Color::srgba(0.2, 0.22, 0.25, 0.5);
+                let (half, step) = (extent.half, extent.step);
+                let count = (half / step).round() as i32;
+                for i in -count..=count {
+                    let t = i as f32 * step;
+                    lines.line(Vec3::new(t, y, -half), Vec3::new(t, y, half), color);
+                    lines.line(Vec3::new(-half, y, t), Vec3::new(half, y, t), color);
+                }
+            }
         }
     }
+}
+
+/// Draws the world axes when on (reads `StageSettings`, slot 0's extent; draws gizmos).
+pub fn draw_axes(
+    settings: Res<StageSettings>,
+    cameras: Query<(&Slot, &StageExtent), With<OrbitCamera>>,
+    mut gizmos: Gizmos,
+) {
+    let Some((_, extent)) = cameras.iter().find(|c| *c.0 == Slot(0)) else { return };
     if settings.axes {
         gizmos.axes(Transform::from_xyz(0.0, settings.floor_height + 0.002, 0.0), 0.5 * extent.step / 0.5);
     }

@@ -10,8 +10,8 @@ use crate::editor::edits::history;
 use crate::editor::present::draw;
 use crate::editor::present::skin_material::{self, SkinAttributeStore, SkinMaterial, SkinMaterialAsset, SkinTextures};
 use crate::editor::present::stage::{
-    StageExtent, apply_stage_settings, draw_grid_and_axes, filter_shadows, fit_shadows_to_camera, fit_stage_to_scene,
-    spawn_stage,
+    DrawnStage, apply_stage_settings, draw_axes, draw_grids, fit_shadows_to_camera, fit_stage_to_scene, spawn_stage,
+    stage_the_settings,
 };
 use crate::editor::scene_doc::document::{Library, NextCharacterId, PendingScene, SceneCharacter, spawn_from_doc};
 use crate::editor::state::StageSettings;
@@ -19,6 +19,7 @@ use crate::editor::state::camera::{FramingAspect, OrbitCamera, apply_orbit_camer
 use crate::editor::state::{Messages, Selection, StartupEdits, StartupPaths, UnloadedCharacters};
 use crate::formats::scene::{CameraDoc, CharacterId, DisplayDoc};
 use crate::rig::SkinTexture;
+use crate::scene::Slot;
 use crate::scene::handoff::SkinAttributes;
 use crate::scene::{Character, CharacterView, HeatJoint, SkinMesh};
 use bevy::mesh::MeshTag;
@@ -44,7 +45,6 @@ impl Plugin for ScenePlugin {
             .init_resource::<crate::editor::state::Pins>()
             .init_resource::<Library>()
             .init_resource::<FramingAspect>()
-            .init_resource::<FrameWhenSkinned>()
             .init_resource::<FramingView>()
             .init_resource::<crate::editor::scene_doc::arrange::ArrangeWhenSkinned>()
             .init_resource::<crate::editor::state::PoseLibrary>()
@@ -53,7 +53,9 @@ impl Plugin for ScenePlugin {
             .add_systems(
                 PostUpdate,
                 (
-                    apply_pending_scene.in_set(crate::editor::order::EditorSystems::OpenScene),
+                    (apply_pending_scene, mark_skins_of_slots)
+                        .chain()
+                        .in_set(crate::editor::order::EditorSystems::OpenScene),
                     (
                         sync_character_views,
                         crate::editor::scene_doc::document::update_humanoid_maps,
@@ -84,7 +86,6 @@ impl Plugin for ViewPlugin {
     fn build(&self, app: &mut App) {
         draw::setup_skeleton_gizmos(app);
         app.init_resource::<StartupPaths>()
-            .init_resource::<StageExtent>()
             .init_resource::<StartupEdits>()
             .add_plugins((ScenePlugin, crate::editor::present::readiness::ReadinessPlugin))
             .add_plugins(crate::editor::present::skin_material::SkinMaterialPlugin)
@@ -96,14 +97,15 @@ impl Plugin for ViewPlugin {
                     store_skin_attributes,
                     choose_skin_material,
                     apply_display_mode,
+                    stage_the_settings,
                     apply_stage_settings,
-                    filter_shadows,
                     frame_when_skinned,
                     apply_orbit_camera,
                     draw::draw_skeletons,
                     fit_stage_to_scene,
                     fit_shadows_to_camera,
-                    draw_grid_and_axes,
+                    draw_grids,
+                    draw_axes,
                 )
                     .chain()
                     .in_set(crate::editor::order::EditorSystems::Present),
@@ -215,9 +217,10 @@ fn apply_startup_options(
 }
 
 /// Opens the pending document in place of the current scene: every character is
-/// replaced, camera and stage set, selection, pins and history cleared; frames the
-/// characters when the document has no camera (reads `PendingScene`; writes entities,
-/// `OrbitCamera`, `StageSettings`, `Messages`).
+/// replaced, camera and stage set, selection, pins and history cleared; and each scene
+/// waiting on another slot's camera in place of that slot's ([`SlotOpening::open`]) (reads
+/// `PendingScene`, `SceneToOpen`; writes entities, `OrbitCamera`, `StageSettings`,
+/// `DrawnStage`, `Messages`).
 #[allow(clippy::too_many_arguments)]
 pub fn apply_pending_scene(
     mut commands: Commands,
@@ -227,41 +230,99 @@ pub fn apply_pending_scene(
     mut ids: ResMut<NextCharacterId>,
     mut messages: ResMut<Messages>,
     mut stage: ResMut<StageSettings>,
-    live: Query<(Entity, &Character)>,
-    mut cameras: Query<&mut OrbitCamera>,
+    live: Query<(Entity, &Character, &Slot)>,
+    mut cameras: Query<(Entity, &Slot, &mut OrbitCamera, Option<&mut DrawnStage>, Option<&mut SceneToOpen>)>,
     mut reset: SceneReset,
-    mut frame: ResMut<FrameWhenSkinned>,
 ) {
-    let Some(doc) = pending.doc.take() else {
-        return;
-    };
-    reset.clear();
-    for (entity, character) in &live {
-        crate::scene::despawn_character(&mut commands, entity, character);
+    let mut opening =
+        SlotOpening { commands: &mut commands, meshes: &mut meshes, library: &mut library, ids: &mut ids };
+    if let Some(doc) = pending.doc.take() {
+        reset.clear();
+        let camera = cameras.iter_mut().find(|c| *c.1 == Slot(0)).map(|(camera, _, orbit, ..)| (camera, orbit));
+        let frame = pending.frame && doc.camera.is_none();
+        reset.unloaded.0 = opening.open(&doc, Slot(0), camera, &live, frame, &mut messages);
+        stage.0 = doc.stage;
+        reset.pose_library.0 = doc.poses;
+        reset.shot.0 = doc.shot;
+        reset.bookmarks.0 = doc.bookmarks;
     }
-    let ids_of_doc = stable_ids(&doc.characters, &mut ids);
-    for (c, id) in doc.characters.iter().zip(ids_of_doc) {
-        match spawn_from_doc(&mut commands, &mut meshes, &mut library, c, id) {
-            Ok((_, notes)) => notes.into_iter().for_each(|m| messages.push(m)),
-            Err(e) => {
-                messages.push(format!("{e} (`{}` is kept in the scene file as it was)", c.name));
-                reset.unloaded.0.push(c.clone());
-            }
-        }
+    for (camera, &slot, orbit, drawn, to_open) in &mut cameras {
+        let (Some(doc), Some(mut drawn)) = (to_open.and_then(|mut o| o.0.take()), drawn) else { continue };
+        opening.open(&doc, slot, Some((camera, orbit)), &live, doc.camera.is_none(), &mut messages);
+        drawn.set_if_neq(DrawnStage(doc.stage));
     }
-    stage.0 = doc.stage;
-    reset.pose_library.0 = doc.poses;
-    reset.shot.0 = doc.shot;
-    reset.bookmarks.0 = doc.bookmarks;
-    if let Some(c) = doc.camera {
-        cameras.iter_mut().for_each(|mut orbit| *orbit = OrbitCamera(c));
-    }
-    frame.0 = doc.camera.is_none() && pending.frame;
 }
 
-/// Asks for the camera to frame every character once they are skinned.
-#[derive(Resource, Default)]
-pub struct FrameWhenSkinned(pub bool);
+/// A scene to open in a slot other than the editor's, on that slot's camera (a data set's
+/// render draws several scenes a frame).
+#[derive(Component, Default)]
+pub struct SceneToOpen(pub Option<Box<crate::formats::scene::SceneDoc>>);
+
+/// What opening a scene in a slot writes.
+struct SlotOpening<'a, 'w, 's> {
+    commands: &'a mut Commands<'w, 's>,
+    meshes: &'a mut Assets<Mesh>,
+    library: &'a mut Library,
+    ids: &'a mut NextCharacterId,
+}
+
+impl SlotOpening<'_, '_, '_> {
+    /// Replaces the slot's characters with the document's and sets its camera (framed once
+    /// they are skinned, where `frame`); returns the characters that did not load.
+    fn open(
+        &mut self,
+        doc: &crate::formats::scene::SceneDoc,
+        slot: Slot,
+        camera: Option<(Entity, Mut<OrbitCamera>)>,
+        live: &Query<(Entity, &Character, &Slot)>,
+        frame: bool,
+        messages: &mut Messages,
+    ) -> Vec<crate::formats::scene::CharacterDoc> {
+        for (entity, character, _) in live.iter().filter(|c| *c.2 == slot) {
+            crate::scene::despawn_character(self.commands, entity, character);
+        }
+        let mut unloaded = Vec::new();
+        for (c, id) in doc.characters.iter().zip(stable_ids(&doc.characters, self.ids)) {
+            match spawn_from_doc(self.commands, self.meshes, self.library, c, id) {
+                Ok((entity, notes)) => {
+                    self.commands.entity(entity).insert(slot.marks());
+                    notes.into_iter().for_each(|m| messages.push(m));
+                }
+                Err(e) => {
+                    messages.push(format!("{e} (`{}` is kept in the scene file as it was)", c.name));
+                    unloaded.push(c.clone());
+                }
+            }
+        }
+        if let Some((camera, mut orbit)) = camera {
+            if let Some(c) = doc.camera {
+                *orbit = OrbitCamera(c);
+            }
+            if frame {
+                self.commands.entity(camera).insert(FrameWhenSkinned);
+            }
+        }
+        unloaded
+    }
+}
+
+/// Puts each new skin on its character's slot's layer (reads `Slot`; writes the skin's
+/// `RenderLayers`).
+fn mark_skins_of_slots(
+    mut commands: Commands,
+    skins: Query<(Entity, &SkinMesh), Added<SkinMesh>>,
+    slots: Query<&Slot>,
+) {
+    for (skin, of) in &skins {
+        if let Ok(&slot) = slots.get(of.character) {
+            commands.entity(skin).insert(slot.marks());
+        }
+    }
+}
+
+/// Asks a slot's camera to frame the slot's characters once they are skinned.
+#[derive(Component)]
+pub struct FrameWhenSkinned;
 
 /// The direction and lens framing starts from (the three-quarter view unless `--view` or
 /// `--ortho` said otherwise).
@@ -274,26 +335,28 @@ impl Default for FramingView {
     }
 }
 
-/// Frames the characters as they stand, posed (their skinned vertices, placed), once all
-/// are skinned after a scene opened (reads `SkinScratch`; writes `OrbitCamera`).
+/// Frames each slot's characters as they stand, posed (their skinned vertices, placed),
+/// once all are skinned after a scene opened (reads `SkinScratch`; writes `OrbitCamera`).
 pub fn frame_when_skinned(
-    mut frame: ResMut<FrameWhenSkinned>,
-    characters: Query<(&crate::scene::Placement, &crate::scene::SkinScratch, &crate::scene::PoseDirty)>,
+    mut commands: Commands,
+    characters: Query<(&crate::scene::Placement, &crate::scene::SkinScratch, &crate::scene::PoseDirty, &Slot)>,
     aspect: Res<FramingAspect>,
     view: Res<FramingView>,
-    mut cameras: Query<&mut OrbitCamera>,
+    mut cameras: Query<(Entity, &Slot, &mut OrbitCamera), With<FrameWhenSkinned>>,
 ) {
-    if !frame.0 || characters.iter().any(|c| *c.2 != crate::scene::PoseDirty::default()) {
-        return;
-    }
-    frame.0 = false;
-    let points = characters.iter().flat_map(|(placement, scratch, _)| {
-        let m = placement.to_mat4();
-        scratch.positions.iter().map(move |&p| m.transform_point3(p))
-    });
-    if points.clone().next().is_some() {
-        let framed = OrbitCamera::framing_from(points, aspect.0, view.0);
-        cameras.iter_mut().for_each(|mut orbit| *orbit = framed);
+    for (camera, slot, mut orbit) in &mut cameras {
+        let slot_characters = || characters.iter().filter(move |c| c.3 == slot);
+        if slot_characters().any(|c| *c.2 != crate::scene::PoseDirty::default()) {
+            continue;
+        }
+        commands.entity(camera).remove::<FrameWhenSkinned>();
+        let points = slot_characters().flat_map(|(placement, scratch, ..)| {
+            let m = placement.to_mat4();
+            scratch.positions.iter().map(move |&p| m.transform_point3(p))
+        });
+        if points.clone().next().is_some() {
+            *orbit = OrbitCamera::framing_from(points, aspect.0, view.0);
+        }
     }
 }
 

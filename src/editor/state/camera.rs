@@ -29,8 +29,9 @@ pub struct CameraRequest(pub Option<CameraDoc>);
 pub struct Bookmarks(pub std::collections::BTreeMap<String, CameraDoc>);
 
 /// The camera's orbit: the scene file's own type (focus, yaw, pitch, distance) on the
-/// camera entity.
+/// camera entity (of slot 0 unless it says otherwise).
 #[derive(Component, Clone, Copy, Debug, Default, PartialEq, Deref, DerefMut)]
+#[require(crate::scene::Slot)]
 pub struct OrbitCamera(pub CameraDoc);
 
 impl OrbitCamera {

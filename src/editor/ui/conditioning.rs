@@ -17,7 +17,7 @@ use crate::editor::order::EditorSystems;
 use crate::editor::present::data::DataScene;
 use crate::editor::state::ShotSettings;
 use crate::editor::state::camera::OrbitCamera;
-use crate::scene::{CharacterView, JointScratch, SkinScratch};
+use crate::scene::{CharacterView, JointScratch, SkinScratch, Slot};
 
 /// Which ControlNet map the viewport shows over the 3D view.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
@@ -126,11 +126,13 @@ pub fn work_out_the_overlay_on_change(
         return;
     }
     // The guide is a centred crop of the view: the view's focal length, the guide's pixels.
-    let (Ok(mut camera), Ok(view)) = (scene.camera(width, height), scene.camera(width, viewport_height)) else {
+    let (Ok(mut camera), Ok(view)) =
+        (scene.camera(Slot(0), width, height), scene.camera(Slot(0), width, viewport_height))
+    else {
         return;
     };
     camera.focal = view.focal;
-    let data = scene.frame_through(camera);
+    let data = scene.frame_through(Slot(0), camera);
     (overlay.pending, overlay.digest) = (Some(map_image(map, &data)), Some(digest));
     overlay.drawn += 1;
     redraw.write(RequestRedraw);
