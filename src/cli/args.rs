@@ -379,7 +379,7 @@ pub struct GenerateArgs {
     #[arg(long, value_name = "N", default_value_t = 1000, value_parser = clap::value_parser!(u32).range(1..=1_000_000))]
     pub shard_size: u32,
     /// Scenes drawn in one frame, each its own picture (1 to 4; the pictures are the same
-    /// however many). Default: as many as fit 1280 × 960 drawn pixels.
+    /// however many). Default: on a GPU as many as fit 1280 × 960 drawn pixels, on the CPU one.
     #[arg(long, value_name = "N", value_parser = clap::value_parser!(u8).range(1..=4))]
     pub scenes_a_frame: Option<u8>,
 }

@@ -479,19 +479,14 @@ fn job_app(setup: JobSetup, opened: bool) -> (App, Outcome) {
         .insert_resource(Library(library))
         .insert_resource(edits)
         .add_plugins((RigCorePlugin, SkinningPlugin, ViewPlugin));
-    let (w, h) = (width * picture.samples, height * picture.samples);
-    let count = match asked {
-        _ if !frames.iter().all(|f| matches!(&f.at, FrameAt::Scene(doc) if shares_a_frame(doc))) => 1,
-        Some(n) => n.clamp(1, MAX_SCENES_A_FRAME),
-        None => scenes_a_frame(w, h),
+    let slots = SlotsAsked {
+        size: (width * picture.samples, height * picture.samples),
+        count: match frames.iter().all(|f| matches!(&f.at, FrameAt::Scene(doc) if shares_a_frame(doc))) {
+            true => asked.map(|n| n.clamp(1, MAX_SCENES_A_FRAME)),
+            false => Some(1),
+        },
+        antialias: picture.antialias,
     };
-    let targets: Vec<Handle<Image>> = (0..count)
-        .map(|_| {
-            let mut image = Image::new_target_texture(w, h, TextureFormat::Rgba8UnormSrgb, None);
-            image.texture_descriptor.usage |= TextureUsages::COPY_SRC;
-            app.world_mut().resource_mut::<Assets<Image>>().add(image)
-        })
-        .collect();
     let outcome = Arc::new(Mutex::new((None, Vec::new())));
     app.insert_resource(RenderJob {
         queue: drawing_order(&frames),
@@ -499,7 +494,7 @@ fn job_app(setup: JobSetup, opened: bool) -> (App, Outcome) {
         set_up: false,
         samples: picture.samples,
         next: 0,
-        slots: targets.iter().map(|target| SlotView { target: target.clone(), last_lights: None }).collect(),
+        slots: Vec::new(),
         drawing: 0,
         sequence,
         first_yaw: None,
@@ -521,32 +516,57 @@ fn job_app(setup: JobSetup, opened: bool) -> (App, Outcome) {
     // The sun's shadow map sized for the picture (the editor's is for a window).
     let shadow_map = stage::shadow_map_for(width * picture.samples, height * picture.samples);
     app.add_systems(PostStartup, move |mut commands: Commands| commands.insert_resource(shadow_map.clone()));
-    let antialias = picture.antialias;
-    app.add_systems(
-        Startup,
-        move |mut commands: Commands,
-              mut meshes: ResMut<Assets<Mesh>>,
-              mut materials: ResMut<Assets<StandardMaterial>>,
-              mut gizmos: ResMut<Assets<GizmoAsset>>| {
-            for (k, target) in targets.iter().enumerate() {
-                let orbit = OrbitCamera::default();
-                let lens = (Camera3d::default(), RenderTarget::Image(target.clone().into()), orbit, orbit.transform());
-                smoothed(&mut commands.spawn((lens, stage::slot_camera(Slot(k)), SceneToOpen::default())), antialias);
-                if k > 0 {
-                    stage::spawn_slot_stage(&mut commands, &mut meshes, &mut materials, &mut gizmos, Slot(k));
-                }
-            }
-        },
-    );
+    app.insert_resource(slots).add_systems(Startup, (open_slots, cluster_lamps_by_layer));
     app.add_systems(
         Last,
         (capture_when_ready, report_when_done, next_frame, scene_frame, pose_frame)
             .chain()
             .after(crate::editor::present::readiness::UpdateCaptureGate),
     )
-    .add_systems(First, draw_only_what_is_captured)
-    .add_systems(Startup, cluster_lamps_by_layer);
+    .add_systems(First, draw_only_what_is_captured);
     (app, outcome)
+}
+
+/// The slots a render asks for: their pictures' size as drawn, how many (where asked or
+/// where its scenes cannot share a frame) and how their edges are smoothed.
+#[derive(Resource)]
+struct SlotsAsked {
+    size: (u32, u32),
+    count: Option<usize>,
+    antialias: Antialias,
+}
+
+/// Opens the render's slots, as many as asked or as [`scenes_a_frame`] finds for the
+/// renderer: each a target and a camera drawing into it, and (after the first, the
+/// editor's) a stage of its own (reads `SlotsAsked`, `RenderAdapterInfo`; writes entities,
+/// images, `RenderJob`).
+fn open_slots(
+    mut commands: Commands,
+    asked: Res<SlotsAsked>,
+    adapter: Option<Res<bevy::render::renderer::RenderAdapterInfo>>,
+    mut job: ResMut<RenderJob>,
+    mut assets: (
+        ResMut<Assets<Image>>,
+        ResMut<Assets<Mesh>>,
+        ResMut<Assets<StandardMaterial>>,
+        ResMut<Assets<GizmoAsset>>,
+    ),
+) {
+    let (images, meshes, materials, gizmos) = (&mut assets.0, &mut assets.1, &mut assets.2, &mut assets.3);
+    let on_cpu = adapter.is_some_and(|a| a.device_type == wgpu_types::DeviceType::Cpu);
+    let (w, h) = asked.size;
+    for k in 0..asked.count.unwrap_or_else(|| scenes_a_frame(w, h, on_cpu)) {
+        let mut image = Image::new_target_texture(w, h, TextureFormat::Rgba8UnormSrgb, None);
+        image.texture_descriptor.usage |= TextureUsages::COPY_SRC;
+        let target = images.add(image);
+        let orbit = OrbitCamera::default();
+        let lens = (Camera3d::default(), RenderTarget::Image(target.clone().into()), orbit, orbit.transform());
+        smoothed(&mut commands.spawn((lens, stage::slot_camera(Slot(k)), SceneToOpen::default())), asked.antialias);
+        if k > 0 {
+            stage::spawn_slot_stage(&mut commands, meshes, materials, gizmos, Slot(k));
+        }
+        job.slots.push(SlotView { target, last_lights: None });
+    }
 }
 
 /// The most scenes a frame draws.
@@ -555,10 +575,14 @@ const MAX_SCENES_A_FRAME: usize = 4;
 /// The pixels a frame draws at most when it draws several scenes.
 const PIXELS_A_FRAME: u32 = 1280 * 960;
 
-/// How many scenes a frame draws for pictures drawn at `width` × `height`: as many as fill
-/// [`PIXELS_A_FRAME`], from one to [`MAX_SCENES_A_FRAME`].
-pub fn scenes_a_frame(width: u32, height: u32) -> usize {
-    (PIXELS_A_FRAME / (width * height).max(1)).clamp(1, MAX_SCENES_A_FRAME as u32) as usize
+/// How many scenes a frame draws for pictures drawn at `width` × `height`: on a GPU as many
+/// as fill [`PIXELS_A_FRAME`], from one to [`MAX_SCENES_A_FRAME`]; one on a rasteriser that
+/// runs `on_cpu` (llvmpipe), whose frames cost their pixels whatever else they draw.
+pub fn scenes_a_frame(width: u32, height: u32, on_cpu: bool) -> usize {
+    match on_cpu {
+        true => 1,
+        false => (PIXELS_A_FRAME / (width * height).max(1)).clamp(1, MAX_SCENES_A_FRAME as u32) as usize,
+    }
 }
 
 /// Whether a scene may be drawn beside others in one frame: its characters drawn as plain
@@ -1112,15 +1136,17 @@ mod tests {
         assert!(!lamps_kept(&studio, &setup(true, &[(false, true), (true, false)])));
     }
 
-    /// Small pictures fill a frame with four scenes, large ones with fewer, the largest with one.
+    /// On a GPU small pictures fill a frame with four scenes, large ones with fewer, the
+    /// largest with one; on the CPU a frame draws one.
     #[test]
     fn a_frame_draws_as_many_scenes_as_fill_its_pixels() {
-        assert_eq!(scenes_a_frame(96, 72), 4);
-        assert_eq!(scenes_a_frame(640, 480), 4);
-        assert_eq!(scenes_a_frame(1280, 720), 1);
-        assert_eq!(scenes_a_frame(800, 600), 2);
-        assert_eq!(scenes_a_frame(4096, 4096), 1);
-        assert_eq!(scenes_a_frame(0, 0), 4);
+        assert_eq!(scenes_a_frame(96, 72, false), 4);
+        assert_eq!(scenes_a_frame(640, 480, false), 4);
+        assert_eq!(scenes_a_frame(1280, 720, false), 1);
+        assert_eq!(scenes_a_frame(800, 600, false), 2);
+        assert_eq!(scenes_a_frame(4096, 4096, false), 1);
+        assert_eq!(scenes_a_frame(0, 0, false), 4);
+        assert_eq!(scenes_a_frame(96, 72, true), 1);
     }
 
     /// A scene shares its frame unless the editor's drawings show in it, a character is found
