@@ -3,8 +3,8 @@
 # 640x480 with depth and normals, made by Blender's Workbench and Cycles (16 samples)
 # (benches/blender_peer.py) and by `marionette generate` (the example spec with
 # `Smpl(folder: ..)` bodies, `per_picture: (3, 3)`, `data: true`; its FXAA, then
-# multisampled); prints each one's pictures a second after the first and Marionette's
-# ratios to both.
+# multisampled, then FXAA with four scenes a frame); prints each one's pictures a second
+# after the first and Marionette's ratios to both.
 #
 #   benches/blender_peer.sh SMPL_DIR [COUNT]      (MARIONETTE: the binary, PYTHON: one with bpy)
 set -euo pipefail
@@ -28,13 +28,15 @@ cycles=$("$python" "$here/blender_peer.py" --smpl "$smpl" --engine cycles --samp
 ours=$("$marionette" generate "$work/spec.ron" --out "$work/marionette" 2>&1 | rate)
 sed 's/antialias: Fxaa/antialias: Multisample/' "$work/spec.ron" > "$work/multisample.ron"
 multisampled=$("$marionette" generate "$work/multisample.ron" --out "$work/multisampled" 2>&1 | rate)
+four=$("$marionette" generate "$work/spec.ron" --out "$work/four" --scenes-a-frame 4 2>&1 | rate)
 
 echo "pictures a second after the first, $count pictures of three SMPL bodies at 640x480:"
 echo "  Blender Workbench           $workbench"
 echo "  Blender Cycles 16           $cycles"
 echo "  Marionette (FXAA)           $ours"
 echo "  Marionette (multisampled)   $multisampled"
-for m in "FXAA $ours" "multisampled $multisampled"; do
+echo "  Marionette (FXAA, 4 a frame) $four"
+for m in "FXAA $ours" "multisampled $multisampled" "FXAA-4-a-frame $four"; do
   awk -v name="${m% *}" -v m="${m#* }" -v w="$workbench" -v c="$cycles" \
     'BEGIN { printf "  Marionette %s / Workbench %.2fx, / Cycles %.1fx\n", name, m / w, m / c }'
 done

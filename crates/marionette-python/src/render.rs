@@ -273,6 +273,7 @@ pub fn generate_pictures(
             merge: None,
             format: SetFormat::Folder,
             shard_size: 1000,
+            scenes_a_frame: None,
         };
         let mut plan = marionette::cli::generate::plan(&args)
             .map_err(|e| SpecError::new_err(format!("{e:#}")))?

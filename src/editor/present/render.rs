@@ -330,7 +330,7 @@ impl Renderer {
             coco_per_picture: true,
             // Said by the caller, not on standard error.
             on_written: Some(Box::new(|_| Ok(()))),
-            scenes_a_frame: Some(1),
+            scenes_a_frame: None,
         };
         let (mut app, outcome) = job_app(setup, false);
         while app.plugins_state() == bevy::app::PluginsState::Adding {
@@ -481,10 +481,7 @@ fn job_app(setup: JobSetup, opened: bool) -> (App, Outcome) {
         .add_plugins((RigCorePlugin, SkinningPlugin, ViewPlugin));
     let slots = SlotsAsked {
         size: (width * picture.samples, height * picture.samples),
-        count: match frames.iter().all(|f| matches!(&f.at, FrameAt::Scene(doc) if shares_a_frame(doc))) {
-            true => asked.map(|n| n.clamp(1, MAX_SCENES_A_FRAME)),
-            false => Some(1),
-        },
+        count: asked.map(|n| n.clamp(1, MAX_SCENES_A_FRAME)),
         antialias: picture.antialias,
     };
     let outcome = Arc::new(Mutex::new((None, Vec::new())));
@@ -527,8 +524,8 @@ fn job_app(setup: JobSetup, opened: bool) -> (App, Outcome) {
     (app, outcome)
 }
 
-/// The slots a render asks for: their pictures' size as drawn, how many (where asked or
-/// where its scenes cannot share a frame) and how their edges are smoothed.
+/// The slots a render asks for: their pictures' size as drawn, how many (where asked) and
+/// how their edges are smoothed.
 #[derive(Resource)]
 struct SlotsAsked {
     size: (u32, u32),
@@ -959,7 +956,10 @@ fn scene_frame(
     if !matches!(job.frames[job.queue[job.next]].at, FrameAt::Scene(_)) {
         return;
     }
-    let count = job.slots.len().min(job.queue.len() - job.next);
+    // A frame draws the scenes from the next on that share a frame, or the next alone.
+    let shares = |k: usize| matches!(&job.frames[job.queue[job.next + k]].at, FrameAt::Scene(d) if shares_a_frame(d));
+    let most = job.slots.len().min(job.queue.len() - job.next);
+    let count = if shares(0) { (0..most).take_while(|&k| shares(k)).count() } else { 1 };
     let (mut opened, mut lit_alike) = (false, true);
     for k in 0..count {
         let FrameAt::Scene(doc) = &job.frames[job.queue[job.next + k]].at else { continue };
