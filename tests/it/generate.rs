@@ -301,14 +301,15 @@ fn a_spec_asks_for_the_controlnet_maps() {
 }
 
 /// A set's pictures are drawn without waiting frames of their own once the renderer is
-/// settled (each checked drawn whole, else drawn again): every one equals, byte for byte,
-/// `render` of the scene file written beside it, which waits for the renderer to settle.
+/// settled (each checked drawn whole, else drawn again), four scenes a frame: every one
+/// equals, byte for byte, `render` of the scene file written beside it, which draws it alone
+/// and waits for the renderer to settle.
 #[test]
 fn a_generated_picture_is_its_scene_rendered_alone() {
     let dir = scratch("generate-alone");
     let spec = small_spec(&dir, 5);
     let out = dir.join("set");
-    let said = generate(&spec, &out, &[], &[]);
+    let said = generate(&spec, &out, &["--scenes-a-frame", "4"], &[]);
     eprintln!("{said}");
     for k in 0..5 {
         let stem = format!("{k:06}");

@@ -956,10 +956,7 @@ fn scene_frame(
     if !matches!(job.frames[job.queue[job.next]].at, FrameAt::Scene(_)) {
         return;
     }
-    // A frame draws the scenes from the next on that share a frame, or the next alone.
-    let shares = |k: usize| matches!(&job.frames[job.queue[job.next + k]].at, FrameAt::Scene(d) if shares_a_frame(d));
-    let most = job.slots.len().min(job.queue.len() - job.next);
-    let count = if shares(0) { (0..most).take_while(|&k| shares(k)).count() } else { 1 };
+    let count = drawn_together(&job.frames, &job.queue[job.next..], job.slots.len());
     let (mut opened, mut lit_alike) = (false, true);
     for k in 0..count {
         let FrameAt::Scene(doc) = &job.frames[job.queue[job.next + k]].at else { continue };
@@ -983,6 +980,14 @@ fn scene_frame(
     }
     job.drawing = count;
     job.set_up = true;
+}
+
+/// How many of the pictures `next` (the queue from the next picture on) are drawn in one
+/// frame of `slots` scenes: those from the first on whose scenes share a frame, or the first
+/// alone.
+fn drawn_together(frames: &[Frame], next: &[usize], slots: usize) -> usize {
+    let shares = |&k: &usize| matches!(&frames[k].at, FrameAt::Scene(doc) if shares_a_frame(doc));
+    next.iter().take(slots).take_while(|k| shares(k)).count().max(1)
 }
 
 /// The order to draw `frames` in: the first (the scene the app opens with) first; a data
@@ -1174,6 +1179,24 @@ mod tests {
         assert!(shares_a_frame(&lit));
         lit.stage.lamps[0].shadows = true;
         assert!(!shares_a_frame(&lit));
+    }
+
+    /// A frame draws the scenes that share one from the next on, as many as it has slots,
+    /// and one that cannot share alone.
+    #[test]
+    fn a_scene_that_cannot_share_a_frame_is_drawn_alone() {
+        use crate::formats::scene::{CharacterDoc, DisplayDoc};
+        let mut skeleton = CharacterDoc::new(SourceDoc::Embedded("puppet".into()), "puppet");
+        skeleton.view.display = DisplayDoc::Skeleton;
+        let drawn_as_skeleton = SceneDoc { characters: vec![skeleton], ..SceneDoc::default() };
+        let alone = Frame::new(FrameAt::Scene(Box::new(drawn_as_skeleton)), PathBuf::new(), 0);
+        let frames = [scene(lit(true, &[])), scene(lit(true, &[])), alone, scene(lit(true, &[]))];
+        assert_eq!(drawn_together(&frames, &[0, 1, 2, 3], 3), 2);
+        assert_eq!(drawn_together(&frames, &[0, 1, 2, 3], 1), 1);
+        assert_eq!(drawn_together(&frames, &[2, 3], 3), 1);
+        assert_eq!(drawn_together(&frames, &[3, 0, 1], 4), 3);
+        let time = Frame::new(FrameAt::Time(0.5), PathBuf::new(), 0);
+        assert_eq!(drawn_together(&[time], &[0], 4), 1);
     }
 
     /// The opened scene first, its lighting's group next, then the groups with more lamps
