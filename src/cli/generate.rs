@@ -176,7 +176,8 @@ pub fn run(args: &GenerateArgs) -> Result<()> {
     let notes = render_scenes(
         first_scene,
         library,
-        (pictures, args.scenes_a_frame.map(usize::from)),
+        pictures,
+        args.scenes_a_frame.map(usize::from),
         picture,
         beside,
         on_written,

@@ -269,7 +269,8 @@ pub fn render_with(
 pub fn render_scenes(
     first_scene: PathBuf,
     library: AssetLibrary,
-    (pictures, scenes_a_frame): (Vec<ScenePicture>, Option<usize>),
+    pictures: Vec<ScenePicture>,
+    scenes_a_frame: Option<usize>,
     picture: ShotDoc,
     beside: Beside,
     on_written: OnWritten,
@@ -960,17 +961,18 @@ fn scene_frame(
     let (mut opened, mut lit_alike) = (false, true);
     for k in 0..count {
         let FrameAt::Scene(doc) = &job.frames[job.queue[job.next + k]].at else { continue };
-        let (doc, lights) = ((**doc).clone(), light_setup(&doc.stage));
+        let lights = light_setup(&doc.stage);
         if job.next > 0 || k > 0 || !job.opened {
             // Lit by lamps the slot's last scene had (of this render, or of the renderer's
             // last), its characters drawn as plain skins.
             let last = job.slots[k].last_lights.as_ref();
-            lit_alike &= last.is_some_and(|last| lamps_kept(last, &lights)) && plainly_drawn(&doc);
+            lit_alike &= last.is_some_and(|last| lamps_kept(last, &lights)) && plainly_drawn(doc);
             opened = true;
+            let doc = doc.clone();
             match k {
                 // A scene without a camera is framed as the command line frames it.
-                0 => *pending = crate::editor::scene_doc::document::PendingScene { frame: true, doc: Some(doc) },
-                _ => to_open.iter_mut().filter(|o| o.0.0 == k).for_each(|mut o| o.1.0 = Some(Box::new(doc.clone()))),
+                0 => *pending = crate::editor::scene_doc::document::PendingScene { frame: true, doc: Some(*doc) },
+                _ => to_open.iter_mut().filter(|o| o.0.0 == k).for_each(|mut o| o.1.0 = Some(doc.clone())),
             }
         }
         job.slots[k].last_lights = Some(lights);

@@ -1,5 +1,6 @@
 //! The stage: a floor with a subtle grid, a sun that casts shadows, an ambient fill, up to
-//! three lamps, the background; all as the scene's `StageDoc` says.
+//! three lamps, the background; all as the scene's `StageDoc` says, one a slot (each scene
+//! drawn in a frame has its own, on its render layer).
 
 use bevy::light::{CascadeShadowConfig, CascadeShadowConfigBuilder, DirectionalLightShadowMap, ShadowFilteringMethod};
 use bevy::prelude::*;

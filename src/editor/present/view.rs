@@ -298,9 +298,10 @@ impl SlotOpening<'_, '_, '_> {
             if let Some(c) = doc.camera {
                 *orbit = OrbitCamera(c);
             }
-            if frame {
-                self.commands.entity(camera).insert(FrameWhenSkinned);
-            }
+            match frame {
+                true => self.commands.entity(camera).insert(FrameWhenSkinned),
+                false => self.commands.entity(camera).remove::<FrameWhenSkinned>(),
+            };
         }
         unloaded
     }
