@@ -131,7 +131,7 @@ pub fn plan(args: &GenerateArgs) -> Result<Option<Plan>> {
 /// time left.
 pub fn run(args: &GenerateArgs) -> Result<()> {
     use crate::editor::present::data::Beside;
-    use crate::editor::present::render::{ScenePicture, opening_picture, render_scenes};
+    use crate::editor::present::render::{ScenePicture, render_scenes};
     let Some(mut plan) = plan(args)? else { return Ok(()) };
     let (todo, finished, shard) = (plan.pictures.len(), plan.finished, plan.shard);
     eprintln!(
@@ -150,7 +150,7 @@ pub fn run(args: &GenerateArgs) -> Result<()> {
         .into_iter()
         .map(|(k, scene, backdrop)| ScenePicture { scene, out: plan.out(k), ids: generate::coco_ids(k), backdrop })
         .collect();
-    let opening = opening_picture(&pictures);
+    let opening = crate::document::drawing::opening_picture(&pictures.iter().map(|p| &p.scene).collect::<Vec<_>>());
     pictures.swap(0, opening);
     numbers.swap(0, opening);
     let first_scene = plan.scene_file(numbers[0]);

@@ -7,6 +7,7 @@
 pub mod annotate;
 pub mod crowd;
 pub mod default_scene;
+pub mod drawing;
 pub mod export;
 pub mod fit;
 pub mod frames;

@@ -14,6 +14,7 @@ use bevy::render::view::screenshot::{Screenshot, ScreenshotCaptured};
 use crate::document::AssetLibrary;
 use crate::document::annotate;
 use crate::document::annotate::controlnet::ControlNet;
+use crate::document::drawing::{self, LightSetup};
 use crate::document::frames::{FrameSequence, PictureRequest, Pictures, frame_path, sequence_path};
 use crate::document::picture;
 use crate::document::scenes::{read_scene, scene_path};
@@ -113,6 +114,14 @@ impl Frame {
     /// The `index`-th picture of a render: COCO ids numbered from it.
     fn new(at: FrameAt, out: PathBuf, index: usize) -> Self {
         Frame { at, out, ids: (index as u64 + 1, 0), backdrop: None }
+    }
+
+    /// The scene of its own it shows, if any.
+    fn scene(&self) -> Option<&SceneDoc> {
+        match &self.at {
+            FrameAt::Scene(doc) => Some(doc),
+            _ => None,
+        }
     }
 }
 
@@ -265,7 +274,7 @@ pub fn render_with(
 /// of the first picture's scene) opens it; every picture after loads its scene in place of
 /// the last, with what `beside` asks written beside it; `on_written` is called with a
 /// picture's index once its files are written; `scenes_a_frame` of them drawn in each frame
-/// (else as many as [`scenes_a_frame`] finds for their size). Returns the notes.
+/// (else as many as [`drawing::scenes_a_frame`] finds for their size). Returns the notes.
 pub fn render_scenes(
     first_scene: PathBuf,
     library: AssetLibrary,
@@ -294,13 +303,6 @@ pub fn render_scenes(
         scenes_a_frame,
     };
     run_job(setup)
-}
-
-/// The picture a data set's app best opens with: the first of those with the most lamps
-/// (the scenes drawn after it then bring no lamp it lacks; see [`drawing_order`]).
-pub fn opening_picture(pictures: &[ScenePicture]) -> usize {
-    let lamps = |k: usize| pictures[k].scene.stage.lamps.len();
-    (0..pictures.len()).max_by_key(|&k| (lamps(k), std::cmp::Reverse(k))).unwrap_or(0)
 }
 
 /// A renderer kept between renders in one process (the Python package's): its app starts
@@ -482,12 +484,12 @@ fn job_app(setup: JobSetup, opened: bool) -> (App, Outcome) {
         .add_plugins((RigCorePlugin, SkinningPlugin, ViewPlugin));
     let slots = SlotsAsked {
         size: (width * picture.samples, height * picture.samples),
-        count: asked.map(|n| n.clamp(1, MAX_SCENES_A_FRAME)),
+        count: asked.map(|n| n.clamp(1, drawing::MAX_SCENES_A_FRAME)),
         antialias: picture.antialias,
     };
     let outcome = Arc::new(Mutex::new((None, Vec::new())));
     app.insert_resource(RenderJob {
-        queue: drawing_order(&frames),
+        queue: drawing::drawing_order(&frames.iter().map(Frame::scene).collect::<Vec<_>>()),
         frames,
         set_up: false,
         samples: picture.samples,
@@ -534,7 +536,7 @@ struct SlotsAsked {
     antialias: Antialias,
 }
 
-/// Opens the render's slots, as many as asked or as [`scenes_a_frame`] finds for the
+/// Opens the render's slots, as many as asked or as [`drawing::scenes_a_frame`] finds for the
 /// renderer: each a target and a camera drawing into it, and (after the first, the
 /// editor's) a stage of its own (reads `SlotsAsked`, `RenderAdapterInfo`; writes entities,
 /// images, `RenderJob`).
@@ -553,7 +555,7 @@ fn open_slots(
     let (images, meshes, materials, gizmos) = (&mut assets.0, &mut assets.1, &mut assets.2, &mut assets.3);
     let on_cpu = adapter.is_some_and(|a| a.device_type == wgpu_types::DeviceType::Cpu);
     let (w, h) = asked.size;
-    for k in 0..asked.count.unwrap_or_else(|| scenes_a_frame(w, h, on_cpu)) {
+    for k in 0..asked.count.unwrap_or_else(|| drawing::scenes_a_frame(w, h, on_cpu)) {
         let mut image = Image::new_target_texture(w, h, TextureFormat::Rgba8UnormSrgb, None);
         image.texture_descriptor.usage |= TextureUsages::COPY_SRC;
         let target = images.add(image);
@@ -565,36 +567,6 @@ fn open_slots(
         }
         job.slots.push(SlotView { target, last_lights: None });
     }
-}
-
-/// The most scenes a frame draws.
-const MAX_SCENES_A_FRAME: usize = 4;
-
-/// The pixels a frame draws at most when it draws several scenes.
-const PIXELS_A_FRAME: u32 = 1280 * 960;
-
-/// How many scenes a frame draws for pictures drawn at `width` × `height`: on a GPU as many
-/// as fill [`PIXELS_A_FRAME`], from one to [`MAX_SCENES_A_FRAME`]; one on a rasteriser that
-/// runs `on_cpu` (llvmpipe), whose frames cost their pixels whatever else they draw.
-pub fn scenes_a_frame(width: u32, height: u32, on_cpu: bool) -> usize {
-    match on_cpu {
-        true => 1,
-        false => (PIXELS_A_FRAME / (width * height).max(1)).clamp(1, MAX_SCENES_A_FRAME as u32) as usize,
-    }
-}
-
-/// Whether a scene may be drawn beside others in one frame: its characters drawn as plain
-/// skins (the editor's drawings are on the first scene's layer), none held by or moving
-/// with another (characters are found by ids, which the scenes of a frame share), no lamp
-/// casting shadows (Bevy details every lamp's shadow map for one camera of the world).
-fn shares_a_frame(doc: &SceneDoc) -> bool {
-    let by_id = |c: &crate::formats::scene::CharacterDoc| {
-        c.attached.is_some()
-            || c.anim
-                .as_ref()
-                .is_some_and(|a| matches!(a.retarget.as_ref().map(|r| &r.from), Some(MotionSourceDoc::Character(_))))
-    };
-    plainly_drawn(doc) && !doc.characters.iter().any(by_id) && !doc.stage.lamps.iter().any(|l| l.shadows)
 }
 
 /// Assigns lamps to the parts of a view they light on the CPU, which leaves out the lamps of
@@ -957,16 +929,16 @@ fn scene_frame(
     if !matches!(job.frames[job.queue[job.next]].at, FrameAt::Scene(_)) {
         return;
     }
-    let count = drawn_together(&job.frames, &job.queue[job.next..], job.slots.len());
+    let count = drawing::drawn_together(job.queue[job.next..].iter().map(|&k| job.frames[k].scene()), job.slots.len());
     let (mut opened, mut lit_alike) = (false, true);
     for k in 0..count {
         let FrameAt::Scene(doc) = &job.frames[job.queue[job.next + k]].at else { continue };
-        let lights = light_setup(&doc.stage);
+        let lights = LightSetup::of(&doc.stage);
         if job.next > 0 || k > 0 || !job.opened {
             // Lit by lamps the slot's last scene had (of this render, or of the renderer's
             // last), its characters drawn as plain skins.
             let last = job.slots[k].last_lights.as_ref();
-            lit_alike &= last.is_some_and(|last| lamps_kept(last, &lights)) && plainly_drawn(doc);
+            lit_alike &= last.is_some_and(|last| drawing::lamps_kept(last, &lights)) && drawing::plainly_drawn(doc);
             opened = true;
             let doc = doc.clone();
             match k {
@@ -982,63 +954,6 @@ fn scene_frame(
     }
     job.drawing = count;
     job.set_up = true;
-}
-
-/// How many of the pictures `next` (the queue from the next picture on) are drawn in one
-/// frame of `slots` scenes: those from the first on whose scenes share a frame, or the first
-/// alone.
-fn drawn_together(frames: &[Frame], next: &[usize], slots: usize) -> usize {
-    let shares = |&k: &usize| matches!(&frames[k].at, FrameAt::Scene(doc) if shares_a_frame(doc));
-    next.iter().take(slots).take_while(|k| shares(k)).count().max(1)
-}
-
-/// The order to draw `frames` in: the first (the scene the app opens with) first; a data
-/// set's scenes then grouped by how they are lit, those lit like the first first, then the
-/// groups with more lamps before those with fewer, so that the renderer settles only where
-/// a group brings a lamp the last had not (the pictures do not depend on the order).
-fn drawing_order(frames: &[Frame]) -> Vec<usize> {
-    let lights = |k: usize| match &frames[k].at {
-        FrameAt::Scene(doc) => Some(light_setup(&doc.stage)),
-        _ => None,
-    };
-    let mut order: Vec<usize> = (0..frames.len()).collect();
-    if let Some(first) = frames.first().and_then(|_| lights(0)) {
-        order[1..].sort_by_cached_key(|&k| {
-            let lit = lights(k);
-            let lamps = lit.as_ref().map_or(0, |l| l.1.len());
-            (lit.as_ref() != Some(&first), std::cmp::Reverse(lamps), lit)
-        });
-    }
-    order
-}
-
-/// Whether a scene lit as `next` is drawn as it should be in its first frame after one lit
-/// as `last`: each of its lamps takes the place of one of the last's of its kind (and
-/// shadows), so no lamp entity is new (a new lamp is taken up frames after it is spawned;
-/// the sun's shadows and lamps removed are taken up at once).
-fn lamps_kept(last: &LightSetup, next: &LightSetup) -> bool {
-    next.1.len() <= last.1.len() && next.1.iter().zip(&last.1).all(|(n, l)| n == l)
-}
-
-/// Whether every character of `doc` is drawn as a plain skin: no skeleton drawn, no weight
-/// colours, no heat map, solid (what a data set's scenes are, and what the renderer takes up
-/// in a scene's first frame: the other views add drawings and materials of later frames).
-fn plainly_drawn(doc: &SceneDoc) -> bool {
-    use crate::formats::scene::DisplayDoc;
-    doc.characters.iter().all(|c| {
-        let v = &c.view;
-        v.display == DisplayDoc::Mesh && !v.weight_colors && !v.heat_of_selected && v.opacity >= 1.0
-    })
-}
-
-/// Shadows at all, and each lamp's kind (spot) and whether it casts shadows.
-type LightSetup = (bool, Vec<(bool, bool)>);
-
-/// What of a stage has the renderer set up its lights' views and passes anew when it
-/// changes: shadows at all, and each lamp's kind and whether it casts shadows (see
-/// [`lamps_kept`]).
-fn light_setup(stage: &crate::formats::scene::StageDoc) -> LightSetup {
-    (stage.shadows, stage.lamps.iter().map(|l| (l.spot.is_some(), l.shadows)).collect())
 }
 
 /// Sets up the frame to render: a pose frame puts the pose on every character that has its
@@ -1107,118 +1022,4 @@ fn contact_sheet(cells: &[PathBuf], out: &std::path::Path) -> Result<(), String>
         .map_err(|e| e.to_string())?;
     crate::formats::write_atomically(out, |w| std::io::Write::write_all(w, &bytes))
         .map_err(|e| format!("{}: {e}", out.display()))
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-    use crate::formats::scene::{LampDoc, SpotDoc, StageDoc};
-
-    fn lit(shadows: bool, lamps: &[(bool, bool)]) -> StageDoc {
-        let lamp = |&(spot, shadows): &(bool, bool)| LampDoc {
-            spot: spot.then_some(SpotDoc { aim: Vec3::ZERO, angle: 30.0 }),
-            shadows,
-            ..LampDoc::default()
-        };
-        StageDoc { shadows, lamps: lamps.iter().map(lamp).collect(), ..StageDoc::default() }
-    }
-
-    fn scene(stage: StageDoc) -> Frame {
-        Frame::new(FrameAt::Scene(Box::new(SceneDoc { stage, ..SceneDoc::default() })), PathBuf::new(), 0)
-    }
-
-    /// A scene is captured in its first frame only where none of its lamps is new: the
-    /// last's lamps moved, fewer of them, the sun's shadows switched; a lamp added, or one
-    /// of another kind or shadows in its place, waits for the renderer to settle.
-    #[test]
-    fn only_scenes_that_bring_no_new_lamp_are_drawn_at_once() {
-        let setup = |shadows, lamps: &[(bool, bool)]| light_setup(&lit(shadows, lamps));
-        let studio = setup(true, &[(false, false), (true, false)]);
-        assert!(lamps_kept(&studio, &studio));
-        assert!(lamps_kept(&studio, &setup(false, &[])));
-        assert!(lamps_kept(&studio, &setup(true, &[(false, false)])));
-        assert!(lamps_kept(&setup(false, &[]), &setup(true, &[])));
-        assert!(!lamps_kept(&setup(true, &[]), &studio));
-        assert!(!lamps_kept(&studio, &setup(true, &[(true, false)])));
-        assert!(!lamps_kept(&studio, &setup(true, &[(false, true), (true, false)])));
-    }
-
-    /// On a GPU small pictures fill a frame with four scenes, large ones with fewer, the
-    /// largest with one; on the CPU a frame draws one.
-    #[test]
-    fn a_frame_draws_as_many_scenes_as_fill_its_pixels() {
-        assert_eq!(scenes_a_frame(96, 72, false), 4);
-        assert_eq!(scenes_a_frame(640, 480, false), 4);
-        assert_eq!(scenes_a_frame(1280, 720, false), 1);
-        assert_eq!(scenes_a_frame(800, 600, false), 2);
-        assert_eq!(scenes_a_frame(4096, 4096, false), 1);
-        assert_eq!(scenes_a_frame(0, 0, false), 4);
-        assert_eq!(scenes_a_frame(96, 72, true), 1);
-    }
-
-    /// A scene shares its frame unless the editor's drawings show in it, a character is found
-    /// by its id (held by, or moved by, another) or a lamp casts shadows.
-    #[test]
-    fn only_scenes_of_plain_independent_characters_share_a_frame() {
-        use crate::formats::scene::{AnimDoc, AttachDoc, CharacterDoc, CharacterId, DisplayDoc};
-        let with = |change: &dyn Fn(&mut CharacterDoc)| {
-            let puppet = || CharacterDoc::new(SourceDoc::Embedded("puppet".into()), "puppet");
-            let mut c = puppet();
-            change(&mut c);
-            SceneDoc { characters: vec![puppet(), c], ..SceneDoc::default() }
-        };
-        let moved_by = |from| Some(AnimDoc { retarget: Some(RetargetDoc::of(from)), ..AnimDoc::default() });
-        assert!(shares_a_frame(&with(&|_| {})));
-        assert!(!shares_a_frame(&with(&|c| c.view.display = DisplayDoc::Skeleton)));
-        assert!(!shares_a_frame(&with(&|c| c.view.weight_colors = true)));
-        let held = AttachDoc { to: CharacterId(1), joint: "hand".into(), offset: Mat4::IDENTITY };
-        assert!(!shares_a_frame(&with(&|c| c.attached = Some(held.clone()))));
-        assert!(!shares_a_frame(&with(&|c| c.anim = moved_by(MotionSourceDoc::Character(CharacterId(1))))));
-        let walk = MotionSourceDoc::File { path: "walk.bvh".into(), clip: None };
-        assert!(shares_a_frame(&with(&|c| c.anim = moved_by(walk.clone()))));
-        let mut lit = with(&|_| {});
-        lit.stage.lamps = vec![crate::formats::scene::LampDoc::default()];
-        assert!(shares_a_frame(&lit));
-        lit.stage.lamps[0].shadows = true;
-        assert!(!shares_a_frame(&lit));
-    }
-
-    /// A frame draws the scenes that share one from the next on, as many as it has slots,
-    /// and one that cannot share alone.
-    #[test]
-    fn a_scene_that_cannot_share_a_frame_is_drawn_alone() {
-        use crate::formats::scene::{CharacterDoc, DisplayDoc};
-        let mut skeleton = CharacterDoc::new(SourceDoc::Embedded("puppet".into()), "puppet");
-        skeleton.view.display = DisplayDoc::Skeleton;
-        let drawn_as_skeleton = SceneDoc { characters: vec![skeleton], ..SceneDoc::default() };
-        let alone = Frame::new(FrameAt::Scene(Box::new(drawn_as_skeleton)), PathBuf::new(), 0);
-        let frames = [scene(lit(true, &[])), scene(lit(true, &[])), alone, scene(lit(true, &[]))];
-        assert_eq!(drawn_together(&frames, &[0, 1, 2, 3], 3), 2);
-        assert_eq!(drawn_together(&frames, &[0, 1, 2, 3], 1), 1);
-        assert_eq!(drawn_together(&frames, &[2, 3], 3), 1);
-        assert_eq!(drawn_together(&frames, &[3, 0, 1], 4), 3);
-        let time = Frame::new(FrameAt::Time(0.5), PathBuf::new(), 0);
-        assert_eq!(drawn_together(&[time], &[0], 4), 1);
-    }
-
-    /// The opened scene first, its lighting's group next, then the groups with more lamps
-    /// before those with fewer: every change after the first group takes lamps away.
-    #[test]
-    fn scenes_are_drawn_in_groups_of_lighting_lamps_going_down() {
-        let frames = [
-            scene(lit(true, &[])),
-            scene(lit(false, &[])),
-            scene(lit(true, &[(false, false), (true, false)])),
-            scene(lit(true, &[])),
-            scene(lit(true, &[(false, false)])),
-            scene(lit(true, &[(false, false), (true, false)])),
-        ];
-        let order = drawing_order(&frames);
-        assert_eq!(order, [0, 3, 2, 5, 4, 1]);
-        let lights = |k: usize| match &frames[k].at {
-            FrameAt::Scene(doc) => light_setup(&doc.stage),
-            _ => unreachable!(),
-        };
-        assert!(order[2..].windows(2).all(|w| lamps_kept(&lights(w[0]), &lights(w[1]))));
-    }
 }
