@@ -308,10 +308,37 @@ fn a_spec_asks_for_the_controlnet_maps() {
 fn a_generated_picture_is_its_scene_rendered_alone() {
     let dir = scratch("generate-alone");
     let spec = small_spec(&dir, 5);
+    each_picture_is_its_scene_rendered_alone(&dir, &spec, 5, &["--scenes-a-frame", "4"]);
+}
+
+/// Khronos characters, one scene a frame: the second picture drawn brings CesiumMan, the
+/// first it shows (its materials take frames of their own); every picture still equals its
+/// scene rendered alone.
+#[test]
+#[cfg_attr(not(marionette_data), ignore)]
+fn pictures_of_files_nobody_here_wrote_are_their_scenes_rendered_alone() {
+    let dir = scratch("generate-khronos");
+    let khronos = crate::common::data_dir().join("khronos").canonicalize().unwrap();
+    let who = ["CesiumMan", "RiggedFigure"]
+        .map(|m| format!("(what: File(path: {:?}), weight: 1.0),", khronos.join(format!("{m}.glb"))))
+        .join(" ");
+    let example = marionette::document::generate::EXAMPLE.replacen("count: 16", "count: 8", 1).replacen(
+        "(what: Puppet, weight: 1.0),",
+        &who,
+        1,
+    );
+    let spec = dir.join("spec.ron");
+    std::fs::write(&spec, example).unwrap();
+    each_picture_is_its_scene_rendered_alone(&dir, &spec, 8, &["--scenes-a-frame", "1"]);
+}
+
+/// Generates `spec` (its `count` pictures) with `extra` and renders each picture's scene
+/// file alone: every picture equals its scene's, byte for byte.
+fn each_picture_is_its_scene_rendered_alone(dir: &Path, spec: &Path, count: usize, extra: &[&str]) {
     let out = dir.join("set");
-    let said = generate(&spec, &out, &["--scenes-a-frame", "4"], &[]);
+    let said = generate(spec, &out, extra, &[]);
     eprintln!("{said}");
-    for k in 0..5 {
+    for k in 0..count {
         let stem = format!("{k:06}");
         let alone = dir.join(format!("{stem}.alone.png"));
         let output = Command::new(env!("CARGO_BIN_EXE_marionette"))

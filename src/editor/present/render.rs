@@ -65,9 +65,9 @@ struct RenderJob {
     written: Arc<Mutex<Vec<(usize, Result<Option<CocoPart>, String>)>>>,
     /// The first failure to write a picture's files.
     failed_save: Option<String>,
-    /// When the first and the last picture so far were captured, and the app's updates
-    /// between them.
-    captures: Option<(std::time::Instant, std::time::Instant, u64)>,
+    /// When the first and the last pictures so far were captured, the app's updates between
+    /// them, and how many pictures the first frame captured held.
+    captures: Option<(std::time::Instant, std::time::Instant, u64, usize)>,
     /// The result of the whole render, once done.
     done: Option<Result<(), String>>,
     /// Where the result and the messages are left for the caller.
@@ -89,6 +89,8 @@ struct RenderJob {
     opened: bool,
     /// Keep each picture in memory here instead of writing its files.
     kept: Option<KeptPictures>,
+    /// The character files the pictures set up so far drew (kept from render to render).
+    sources_drawn: std::collections::HashSet<SourceDoc>,
 }
 
 /// One of the scenes a frame draws: where its picture is drawn, and how the last scene
@@ -512,6 +514,7 @@ fn job_app(setup: JobSetup, opened: bool) -> (App, Outcome) {
         on_written,
         opened,
         kept: None,
+        sources_drawn: Default::default(),
     });
     // The sun's shadow map sized for the picture (the editor's is for a window).
     let shadow_map = stage::shadow_map_for(width * picture.samples, height * picture.samples);
@@ -653,7 +656,7 @@ fn capture_when_ready(
         job.done = Some(Err(format!("cannot render: {failed}")));
         return;
     }
-    let waiting_since = job.captures.map_or(job.started, |(_, last, _)| last);
+    let waiting_since = job.captures.map_or(job.started, |(_, last, ..)| last);
     if waiting_since.elapsed().as_secs() > GIVE_UP_SECONDS {
         let pending = gate.last_reason.clone().unwrap_or_else(|| "nothing reported".into());
         job.done = Some(Err(format!("the render was not ready within {GIVE_UP_SECONDS} s; still pending: {pending}")));
@@ -670,7 +673,7 @@ fn capture_when_ready(
         }
         return;
     }
-    if let Some((_, _, updates)) = job.captures.as_mut() {
+    if let Some((_, _, updates, _)) = job.captures.as_mut() {
         *updates += 1;
     }
     if !job.set_up || !gate.is_ready() || job.in_flight >= MAX_IN_FLIGHT_A_SLOT * job.slots.len() {
@@ -693,7 +696,8 @@ fn capture_when_ready(
     // These frames are the ones captured: the next pictures are set up from the next frame on.
     job.in_flight += job.drawing;
     let now = std::time::Instant::now();
-    job.captures = Some(job.captures.map_or((now, now, 0), |(first, _, updates)| (first, now, updates)));
+    let first_frame = job.drawing;
+    job.captures = Some(job.captures.map_or((now, now, 0, first_frame), |(first, _, u, n)| (first, now, u, n)));
     job.next += job.drawing;
     job.set_up = false;
 }
@@ -789,12 +793,12 @@ const MAX_IN_FLIGHT_A_SLOT: usize = 4;
 
 /// Once every picture is written: the COCO file of `--data`, and the pictures' rate.
 fn finish(job: &mut RenderJob) -> Result<(), String> {
-    if let Some((first, last, updates)) = job.captures {
-        let after_first = job.frames.len().saturating_sub(1);
+    if let Some((first, last, updates, first_frame)) = job.captures {
+        let after_first = job.frames.len().saturating_sub(first_frame);
         let seconds = (last - first).as_secs_f64();
         if after_first > 0 && updates > 0 {
             eprintln!(
-                "render: {:.2} pictures a second after the first, a drawn frame {:.0} ms, {:.1} frames a picture",
+                "render: {:.2} pictures a second after the first frame's, a drawn frame {:.0} ms, {:.2} frames a picture",
                 after_first as f64 / seconds,
                 seconds / updates as f64 * 1e3,
                 updates as f64 / after_first as f64
@@ -934,11 +938,15 @@ fn scene_frame(
     for k in 0..count {
         let FrameAt::Scene(doc) = &job.frames[job.queue[job.next + k]].at else { continue };
         let lights = LightSetup::of(&doc.stage);
+        let sources: Vec<SourceDoc> = doc.characters.iter().map(|c| c.source.clone()).collect();
         if job.next > 0 || k > 0 || !job.opened {
             // Lit by lamps the slot's last scene had (of this render, or of the renderer's
-            // last), its characters drawn as plain skins.
+            // last), its characters drawn as plain skins, from files drawn before (a file's
+            // first materials take frames of their own).
             let last = job.slots[k].last_lights.as_ref();
-            lit_alike &= last.is_some_and(|last| drawing::lamps_kept(last, &lights)) && drawing::plainly_drawn(doc);
+            let known = sources.iter().all(|s| job.sources_drawn.contains(s));
+            lit_alike &=
+                last.is_some_and(|last| drawing::lamps_kept(last, &lights)) && drawing::plainly_drawn(doc) && known;
             opened = true;
             let doc = doc.clone();
             match k {
@@ -948,6 +956,7 @@ fn scene_frame(
             }
         }
         job.slots[k].last_lights = Some(lights);
+        job.sources_drawn.extend(sources);
     }
     if opened {
         if lit_alike { gate.next_picture() } else { gate.restart() }
